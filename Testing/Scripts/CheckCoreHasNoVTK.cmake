@@ -1,0 +1,18 @@
+# The algorithm core must build without VTK or ParaView (shared/STYLE.md, TTK's
+# core/wrapper split): fail if any file under CORE_DIR includes their headers.
+file(GLOB_RECURSE core_files "${CORE_DIR}/*.h" "${CORE_DIR}/*.cxx")
+if (NOT core_files)
+  message(FATAL_ERROR "FAILED: no core files found under ${CORE_DIR}")
+endif ()
+set(offenders)
+foreach (file IN LISTS core_files)
+  file(STRINGS "${file}" includes REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"](vtk|pq|vtksys/)")
+  if (includes)
+    list(APPEND offenders "${file}: ${includes}")
+  endif ()
+endforeach ()
+if (offenders)
+  message(FATAL_ERROR "FAILED: the core includes VTK/ParaView headers:\n${offenders}")
+endif ()
+list(LENGTH core_files count)
+message(STATUS "core is VTK-free (${count} files checked)")
