@@ -4,7 +4,7 @@
  * @brief   Deterministic synthetic CT head (int16, Hounsfield-like units).
  *
  * vtkMedicalPhantomSource produces a 3D image of an anatomical head phantom:
- * air (-1000 HU), scalp and neck soft tissue (40), skull (1100), a cervical
+ * air (-1000 HU), scalp, face and neck soft tissue (40), skull and mandible (1100), a cervical
  * vertebra (800), CSF (5) around the brain (35), two ventricles, two eyes
  * carving the orbits, a soft-tissue lesion (70) and a small calcification
  * (600). Tissue boundaries are smooth, so the isosurfaces at the usual CT

@@ -19,9 +19,14 @@ std::vector<PhantomEllipsoid> MakeDefaultHead()
   using HU = PhantomHU;
   return {
     { "scalp", { 0.0, 0.0, -0.05 }, { 0.74, 0.90, 0.94 }, HU::Scalp },
+    { "lower face", { 0.0, 0.22, -0.50 }, { 0.52, 0.60, 0.32 }, HU::Scalp },
     { "nose", { 0.0, 0.84, -0.22 }, { 0.07, 0.11, 0.15 }, HU::Scalp },
     { "neck", { 0.0, -0.05, -1.05 }, { 0.42, 0.46, 0.50 }, HU::Scalp },
     { "vertebra", { 0.0, -0.22, -1.02 }, { 0.11, 0.11, 0.42 }, HU::Vertebra },
+    // The mandible: a bone slab hollowed from behind by soft tissue, leaving
+    // a U open towards the neck.
+    { "mandible", { 0.0, 0.34, -0.60 }, { 0.42, 0.40, 0.08 }, HU::Bone },
+    { "floor of mouth", { 0.0, 0.25, -0.60 }, { 0.35, 0.40, 0.20 }, HU::Scalp },
     { "skull", { 0.0, 0.0, -0.02 }, { 0.68, 0.84, 0.84 }, HU::Bone },
     { "csf", { 0.0, 0.0, -0.02 }, { 0.61, 0.77, 0.77 }, HU::CSF },
     { "brain", { 0.0, 0.0, -0.02 }, { 0.59, 0.75, 0.75 }, HU::Brain },
