@@ -20,13 +20,12 @@ void Check(bool ok, const char* what)
   }
 }
 
-std::vector<std::int16_t> FillWhole(const mediso::HeadPhantom& p, const int dims[3], const int ext[6])
+std::vector<std::int16_t> Fill(const mediso::HeadPhantom& p, const int ext[6])
 {
   const int nx = ext[1] - ext[0] + 1;
   const std::size_t n = static_cast<std::size_t>(nx) * (ext[3] - ext[2] + 1) * (ext[5] - ext[4] + 1);
   std::vector<std::int16_t> out(n);
   std::vector<double> row(nx);
-  (void)dims;
   p.FillSlices(ext, ext[4], ext[5] + 1, out.data(), row.data());
   return out;
 }
@@ -52,7 +51,7 @@ void TestRowsMatchPoints()
   const int dims[3] = { 37, 44, 29 };
   const mediso::HeadPhantom p(dims, 12.5, 7);
   const int ext[6] = { 0, dims[0] - 1, 0, dims[1] - 1, 0, dims[2] - 1 };
-  const auto whole = FillWhole(p, dims, ext);
+  const auto whole = Fill(p, ext);
   int mismatches = 0;
   std::size_t idx = 0;
   for (int k = 0; k < dims[2]; ++k)
@@ -63,7 +62,7 @@ void TestRowsMatchPoints()
 
   // A sub-extent holds exactly the whole grid's values (pieces join seamlessly).
   const int sub[6] = { 5, 30, 11, 40, 3, 20 };
-  const auto part = FillWhole(p, dims, sub);
+  const auto part = Fill(p, sub);
   mismatches = 0;
   idx = 0;
   for (int k = sub[4]; k <= sub[5]; ++k)

@@ -12,7 +12,6 @@ import sys
 
 from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 from paraview import servermanager
-from paraview.modules.vtkRemotingCore import vtkProcessModule  # noqa: F401
 from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow, vtkStringOutputWindow
 
 failures = []
