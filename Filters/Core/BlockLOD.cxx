@@ -1,0 +1,576 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "BlockLOD.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+
+namespace mediso
+{
+namespace
+{
+// Cube corners in vtkMarchingCubes' order.
+constexpr int CornerOffset[8][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 },
+  { 0, 0, 1 }, { 1, 0, 1 }, { 1, 1, 1 }, { 0, 1, 1 } };
+// Cube edges as (lower corner, upper corner), vtkMarchingCubes' numbering.
+constexpr int EdgeCorners[12][2] = { { 0, 1 }, { 1, 2 }, { 3, 2 }, { 0, 3 }, { 4, 5 }, { 5, 6 },
+  { 7, 6 }, { 4, 7 }, { 0, 4 }, { 1, 5 }, { 3, 7 }, { 2, 6 } };
+
+int EdgeAxis(int edge)
+{
+  const int* a = CornerOffset[EdgeCorners[edge][0]];
+  const int* b = CornerOffset[EdgeCorners[edge][1]];
+  return a[0] != b[0] ? 0 : (a[1] != b[1] ? 1 : 2);
+}
+
+// Number of triangles of each case of a table.
+struct TriangleCounts
+{
+  int Count[256];
+  explicit TriangleCounts(TriangleCaseTable cases)
+  {
+    for (int c = 0; c < 256; ++c)
+    {
+      int n = 0;
+      while (n < 5 && cases[c][3 * n] >= 0)
+      {
+        ++n;
+      }
+      this->Count[c] = n;
+    }
+  }
+};
+
+template <typename T>
+inline bool IsNaN(T v)
+{
+  return v != v; // false, and compiled away, for integer types
+}
+
+// The samples of one block at one level (see BlockLOD.h).
+struct BlockSamples
+{
+  int First[3];
+  int Last[3];
+  int Count[3]; // samples along each axis (cubes = Count - 1)
+  bool LastBlock[3];
+  int Stride;
+  int Layout; // samples per axis of the bit layout: 8 / stride + 1
+
+  BlockSamples(const BlockRanges& ranges, std::int64_t block, int stride)
+    : Stride(stride)
+    , Layout(BlockCells / stride + 1)
+  {
+    const std::int64_t b[3] = { block % ranges.Blocks[0],
+      (block / ranges.Blocks[0]) % ranges.Blocks[1], block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]) };
+    for (int a = 0; a < 3; ++a)
+    {
+      this->First[a] = static_cast<int>(b[a]) * BlockCells;
+      this->Last[a] = std::min(this->First[a] + BlockCells, ranges.Dims[a] - 1);
+      this->Count[a] = (this->Last[a] - this->First[a] + stride - 1) / stride + 1;
+      this->LastBlock[a] = b[a] == ranges.Blocks[a] - 1;
+    }
+  }
+  int Point(int axis, int sample) const
+  {
+    return std::min(this->First[axis] + sample * this->Stride, this->Last[axis]);
+  }
+  bool Owns(const int l[3]) const
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      if (l[a] == this->Count[a] - 1 && !this->LastBlock[a])
+      {
+        return false;
+      }
+    }
+    return true;
+  }
+  int Bit(int i, int j, int k, int axis) const
+  {
+    return ((k * this->Layout + j) * this->Layout + i) * 3 + axis;
+  }
+};
+
+int WordsPerBlock(int level)
+{
+  const int layout = BlockCells / LevelStride(level) + 1;
+  return (3 * layout * layout * layout + 63) / 64;
+}
+
+// Sample values of a block, x fastest, as double.
+template <typename T>
+void Gather(const Volume<T>& v, const BlockSamples& s, std::vector<double>& values)
+{
+  values.resize(static_cast<std::size_t>(s.Count[0]) * s.Count[1] * s.Count[2]);
+  const std::int64_t sx = v.Dims[0];
+  const std::int64_t sxy = sx * v.Dims[1];
+  int xs[BlockCells + 1];
+  for (int i = 0; i < s.Count[0]; ++i)
+  {
+    xs[i] = s.Point(0, i);
+  }
+  double* out = values.data();
+  for (int k = 0; k < s.Count[2]; ++k)
+  {
+    const std::int64_t zoff = s.Point(2, k) * sxy;
+    for (int j = 0; j < s.Count[1]; ++j)
+    {
+      const T* row = v.Data + zoff + s.Point(1, j) * sx;
+      for (int i = 0; i < s.Count[0]; ++i)
+      {
+        *out++ = static_cast<double>(row[xs[i]]);
+      }
+    }
+  }
+}
+
+// Marching-cubes case of the cube at (i, j, k) of the gathered samples, or -1
+// when a corner is NaN.
+inline int CubeCase(const double* values, const int count[3], int i, int j, int k, double iso)
+{
+  int index = 0;
+  for (int c = 0; c < 8; ++c)
+  {
+    const double v = values[((k + CornerOffset[c][2]) * count[1] + j + CornerOffset[c][1]) *
+        count[0] + i + CornerOffset[c][0]];
+    if (IsNaN(v))
+    {
+      return -1;
+    }
+    index |= (v >= iso) << c;
+  }
+  return index;
+}
+
+// Pass-1 work on one block: triangle count, and (when bits is not null) the
+// owned cut edges. Returns the number of owned cut edges.
+std::int64_t CountBlock(const std::vector<double>& values, const BlockSamples& s,
+  const TriangleCounts& counts, double iso, std::int64_t& triangles, std::uint64_t* bits)
+{
+  const int* n = s.Count;
+  std::int64_t tris = 0;
+  for (int k = 0; k + 1 < n[2]; ++k)
+  {
+    for (int j = 0; j + 1 < n[1]; ++j)
+    {
+      for (int i = 0; i + 1 < n[0]; ++i)
+      {
+        const int c = CubeCase(values.data(), n, i, j, k, iso);
+        tris += c > 0 ? counts.Count[c] : 0;
+      }
+    }
+  }
+  triangles = tris;
+
+  std::int64_t points = 0;
+  const int step[3] = { 1, n[0], n[0] * n[1] };
+  for (int k = 0; k < n[2]; ++k)
+  {
+    for (int j = 0; j < n[1]; ++j)
+    {
+      for (int i = 0; i < n[0]; ++i)
+      {
+        const int l[3] = { i, j, k };
+        if (!s.Owns(l))
+        {
+          continue;
+        }
+        const int idx = (k * n[1] + j) * n[0] + i;
+        const double v0 = values[idx];
+        if (IsNaN(v0))
+        {
+          continue;
+        }
+        for (int a = 0; a < 3; ++a)
+        {
+          if (l[a] + 1 >= n[a])
+          {
+            continue;
+          }
+          const double v1 = values[idx + step[a]];
+          if (!IsNaN(v1) && ((v0 >= iso) != (v1 >= iso)))
+          {
+            ++points;
+            if (bits)
+            {
+              const int bit = s.Bit(i, j, k, a);
+              bits[bit >> 6] |= std::uint64_t(1) << (bit & 63);
+            }
+          }
+        }
+      }
+    }
+  }
+  return points;
+}
+
+inline int PopCount(std::uint64_t x)
+{
+  return __builtin_popcountll(x);
+}
+
+// Negative gradient of the original data at a point (central differences,
+// one-sided on the boundary, divided by the spacing), as vtkMarchingCubes.
+template <typename T>
+void NegativeGradient(const Volume<T>& v, const int p[3], double g[3])
+{
+  const std::int64_t stride[3] = { 1, v.Dims[0], static_cast<std::int64_t>(v.Dims[0]) * v.Dims[1] };
+  const std::int64_t at = p[0] + p[1] * stride[1] + p[2] * stride[2];
+  for (int a = 0; a < 3; ++a)
+  {
+    const bool low = p[a] == 0;
+    const bool high = p[a] == v.Dims[a] - 1;
+    const double sm = static_cast<double>(v.Data[low ? at : at - stride[a]]);
+    const double sp = static_cast<double>(v.Data[high ? at : at + stride[a]]);
+    g[a] = (low || high ? (sm - sp) : 0.5 * (sm - sp)) / v.Spacing[a];
+  }
+}
+} // namespace
+
+void SerialFor(std::int64_t begin, std::int64_t end, const RangeBody& body)
+{
+  if (begin < end)
+  {
+    body(begin, end);
+  }
+}
+
+template <typename T>
+void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const ParallelFor& parallel)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    ranges.Dims[a] = volume.Dims[a];
+    ranges.Blocks[a] = (volume.Dims[a] - 1 + BlockCells - 1) / BlockCells;
+  }
+  const std::int64_t numBlocks = ranges.GetNumberOfBlocks();
+  ranges.Min.assign(numBlocks, std::numeric_limits<double>::infinity());
+  ranges.Max.assign(numBlocks, -std::numeric_limits<double>::infinity());
+  std::vector<std::int64_t> nanPerSlab(ranges.Blocks[2], 0);
+
+  // One z-slab of blocks per task: each block row reads its points once
+  // (the shared face plane is read by both slabs).
+  const std::int64_t sx = volume.Dims[0];
+  const std::int64_t sxy = sx * volume.Dims[1];
+  parallel(0, ranges.Blocks[2], [&](std::int64_t bz0, std::int64_t bz1) {
+    for (std::int64_t bz = bz0; bz < bz1; ++bz)
+    {
+      const int z0 = static_cast<int>(bz) * BlockCells;
+      const int z1 = std::min(z0 + BlockCells, volume.Dims[2] - 1);
+      std::int64_t nans = 0;
+      for (int by = 0; by < ranges.Blocks[1]; ++by)
+      {
+        const int y0 = by * BlockCells;
+        const int y1 = std::min(y0 + BlockCells, volume.Dims[1] - 1);
+        for (int bx = 0; bx < ranges.Blocks[0]; ++bx)
+        {
+          const int x0 = bx * BlockCells;
+          const int x1 = std::min(x0 + BlockCells, volume.Dims[0] - 1);
+          T lo = std::numeric_limits<T>::max();
+          T hi = std::numeric_limits<T>::lowest();
+          for (int z = z0; z <= z1; ++z)
+          {
+            for (int y = y0; y <= y1; ++y)
+            {
+              const T* row = volume.Data + z * sxy + y * sx;
+              for (int x = x0; x <= x1; ++x)
+              {
+                const T v = row[x];
+                if (IsNaN(v))
+                {
+                  ++nans;
+                  continue;
+                }
+                lo = v < lo ? v : lo;
+                hi = v > hi ? v : hi;
+              }
+            }
+          }
+          const std::int64_t b = (bz * ranges.Blocks[1] + by) * ranges.Blocks[0] + bx;
+          if (lo <= hi)
+          {
+            ranges.Min[b] = static_cast<double>(lo);
+            ranges.Max[b] = static_cast<double>(hi);
+          }
+        }
+      }
+      nanPerSlab[bz] = nans;
+    }
+  });
+  // Shared faces count NaNs twice; report the exact count only when there are none.
+  ranges.NaNCount = 0;
+  for (std::int64_t n : nanPerSlab)
+  {
+    ranges.NaNCount += n;
+  }
+  ranges.ValueRange[0] = *std::min_element(ranges.Min.begin(), ranges.Min.end());
+  ranges.ValueRange[1] = *std::max_element(ranges.Max.begin(), ranges.Max.end());
+}
+
+template <typename T>
+bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
+  double isovalue, int level, ExtractionPlan& plan, const ParallelFor& parallel,
+  const std::function<bool()>& abort)
+{
+  plan.Isovalue = isovalue;
+  plan.Level = level;
+  plan.WordsPerBlock = WordsPerBlock(level);
+  const int stride = LevelStride(level);
+  const std::int64_t numBlocks = ranges.GetNumberOfBlocks();
+
+  plan.ActiveBlocks.clear();
+  plan.ActiveIndex.assign(numBlocks, -1);
+  for (std::int64_t b = 0; b < numBlocks; ++b)
+  {
+    if (ranges.IsActive(b, isovalue))
+    {
+      plan.ActiveIndex[b] = static_cast<std::int32_t>(plan.ActiveBlocks.size());
+      plan.ActiveBlocks.push_back(static_cast<std::int32_t>(b));
+    }
+  }
+  const std::int64_t numActive = static_cast<std::int64_t>(plan.ActiveBlocks.size());
+  const int words = plan.WordsPerBlock;
+  plan.EdgeBits.assign(numActive * words, 0);
+  plan.EdgeRank.assign(numActive * words, 0);
+  plan.PointOffset.assign(numActive + 1, 0);
+  plan.TriangleOffset.assign(numActive + 1, 0);
+
+  const TriangleCounts counts(cases);
+  std::atomic<bool> aborted(false);
+  parallel(0, numActive, [&](std::int64_t a0, std::int64_t a1) {
+    if (aborted || (abort && abort()))
+    {
+      aborted = true;
+      return;
+    }
+    std::vector<double> values;
+    for (std::int64_t a = a0; a < a1; ++a)
+    {
+      const BlockSamples samples(ranges, plan.ActiveBlocks[a], stride);
+      Gather(volume, samples, values);
+      std::uint64_t* bits = plan.EdgeBits.data() + a * words;
+      std::int64_t triangles = 0;
+      plan.PointOffset[a + 1] = CountBlock(values, samples, counts, isovalue, triangles, bits);
+      plan.TriangleOffset[a + 1] = triangles;
+      std::uint32_t* rank = plan.EdgeRank.data() + a * words;
+      std::uint32_t before = 0;
+      for (int w = 0; w < words; ++w)
+      {
+        rank[w] = before;
+        before += static_cast<std::uint32_t>(PopCount(bits[w]));
+      }
+    }
+  });
+  if (aborted)
+  {
+    return false;
+  }
+  for (std::int64_t a = 0; a < numActive; ++a)
+  {
+    plan.PointOffset[a + 1] += plan.PointOffset[a];
+    plan.TriangleOffset[a + 1] += plan.TriangleOffset[a];
+  }
+  return true;
+}
+
+template <typename T, typename IdType>
+void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
+  const ExtractionPlan& plan, const SurfaceBuffers<IdType>& out, const ParallelFor& parallel)
+{
+  const int stride = LevelStride(plan.Level);
+  const int words = plan.WordsPerBlock;
+  const double iso = plan.Isovalue;
+  int edgeOrigin[12][3];
+  int edgeAxis[12];
+  for (int e = 0; e < 12; ++e)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      edgeOrigin[e][a] = CornerOffset[EdgeCorners[e][0]][a];
+    }
+    edgeAxis[e] = EdgeAxis(e);
+  }
+  const std::int64_t numActive = static_cast<std::int64_t>(plan.ActiveBlocks.size());
+
+  parallel(0, numActive, [&](std::int64_t a0, std::int64_t a1) {
+    std::vector<double> values;
+    for (std::int64_t a = a0; a < a1; ++a)
+    {
+      const std::int64_t block = plan.ActiveBlocks[a];
+      const BlockSamples s(ranges, block, stride);
+      Gather(volume, s, values);
+      const int* n = s.Count;
+
+      // Points of the owned cut edges, in bit order.
+      const std::uint64_t* bits = plan.EdgeBits.data() + a * words;
+      std::int64_t pid = plan.PointOffset[a];
+      const int layout = s.Layout;
+      for (int w = 0; w < words; ++w)
+      {
+        for (std::uint64_t m = bits[w]; m; m &= m - 1)
+        {
+          const int bit = w * 64 + __builtin_ctzll(m);
+          const int axis = bit % 3;
+          const int cell = bit / 3;
+          const int l[3] = { cell % layout, (cell / layout) % layout, cell / (layout * layout) };
+          int l1[3] = { l[0], l[1], l[2] };
+          ++l1[axis];
+          const double v0 = values[(l[2] * n[1] + l[1]) * n[0] + l[0]];
+          const double v1 = values[(l1[2] * n[1] + l1[1]) * n[0] + l1[0]];
+          const double t = (iso - v0) / (v1 - v0);
+          const int p0[3] = { s.Point(0, l[0]), s.Point(1, l[1]), s.Point(2, l[2]) };
+          const int p1[3] = { s.Point(0, l1[0]), s.Point(1, l1[1]), s.Point(2, l1[2]) };
+          float* x = out.Points + 3 * pid;
+          for (int c = 0; c < 3; ++c)
+          {
+            const double index = p0[c] + t * (p1[c] - p0[c]);
+            x[c] = static_cast<float>(volume.Origin[c] + volume.Spacing[c] * index);
+          }
+          if (out.Normals)
+          {
+            double g0[3], g1[3], g[3];
+            NegativeGradient(volume, p0, g0);
+            NegativeGradient(volume, p1, g1);
+            double len2 = 0;
+            for (int c = 0; c < 3; ++c)
+            {
+              g[c] = g0[c] + t * (g1[c] - g0[c]);
+              len2 += g[c] * g[c];
+            }
+            const double inv = len2 > 0 ? 1.0 / std::sqrt(len2) : 0.0;
+            float* nn = out.Normals + 3 * pid;
+            for (int c = 0; c < 3; ++c)
+            {
+              nn[c] = static_cast<float>(g[c] * inv);
+            }
+          }
+          if (out.Scalars)
+          {
+            out.Scalars[pid] = static_cast<float>(iso);
+          }
+          ++pid;
+        }
+      }
+
+      // Triangles of every cut cube; a vertex's id is found in the block that owns its edge.
+      std::int64_t tid = plan.TriangleOffset[a];
+      const std::int64_t bxyz[3] = { block % ranges.Blocks[0], (block / ranges.Blocks[0]) % ranges.Blocks[1],
+        block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]) };
+      for (int k = 0; k + 1 < n[2]; ++k)
+      {
+        for (int j = 0; j + 1 < n[1]; ++j)
+        {
+          for (int i = 0; i + 1 < n[0]; ++i)
+          {
+            const int c = CubeCase(values.data(), n, i, j, k, iso);
+            if (c <= 0 || c == 255)
+            {
+              continue;
+            }
+            const int* edges = cases[c];
+            for (int e = 0; e < 15 && edges[e] >= 0; ++e)
+            {
+              const int edge = edges[e];
+              int l[3] = { i + edgeOrigin[edge][0], j + edgeOrigin[edge][1], k + edgeOrigin[edge][2] };
+              std::int64_t owner[3] = { bxyz[0], bxyz[1], bxyz[2] };
+              for (int d = 0; d < 3; ++d)
+              {
+                if (l[d] == n[d] - 1 && !s.LastBlock[d])
+                {
+                  ++owner[d];
+                  l[d] = 0;
+                }
+              }
+              const std::int64_t ownerBlock =
+                (owner[2] * ranges.Blocks[1] + owner[1]) * ranges.Blocks[0] + owner[0];
+              const std::int64_t oa = plan.ActiveIndex[ownerBlock];
+              const int bit = s.Bit(l[0], l[1], l[2], edgeAxis[edge]);
+              const std::uint64_t word = plan.EdgeBits[oa * words + (bit >> 6)];
+              const std::int64_t rank = plan.EdgeRank[oa * words + (bit >> 6)] +
+                PopCount(word & ((std::uint64_t(1) << (bit & 63)) - 1));
+              out.Connectivity[3 * tid + e % 3] =
+                static_cast<IdType>(out.FirstPointId + plan.PointOffset[oa] + rank);
+              if (e % 3 == 2)
+              {
+                if (out.BlockIds)
+                {
+                  out.BlockIds[tid] = static_cast<std::int32_t>(block);
+                }
+                ++tid;
+              }
+            }
+          }
+        }
+      }
+    }
+  });
+}
+
+template <typename T>
+SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
+  TriangleCaseTable cases, double isovalue, int level, int sampleStep, const ParallelFor& parallel)
+{
+  SampledCounts result;
+  std::vector<std::int32_t> active;
+  const std::int64_t numBlocks = ranges.GetNumberOfBlocks();
+  for (std::int64_t b = 0; b < numBlocks; ++b)
+  {
+    if (ranges.IsActive(b, isovalue))
+    {
+      active.push_back(static_cast<std::int32_t>(b));
+    }
+  }
+  result.ActiveBlocks = static_cast<std::int64_t>(active.size());
+  sampleStep = std::max(1, sampleStep);
+  const std::int64_t sampled = (result.ActiveBlocks + sampleStep - 1) / sampleStep;
+  result.SampledBlocks = sampled;
+  std::vector<std::int64_t> points(sampled, 0), triangles(sampled, 0);
+  const TriangleCounts counts(cases);
+  const int stride = LevelStride(level);
+  parallel(0, sampled, [&](std::int64_t s0, std::int64_t s1) {
+    std::vector<double> values;
+    for (std::int64_t s = s0; s < s1; ++s)
+    {
+      const BlockSamples samples(ranges, active[s * sampleStep], stride);
+      Gather(volume, samples, values);
+      points[s] = CountBlock(values, samples, counts, isovalue, triangles[s], nullptr);
+    }
+  });
+  double p = 0, t = 0;
+  for (std::int64_t s = 0; s < sampled; ++s)
+  {
+    p += static_cast<double>(points[s]);
+    t += static_cast<double>(triangles[s]);
+  }
+  const double scale = sampled > 0 ? static_cast<double>(result.ActiveBlocks) / sampled : 0.0;
+  result.Points = p * scale;
+  result.Triangles = t * scale;
+  return result;
+}
+
+#define MEDISO_INSTANTIATE(T)                                                                      \
+  template void ComputeBlockRanges<T>(const Volume<T>&, BlockRanges&, const ParallelFor&);         \
+  template bool PlanExtraction<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable, double, \
+    int, ExtractionPlan&, const ParallelFor&, const std::function<bool()>&);                       \
+  template void GenerateSurface<T, std::int32_t>(const Volume<T>&, const BlockRanges&,            \
+    TriangleCaseTable, const ExtractionPlan&, const SurfaceBuffers<std::int32_t>&,                 \
+    const ParallelFor&);                                                                           \
+  template void GenerateSurface<T, std::int64_t>(const Volume<T>&, const BlockRanges&,            \
+    TriangleCaseTable, const ExtractionPlan&, const SurfaceBuffers<std::int64_t>&,                 \
+    const ParallelFor&);                                                                           \
+  template SampledCounts CountSampled<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable,  \
+    double, int, int, const ParallelFor&)
+
+MEDISO_INSTANTIATE(std::int8_t);
+MEDISO_INSTANTIATE(std::uint8_t);
+MEDISO_INSTANTIATE(std::int16_t);
+MEDISO_INSTANTIATE(std::uint16_t);
+MEDISO_INSTANTIATE(std::int32_t);
+MEDISO_INSTANTIATE(std::uint32_t);
+MEDISO_INSTANTIATE(float);
+MEDISO_INSTANTIATE(double);
+#undef MEDISO_INSTANTIATE
+
+} // namespace mediso

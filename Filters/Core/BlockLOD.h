@@ -1,0 +1,185 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file BlockLOD.h
+ * @brief Block-based, level-of-detail marching cubes (no VTK).
+ *
+ * The CPU isosurface method of "Hardware Accelerated Medical Data
+ * Visualisation on the Web" (section 4.2), in the form used by
+ * vtkBlockLODContour:
+ *
+ * - The volume (nx x ny x nz points) is split into blocks of 8 x 8 x 8 cells.
+ *   Block b along an axis covers the points [8b, min(8b + 8, n - 1)], so
+ *   neighbouring blocks share a face of points. BlockRanges holds every
+ *   block's minimum and maximum, computed once per input.
+ * - Level of detail L in 0..3 samples the volume with a stride s = 8 >> L
+ *   (cube edges of 8, 4, 2, 1 voxels; level 3 is full resolution). The samples
+ *   of a level are the points whose index is a multiple of s, plus the last
+ *   point n - 1 of each axis (so the last cube of an axis may be shorter and
+ *   the whole volume is covered). Block faces are multiples of 8, hence of s:
+ *   neighbouring blocks see the same samples on their shared face.
+ * - For an isovalue only the blocks with min < iso <= max are visited (a cube
+ *   is cut when some corner value >= iso and some corner < iso, the
+ *   convention of vtkMarchingCubes); no cut cube lies outside them.
+ * - Points live on the cut edges of the sample grid. Each edge belongs to
+ *   exactly one block (the one holding its lower end, faces going to the
+ *   block above them, except on the volume's last face), and that block is
+ *   always visited, because it holds both ends of the edge. Pass 1 marks each
+ *   block's cut edges in a bit mask and counts triangles; a prefix sum over
+ *   the visited blocks gives every block its first point and first triangle;
+ *   the output is allocated once; pass 2 writes the points of owned edges in
+ *   bit order and the triangles of every cube, finding a point's id as
+ *   "first point of the owner block + rank of the edge's bit". Points on
+ *   shared edges are therefore merged within and across blocks, at every
+ *   level: the surface is watertight (no duplicate points, no cracks).
+ * - Triangles come from the marching-cubes case table the caller passes
+ *   (vtkBlockLODContour passes VTK's vtkMarchingCubesTriangleCases, so this
+ *   file holds no table). Points are interpolated on the edge exactly as in
+ *   vtkMarchingCubes; normals are the normalised negative gradient of the
+ *   original data (central differences at full resolution, one-sided on the
+ *   boundary, divided by the spacing), interpolated along the edge.
+ * - Degenerate triangles: like vtkFlyingEdges3D, a point is created per cut
+ *   edge and every triangle of the case table is kept; a triangle can only
+ *   have coincident vertices when a sample value equals the isovalue exactly.
+ * - NaN samples: an edge with a NaN end is never cut and a cube with a NaN
+ *   corner makes no triangle, so NaN regions leave holes but never NaN points.
+ *
+ * Every pass runs over ranges of blocks through a caller-supplied ParallelFor
+ * (vtkBlockLODContour passes vtkSMPTools), so the core is testable alone.
+ */
+#ifndef MedicalIsosurfaces_BlockLOD_h
+#define MedicalIsosurfaces_BlockLOD_h
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace mediso
+{
+
+/// Cells along a block edge.
+constexpr int BlockCells = 8;
+/// Number of levels of detail (0 coarsest .. 3 full resolution).
+constexpr int NumberOfLevels = 4;
+
+/// Sample stride (in voxels) of a level of detail.
+constexpr int LevelStride(int level)
+{
+  return BlockCells >> level;
+}
+
+/// Runs body(begin, end) over sub-ranges that together cover [begin, end),
+/// possibly concurrently.
+using RangeBody = std::function<void(std::int64_t, std::int64_t)>;
+using ParallelFor = std::function<void(std::int64_t, std::int64_t, const RangeBody&)>;
+
+/// A ParallelFor that runs everything on the calling thread.
+void SerialFor(std::int64_t begin, std::int64_t end, const RangeBody& body);
+
+/// Marching-cubes triangle table: 256 cases, each up to 5 triangles given as
+/// edge triples and terminated by -1 (the layout of vtkMarchingCubesTriangleCases;
+/// edges and corners numbered as in vtkMarchingCubes).
+using TriangleCaseTable = const int (*)[16];
+
+/// A scalar volume, x fastest, contiguous, with its placement in space.
+template <typename T>
+struct Volume
+{
+  const T* Data = nullptr;
+  int Dims[3] = { 0, 0, 0 };      ///< Points along x, y, z.
+  double Origin[3] = { 0, 0, 0 }; ///< World position of point (0, 0, 0).
+  double Spacing[3] = { 1, 1, 1 };
+};
+
+/// Per-block value ranges of a volume (computed once, reused for every isovalue).
+struct BlockRanges
+{
+  int Dims[3] = { 0, 0, 0 };
+  int Blocks[3] = { 0, 0, 0 };
+  std::vector<double> Min; ///< NaN-free minimum of each block (x fastest).
+  std::vector<double> Max;
+  std::int64_t NaNCount = 0; ///< NaN samples in the whole volume.
+  double ValueRange[2] = { 0, 0 };
+
+  std::int64_t GetNumberOfBlocks() const
+  {
+    return static_cast<std::int64_t>(this->Blocks[0]) * this->Blocks[1] * this->Blocks[2];
+  }
+  /// True for a block that can hold a cut cube of this isovalue.
+  bool IsActive(std::int64_t block, double isovalue) const
+  {
+    return this->Min[block] < isovalue && isovalue <= this->Max[block];
+  }
+};
+
+/// Computes BlockRanges of a volume (one read of the data, in parallel).
+template <typename T>
+void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const ParallelFor& parallel);
+
+/// Exact counts for one (isovalue, level), and what pass 2 needs to write it.
+struct ExtractionPlan
+{
+  double Isovalue = 0;
+  int Level = 3;
+  std::vector<std::int32_t> ActiveBlocks;   ///< Linear indices of visited blocks.
+  std::vector<std::int32_t> ActiveIndex;    ///< Per block: position in ActiveBlocks or -1.
+  std::vector<std::int64_t> PointOffset;    ///< Per active block (+1): first point.
+  std::vector<std::int64_t> TriangleOffset; ///< Per active block (+1): first triangle.
+  std::vector<std::uint64_t> EdgeBits;      ///< Per active block: owned cut edges.
+  std::vector<std::uint32_t> EdgeRank;      ///< Per active block and word: bits before it.
+  int WordsPerBlock = 0;
+
+  std::int64_t GetNumberOfPoints() const
+  {
+    return this->PointOffset.empty() ? 0 : this->PointOffset.back();
+  }
+  std::int64_t GetNumberOfTriangles() const
+  {
+    return this->TriangleOffset.empty() ? 0 : this->TriangleOffset.back();
+  }
+};
+
+/// Pass 1: active blocks, cut-edge masks and exact point and triangle counts.
+/// `abort` (may be empty) is polled between blocks; when it returns true the
+/// plan is left incomplete and false is returned.
+template <typename T>
+bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
+  double isovalue, int level, ExtractionPlan& plan, const ParallelFor& parallel,
+  const std::function<bool()>& abort = {});
+
+/// Where pass 2 writes. Arrays are sized from the plan; optional ones may be null.
+template <typename IdType>
+struct SurfaceBuffers
+{
+  float* Points = nullptr;         ///< 3 per point (world coordinates).
+  float* Normals = nullptr;        ///< 3 per point, or null.
+  float* Scalars = nullptr;        ///< 1 per point (the isovalue), or null.
+  IdType* Connectivity = nullptr;  ///< 3 per triangle.
+  std::int32_t* BlockIds = nullptr; ///< 1 per triangle (linear block index), or null.
+  IdType FirstPointId = 0;         ///< Added to every point id (several isovalues in one output).
+};
+
+/// Pass 2: writes the surface of a completed plan.
+template <typename T, typename IdType>
+void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
+  const ExtractionPlan& plan, const SurfaceBuffers<IdType>& out, const ParallelFor& parallel);
+
+/// Counts for an estimate: exact when every active block is counted, else
+/// scaled from every `sampleStep`-th active block (spread over the volume).
+struct SampledCounts
+{
+  std::int64_t ActiveBlocks = 0;
+  std::int64_t SampledBlocks = 0;
+  double Points = 0;
+  double Triangles = 0;
+};
+
+/// Counts cut cubes' triangles and cut edges at a level over a sample of the
+/// active blocks (no allocation proportional to the output).
+template <typename T>
+SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
+  TriangleCaseTable cases, double isovalue, int level, int sampleStep,
+  const ParallelFor& parallel);
+
+} // namespace mediso
+
+#endif
