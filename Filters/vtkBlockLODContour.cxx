@@ -236,7 +236,8 @@ struct vtkBlockLODContour::vtkInternals
 
   OutputFlags CacheFlags{ true, false, false };
   std::map<Key, CacheEntry> Cache;
-  std::map<Key, Counts> Exact; // exact counts of every planned pair
+  std::map<Key, Counts> Exact;   // exact counts of every planned pair
+  std::map<Key, Counts> Sampled; // sampled estimates, kept until the input changes
   std::uint64_t Clock = 0;
 
   // Level growth measured on this input: sum of log(triangles(L+1)/triangles(L)).
@@ -276,6 +277,7 @@ struct vtkBlockLODContour::vtkInternals
     this->RangesValid = false;
     this->Cache.clear();
     this->Exact.clear();
+    this->Sampled.clear();
     this->LogGrowth = 0;
     this->GrowthSamples = 0;
     this->WarnedNaN = false;
@@ -420,6 +422,12 @@ struct vtkBlockLODContour::vtkInternals
         return c;
       }
     }
+    auto sampled = this->Sampled.find(key);
+    if (sampled != this->Sampled.end())
+    {
+      method = 2;
+      return sampled->second;
+    }
     Counts c;
     const std::int64_t active = this->CountActive(iso);
     const int step = static_cast<int>(std::max<std::int64_t>(1, active / EstimateSampleBlocks));
@@ -434,6 +442,10 @@ struct vtkBlockLODContour::vtkInternals
     if (step == 1)
     {
       this->RecordExact(key, c); // every active block counted: the count is exact
+    }
+    else
+    {
+      this->Sampled[key] = c;
     }
     return c;
   }

@@ -126,71 +126,86 @@ void Gather(const Volume<T>& v, const BlockSamples& s, std::vector<double>& valu
   }
 }
 
-// Marching-cubes case of the cube at (i, j, k) of the gathered samples, or -1
-// when a corner is NaN.
-inline int CubeCase(const double* values, const int count[3], int i, int j, int k, double iso)
+// Per-sample classification of a gathered block: 1 when value >= iso, 0 when
+// below, NaNFlag when NaN.
+constexpr std::uint8_t NaNFlag = 2;
+
+void Classify(const std::vector<double>& values, double iso, std::vector<std::uint8_t>& flags)
 {
-  int index = 0;
-  for (int c = 0; c < 8; ++c)
+  flags.resize(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i)
   {
-    const double v = values[((k + CornerOffset[c][2]) * count[1] + j + CornerOffset[c][1]) *
-        count[0] + i + CornerOffset[c][0]];
-    if (IsNaN(v))
-    {
-      return -1;
-    }
-    index |= (v >= iso) << c;
+    const double v = values[i];
+    flags[i] = IsNaN(v) ? NaNFlag : static_cast<std::uint8_t>(v >= iso);
   }
-  return index;
 }
 
-// Pass-1 work on one block: triangle count, and (when bits is not null) the
-// owned cut edges. Returns the number of owned cut edges.
-std::int64_t CountBlock(const std::vector<double>& values, const BlockSamples& s,
-  const TriangleCounts& counts, double iso, std::int64_t& triangles, std::uint64_t* bits)
+// Pass-1 work on one block: the case of every cube (into `cubeCases` when not
+// null; 0 for a cube with a NaN corner), the triangle count, and the owned cut
+// edges (into `bits` when not null). Returns the number of owned cut edges.
+std::int64_t CountBlock(const std::vector<std::uint8_t>& flags, const BlockSamples& s,
+  const TriangleCounts& counts, std::int64_t& triangles, std::uint8_t* cubeCases,
+  std::uint64_t* bits)
 {
   const int* n = s.Count;
+  const int sx = n[0];
+  const int sxy = n[0] * n[1];
+  const int corner[8] = { 0, 1, 1 + sx, sx, sxy, 1 + sxy, 1 + sx + sxy, sx + sxy };
   std::int64_t tris = 0;
+  int cube = 0;
   for (int k = 0; k + 1 < n[2]; ++k)
   {
     for (int j = 0; j + 1 < n[1]; ++j)
     {
-      for (int i = 0; i + 1 < n[0]; ++i)
+      const std::uint8_t* f = flags.data() + k * sxy + j * sx;
+      for (int i = 0; i + 1 < n[0]; ++i, ++f, ++cube)
       {
-        const int c = CubeCase(values.data(), n, i, j, k, iso);
-        tris += c > 0 ? counts.Count[c] : 0;
+        int index = 0;
+        int nan = 0;
+        for (int c = 0; c < 8; ++c)
+        {
+          const int v = f[corner[c]];
+          index |= (v & 1) << c;
+          nan |= v & NaNFlag;
+        }
+        index = nan ? 0 : index;
+        tris += counts.Count[index];
+        if (cubeCases)
+        {
+          cubeCases[cube] = static_cast<std::uint8_t>(index);
+        }
       }
     }
   }
   triangles = tris;
 
   std::int64_t points = 0;
-  const int step[3] = { 1, n[0], n[0] * n[1] };
-  for (int k = 0; k < n[2]; ++k)
+  const int step[3] = { 1, sx, sxy };
+  // Owned samples: all but the last along an axis, unless the block is the
+  // volume's last along that axis.
+  const int own[3] = { s.LastBlock[0] ? n[0] : n[0] - 1, s.LastBlock[1] ? n[1] : n[1] - 1,
+    s.LastBlock[2] ? n[2] : n[2] - 1 };
+  for (int k = 0; k < own[2]; ++k)
   {
-    for (int j = 0; j < n[1]; ++j)
+    for (int j = 0; j < own[1]; ++j)
     {
-      for (int i = 0; i < n[0]; ++i)
+      for (int i = 0; i < own[0]; ++i)
       {
+        const int idx = k * sxy + j * sx + i;
+        const int f0 = flags[idx];
+        if (f0 == NaNFlag)
+        {
+          continue;
+        }
         const int l[3] = { i, j, k };
-        if (!s.Owns(l))
-        {
-          continue;
-        }
-        const int idx = (k * n[1] + j) * n[0] + i;
-        const double v0 = values[idx];
-        if (IsNaN(v0))
-        {
-          continue;
-        }
         for (int a = 0; a < 3; ++a)
         {
           if (l[a] + 1 >= n[a])
           {
             continue;
           }
-          const double v1 = values[idx + step[a]];
-          if (!IsNaN(v1) && ((v0 >= iso) != (v1 >= iso)))
+          const int f1 = flags[idx + step[a]];
+          if (f1 != NaNFlag && f1 != f0)
           {
             ++points;
             if (bits)
@@ -332,6 +347,9 @@ bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, Triangle
   }
   const std::int64_t numActive = static_cast<std::int64_t>(plan.ActiveBlocks.size());
   const int words = plan.WordsPerBlock;
+  const int cubesPerAxis = BlockCells / stride;
+  plan.CubesPerBlock = cubesPerAxis * cubesPerAxis * cubesPerAxis;
+  plan.CubeCases.assign(numActive * plan.CubesPerBlock, 0);
   plan.EdgeBits.assign(numActive * words, 0);
   plan.EdgeRank.assign(numActive * words, 0);
   plan.PointOffset.assign(numActive + 1, 0);
@@ -346,13 +364,16 @@ bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, Triangle
       return;
     }
     std::vector<double> values;
+    std::vector<std::uint8_t> flags;
     for (std::int64_t a = a0; a < a1; ++a)
     {
       const BlockSamples samples(ranges, plan.ActiveBlocks[a], stride);
       Gather(volume, samples, values);
+      Classify(values, isovalue, flags);
       std::uint64_t* bits = plan.EdgeBits.data() + a * words;
       std::int64_t triangles = 0;
-      plan.PointOffset[a + 1] = CountBlock(values, samples, counts, isovalue, triangles, bits);
+      plan.PointOffset[a + 1] = CountBlock(flags, samples, counts, triangles,
+        plan.CubeCases.data() + a * plan.CubesPerBlock, bits);
       plan.TriangleOffset[a + 1] = triangles;
       std::uint32_t* rank = plan.EdgeRank.data() + a * words;
       std::uint32_t before = 0;
@@ -394,16 +415,16 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
   }
   const std::int64_t numActive = static_cast<std::int64_t>(plan.ActiveBlocks.size());
 
+  const std::int64_t sx = volume.Dims[0];
+  const std::int64_t sxy = sx * volume.Dims[1];
   parallel(0, numActive, [&](std::int64_t a0, std::int64_t a1) {
-    std::vector<double> values;
     for (std::int64_t a = a0; a < a1; ++a)
     {
       const std::int64_t block = plan.ActiveBlocks[a];
       const BlockSamples s(ranges, block, stride);
-      Gather(volume, s, values);
       const int* n = s.Count;
 
-      // Points of the owned cut edges, in bit order.
+      // Points of the owned cut edges, in bit order (values read in place).
       const std::uint64_t* bits = plan.EdgeBits.data() + a * words;
       std::int64_t pid = plan.PointOffset[a];
       const int layout = s.Layout;
@@ -415,13 +436,12 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
           const int axis = bit % 3;
           const int cell = bit / 3;
           const int l[3] = { cell % layout, (cell / layout) % layout, cell / (layout * layout) };
-          int l1[3] = { l[0], l[1], l[2] };
-          ++l1[axis];
-          const double v0 = values[(l[2] * n[1] + l[1]) * n[0] + l[0]];
-          const double v1 = values[(l1[2] * n[1] + l1[1]) * n[0] + l1[0]];
-          const double t = (iso - v0) / (v1 - v0);
           const int p0[3] = { s.Point(0, l[0]), s.Point(1, l[1]), s.Point(2, l[2]) };
-          const int p1[3] = { s.Point(0, l1[0]), s.Point(1, l1[1]), s.Point(2, l1[2]) };
+          int p1[3] = { p0[0], p0[1], p0[2] };
+          p1[axis] = s.Point(axis, l[axis] + 1);
+          const double v0 = static_cast<double>(volume.Data[p0[0] + p0[1] * sx + p0[2] * sxy]);
+          const double v1 = static_cast<double>(volume.Data[p1[0] + p1[1] * sx + p1[2] * sxy]);
+          const double t = (iso - v0) / (v1 - v0);
           float* x = out.Points + 3 * pid;
           for (int c = 0; c < 3; ++c)
           {
@@ -454,51 +474,65 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
         }
       }
 
-      // Triangles of every cut cube; a vertex's id is found in the block that owns its edge.
+      // Triangles of every cut cube. A vertex's edge is owned by this block
+      // unless its origin lies on the block's upper face: then by a neighbour.
       std::int64_t tid = plan.TriangleOffset[a];
-      const std::int64_t bxyz[3] = { block % ranges.Blocks[0], (block / ranges.Blocks[0]) % ranges.Blocks[1],
+      const std::int64_t bxyz[3] = { block % ranges.Blocks[0],
+        (block / ranges.Blocks[0]) % ranges.Blocks[1],
         block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]) };
+      const std::uint8_t* cubeCase = plan.CubeCases.data() + a * plan.CubesPerBlock;
+      const std::uint64_t* ownBits = plan.EdgeBits.data() + a * words;
+      const std::uint32_t* ownRank = plan.EdgeRank.data() + a * words;
+      const IdType ownFirst = static_cast<IdType>(out.FirstPointId + plan.PointOffset[a]);
+      auto pointId = [&](int i, int j, int k, int edge) -> IdType {
+        int l[3] = { i + edgeOrigin[edge][0], j + edgeOrigin[edge][1], k + edgeOrigin[edge][2] };
+        const std::uint64_t* wordBits = ownBits;
+        const std::uint32_t* wordRank = ownRank;
+        IdType first = ownFirst;
+        if ((l[0] == n[0] - 1 && !s.LastBlock[0]) || (l[1] == n[1] - 1 && !s.LastBlock[1]) ||
+          (l[2] == n[2] - 1 && !s.LastBlock[2]))
+        {
+          std::int64_t owner[3] = { bxyz[0], bxyz[1], bxyz[2] };
+          for (int d = 0; d < 3; ++d)
+          {
+            if (l[d] == n[d] - 1 && !s.LastBlock[d])
+            {
+              ++owner[d];
+              l[d] = 0;
+            }
+          }
+          const std::int64_t oa = plan.ActiveIndex[(owner[2] * ranges.Blocks[1] + owner[1]) *
+              ranges.Blocks[0] + owner[0]];
+          wordBits = plan.EdgeBits.data() + oa * words;
+          wordRank = plan.EdgeRank.data() + oa * words;
+          first = static_cast<IdType>(out.FirstPointId + plan.PointOffset[oa]);
+        }
+        const int bit = s.Bit(l[0], l[1], l[2], edgeAxis[edge]);
+        const std::uint64_t below = wordBits[bit >> 6] & ((std::uint64_t(1) << (bit & 63)) - 1);
+        return first + static_cast<IdType>(wordRank[bit >> 6] + PopCount(below));
+      };
+      int cube = 0;
       for (int k = 0; k + 1 < n[2]; ++k)
       {
         for (int j = 0; j + 1 < n[1]; ++j)
         {
-          for (int i = 0; i + 1 < n[0]; ++i)
+          for (int i = 0; i + 1 < n[0]; ++i, ++cube)
           {
-            const int c = CubeCase(values.data(), n, i, j, k, iso);
-            if (c <= 0 || c == 255)
+            const int c = cubeCase[cube];
+            if (c == 0 || c == 255)
             {
               continue;
             }
             const int* edges = cases[c];
-            for (int e = 0; e < 15 && edges[e] >= 0; ++e)
+            for (int e = 0; e < 15 && edges[e] >= 0; e += 3, ++tid)
             {
-              const int edge = edges[e];
-              int l[3] = { i + edgeOrigin[edge][0], j + edgeOrigin[edge][1], k + edgeOrigin[edge][2] };
-              std::int64_t owner[3] = { bxyz[0], bxyz[1], bxyz[2] };
-              for (int d = 0; d < 3; ++d)
+              IdType* tri = out.Connectivity + 3 * tid;
+              tri[0] = pointId(i, j, k, edges[e]);
+              tri[1] = pointId(i, j, k, edges[e + 1]);
+              tri[2] = pointId(i, j, k, edges[e + 2]);
+              if (out.BlockIds)
               {
-                if (l[d] == n[d] - 1 && !s.LastBlock[d])
-                {
-                  ++owner[d];
-                  l[d] = 0;
-                }
-              }
-              const std::int64_t ownerBlock =
-                (owner[2] * ranges.Blocks[1] + owner[1]) * ranges.Blocks[0] + owner[0];
-              const std::int64_t oa = plan.ActiveIndex[ownerBlock];
-              const int bit = s.Bit(l[0], l[1], l[2], edgeAxis[edge]);
-              const std::uint64_t word = plan.EdgeBits[oa * words + (bit >> 6)];
-              const std::int64_t rank = plan.EdgeRank[oa * words + (bit >> 6)] +
-                PopCount(word & ((std::uint64_t(1) << (bit & 63)) - 1));
-              out.Connectivity[3 * tid + e % 3] =
-                static_cast<IdType>(out.FirstPointId + plan.PointOffset[oa] + rank);
-              if (e % 3 == 2)
-              {
-                if (out.BlockIds)
-                {
-                  out.BlockIds[tid] = static_cast<std::int32_t>(block);
-                }
-                ++tid;
+                out.BlockIds[tid] = static_cast<std::int32_t>(block);
               }
             }
           }
@@ -531,11 +565,13 @@ SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
   const int stride = LevelStride(level);
   parallel(0, sampled, [&](std::int64_t s0, std::int64_t s1) {
     std::vector<double> values;
+    std::vector<std::uint8_t> flags;
     for (std::int64_t s = s0; s < s1; ++s)
     {
       const BlockSamples samples(ranges, active[s * sampleStep], stride);
       Gather(volume, samples, values);
-      points[s] = CountBlock(values, samples, counts, isovalue, triangles[s], nullptr);
+      Classify(values, isovalue, flags);
+      points[s] = CountBlock(flags, samples, counts, triangles[s], nullptr, nullptr);
     }
   });
   double p = 0, t = 0;

@@ -126,7 +126,9 @@ struct ExtractionPlan
   std::vector<std::int64_t> TriangleOffset; ///< Per active block (+1): first triangle.
   std::vector<std::uint64_t> EdgeBits;      ///< Per active block: owned cut edges.
   std::vector<std::uint32_t> EdgeRank;      ///< Per active block and word: bits before it.
+  std::vector<std::uint8_t> CubeCases;      ///< Per active block: case of each cube.
   int WordsPerBlock = 0;
+  int CubesPerBlock = 0; ///< (8 / stride)^3: stride of CubeCases.
 
   std::int64_t GetNumberOfPoints() const
   {
