@@ -238,11 +238,8 @@ struct vtkBlockLODContour::vtkInternals
   std::map<Key, CacheEntry> Cache;
   std::map<Key, Counts> Exact;   // exact counts of every planned pair
   std::map<Key, Counts> Sampled; // sampled estimates, kept until the input changes
+  std::map<double, std::int64_t> ActiveCount; // active blocks per isovalue
   std::uint64_t Clock = 0;
-
-  // Level growth measured on this input: sum of log(triangles(L+1)/triangles(L)).
-  double LogGrowth = 0;
-  int GrowthSamples = 0;
 
   // Cost model: seconds = A * cubes visited + B * triangles, least squares over
   // this filter's extractions (sums of the normal equations).
@@ -278,8 +275,7 @@ struct vtkBlockLODContour::vtkInternals
     this->Cache.clear();
     this->Exact.clear();
     this->Sampled.clear();
-    this->LogGrowth = 0;
-    this->GrowthSamples = 0;
+    this->ActiveCount.clear();
     this->WarnedNaN = false;
   }
 
@@ -315,42 +311,24 @@ struct vtkBlockLODContour::vtkInternals
     return true;
   }
 
-  std::int64_t CountActive(double iso) const
+  std::int64_t CountActive(double iso)
   {
+    auto known = this->ActiveCount.find(iso);
+    if (known != this->ActiveCount.end())
+    {
+      return known->second;
+    }
     std::int64_t n = 0;
     const std::int64_t blocks = this->Ranges.GetNumberOfBlocks();
     for (std::int64_t b = 0; b < blocks; ++b)
     {
       n += this->Ranges.IsActive(b, iso);
     }
+    this->ActiveCount[iso] = n;
     return n;
   }
 
-  double Growth() const
-  {
-    // Marching-cubes surfaces have about 4x the triangles per halving of the cube size.
-    return this->GrowthSamples > 0 ? std::exp(this->LogGrowth / this->GrowthSamples) : 4.0;
-  }
-
-  void RecordExact(const Key& key, const Counts& counts)
-  {
-    if (this->Exact.count(key))
-    {
-      return;
-    }
-    this->Exact[key] = counts;
-    for (int d : { -1, 1 })
-    {
-      auto other = this->Exact.find(Key(key.first, key.second + d));
-      if (other != this->Exact.end() && other->second.Triangles > 0 && counts.Triangles > 0)
-      {
-        const double ratio = d > 0 ? other->second.Triangles / counts.Triangles
-                                   : counts.Triangles / other->second.Triangles;
-        this->LogGrowth += std::log(ratio);
-        ++this->GrowthSamples;
-      }
-    }
-  }
+  void RecordExact(const Key& key, const Counts& counts) { this->Exact[key] = counts; }
 
   void RecordCost(double cubes, double triangles, double seconds)
   {
@@ -393,7 +371,12 @@ struct vtkBlockLODContour::vtkInternals
     return a * cubes + b * triangles;
   }
 
-  // Estimated counts, and how they were obtained (0 exact, 1 scaled, 2 sampled).
+  // Estimated counts, and how they were obtained (0 exact, 1 scaled, 2 sampled):
+  // exact for a planned pair; the memoized sampled count; scaled from two
+  // exact levels of the same isovalue, by that isovalue's own growth per
+  // level (growth is about 4x for smooth surfaces but nearer 2x for thin
+  // structures, so no global factor is trusted); otherwise a new count on
+  // sampled blocks.
   Counts Estimate(double iso, int level, int& method)
   {
     const Key key(iso, level);
@@ -403,24 +386,33 @@ struct vtkBlockLODContour::vtkInternals
       method = 0;
       return exact->second;
     }
-    // Nearest computed level of the same isovalue.
-    for (int d = 1; d < mediso::NumberOfLevels; ++d)
+    std::vector<int> known;
+    for (int l = 0; l < mediso::NumberOfLevels; ++l)
     {
-      for (int other : { level - d, level + d })
+      auto it = this->Exact.find(Key(iso, l));
+      if (it != this->Exact.end() && it->second.Triangles > 0)
       {
-        auto it = this->Exact.find(Key(iso, other));
-        if (other < 0 || other >= mediso::NumberOfLevels || it == this->Exact.end())
-        {
-          continue;
-        }
-        const double f = std::pow(this->Growth(), level - other);
-        Counts c;
-        c.Triangles = it->second.Triangles * f;
-        c.Points = it->second.Points * f;
-        c.ActiveBlocks = it->second.ActiveBlocks;
-        method = 1;
-        return c;
+        known.push_back(l);
       }
+    }
+    // Scale only where counting would be approximate: with few active blocks
+    // every block is counted, which is exact and cheap.
+    if (known.size() >= 2 && !this->Sampled.count(key) &&
+      this->CountActive(iso) > EstimateSampleBlocks)
+    {
+      // The two known levels nearest to the requested one.
+      std::sort(known.begin(), known.end(),
+        [level](int a, int b) { return std::abs(a - level) < std::abs(b - level); });
+      const Counts& a = this->Exact[Key(iso, known[0])];
+      const Counts& b = this->Exact[Key(iso, known[1])];
+      const double growth = std::pow(a.Triangles / b.Triangles, 1.0 / (known[0] - known[1]));
+      const double f = std::pow(growth, level - known[0]);
+      Counts c;
+      c.Triangles = a.Triangles * f;
+      c.Points = a.Points * f;
+      c.ActiveBlocks = a.ActiveBlocks;
+      method = 1;
+      return c;
     }
     auto sampled = this->Sampled.find(key);
     if (sampled != this->Sampled.end())

@@ -25,15 +25,20 @@
  *    CacheMemoryLimit (least recently used surfaces go first). Asking again
  *    for a cached pair costs no extraction (see GetNumberOfExtractions()).
  * -# Estimates. EstimateTriangles()/EstimateMegabytes()/EstimateSeconds()
- *    predict a pair's output before extracting it: exact for a cached or
- *    planned pair; scaled from another level of the same isovalue by the
- *    per-level growth factor measured on this input (marching-cubes surfaces
- *    grow about 4x per level, not the 8x of the paper's Table 1); otherwise
- *    counted exactly on an evenly spread sample of the active blocks (the
- *    paper used a fixed 2 triangles per cube). Bytes are those the output
- *    vtkPolyData will hold (points, normals, scalars, connectivity, offsets,
- *    block ids); seconds follow a cost model fitted to this filter's own
- *    extractions (the paper's future work).
+ *    predict a pair's output before extracting it. Exact for a cached or
+ *    planned pair. For a new pair, the cut cubes and cut edges are counted
+ *    exactly on an evenly spread sample of about 256 active blocks and scaled
+ *    to all active blocks (exact when there are fewer); the paper used a fixed
+ *    2 triangles per cube instead. When two levels of the isovalue are already
+ *    known and counting would be approximate, the estimate is scaled from them
+ *    by that isovalue's own growth per level: marching-cubes surfaces grow
+ *    about 4x per level when smooth (not the 8x of the paper's Table 1), but
+ *    thin structures such as cortical bone grow nearer 2x at coarse levels and
+ *    8x when they first appear, so no global factor is used. Bytes are those
+ *    the output vtkPolyData holds (points, normals, scalars, connectivity,
+ *    offsets, block ids); seconds follow a cost model (per visited cube and
+ *    per triangle) fitted to this filter's own extractions, the paper's
+ *    future work.
  * -# AutoLOD. With AutoLOD on, the filter picks the highest level whose
  *    estimated output fits MemoryBudget (MB, all isovalues together). Exact
  *    counts are known before any output is allocated, so an underestimate
