@@ -226,20 +226,24 @@ inline int PopCount(std::uint64_t x)
   return __builtin_popcountll(x);
 }
 
-// Negative gradient of the original data at a point (central differences,
-// one-sided on the boundary, divided by the spacing), as vtkMarchingCubes.
+// Negative gradient of the original data at a point, by central differences
+// over the level's stride (one-sided on the boundary), in world units. At full
+// resolution (stride 1) this is vtkMarchingCubes' gradient divided by the
+// spacing; at coarse levels it describes the data as the coarse grid sees it,
+// which full-resolution differences at a coarse sample do not (they can point
+// anywhere in thin or noisy structures).
 template <typename T>
-void NegativeGradient(const Volume<T>& v, const int p[3], double g[3])
+void NegativeGradient(const Volume<T>& v, const int p[3], int stride, double g[3])
 {
-  const std::int64_t stride[3] = { 1, v.Dims[0], static_cast<std::int64_t>(v.Dims[0]) * v.Dims[1] };
-  const std::int64_t at = p[0] + p[1] * stride[1] + p[2] * stride[2];
+  const std::int64_t step[3] = { 1, v.Dims[0], static_cast<std::int64_t>(v.Dims[0]) * v.Dims[1] };
+  const std::int64_t at = p[0] + p[1] * step[1] + p[2] * step[2];
   for (int a = 0; a < 3; ++a)
   {
-    const bool low = p[a] == 0;
-    const bool high = p[a] == v.Dims[a] - 1;
-    const double sm = static_cast<double>(v.Data[low ? at : at - stride[a]]);
-    const double sp = static_cast<double>(v.Data[high ? at : at + stride[a]]);
-    g[a] = (low || high ? (sm - sp) : 0.5 * (sm - sp)) / v.Spacing[a];
+    const int lo = std::max(0, p[a] - stride);
+    const int hi = std::min(v.Dims[a] - 1, p[a] + stride);
+    const double sm = static_cast<double>(v.Data[at + (lo - p[a]) * step[a]]);
+    const double sp = static_cast<double>(v.Data[at + (hi - p[a]) * step[a]]);
+    g[a] = hi > lo ? (sm - sp) / ((hi - lo) * v.Spacing[a]) : 0.0;
   }
 }
 } // namespace
@@ -451,15 +455,22 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
           if (out.Normals)
           {
             double g0[3], g1[3], g[3];
-            NegativeGradient(volume, p0, g0);
-            NegativeGradient(volume, p1, g1);
+            NegativeGradient(volume, p0, stride, g0);
+            NegativeGradient(volume, p1, stride, g1);
             double len2 = 0;
             for (int c = 0; c < 3; ++c)
             {
               g[c] = g0[c] + t * (g1[c] - g0[c]);
               len2 += g[c] * g[c];
             }
-            const double inv = len2 > 0 ? 1.0 / std::sqrt(len2) : 0.0;
+            if (!(len2 > 0))
+            {
+              // Flat or NaN gradient: use the edge itself, pointing to lower values.
+              g[0] = g[1] = g[2] = 0;
+              g[axis] = v1 > v0 ? -1.0 : 1.0;
+              len2 = 1;
+            }
+            const double inv = 1.0 / std::sqrt(len2);
             float* nn = out.Normals + 3 * pid;
             for (int c = 0; c < 3; ++c)
             {
