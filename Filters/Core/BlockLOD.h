@@ -35,8 +35,10 @@
  *   (vtkBlockLODContour passes VTK's vtkMarchingCubesTriangleCases, so this
  *   file holds no table). Points are interpolated on the edge exactly as in
  *   vtkMarchingCubes; normals are the normalised negative gradient of the
- *   original data (central differences at full resolution, one-sided on the
- *   boundary, divided by the spacing), interpolated along the edge.
+ *   original data by central differences over the level's stride (one-sided
+ *   on the boundary, divided by the spacing), interpolated along the edge; at
+ *   level 3 this is vtkMarchingCubes' gradient. A flat gradient falls back
+ *   to the edge direction, so no normal is zero.
  * - Degenerate triangles: like vtkFlyingEdges3D, a point is created per cut
  *   edge and every triangle of the case table is kept; a triangle can only
  *   have coincident vertices when a sample value equals the isovalue exactly.
