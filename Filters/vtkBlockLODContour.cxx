@@ -23,6 +23,9 @@
 #include "vtkSmartPointer.h"
 #include "vtkTypeInt32Array.h"
 #include "vtkTypeInt64Array.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkDataSetAttributes.h"
 
 #include <algorithm>
 #include <array>
@@ -230,6 +233,7 @@ struct vtkBlockLODContour::vtkInternals
   double Spacing[3] = { 1, 1, 1 };
   int ScalarType = -1;
   const void* Data = nullptr;
+  int OwnedCells[6] = { 0, -1, 0, -1, 0, -1 };
   bool RangesValid = false;
   mediso::BlockRanges Ranges;
   bool WarnedNaN = false;
@@ -256,6 +260,8 @@ struct vtkBlockLODContour::vtkInternals
       v.Dims[a] = this->Extent[2 * a + 1] - this->Extent[2 * a] + 1;
       v.Origin[a] = this->Origin[a] + this->Spacing[a] * this->Extent[2 * a];
       v.Spacing[a] = this->Spacing[a];
+      v.OwnedCells[2 * a] = this->OwnedCells[2 * a];
+      v.OwnedCells[2 * a + 1] = this->OwnedCells[2 * a + 1];
     }
     return v;
   }
@@ -279,18 +285,66 @@ struct vtkBlockLODContour::vtkInternals
     this->WarnedNaN = false;
   }
 
+  // Cells that are not ghosts, as an inclusive cell index range per axis:
+  // ghost layers of a structured piece are whole slabs at its faces.
+  static void FindOwnedCells(vtkImageData* input, const int dims[3], int owned[6])
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      owned[2 * a] = 0;
+      owned[2 * a + 1] = dims[a] - 2;
+    }
+    vtkUnsignedCharArray* ghosts = input->GetCellGhostArray();
+    if (!ghosts)
+    {
+      return;
+    }
+    const int cells[3] = { dims[0] - 1, dims[1] - 1, dims[2] - 1 };
+    std::vector<char> real[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      real[a].assign(cells[a], 0);
+    }
+    const unsigned char* g = ghosts->GetPointer(0);
+    vtkIdType id = 0;
+    for (int k = 0; k < cells[2]; ++k)
+      for (int j = 0; j < cells[1]; ++j)
+        for (int i = 0; i < cells[0]; ++i, ++id)
+          if (!(g[id] & vtkDataSetAttributes::DUPLICATECELL))
+          {
+            real[0][i] = real[1][j] = real[2][k] = 1;
+          }
+    for (int a = 0; a < 3; ++a)
+    {
+      int lo = 0, hi = cells[a] - 1;
+      while (lo < hi && !real[a][lo])
+      {
+        ++lo;
+      }
+      while (hi > lo && !real[a][hi])
+      {
+        --hi;
+      }
+      owned[2 * a] = lo;
+      owned[2 * a + 1] = hi;
+    }
+  }
+
   // Brings block ranges up to date with the input; returns true when they were recomputed.
   bool Refresh(vtkImageData* input, vtkDataArray* array)
   {
     int extent[6];
     input->GetExtent(extent);
+    int dims[3] = { extent[1] - extent[0] + 1, extent[3] - extent[2] + 1, extent[5] - extent[4] + 1 };
+    int owned[6];
+    FindOwnedCells(input, dims, owned);
     double origin[3], spacing[3];
     input->GetOrigin(origin);
     input->GetSpacing(spacing);
     const bool same = this->RangesValid && input == this->Input && array == this->Array &&
       array->GetMTime() == this->ArrayMTime && std::equal(extent, extent + 6, this->Extent) &&
       std::equal(origin, origin + 3, this->Origin) && std::equal(spacing, spacing + 3, this->Spacing) &&
-      array->GetVoidPointer(0) == this->Data;
+      std::equal(owned, owned + 6, this->OwnedCells) && array->GetVoidPointer(0) == this->Data;
     if (same)
     {
       return false;
@@ -302,6 +356,7 @@ struct vtkBlockLODContour::vtkInternals
     std::copy(extent, extent + 6, this->Extent);
     std::copy(origin, origin + 3, this->Origin);
     std::copy(spacing, spacing + 3, this->Spacing);
+    std::copy(owned, owned + 6, this->OwnedCells);
     this->ScalarType = array->GetDataType();
     this->Data = array->GetVoidPointer(0);
     this->WithVolume([&](const auto& volume) {
@@ -489,6 +544,22 @@ vtkBlockLODContour::~vtkBlockLODContour() = default;
 vtkMTimeType vtkBlockLODContour::GetMTime()
 {
   return std::max(this->Superclass::GetMTime(), this->ContourValues->GetMTime());
+}
+
+int vtkBlockLODContour::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (!this->Superclass::RequestUpdateExtent(request, inputVector, outputVector))
+  {
+    return 0;
+  }
+  // One ghost layer more than asked: gradients at a piece's faces see the
+  // neighbour's data, and the ghost cells themselves make no triangles.
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  const int ghosts = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS());
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), ghosts + 1);
+  return 1;
 }
 
 int vtkBlockLODContour::FillInputPortInformation(int, vtkInformation* info)

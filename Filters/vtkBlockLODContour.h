@@ -53,6 +53,12 @@
  * "BlockLODEstimatedMB" and "BlockLODEstimatedSeconds" (4 values each, levels
  * 0..3, for the first isovalue).
  *
+ * Parallel pieces: the filter asks its input for one ghost layer more than
+ * its output needs and makes no triangle in ghost cells (vtkGhostType), so at
+ * level 3 pieces join without duplicate triangles or cracks and their normals
+ * match the one-process result. (Coarse levels sample each piece on its own
+ * grid; joining them across pieces is left to the MPI work.)
+ *
  * Inputs: vtkImageData with a one-component point array of type char, signed
  * char, unsigned char, short, unsigned short, int, unsigned int, float or
  * double; spacing, origin and extent are honoured; a non-identity direction
@@ -223,6 +229,7 @@ protected:
   ~vtkBlockLODContour() override;
 
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int FillInputPortInformation(int port, vtkInformation* info) override;
 
   vtkNew<vtkContourValues> ContourValues;

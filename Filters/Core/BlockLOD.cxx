@@ -143,9 +143,54 @@ void Classify(const std::vector<double>& values, double iso, std::vector<std::ui
 // Pass-1 work on one block: the case of every cube (into `cubeCases` when not
 // null; 0 for a cube with a NaN corner), the triangle count, and the owned cut
 // edges (into `bits` when not null). Returns the number of owned cut edges.
+// Which samples of a block start an owned cube along each axis (all of them
+// without ghost cells).
+struct OwnedSamples
+{
+  bool Any = false; // false: every cube is owned
+  bool Starts[3][BlockCells + 1];
+
+  template <typename T>
+  OwnedSamples(const Volume<T>& v, const BlockSamples& s)
+    : Any(v.HasGhostCells())
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      for (int l = 0; l < s.Count[a]; ++l)
+      {
+        const int p = s.Point(a, l);
+        this->Starts[a][l] = p >= v.OwnedCells[2 * a] && p <= v.OwnedCells[2 * a + 1];
+      }
+    }
+  }
+  bool Cube(int i, int j, int k) const
+  {
+    return !this->Any || (this->Starts[0][i] && this->Starts[1][j] && this->Starts[2][k]);
+  }
+  // An edge from sample l along `axis` is used by an owned cube: the cube
+  // starting at l along the axis, and at l - 1 or l along the other two.
+  bool Edge(const int l[3], int axis) const
+  {
+    if (!this->Any)
+    {
+      return true;
+    }
+    for (int b = 0; b < 3; ++b)
+    {
+      const bool here = this->Starts[b][l[b]];
+      const bool before = b != axis && l[b] > 0 && this->Starts[b][l[b] - 1];
+      if (!(here || before))
+      {
+        return false;
+      }
+    }
+    return true;
+  }
+};
+
 std::int64_t CountBlock(const std::vector<std::uint8_t>& flags, const BlockSamples& s,
-  const TriangleCounts& counts, std::int64_t& triangles, std::uint8_t* cubeCases,
-  std::uint64_t* bits)
+  const OwnedSamples& owned, const TriangleCounts& counts, std::int64_t& triangles,
+  std::uint8_t* cubeCases, std::uint64_t* bits)
 {
   const int* n = s.Count;
   const int sx = n[0];
@@ -168,7 +213,7 @@ std::int64_t CountBlock(const std::vector<std::uint8_t>& flags, const BlockSampl
           index |= (v & 1) << c;
           nan |= v & NaNFlag;
         }
-        index = nan ? 0 : index;
+        index = (nan || !owned.Cube(i, j, k)) ? 0 : index;
         tris += counts.Count[index];
         if (cubeCases)
         {
@@ -205,7 +250,7 @@ std::int64_t CountBlock(const std::vector<std::uint8_t>& flags, const BlockSampl
             continue;
           }
           const int f1 = flags[idx + step[a]];
-          if (f1 != NaNFlag && f1 != f0)
+          if (f1 != NaNFlag && f1 != f0 && owned.Edge(l, a))
           {
             ++points;
             if (bits)
@@ -376,8 +421,8 @@ bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, Triangle
       Classify(values, isovalue, flags);
       std::uint64_t* bits = plan.EdgeBits.data() + a * words;
       std::int64_t triangles = 0;
-      plan.PointOffset[a + 1] = CountBlock(flags, samples, counts, triangles,
-        plan.CubeCases.data() + a * plan.CubesPerBlock, bits);
+      plan.PointOffset[a + 1] = CountBlock(flags, samples, OwnedSamples(volume, samples), counts,
+        triangles, plan.CubeCases.data() + a * plan.CubesPerBlock, bits);
       plan.TriangleOffset[a + 1] = triangles;
       std::uint32_t* rank = plan.EdgeRank.data() + a * words;
       std::uint32_t before = 0;
@@ -582,7 +627,8 @@ SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
       const BlockSamples samples(ranges, active[s * sampleStep], stride);
       Gather(volume, samples, values);
       Classify(values, isovalue, flags);
-      points[s] = CountBlock(flags, samples, counts, triangles[s], nullptr, nullptr);
+      points[s] = CountBlock(
+        flags, samples, OwnedSamples(volume, samples), counts, triangles[s], nullptr, nullptr);
     }
   });
   double p = 0, t = 0;

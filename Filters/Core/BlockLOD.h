@@ -90,6 +90,22 @@ struct Volume
   int Dims[3] = { 0, 0, 0 };      ///< Points along x, y, z.
   double Origin[3] = { 0, 0, 0 }; ///< World position of point (0, 0, 0).
   double Spacing[3] = { 1, 1, 1 };
+  /// Cells (by lower corner index) whose cubes make triangles: {x0, x1, y0,
+  /// y1, z0, z1}, inclusive. A parallel piece passes the range without its
+  /// ghost layers, so pieces join without duplicate triangles while their
+  /// normals still see the neighbour's data. Default: every cell.
+  int OwnedCells[6] = { 0, 1 << 30, 0, 1 << 30, 0, 1 << 30 };
+  bool HasGhostCells() const
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      if (this->OwnedCells[2 * a] > 0 || this->OwnedCells[2 * a + 1] < this->Dims[a] - 2)
+      {
+        return true;
+      }
+    }
+    return false;
+  }
 };
 
 /// Per-block value ranges of a volume (computed once, reused for every isovalue).
