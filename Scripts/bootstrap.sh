@@ -23,8 +23,8 @@ packages=(
   qtbase5-dev qttools5-dev libqt5svg5-dev libqt5opengl5-dev qtxmlpatterns5-dev-tools
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev
   libhdf5-dev libgdal-dev libnetcdf-dev libgl2ps-dev libglew-dev libtheora-dev libtiff-dev
-  # toolchain
-  cmake ninja-build g++ make
+  # toolchain (python3 runs the data script and the offline format test)
+  cmake ninja-build g++ make python3
   # rendering without a display (Mesa llvmpipe), and tests' network namespaces
   xvfb libgl1-mesa-dri iproute2 util-linux
 )

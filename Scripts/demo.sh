@@ -28,11 +28,15 @@ if [ $fetch_status -eq 0 ]; then
 else
   reason=$(echo "$fetch_log" | grep -m1 -E "unavailable|check failed" || echo "data fetch failed")
   echo "demo: the real CT is not available ($reason); falling back to the synthetic MedicalPhantom"
-  source_args=(--phantom --fallback-reason "real CT unavailable: ${reason#fetch_data: }")
+  reason=${reason#fetch_data: }
+  reason=${reason#unavailable: }
+  source_args=(--phantom --fallback-reason "real CT unavailable: ${reason:0:120}")
 fi
 
 # ParaView 5.11's VTK defaults to the Sequential SMP backend; use the threads we have.
 export VTK_SMP_BACKEND_IN_USE=${VTK_SMP_BACKEND_IN_USE:-STDThread}
-"$repo/Testing/Scripts/with-xvfb.sh" pvpython --force-offscreen-rendering \
+# --no-mpi: the demo is one process, and OpenMPI's start-up fails on a machine
+# with no network interface at all (where the phantom fallback matters most).
+"$repo/Testing/Scripts/with-xvfb.sh" pvpython --no-mpi --force-offscreen-rendering \
   "$repo/Python/demo.py" --plugin "$plugin" --out "$out" "${source_args[@]}"
 echo "demo: images and report in $out"
