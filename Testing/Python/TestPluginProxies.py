@@ -30,7 +30,7 @@ check("MedicalPhantom" in globals(), "LoadPlugin(ns=globals()) defines MedicalPh
 # --- proxies and their documentation -----------------------------------------
 pxm = servermanager.ProxyManager()
 definitions = pxm.SMProxyManager.GetProxyDefinitionManager()
-expected = [("sources", "MedicalPhantom")]
+expected = [("sources", "MedicalPhantom"), ("filters", "BlockLODContour")]
 for group, name in expected:
     check(definitions.HasDefinition(group, name), "proxy %s/%s is defined" % (group, name))
     proxy = servermanager._getPyProxy(pxm.SMProxyManager.NewProxy(group, name))
@@ -59,6 +59,35 @@ hu = phantom.PointData["HU"]
 check(hu is not None and hu.GetDataType() == 4, "HU array is VTK_SHORT (int16)")  # 4 == VTK_SHORT
 check(hu.GetRange()[0] == -1000.0 and hu.GetRange()[1] > 400.0, "HU range %s" % (hu.GetRange(),))
 print("MedicalPhantom: extent %s, HU range %s" % (info.GetExtent(), hu.GetRange()))
+
+# --- BlockLODContour through its proxy ------------------------------------------
+check("BlockLODContour" in globals(), "LoadPlugin(ns=globals()) defines BlockLODContour")
+head = MedicalPhantom(Dimensions=[64, 64, 64])
+lod = BlockLODContour(Input=head, ContourBy=["POINTS", "HU"], Isosurfaces=[400.0], LOD=2)
+lod.UpdatePipeline()
+lod.UpdatePropertyInformation()
+triangles = lod.GetDataInformation().DataInformation.GetNumberOfCells()
+estimates = list(lod.GetProperty("EstimatedTriangles"))
+check(triangles > 0, "BlockLODContour makes a surface")
+check(lod.GetProperty("ChosenLevel")[0] == 2, "ChosenLevel reports LOD 2")
+check(len(estimates) == 4 and estimates[0] < estimates[1] < estimates[2] < estimates[3],
+      "estimates grow with the level: %s" % estimates)
+check(abs(estimates[2] - triangles) <= 0.1 * triangles,
+      "level-2 estimate %g within 10%% of %d" % (estimates[2], triangles))
+lod.AutoLOD = 1
+lod.MemoryBudget = 0.05  # MB: too small for the finer levels of a 64^3 head
+lod.UpdatePipeline()
+lod.UpdatePropertyInformation()
+chosen = lod.GetProperty("ChosenLevel")[0]
+megabytes = list(lod.GetProperty("EstimatedMB"))
+check(0 <= chosen < 3 and megabytes[chosen] <= 0.05 and megabytes[chosen + 1] > 0.05,
+      "AutoLOD picks the highest level within 0.05 MB: level %d of %s" % (chosen, megabytes))
+level = lod.FieldData["BlockLODLevel"]
+check(level is not None and level.GetRange()[0] == chosen, "the chosen level is in field data")
+print("BlockLODContour: %d triangles at LOD 2, estimates %s; AutoLOD(0.05 MB) chose level %d"
+      % (triangles, [int(e) for e in estimates], chosen))
+Delete(lod)
+Delete(head)
 
 # --- bad parameters -----------------------------------------------------------
 # Errors are captured (so a passing run prints none) and checked for content.
