@@ -1,7 +1,7 @@
 """BlockLODContour benchmark (pvpython): the plugin's CPU isosurface filter against its peers.
 
     pvpython Python/benchmark_blocklod.py [--inputs ct,ct512,phantom256,phantom512]
-        [--repeats N] [--quick] [--sweep N] [--isovalues -500,400] [--backend STDThread|Sequential]
+        [--repeats N] [--quick] [--sweep N] [--isovalues=-500,400] [--backend STDThread|Sequential]
         [--threads 2] [--out FILE.md] [--json FILE.json] [--plugin PATH] [--marching-cubes]
 
 Measures, on the real head CT (256x256x108 int16), the CT resampled (linear) to 512x512x216, and
@@ -92,7 +92,8 @@ def parse_args(argv=None):
                              "512-wide inputs to keep the run short)" % (PAPER_SWEEP, QUICK_SWEEP))
     parser.add_argument("--isovalues", default="",
                         help="comma list of isovalues for the cold/warm tables "
-                             "(default -500,400: skin and bone)")
+                             "(default -500,400: skin and bone; write --isovalues=-500,400 "
+                             "when the list starts with a minus sign)")
     parser.add_argument("--backend", default="STDThread", help="vtkSMPTools backend")
     parser.add_argument("--threads", type=int, default=2,
                         help="SMP threads (default 2; 1 with the Sequential backend)")
@@ -524,7 +525,7 @@ def input_title(r):
 
 
 def smp_text(r):
-    return "backend %s, %d threads" % (r["backend"], r["threads"])
+    return "backend %s, %d thread(s)" % (r["backend"], r["threads"])
 
 
 def errors(estimates, actuals, min_triangles):
@@ -573,6 +574,7 @@ def report(args, results, skipped, command, started, wall, load_before, load_aft
             "= MemoryBudget = %g MB, AutoLOD off, normals on" % (r0["paraview"],
                                                                  platform.python_version(),
                                                                  smp_text(r0), args.cache_mb))
+    out("- plugin: %s" % build_text(args.plugin))
     for name, why in skipped:
         out("- skipped %s: %s" % (name, why))
     out("- times: seconds of one update; min and median of the runs; ratio = median / median "
@@ -794,6 +796,27 @@ def report(args, results, skipped, command, started, wall, load_before, load_aft
     return lines
 
 
+def build_text(plugin):
+    """The plugin's path, the newest build time of its libraries and the source revision."""
+    folder = os.path.dirname(plugin)
+    try:
+        newest = max(os.path.getmtime(os.path.join(folder, f)) for f in os.listdir(folder)
+                     if f.endswith(".so"))
+        built = time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(newest))
+    except (OSError, ValueError):
+        built = "unknown"
+    here = os.path.dirname(os.path.abspath(__file__))
+    try:
+        rev = subprocess.run(["git", "-C", here, "rev-parse", "--short", "HEAD"],
+                             capture_output=True, text=True, timeout=10).stdout.strip()
+        dirty = subprocess.run(["git", "-C", here, "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, timeout=10).stdout.strip()
+        rev = (rev or "unknown") + (" + uncommitted changes" if dirty else "")
+    except (OSError, subprocess.SubprocessError):
+        rev = "unknown"
+    return "%s (libraries built %s; source %s)" % (plugin, built, rev)
+
+
 def cpu_model():
     try:
         with open("/proc/cpuinfo") as f:
@@ -850,12 +873,14 @@ def run_parent(args, argv):
         progress("skipping %s: %s" % (name, why))
     t0 = time.perf_counter()
     results = []
-    passthrough = [a for a in argv]
+    passthrough = list(argv)
     for name in inputs:
         progress("=== %s (child process) ===" % name)
         handle, result_path = tempfile.mkstemp(prefix="bench_blocklod_", suffix=".json")
         os.close(handle)
-        child_cmd = [interpreter, os.path.abspath(__file__)] + passthrough + [
+        # --no-mpi: OpenMPI start-up fails on machines with no network interface.
+        mpi = ["--no-mpi"] if os.path.basename(interpreter).startswith("pvpython") else []
+        child_cmd = [interpreter] + mpi + [os.path.abspath(__file__)] + passthrough + [
             "--child", name, "--child-result", result_path, "--plugin", args.plugin]
         child_start = time.perf_counter()
         rc = subprocess.call(child_cmd)
