@@ -34,6 +34,8 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <memory>
+#include <type_traits>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -46,6 +48,12 @@ constexpr double BytesPerMB = 1.0e6;
 // Sampled estimates count about this many active blocks.
 constexpr std::int64_t EstimateSampleBlocks = 256;
 
+// Every `step`-th active block is counted; step 1 counts them all (exact).
+int SampleStep(std::int64_t activeBlocks)
+{
+  return static_cast<int>(std::max<std::int64_t>(1, activeBlocks / EstimateSampleBlocks));
+}
+
 mediso::TriangleCaseTable VTKCaseTable()
 {
   return reinterpret_cast<mediso::TriangleCaseTable>(vtkMarchingCubesTriangleCases::GetCases());
@@ -57,7 +65,10 @@ void SMPFor(std::int64_t begin, std::int64_t end, const mediso::RangeBody& body)
   {
     return;
   }
-  const vtkIdType grain = std::max<vtkIdType>(1, (end - begin) / 256);
+  // About 8 tasks per thread: enough to balance blocks of uneven work, few
+  // enough that the thread pool's per-task cost stays small against the work.
+  const vtkIdType threads = std::max(1, vtkSMPTools::GetEstimatedNumberOfThreads());
+  const vtkIdType grain = std::max<vtkIdType>(1, (end - begin) / (8 * threads));
   vtkSMPTools::For(begin, end, grain, [&](vtkIdType b, vtkIdType e) { body(b, e); });
 }
 
@@ -206,7 +217,21 @@ struct Counts
 {
   double Points = 0;
   double Triangles = 0;
-  std::int64_t ActiveBlocks = 0;
+  double Cubes = 0; ///< Cubes visited to extract the pair (cost model).
+};
+
+// A level's samples as a small contiguous volume of their own, with its block
+// ranges (built once per input, the first time the level is extracted).
+struct CoarseLevelBase
+{
+  virtual ~CoarseLevelBase() = default;
+  mediso::BlockRanges Ranges;
+};
+template <typename T>
+struct CoarseLevel : CoarseLevelBase
+{
+  std::vector<T> Values;
+  mediso::Volume<T> Volume;
 };
 
 struct CacheEntry
@@ -236,13 +261,14 @@ struct vtkBlockLODContour::vtkInternals
   int OwnedCells[6] = { 0, -1, 0, -1, 0, -1 };
   bool RangesValid = false;
   mediso::BlockRanges Ranges;
+  std::unique_ptr<CoarseLevelBase> Coarse[mediso::NumberOfLevels - 1];
   bool WarnedNaN = false;
 
   OutputFlags CacheFlags{ true, false, false };
   std::map<Key, CacheEntry> Cache;
   std::map<Key, Counts> Exact;   // exact counts of every planned pair
   std::map<Key, Counts> Sampled; // sampled estimates, kept until the input changes
-  std::map<double, std::int64_t> ActiveCount; // active blocks per isovalue
+  std::vector<std::pair<double, std::vector<std::int32_t>>> ActiveLists;
   std::uint64_t Clock = 0;
 
   // Cost model: seconds = A * cubes visited + B * triangles, least squares over
@@ -278,10 +304,14 @@ struct vtkBlockLODContour::vtkInternals
   void ForgetInput()
   {
     this->RangesValid = false;
+    for (auto& c : this->Coarse)
+    {
+      c.reset();
+    }
     this->Cache.clear();
     this->Exact.clear();
     this->Sampled.clear();
-    this->ActiveCount.clear();
+    this->ActiveLists.clear();
     this->WarnedNaN = false;
   }
 
@@ -366,21 +396,53 @@ struct vtkBlockLODContour::vtkInternals
     return true;
   }
 
+  // Runs f(volume, ranges) on the volume a level is extracted from: the full
+  // volume at level 3, the level's coarse copy below (built on first use).
+  template <typename F>
+  void WithLevelVolume(int level, F&& f)
+  {
+    this->WithVolume([&](const auto& full) {
+      using T = std::remove_const_t<std::remove_pointer_t<decltype(full.Data)>>;
+      if (level == mediso::NumberOfLevels - 1)
+      {
+        f(full, this->Ranges);
+        return;
+      }
+      auto& slot = this->Coarse[level];
+      if (!slot)
+      {
+        auto coarse = std::make_unique<CoarseLevel<T>>();
+        coarse->Volume = mediso::MakeCoarseCopy(full, level, coarse->Values, SMPFor);
+        mediso::ComputeBlockRanges(coarse->Volume, coarse->Ranges, SMPFor);
+        slot = std::move(coarse);
+      }
+      auto* coarse = static_cast<CoarseLevel<T>*>(slot.get());
+      f(coarse->Volume, coarse->Ranges);
+    });
+  }
+
+  // Active blocks of an isovalue (full-volume blocks), listed once and kept
+  // for the last few isovalues: every estimate of every level uses them.
+  const std::vector<std::int32_t>& ActiveBlocks(double iso)
+  {
+    for (auto& entry : this->ActiveLists)
+    {
+      if (entry.first == iso)
+      {
+        return entry.second;
+      }
+    }
+    if (this->ActiveLists.size() >= 4)
+    {
+      this->ActiveLists.erase(this->ActiveLists.begin());
+    }
+    this->ActiveLists.emplace_back(iso, mediso::ListActiveBlocks(this->Ranges, iso));
+    return this->ActiveLists.back().second;
+  }
+
   std::int64_t CountActive(double iso)
   {
-    auto known = this->ActiveCount.find(iso);
-    if (known != this->ActiveCount.end())
-    {
-      return known->second;
-    }
-    std::int64_t n = 0;
-    const std::int64_t blocks = this->Ranges.GetNumberOfBlocks();
-    for (std::int64_t b = 0; b < blocks; ++b)
-    {
-      n += this->Ranges.IsActive(b, iso);
-    }
-    this->ActiveCount[iso] = n;
-    return n;
+    return static_cast<std::int64_t>(this->ActiveBlocks(iso).size());
   }
 
   void RecordExact(const Key& key, const Counts& counts) { this->Exact[key] = counts; }
@@ -452,8 +514,7 @@ struct vtkBlockLODContour::vtkInternals
     }
     // Scale only where counting would be approximate: with few active blocks
     // every block is counted, which is exact and cheap.
-    if (known.size() >= 2 && !this->Sampled.count(key) &&
-      this->CountActive(iso) > EstimateSampleBlocks)
+    if (known.size() >= 2 && !this->Sampled.count(key) && SampleStep(this->CountActive(iso)) > 1)
     {
       // The two known levels nearest to the requested one.
       std::sort(known.begin(), known.end(),
@@ -465,7 +526,7 @@ struct vtkBlockLODContour::vtkInternals
       Counts c;
       c.Triangles = a.Triangles * f;
       c.Points = a.Points * f;
-      c.ActiveBlocks = a.ActiveBlocks;
+      c.Cubes = a.Cubes * std::pow(8.0, level - known[0]);
       method = 1;
       return c;
     }
@@ -476,15 +537,33 @@ struct vtkBlockLODContour::vtkInternals
       return sampled->second;
     }
     Counts c;
-    const std::int64_t active = this->CountActive(iso);
-    const int step = static_cast<int>(std::max<std::int64_t>(1, active / EstimateSampleBlocks));
-    this->WithVolume([&](const auto& volume) {
-      const mediso::SampledCounts s =
-        mediso::CountSampled(volume, this->Ranges, VTKCaseTable(), iso, level, step, SMPFor);
-      c.Points = s.Points;
-      c.Triangles = s.Triangles;
-      c.ActiveBlocks = s.ActiveBlocks;
-    });
+    int step = 1;
+    if (level < mediso::NumberOfLevels - 1 && this->Coarse[level])
+    {
+      // The level's coarse copy exists: sample it (contiguous, cheap).
+      this->WithLevelVolume(level, [&](const auto& volume, const mediso::BlockRanges& ranges) {
+        const std::vector<std::int32_t> active = mediso::ListActiveBlocks(ranges, iso);
+        step = SampleStep(static_cast<std::int64_t>(active.size()));
+        const mediso::SampledCounts s =
+          mediso::CountSampled(volume, ranges, VTKCaseTable(), active, iso, 3, step, SMPFor);
+        c.Points = s.Points;
+        c.Triangles = s.Triangles;
+        c.Cubes = static_cast<double>(s.ActiveBlocks) * std::pow(mediso::BlockCells, 3);
+      });
+    }
+    else
+    {
+      const std::vector<std::int32_t>& active = this->ActiveBlocks(iso);
+      step = SampleStep(static_cast<std::int64_t>(active.size()));
+      this->WithVolume([&](const auto& volume) {
+        const mediso::SampledCounts s = mediso::CountSampled(
+          volume, this->Ranges, VTKCaseTable(), active, iso, level, step, SMPFor);
+        c.Points = s.Points;
+        c.Triangles = s.Triangles;
+        c.Cubes = static_cast<double>(s.ActiveBlocks) *
+          std::pow(mediso::BlockCells / mediso::LevelStride(level), 3);
+      });
+    }
     method = 2;
     if (step == 1)
     {
@@ -620,8 +699,7 @@ double vtkBlockLODContour::EstimateSeconds(double isovalue, int level)
     return 0.0; // served from the cache
   }
   const Counts c = this->Internals->Estimate(isovalue, level, this->LastEstimateMethod);
-  const double cubesPerBlock = std::pow(mediso::BlockCells / mediso::LevelStride(level), 3);
-  return this->Internals->PredictSeconds(c.ActiveBlocks * cubesPerBlock, c.Triangles);
+  return this->Internals->PredictSeconds(c.Cubes, c.Triangles);
 }
 
 //------------------------------------------------------------------------------
@@ -733,12 +811,6 @@ int vtkBlockLODContour::RequestData(
 
   // --- Estimates and the level ----------------------------------------------------
   const double budgetBytes = this->MemoryBudget * BytesPerMB;
-  for (int level = 0; level < mediso::NumberOfLevels; ++level)
-  {
-    this->EstimatedTriangles[level] = this->EstimateTriangles(values[0], level);
-    this->EstimatedMegabytes[level] = this->EstimateMegabytes(values[0], level);
-    this->EstimatedSeconds[level] = this->EstimateSeconds(values[0], level);
-  }
   int level = this->LOD;
   if (this->AutoLOD)
   {
@@ -788,9 +860,9 @@ int vtkBlockLODContour::RequestData(
       mediso::ExtractionPlan& plan = plans[v];
       const double start = Now();
       bool complete = true;
-      in.WithVolume([&](const auto& volume) {
-        complete =
-          mediso::PlanExtraction(volume, in.Ranges, cases, v, level, plan, SMPFor, abort);
+      // Marching cubes at stride 1 on the level's samples: the level's surface.
+      in.WithLevelVolume(level, [&](const auto& volume, const mediso::BlockRanges& ranges) {
+        complete = mediso::PlanExtraction(volume, ranges, cases, v, 3, plan, SMPFor, abort);
       });
       if (!complete || this->CheckAbort())
       {
@@ -801,7 +873,7 @@ int vtkBlockLODContour::RequestData(
       Counts exact;
       exact.Points = static_cast<double>(plan.GetNumberOfPoints());
       exact.Triangles = static_cast<double>(plan.GetNumberOfTriangles());
-      exact.ActiveBlocks = static_cast<std::int64_t>(plan.ActiveBlocks.size());
+      exact.Cubes = static_cast<double>(plan.ActiveBlocks.size()) * plan.CubesPerBlock;
       in.RecordExact(key, exact);
       bytes += SurfaceBytes(exact.Points, exact.Triangles, flags);
     }
@@ -821,6 +893,14 @@ int vtkBlockLODContour::RequestData(
     --level;
   }
   this->ChosenLevel = level;
+  // Estimates of every level for the first isovalue, reported after planning:
+  // the planned level's is exact, and AutoLOD's were made while choosing.
+  for (int l = 0; l < mediso::NumberOfLevels; ++l)
+  {
+    this->EstimatedTriangles[l] = this->EstimateTriangles(values[0], l);
+    this->EstimatedMegabytes[l] = this->EstimateMegabytes(values[0], l);
+    this->EstimatedSeconds[l] = this->EstimateSeconds(values[0], l);
+  }
   this->UpdateProgress(0.5);
 
   // --- Pass 2: generate, cache -------------------------------------------------
@@ -842,7 +922,7 @@ int vtkBlockLODContour::RequestData(
     const double start = Now();
     SurfaceArrays arrays =
       AllocateSurface(plan.GetNumberOfPoints(), plan.GetNumberOfTriangles(), flags);
-    in.WithVolume([&](const auto& volume) {
+    in.WithLevelVolume(level, [&](const auto& volume, const mediso::BlockRanges& ranges) {
       if (arrays.Connectivity32)
       {
         mediso::SurfaceBuffers<std::int32_t> buffers;
@@ -851,7 +931,7 @@ int vtkBlockLODContour::RequestData(
         buffers.Scalars = arrays.Scalars;
         buffers.BlockIds = arrays.BlockIds;
         buffers.Connectivity = arrays.Connectivity32;
-        mediso::GenerateSurface(volume, in.Ranges, cases, plan, buffers, SMPFor);
+        mediso::GenerateSurface(volume, ranges, cases, plan, buffers, SMPFor);
       }
       else
       {
@@ -861,13 +941,12 @@ int vtkBlockLODContour::RequestData(
         buffers.Scalars = arrays.Scalars;
         buffers.BlockIds = arrays.BlockIds;
         buffers.Connectivity = arrays.Connectivity64;
-        mediso::GenerateSurface(volume, in.Ranges, cases, plan, buffers, SMPFor);
+        mediso::GenerateSurface(volume, ranges, cases, plan, buffers, SMPFor);
       }
     });
     ++this->NumberOfExtractions;
     const double seconds = planSeconds[v] + (Now() - start);
-    const double cubesPerBlock = std::pow(mediso::BlockCells / mediso::LevelStride(level), 3);
-    in.RecordCost(static_cast<double>(plan.ActiveBlocks.size()) * cubesPerBlock,
+    in.RecordCost(static_cast<double>(plan.ActiveBlocks.size()) * plan.CubesPerBlock,
       static_cast<double>(plan.GetNumberOfTriangles()), seconds);
     pieces.push_back(arrays.Surface);
     if (this->CacheMemoryLimit > 0)

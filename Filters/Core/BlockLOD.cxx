@@ -99,11 +99,15 @@ int WordsPerBlock(int level)
   return (3 * layout * layout * layout + 63) / 64;
 }
 
-// Sample values of a block, x fastest, as double.
+// Per-sample classification of a gathered block: 1 when value >= iso, 0 when
+// below, NaNFlag when NaN.
+constexpr std::uint8_t NaNFlag = 2;
+
+// Classifies a block's samples straight from the data (no copy of the values).
 template <typename T>
-void Gather(const Volume<T>& v, const BlockSamples& s, std::vector<double>& values)
+void Classify(const Volume<T>& v, const BlockSamples& s, double iso, std::vector<std::uint8_t>& flags)
 {
-  values.resize(static_cast<std::size_t>(s.Count[0]) * s.Count[1] * s.Count[2]);
+  flags.resize(static_cast<std::size_t>(s.Count[0]) * s.Count[1] * s.Count[2]);
   const std::int64_t sx = v.Dims[0];
   const std::int64_t sxy = sx * v.Dims[1];
   int xs[BlockCells + 1];
@@ -111,32 +115,31 @@ void Gather(const Volume<T>& v, const BlockSamples& s, std::vector<double>& valu
   {
     xs[i] = s.Point(0, i);
   }
-  double* out = values.data();
+  std::uint8_t* out = flags.data();
   for (int k = 0; k < s.Count[2]; ++k)
   {
     const std::int64_t zoff = s.Point(2, k) * sxy;
     for (int j = 0; j < s.Count[1]; ++j)
     {
       const T* row = v.Data + zoff + s.Point(1, j) * sx;
-      for (int i = 0; i < s.Count[0]; ++i)
+      if (s.Stride == 1)
       {
-        *out++ = static_cast<double>(row[xs[i]]);
+        const T* r = row + xs[0];
+        for (int i = 0; i < s.Count[0]; ++i)
+        {
+          const double value = static_cast<double>(r[i]);
+          *out++ = IsNaN(value) ? NaNFlag : static_cast<std::uint8_t>(value >= iso);
+        }
+      }
+      else
+      {
+        for (int i = 0; i < s.Count[0]; ++i)
+        {
+          const double value = static_cast<double>(row[xs[i]]);
+          *out++ = IsNaN(value) ? NaNFlag : static_cast<std::uint8_t>(value >= iso);
+        }
       }
     }
-  }
-}
-
-// Per-sample classification of a gathered block: 1 when value >= iso, 0 when
-// below, NaNFlag when NaN.
-constexpr std::uint8_t NaNFlag = 2;
-
-void Classify(const std::vector<double>& values, double iso, std::vector<std::uint8_t>& flags)
-{
-  flags.resize(values.size());
-  for (std::size_t i = 0; i < values.size(); ++i)
-  {
-    const double v = values[i];
-    flags[i] = IsNaN(v) ? NaNFlag : static_cast<std::uint8_t>(v >= iso);
   }
 }
 
@@ -288,7 +291,8 @@ void NegativeGradient(const Volume<T>& v, const int p[3], int stride, double g[3
     const int hi = std::min(v.Dims[a] - 1, p[a] + stride);
     const double sm = static_cast<double>(v.Data[at + (lo - p[a]) * step[a]]);
     const double sp = static_cast<double>(v.Data[at + (hi - p[a]) * step[a]]);
-    g[a] = hi > lo ? (sm - sp) / ((hi - lo) * v.Spacing[a]) : 0.0;
+    const int distance = v.FullIndex(a, hi) - v.FullIndex(a, lo);
+    g[a] = distance > 0 ? (sm - sp) / (distance * v.Spacing[a]) : 0.0;
   }
 }
 } // namespace
@@ -299,6 +303,50 @@ void SerialFor(std::int64_t begin, std::int64_t end, const RangeBody& body)
   {
     body(begin, end);
   }
+}
+
+template <typename T>
+Volume<T> MakeCoarseCopy(const Volume<T>& full, int level, std::vector<T>& storage,
+  const ParallelFor& parallel)
+{
+  const int stride = LevelStride(level);
+  Volume<T> coarse = full;
+  coarse.SampleStride = stride;
+  std::vector<int> points[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    coarse.FullDims[a] = full.Dims[a];
+    coarse.Dims[a] = (full.Dims[a] - 1 + stride - 1) / stride + 1;
+    points[a].resize(coarse.Dims[a]);
+    for (int c = 0; c < coarse.Dims[a]; ++c)
+    {
+      points[a][c] = std::min(c * stride, full.Dims[a] - 1);
+    }
+    // Owned cells: those whose lower sample lies in the full volume's owned range.
+    const int lo = full.OwnedCells[2 * a];
+    const int hi = full.OwnedCells[2 * a + 1];
+    coarse.OwnedCells[2 * a] = (std::max(lo, 0) + stride - 1) / stride;
+    coarse.OwnedCells[2 * a + 1] = hi >= (1 << 29) ? hi : hi / stride;
+  }
+  storage.resize(static_cast<std::size_t>(coarse.Dims[0]) * coarse.Dims[1] * coarse.Dims[2]);
+  const std::int64_t sx = full.Dims[0];
+  const std::int64_t sxy = sx * full.Dims[1];
+  parallel(0, coarse.Dims[2], [&](std::int64_t k0, std::int64_t k1) {
+    for (std::int64_t k = k0; k < k1; ++k)
+    {
+      T* out = storage.data() + k * coarse.Dims[0] * static_cast<std::int64_t>(coarse.Dims[1]);
+      for (int j = 0; j < coarse.Dims[1]; ++j)
+      {
+        const T* row = full.Data + points[2][k] * sxy + points[1][j] * sx;
+        for (int i = 0; i < coarse.Dims[0]; ++i)
+        {
+          *out++ = row[points[0][i]];
+        }
+      }
+    }
+  });
+  coarse.Data = storage.data();
+  return coarse;
 }
 
 template <typename T>
@@ -412,13 +460,11 @@ bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, Triangle
       aborted = true;
       return;
     }
-    std::vector<double> values;
     std::vector<std::uint8_t> flags;
     for (std::int64_t a = a0; a < a1; ++a)
     {
       const BlockSamples samples(ranges, plan.ActiveBlocks[a], stride);
-      Gather(volume, samples, values);
-      Classify(values, isovalue, flags);
+      Classify(volume, samples, isovalue, flags);
       std::uint64_t* bits = plan.EdgeBits.data() + a * words;
       std::int64_t triangles = 0;
       plan.PointOffset[a + 1] = CountBlock(flags, samples, OwnedSamples(volume, samples), counts,
@@ -467,6 +513,9 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
   const std::int64_t sx = volume.Dims[0];
   const std::int64_t sxy = sx * volume.Dims[1];
   parallel(0, numActive, [&](std::int64_t a0, std::int64_t a1) {
+    // Point id of each of the block's own cut edges, by bit: filled while the
+    // points are written, so most triangle vertices are one load.
+    std::vector<IdType> ownIds(static_cast<std::size_t>(words) * 64);
     for (std::int64_t a = a0; a < a1; ++a)
     {
       const std::int64_t block = plan.ActiveBlocks[a];
@@ -494,7 +543,8 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
           float* x = out.Points + 3 * pid;
           for (int c = 0; c < 3; ++c)
           {
-            const double index = p0[c] + t * (p1[c] - p0[c]);
+            const double f0 = volume.FullIndex(c, p0[c]);
+            const double index = f0 + t * (volume.FullIndex(c, p1[c]) - f0);
             x[c] = static_cast<float>(volume.Origin[c] + volume.Spacing[c] * index);
           }
           if (out.Normals)
@@ -526,43 +576,41 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
           {
             out.Scalars[pid] = static_cast<float>(iso);
           }
+          ownIds[bit] = static_cast<IdType>(out.FirstPointId + pid);
           ++pid;
         }
       }
 
       // Triangles of every cut cube. A vertex's edge is owned by this block
-      // unless its origin lies on the block's upper face: then by a neighbour.
+      // (its id is in ownIds) unless its origin lies on the block's upper face.
       std::int64_t tid = plan.TriangleOffset[a];
       const std::int64_t bxyz[3] = { block % ranges.Blocks[0],
         (block / ranges.Blocks[0]) % ranges.Blocks[1],
         block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]) };
       const std::uint8_t* cubeCase = plan.CubeCases.data() + a * plan.CubesPerBlock;
-      const std::uint64_t* ownBits = plan.EdgeBits.data() + a * words;
-      const std::uint32_t* ownRank = plan.EdgeRank.data() + a * words;
-      const IdType ownFirst = static_cast<IdType>(out.FirstPointId + plan.PointOffset[a]);
       auto pointId = [&](int i, int j, int k, int edge) -> IdType {
         int l[3] = { i + edgeOrigin[edge][0], j + edgeOrigin[edge][1], k + edgeOrigin[edge][2] };
-        const std::uint64_t* wordBits = ownBits;
-        const std::uint32_t* wordRank = ownRank;
-        IdType first = ownFirst;
-        if ((l[0] == n[0] - 1 && !s.LastBlock[0]) || (l[1] == n[1] - 1 && !s.LastBlock[1]) ||
-          (l[2] == n[2] - 1 && !s.LastBlock[2]))
+        if (!((l[0] == n[0] - 1 && !s.LastBlock[0]) || (l[1] == n[1] - 1 && !s.LastBlock[1]) ||
+              (l[2] == n[2] - 1 && !s.LastBlock[2])))
         {
-          std::int64_t owner[3] = { bxyz[0], bxyz[1], bxyz[2] };
-          for (int d = 0; d < 3; ++d)
-          {
-            if (l[d] == n[d] - 1 && !s.LastBlock[d])
-            {
-              ++owner[d];
-              l[d] = 0;
-            }
-          }
-          const std::int64_t oa = plan.ActiveIndex[(owner[2] * ranges.Blocks[1] + owner[1]) *
-              ranges.Blocks[0] + owner[0]];
-          wordBits = plan.EdgeBits.data() + oa * words;
-          wordRank = plan.EdgeRank.data() + oa * words;
-          first = static_cast<IdType>(out.FirstPointId + plan.PointOffset[oa]);
+          return ownIds[s.Bit(l[0], l[1], l[2], edgeAxis[edge])];
         }
+        // The edge starts on an upper face: a neighbour block owns it; its id is
+        // that block's first point plus the rank of the edge's bit.
+        std::int64_t owner[3] = { bxyz[0], bxyz[1], bxyz[2] };
+        for (int d = 0; d < 3; ++d)
+        {
+          if (l[d] == n[d] - 1 && !s.LastBlock[d])
+          {
+            ++owner[d];
+            l[d] = 0;
+          }
+        }
+        const std::int64_t oa = plan.ActiveIndex[(owner[2] * ranges.Blocks[1] + owner[1]) *
+            ranges.Blocks[0] + owner[0]];
+        const std::uint64_t* wordBits = plan.EdgeBits.data() + oa * words;
+        const std::uint32_t* wordRank = plan.EdgeRank.data() + oa * words;
+        const IdType first = static_cast<IdType>(out.FirstPointId + plan.PointOffset[oa]);
         const int bit = s.Bit(l[0], l[1], l[2], edgeAxis[edge]);
         const std::uint64_t below = wordBits[bit >> 6] & ((std::uint64_t(1) << (bit & 63)) - 1);
         return first + static_cast<IdType>(wordRank[bit >> 6] + PopCount(below));
@@ -598,11 +646,8 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
   });
 }
 
-template <typename T>
-SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
-  TriangleCaseTable cases, double isovalue, int level, int sampleStep, const ParallelFor& parallel)
+std::vector<std::int32_t> ListActiveBlocks(const BlockRanges& ranges, double isovalue)
 {
-  SampledCounts result;
   std::vector<std::int32_t> active;
   const std::int64_t numBlocks = ranges.GetNumberOfBlocks();
   for (std::int64_t b = 0; b < numBlocks; ++b)
@@ -612,6 +657,23 @@ SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
       active.push_back(static_cast<std::int32_t>(b));
     }
   }
+  return active;
+}
+
+template <typename T>
+SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
+  TriangleCaseTable cases, double isovalue, int level, int sampleStep, const ParallelFor& parallel)
+{
+  return CountSampled(volume, ranges, cases, ListActiveBlocks(ranges, isovalue), isovalue, level,
+    sampleStep, parallel);
+}
+
+template <typename T>
+SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
+  TriangleCaseTable cases, const std::vector<std::int32_t>& active, double isovalue, int level,
+  int sampleStep, const ParallelFor& parallel)
+{
+  SampledCounts result;
   result.ActiveBlocks = static_cast<std::int64_t>(active.size());
   sampleStep = std::max(1, sampleStep);
   const std::int64_t sampled = (result.ActiveBlocks + sampleStep - 1) / sampleStep;
@@ -620,13 +682,11 @@ SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
   const TriangleCounts counts(cases);
   const int stride = LevelStride(level);
   parallel(0, sampled, [&](std::int64_t s0, std::int64_t s1) {
-    std::vector<double> values;
     std::vector<std::uint8_t> flags;
     for (std::int64_t s = s0; s < s1; ++s)
     {
       const BlockSamples samples(ranges, active[s * sampleStep], stride);
-      Gather(volume, samples, values);
-      Classify(values, isovalue, flags);
+      Classify(volume, samples, isovalue, flags);
       points[s] = CountBlock(
         flags, samples, OwnedSamples(volume, samples), counts, triangles[s], nullptr, nullptr);
     }
@@ -644,6 +704,7 @@ SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
 }
 
 #define MEDISO_INSTANTIATE(T)                                                                      \
+  template Volume<T> MakeCoarseCopy<T>(const Volume<T>&, int, std::vector<T>&, const ParallelFor&); \
   template void ComputeBlockRanges<T>(const Volume<T>&, BlockRanges&, const ParallelFor&);         \
   template bool PlanExtraction<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable, double, \
     int, ExtractionPlan&, const ParallelFor&, const std::function<bool()>&);                       \
@@ -654,7 +715,9 @@ SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
     TriangleCaseTable, const ExtractionPlan&, const SurfaceBuffers<std::int64_t>&,                 \
     const ParallelFor&);                                                                           \
   template SampledCounts CountSampled<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable,  \
-    double, int, int, const ParallelFor&)
+    double, int, int, const ParallelFor&);                                                         \
+  template SampledCounts CountSampled<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable,  \
+    const std::vector<std::int32_t>&, double, int, int, const ParallelFor&)
 
 MEDISO_INSTANTIATE(std::int8_t);
 MEDISO_INSTANTIATE(std::uint8_t);

@@ -51,6 +51,7 @@
 #ifndef MedicalIsosurfaces_BlockLOD_h
 #define MedicalIsosurfaces_BlockLOD_h
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -90,6 +91,17 @@ struct Volume
   int Dims[3] = { 0, 0, 0 };      ///< Points along x, y, z.
   double Origin[3] = { 0, 0, 0 }; ///< World position of point (0, 0, 0).
   double Spacing[3] = { 1, 1, 1 };
+  /// For a coarse copy of a volume (see MakeCoarseCopy): sample c along an
+  /// axis stands for point min(c * SampleStride, FullDims - 1) of the full
+  /// volume, whose Origin and Spacing these are. 1 for a full volume.
+  int SampleStride = 1;
+  int FullDims[3] = { 0, 0, 0 };
+  /// Full-volume index of sample c along an axis.
+  int FullIndex(int axis, int c) const
+  {
+    return this->SampleStride == 1 ? c
+                                   : std::min(c * this->SampleStride, this->FullDims[axis] - 1);
+  }
   /// Cells (by lower corner index) whose cubes make triangles: {x0, x1, y0,
   /// y1, z0, z1}, inclusive. A parallel piece passes the range without its
   /// ghost layers, so pieces join without duplicate triangles while their
@@ -128,6 +140,16 @@ struct BlockRanges
     return this->Min[block] < isovalue && isovalue <= this->Max[block];
   }
 };
+
+/// The samples of a level of detail as a volume of their own: the points whose
+/// index is a multiple of LevelStride(level), plus the last point of each axis.
+/// Marching cubes at stride 1 on it gives exactly the level's surface, but
+/// reads a small contiguous array instead of scattered samples of the full one
+/// (1/512, 1/64, 1/8 of the data for levels 0, 1, 2). `storage` receives the
+/// values; the returned volume points into it.
+template <typename T>
+Volume<T> MakeCoarseCopy(const Volume<T>& full, int level, std::vector<T>& storage,
+  const ParallelFor& parallel);
 
 /// Computes BlockRanges of a volume (one read of the data, in parallel).
 template <typename T>
@@ -199,6 +221,16 @@ template <typename T>
 SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
   TriangleCaseTable cases, double isovalue, int level, int sampleStep,
   const ParallelFor& parallel);
+
+/// The same, with the isovalue's active blocks already listed (linear indices
+/// in increasing order, as ListActiveBlocks gives them).
+template <typename T>
+SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
+  TriangleCaseTable cases, const std::vector<std::int32_t>& active, double isovalue, int level,
+  int sampleStep, const ParallelFor& parallel);
+
+/// Linear indices of the blocks active for an isovalue, in increasing order.
+std::vector<std::int32_t> ListActiveBlocks(const BlockRanges& ranges, double isovalue);
 
 } // namespace mediso
 
