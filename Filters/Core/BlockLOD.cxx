@@ -269,10 +269,7 @@ std::int64_t CountBlock(const std::vector<std::uint8_t>& flags, const BlockSampl
   return points;
 }
 
-inline int PopCount(std::uint64_t x)
-{
-  return __builtin_popcountll(x);
-}
+
 
 // Negative gradient of the original data at a point, by central differences
 // over the level's stride (one-sided on the boundary), in world units. At full
@@ -281,19 +278,57 @@ inline int PopCount(std::uint64_t x)
 // which full-resolution differences at a coarse sample do not (they can point
 // anywhere in thin or noisy structures).
 template <typename T>
-void NegativeGradient(const Volume<T>& v, const int p[3], int stride, double g[3])
+struct GradientOperator
 {
-  const std::int64_t step[3] = { 1, v.Dims[0], static_cast<std::int64_t>(v.Dims[0]) * v.Dims[1] };
-  const std::int64_t at = p[0] + p[1] * step[1] + p[2] * step[2];
-  for (int a = 0; a < 3; ++a)
+  const Volume<T>& V;
+  int Stride;
+  std::int64_t Step[3];
+  int Interior[3];        // full-index distance between the neighbours of an interior sample
+  double InvInterior[3];  // 1 / (that distance * spacing): no division in the common case
+
+  GradientOperator(const Volume<T>& v, int stride)
+    : V(v)
+    , Stride(stride)
   {
-    const int lo = std::max(0, p[a] - stride);
-    const int hi = std::min(v.Dims[a] - 1, p[a] + stride);
-    const double sm = static_cast<double>(v.Data[at + (lo - p[a]) * step[a]]);
-    const double sp = static_cast<double>(v.Data[at + (hi - p[a]) * step[a]]);
-    const int distance = v.FullIndex(a, hi) - v.FullIndex(a, lo);
-    g[a] = distance > 0 ? (sm - sp) / (distance * v.Spacing[a]) : 0.0;
+    this->Step[0] = 1;
+    this->Step[1] = v.Dims[0];
+    this->Step[2] = static_cast<std::int64_t>(v.Dims[0]) * v.Dims[1];
+    for (int a = 0; a < 3; ++a)
+    {
+      this->Interior[a] = 2 * stride * v.SampleStride;
+      this->InvInterior[a] = 1.0 / (this->Interior[a] * v.Spacing[a]);
+    }
   }
+
+  void operator()(const int p[3], double g[3]) const
+  {
+    const std::int64_t at = p[0] + p[1] * this->Step[1] + p[2] * this->Step[2];
+    for (int a = 0; a < 3; ++a)
+    {
+      const int lo = std::max(0, p[a] - this->Stride);
+      const int hi = std::min(this->V.Dims[a] - 1, p[a] + this->Stride);
+      const double sm = static_cast<double>(this->V.Data[at + (lo - p[a]) * this->Step[a]]);
+      const double sp = static_cast<double>(this->V.Data[at + (hi - p[a]) * this->Step[a]]);
+      const int distance = this->V.FullIndex(a, hi) - this->V.FullIndex(a, lo);
+      g[a] = distance == this->Interior[a] ? (sm - sp) * this->InvInterior[a]
+        : distance > 0                     ? (sm - sp) / (distance * this->V.Spacing[a])
+                                           : 0.0;
+    }
+  }
+};
+
+inline int PopCount64(std::uint64_t x)
+{
+#if defined(__POPCNT__)
+  return __builtin_popcountll(x);
+#else
+  // Without the POPCNT instruction (x86-64 baseline) the builtin is a libgcc
+  // call; this SWAR count is inlined.
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+  return static_cast<int>((x * 0x0101010101010101ull) >> 56);
+#endif
 }
 } // namespace
 
@@ -475,7 +510,7 @@ bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, Triangle
       for (int w = 0; w < words; ++w)
       {
         rank[w] = before;
-        before += static_cast<std::uint32_t>(PopCount(bits[w]));
+        before += static_cast<std::uint32_t>(PopCount64(bits[w]));
       }
     }
   });
@@ -512,6 +547,7 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
 
   const std::int64_t sx = volume.Dims[0];
   const std::int64_t sxy = sx * volume.Dims[1];
+  const GradientOperator<T> gradient(volume, stride);
   parallel(0, numActive, [&](std::int64_t a0, std::int64_t a1) {
     // Point id of each of the block's own cut edges, by bit: filled while the
     // points are written, so most triangle vertices are one load.
@@ -550,8 +586,8 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
           if (out.Normals)
           {
             double g0[3], g1[3], g[3];
-            NegativeGradient(volume, p0, stride, g0);
-            NegativeGradient(volume, p1, stride, g1);
+            gradient(p0, g0);
+            gradient(p1, g1);
             double len2 = 0;
             for (int c = 0; c < 3; ++c)
             {
@@ -613,7 +649,7 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
         const IdType first = static_cast<IdType>(out.FirstPointId + plan.PointOffset[oa]);
         const int bit = s.Bit(l[0], l[1], l[2], edgeAxis[edge]);
         const std::uint64_t below = wordBits[bit >> 6] & ((std::uint64_t(1) << (bit & 63)) - 1);
-        return first + static_cast<IdType>(wordRank[bit >> 6] + PopCount(below));
+        return first + static_cast<IdType>(wordRank[bit >> 6] + PopCount64(below));
       };
       int cube = 0;
       for (int k = 0; k + 1 < n[2]; ++k)
