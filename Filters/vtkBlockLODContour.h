@@ -21,6 +21,11 @@
  *    vtkMarchingCubes (same case table: VTK's vtkMarchingCubesTriangleCases).
  *    Every level is watertight: points on shared edges are merged within and
  *    across blocks.
+ * -# Coarse copies. Levels 0-2 are extracted from a contiguous copy of the
+ *    level's samples, made the first time the level is used on an input and
+ *    kept with the block ranges (1/512, 1/64, 1/8 of the input's memory for
+ *    levels 0, 1, 2): the same cubes, read from a small array instead of
+ *    scattered through the full volume.
  * -# Cache. Each (isovalue, level) surface is kept after extraction, within
  *    CacheMemoryLimit (least recently used surfaces go first). Asking again
  *    for a cached pair costs no extraction (see GetNumberOfExtractions()).
