@@ -6,6 +6,7 @@
 // - across the paper's 95-isovalue sweep with AutoLOD, the output never
 //   exceeds MemoryBudget, and the level is the highest that fits.
 // Inputs: the phantom with noise (256x240x200) and the real CT when cached.
+#include "MedicalTestUtilities.h"
 #include "vtkBlockLODContour.h"
 #include "vtkMedicalPhantomSource.h"
 
@@ -30,17 +31,7 @@
 
 namespace
 {
-int Failures = 0;
-
-void Check(bool ok, const std::string& what)
-{
-  if (!ok)
-  {
-    std::printf("FAILED: %s\n", what.c_str());
-    ++Failures;
-  }
-}
-
+using medical_test::Check;
 int Occurrences(const std::string& text, const std::string& word)
 {
   int n = 0;
@@ -162,14 +153,7 @@ int TestBlockLODContourEstimator(int, char*[])
   phantom->Update();
   Sweep("phantom 256x240x200 noise 20", phantom->GetOutput());
 
-  std::string dir;
-  if (!vtksys::SystemTools::GetEnv("MEDISO_DATA_DIR", dir))
-  {
-    std::string home;
-    vtksys::SystemTools::GetEnv("HOME", home);
-    dir = home + "/.cache/medical-isosurfaces";
-  }
-  const std::string ct = dir + "/ct_head.mha";
+  const std::string ct = medical_test::DataFile("ct_head.mha");
   if (vtksys::SystemTools::FileExists(ct))
   {
     vtkNew<vtkMetaImageReader> reader;
@@ -181,11 +165,5 @@ int TestBlockLODContourEstimator(int, char*[])
   {
     std::printf("real CT not cached (%s): phantom only\n", ct.c_str());
   }
-  if (Failures)
-  {
-    std::printf("%d check(s) failed\n", Failures);
-    return 1;
-  }
-  std::printf("vtkBlockLODContour estimator: all checks passed\n");
-  return 0;
+  return medical_test::Finish("vtkBlockLODContour estimator: all checks passed");
 }

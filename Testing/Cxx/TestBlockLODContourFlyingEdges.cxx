@@ -9,6 +9,7 @@
 // Degenerate-triangle policy: both filters create one point per cut edge and
 // keep every triangle of the case table, so the counts are expected to match
 // exactly; the 0.5% tolerance is the issue's.
+#include "MedicalTestUtilities.h"
 #include "vtkBlockLODContour.h"
 #include "vtkMedicalPhantomSource.h"
 
@@ -36,17 +37,7 @@
 
 namespace
 {
-int Failures = 0;
-
-void Check(bool ok, const std::string& what)
-{
-  if (!ok)
-  {
-    std::printf("FAILED: %s\n", what.c_str());
-    ++Failures;
-  }
-}
-
+using medical_test::Check;
 double Area(vtkPolyData* pd)
 {
   vtkNew<vtkMassProperties> mass;
@@ -165,14 +156,7 @@ int TestBlockLODContourFlyingEdges(int, char*[])
   Compare("phantom uint8 (clamped)", toUChar->GetOutput(), 20.5);
 
   // The real head CT, when cached.
-  std::string dir;
-  if (vtksys::SystemTools::GetEnv("MEDISO_DATA_DIR", dir) == false)
-  {
-    std::string home;
-    vtksys::SystemTools::GetEnv("HOME", home);
-    dir = home + "/.cache/medical-isosurfaces";
-  }
-  const std::string ct = dir + "/ct_head.mha";
+  const std::string ct = medical_test::DataFile("ct_head.mha");
   if (vtksys::SystemTools::FileExists(ct))
   {
     vtkNew<vtkMetaImageReader> reader;
@@ -188,11 +172,5 @@ int TestBlockLODContourFlyingEdges(int, char*[])
     std::printf("real CT not cached (%s): compared on the phantom only\n", ct.c_str());
   }
 
-  if (Failures)
-  {
-    std::printf("%d check(s) failed\n", Failures);
-    return 1;
-  }
-  std::printf("vtkBlockLODContour level 3 equals vtkFlyingEdges3D\n");
-  return 0;
+  return medical_test::Finish("vtkBlockLODContour level 3 equals vtkFlyingEdges3D");
 }

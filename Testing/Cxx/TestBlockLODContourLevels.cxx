@@ -13,6 +13,7 @@
 // - parallel pieces (with the ghost layer the filter requests) give, at level 3,
 //   exactly the one-process triangles: none duplicated, none missing, and the
 //   same normals at the pieces' faces.
+#include "MedicalTestUtilities.h"
 #include "vtkBlockLODContour.h"
 #include "vtkMedicalPhantomSource.h"
 
@@ -40,17 +41,7 @@
 
 namespace
 {
-int Failures = 0;
-
-void Check(bool ok, const std::string& what)
-{
-  if (!ok)
-  {
-    std::printf("FAILED: %s\n", what.c_str());
-    ++Failures;
-  }
-}
-
+using medical_test::Check;
 vtkSmartPointer<vtkImageData> Field(int n, double spacing, const std::function<double(double, double, double)>& f)
 {
   auto image = vtkSmartPointer<vtkImageData>::New();
@@ -332,11 +323,5 @@ int TestBlockLODContourLevels(int, char*[])
   TestCache();
   TestPieces();
 
-  if (Failures)
-  {
-    std::printf("%d check(s) failed\n", Failures);
-    return 1;
-  }
-  std::printf("vtkBlockLODContour levels: all checks passed\n");
-  return 0;
+  return medical_test::Finish("vtkBlockLODContour levels: all checks passed");
 }

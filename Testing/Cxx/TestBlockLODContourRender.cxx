@@ -2,6 +2,7 @@
 // Baseline image: the real head CT's bone (400 HU) from vtkBlockLODContour at
 // levels 0, 1, 2, 3, side by side. Skipped (125) when the CT is not cached
 // (Python/fetch_data.py; MEDISO_DATA_DIR or ~/.cache/medical-isosurfaces).
+#include "MedicalTestUtilities.h"
 #include "vtkBlockLODContour.h"
 
 #include "vtkActor.h"
@@ -21,14 +22,7 @@
 
 int TestBlockLODContourRender(int argc, char* argv[])
 {
-  std::string dir;
-  if (!vtksys::SystemTools::GetEnv("MEDISO_DATA_DIR", dir))
-  {
-    std::string home;
-    vtksys::SystemTools::GetEnv("HOME", home);
-    dir = home + "/.cache/medical-isosurfaces";
-  }
-  const std::string ct = dir + "/ct_head.mha";
+  const std::string ct = medical_test::DataFile("ct_head.mha");
   if (!vtksys::SystemTools::FileExists(ct))
   {
     std::printf("SKIP: the real CT is not cached (%s); run python3 Python/fetch_data.py\n",

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Unit test of the VTK-free phantom core (Filters/Core/HeadPhantom). Builds
 // and runs without VTK or ParaView.
+#include "MedicalTestUtilities.h"
 #include "HeadPhantom.h"
 
 #include <cmath>
@@ -9,17 +10,7 @@
 
 namespace
 {
-int Failures = 0;
-
-void Check(bool ok, const char* what)
-{
-  if (!ok)
-  {
-    std::fprintf(stderr, "FAILED: %s\n", what);
-    ++Failures;
-  }
-}
-
+using medical_test::Check;
 std::vector<std::int16_t> Fill(const mediso::HeadPhantom& p, const int ext[6])
 {
   const int nx = ext[1] - ext[0] + 1;
@@ -133,11 +124,5 @@ int main()
   TestRowsMatchPoints();
   TestTissues();
   TestNoise();
-  if (Failures)
-  {
-    std::fprintf(stderr, "%d check(s) failed\n", Failures);
-    return 1;
-  }
-  std::printf("all phantom core checks passed\n");
-  return 0;
+  return medical_test::Finish("all phantom core checks passed");
 }

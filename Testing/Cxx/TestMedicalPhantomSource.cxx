@@ -2,6 +2,7 @@
 // Numeric test of vtkMedicalPhantomSource: requested extent, type, spacing and
 // origin; identical output for any SMP backend and for any piece split; clear
 // errors and empty output for bad parameters.
+#include "MedicalTestUtilities.h"
 #include "vtkMedicalPhantomSource.h"
 
 #include "vtkDataArray.h"
@@ -21,17 +22,7 @@
 
 namespace
 {
-int Failures = 0;
-
-void Check(bool ok, const std::string& what)
-{
-  if (!ok)
-  {
-    std::fprintf(stderr, "FAILED: %s\n", what.c_str());
-    ++Failures;
-  }
-}
-
+using medical_test::Check;
 // Copy of the source's output after a full update with the given backend.
 vtkSmartPointer<vtkImageData> Generate(const char* backend, double noise)
 {
@@ -151,11 +142,5 @@ int TestMedicalPhantomSource(int, char*[])
   TestBadInput("2D request", 64, 64, 1, 1.0, "3D volume");
   TestBadInput("absurd size", 100000, 100000, 100000, 1.0, "MiB");
   TestBadInput("negative spacing", 16, 16, 16, -1.0, "spacing");
-  if (Failures)
-  {
-    std::fprintf(stderr, "%d check(s) failed\n", Failures);
-    return 1;
-  }
-  std::printf("vtkMedicalPhantomSource: all checks passed\n");
-  return 0;
+  return medical_test::Finish("vtkMedicalPhantomSource: all checks passed");
 }
