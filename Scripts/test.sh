@@ -22,7 +22,7 @@ if [ "${MEDISO_ASAN:-1}" != 0 ]; then
     cmake -S "$repo" -B "$asan" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
       -DMEDISO_ENABLE_ASAN=ON -DMEDISO_WARNINGS_AS_ERRORS=ON >/dev/null
   fi
-  cmake --build "$asan" --parallel "$(nproc)" --target TestHeadPhantomCore MedicalIsosurfacesCxxTests
+  cmake --build "$asan" --parallel "$(nproc)" --target MedicalIsosurfacesCxxTestTargets
   (cd "$asan" &&
     ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -L '^cxx$' &&
     ASAN_OPTIONS=detect_leaks=0 ctest --output-on-failure -L '^cxx-render$')

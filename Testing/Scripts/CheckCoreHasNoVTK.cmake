@@ -1,6 +1,11 @@
 # The algorithm core must build without VTK or ParaView (shared/STYLE.md, TTK's
 # core/wrapper split): fail if any file under CORE_DIR includes their headers.
-file(GLOB_RECURSE core_files "${CORE_DIR}/*.h" "${CORE_DIR}/*.cxx")
+# CORE_DIR may list several folders.
+set(core_files)
+foreach (dir IN LISTS CORE_DIR)
+  file(GLOB_RECURSE files "${dir}/*.h" "${dir}/*.cxx")
+  list(APPEND core_files ${files})
+endforeach ()
 if (NOT core_files)
   message(FATAL_ERROR "FAILED: no core files found under ${CORE_DIR}")
 endif ()
