@@ -16,8 +16,8 @@ build=${MEDISO_BUILD_DIR:-$repo/build}
 # Everything the build, the tests and the demo use, named here so that a fresh
 # machine needs nothing else (CI machines may hold leftovers; never rely on them).
 packages=(
-  # ParaView 5.11 with its VTK, pvpython, pvbatch, pvserver, OpenMPI
-  paraview paraview-dev python3-paraview
+  # ParaView 5.11 with its VTK, pvpython, pvbatch, pvserver, OpenMPI; numpy for the benchmark
+  paraview paraview-dev python3-paraview python3-numpy
   # packages the ParaView CMake components we request look for at configure time
   libopenmpi-dev libdouble-conversion-dev libutfcpp-dev liblz4-dev
   qtbase5-dev qttools5-dev libqt5svg5-dev libqt5opengl5-dev qtxmlpatterns5-dev-tools
