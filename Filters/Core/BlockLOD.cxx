@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "BlockLOD.h"
 
+#include "ScalarTypes.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -755,14 +757,7 @@ SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
   template SampledCounts CountSampled<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable,  \
     const std::vector<std::int32_t>&, double, int, int, const ParallelFor&)
 
-MEDISO_INSTANTIATE(std::int8_t);
-MEDISO_INSTANTIATE(std::uint8_t);
-MEDISO_INSTANTIATE(std::int16_t);
-MEDISO_INSTANTIATE(std::uint16_t);
-MEDISO_INSTANTIATE(std::int32_t);
-MEDISO_INSTANTIATE(std::uint32_t);
-MEDISO_INSTANTIATE(float);
-MEDISO_INSTANTIATE(double);
+MEDISO_FOR_EACH_SCALAR_TYPE(MEDISO_INSTANTIATE);
 #undef MEDISO_INSTANTIATE
 
 } // namespace mediso

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "HistoPyramid.h"
 
+#include "ScalarTypes.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -178,14 +180,7 @@ void HistoPyramid::Traverse(std::uint64_t index, const double eye[3], int cell[3
 #define MEDISO_INSTANTIATE(T)                                                                      \
   template std::vector<std::uint32_t> HistoPyramid::CountCrossings<T>(                             \
     const T*, const int[3], const std::vector<double>&)
-MEDISO_INSTANTIATE(std::int8_t);
-MEDISO_INSTANTIATE(std::uint8_t);
-MEDISO_INSTANTIATE(std::int16_t);
-MEDISO_INSTANTIATE(std::uint16_t);
-MEDISO_INSTANTIATE(std::int32_t);
-MEDISO_INSTANTIATE(std::uint32_t);
-MEDISO_INSTANTIATE(float);
-MEDISO_INSTANTIATE(double);
+MEDISO_FOR_EACH_SCALAR_TYPE(MEDISO_INSTANTIATE);
 #undef MEDISO_INSTANTIATE
 
 } // namespace mediso
