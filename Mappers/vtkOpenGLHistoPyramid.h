@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkOpenGLHistoPyramid
+ * @brief   Builds the 3D HistoPyramid of a scalar volume on the GPU (OpenGL 3.2).
+ *
+ * vtkOpenGLHistoPyramid is the GPU half of the cell-rasterisation isosurface
+ * mapper: it counts, for every cell of a volume, how many of up to eight
+ * isovalues cross it, and sums those counts up a 3D 8:1 HistoPyramid
+ * (Ziegler, Tevs, Theobalt & Seidel, "On-the-fly point clouds through
+ * histogram pyramids", VMV 2006). The mapper then draws GetTotal() primitives
+ * and each one finds its cell by walking down the pyramid (Liu, Clapworthy &
+ * Dong, "Octree based HistoPyramid", 2009; the cell-rasterisation scheme of
+ * "Hardware Accelerated Medical Data Visualisation on the Web", section 4.1).
+ *
+ * The layout is exactly the one of the CPU reference mediso::HistoPyramid
+ * (Mappers/Core/HistoPyramid.h), so that both can be compared number for
+ * number: level 0 is the cell grid padded to a power of two per axis (padding
+ * cells count 0), and each level above halves every axis larger than 1, down
+ * to a single 1x1x1 node. Every level is a GL_R32UI 3D texture.
+ *
+ * Only OpenGL 3.2 core / GLSL 1.50 is used (no compute shaders, no shader
+ * storage buffers, no image load/store). The build is a sequence of
+ * full-screen passes (vtkOpenGLQuadHelper), one per z-slice of each level,
+ * rendered into that slice (glFramebufferTextureLayer) with an unsigned
+ * integer fragment output:
+ * -# Base pass (vtkHistoPyramidBase_fs.glsl): fragment (i, j) of slice k is
+ *    cell (i, j, k); it reads the cell's eight corners with texelFetch and
+ *    writes the number of isovalues with min < iso <= max (the convention of
+ *    vtkMarchingCubes). Cells with a NaN corner and padding cells write 0.
+ *    The comparisons are exact: isovalues are turned on the CPU into
+ *    thresholds of the texture's own value type (ceil(iso) for integer data,
+ *    the smallest float >= iso for float data), so that the GPU counts equal
+ *    the CPU counts computed in double precision.
+ * -# Reduction passes (vtkHistoPyramidReduce_fs.glsl): node (i, j, k) of
+ *    level l + 1 is the sum of its 2x2x2 children of level l (2x2x1, 2x1x1,
+ *    ... once an axis has reached 1), read with texelFetch.
+ * -# Read-back: only the top node (one 32-bit integer) comes back to the
+ *    CPU, as GetTotal().
+ *
+ * The volume is uploaded once by UploadVolume() and kept until it is called
+ * again, as a single-channel 3D texture that keeps the data's precision:
+ * signed/unsigned char to GL_R8I/GL_R8UI, short/unsigned short to
+ * GL_R16I/GL_R16UI, int/unsigned int to GL_R32I/GL_R32UI (all read with
+ * texelFetch from an isampler3D or usampler3D), float to GL_R32F (sampler3D).
+ * Double data is converted to float (GL_R32F): counts then match a CPU
+ * reference computed on the double values only where those values are
+ * representable as floats.
+ *
+ * Every call saves and restores the OpenGL state it changes (current context,
+ * framebuffer bindings, draw/read buffers, viewport, blend/depth/scissor/
+ * stencil/cull enables, colour mask, active texture unit, pixel store
+ * alignment and pixel buffer bindings, bound program), so it can run inside a
+ * render. The mapper that owns it must call ReleaseGraphicsResources() when
+ * its window releases its resources.
+ *
+ * @warning Counts are 32-bit: the total must stay below 2^32 (a volume of
+ * 512^3 cells with 8 isovalues crossing every cell would overflow).
+ *
+ * @sa vtkMedicalGLCapabilities mediso::HistoPyramid
+ */
+#ifndef vtkOpenGLHistoPyramid_h
+#define vtkOpenGLHistoPyramid_h
+
+#include "MedicalIsosurfacesMappersModule.h" // For export macro
+#include "vtkObject.h"
+
+#include <cstdint> // For std::uint32_t
+#include <memory>  // For std::unique_ptr
+#include <vector>  // For std::vector
+
+class vtkDataArray;
+class vtkOpenGLRenderWindow;
+class vtkWindow;
+
+class MEDICALISOSURFACESMAPPERS_EXPORT vtkOpenGLHistoPyramid : public vtkObject
+{
+public:
+  static vtkOpenGLHistoPyramid* New();
+  vtkTypeMacro(vtkOpenGLHistoPyramid, vtkObject);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// Most isovalues one Build() can count (a uniform array of the base pass).
+  static constexpr int MaximumNumberOfIsovalues = 8;
+
+  /**
+   * Upload the single-component @a scalars of a volume of @a pointDims points
+   * (x fastest, each >= 2) as a 3D texture (see the class description for the
+   * formats). Replaces the previous volume and invalidates the pyramid.
+   * Returns false, with an error, on an unsupported array or a GL failure.
+   */
+  bool UploadVolume(vtkOpenGLRenderWindow* renWin, vtkDataArray* scalars, const int pointDims[3]);
+
+  /**
+   * Build the pyramid of the uploaded volume for 1 to
+   * MaximumNumberOfIsovalues @a isovalues (NaN ones count nothing) and read
+   * back the total. Reuses the level textures while the volume size stays.
+   */
+  bool Build(vtkOpenGLRenderWindow* renWin, const std::vector<double>& isovalues);
+
+  /// Number of primitives of the last successful Build() (0 before).
+  std::uint64_t GetTotal() const;
+
+  /// Number of levels of the last successful Build(), base (0) to top; 0 before.
+  int GetNumberOfLevels() const;
+
+  /**
+   * Read a whole level back (x fastest) and its size, for tests. Needs the
+   * window of the last Build() to be alive. Returns false when there is no
+   * such level or reading fails.
+   */
+  bool ReadLevel(int level, std::vector<std::uint32_t>& counts, int size[3]);
+
+  /// Bytes of the GPU textures this object owns now (volume and levels).
+  std::uint64_t GetGPUMemoryBytes() const;
+
+  /**
+   * Release every OpenGL object (volume, levels, framebuffer, programs).
+   * UploadVolume() must be called again before the next Build().
+   */
+  void ReleaseGraphicsResources(vtkWindow* win);
+
+protected:
+  vtkOpenGLHistoPyramid();
+  ~vtkOpenGLHistoPyramid() override;
+
+private:
+  vtkOpenGLHistoPyramid(const vtkOpenGLHistoPyramid&) = delete;
+  void operator=(const vtkOpenGLHistoPyramid&) = delete;
+
+  struct Internals;
+  std::unique_ptr<Internals> Impl;
+};
+
+#endif

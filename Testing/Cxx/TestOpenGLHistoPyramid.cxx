@@ -1,0 +1,351 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Builds the HistoPyramid of the head phantom on the GPU (vtkOpenGLHistoPyramid)
+// and checks it number for number against the CPU reference
+// mediso::HistoPyramid: the total and every level, for the phantom stored as
+// each supported scalar type and for many isovalue sets (single isovalues
+// across the range, isovalues equal to data values and just beside them,
+// sets of 2 to 8, duplicates, NaN). Also checks that the OpenGL state is left
+// as it was, that ReleaseGraphicsResources() then a new upload and build work,
+// and reports the GPU memory of a 256^3 int16 volume.
+//  - exit 0 when everything matches;
+//  - exit 125 (skip), printing "SKIP: <reason>", where the context cannot run
+//    the GPU path;
+//  - exit 1 on any mismatch.
+#include "vtkMedicalGLCapabilities.h"
+#include "vtkOpenGLHistoPyramid.h"
+
+#include "vtkAOSDataArrayTemplate.h"
+#include "vtkNew.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkRenderWindow.h"
+#include "vtkRenderer.h"
+#include "vtk_glew.h"
+
+#include "HeadPhantom.h"
+#include "HistoPyramid.h"
+#include "MedicalTestUtilities.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <iostream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using medical_test::Check;
+
+namespace
+{
+std::vector<std::int16_t> MakePhantom(const int dims[3], double noise, std::uint32_t seed)
+{
+  const mediso::HeadPhantom phantom(dims, noise, seed);
+  std::vector<std::int16_t> values(static_cast<std::size_t>(phantom.GetNumberOfPoints()));
+  const int extent[6] = { 0, dims[0] - 1, 0, dims[1] - 1, 0, dims[2] - 1 };
+  std::vector<double> scratch(static_cast<std::size_t>(dims[0]));
+  phantom.FillSlices(extent, 0, dims[2], values.data(), scratch.data());
+  return values;
+}
+
+std::string Describe(const std::vector<double>& isovalues)
+{
+  std::ostringstream os;
+  os.precision(17);
+  os << "{";
+  for (std::size_t i = 0; i < isovalues.size(); ++i)
+  {
+    os << (i ? ", " : "") << isovalues[i];
+  }
+  os << "}";
+  return os.str();
+}
+
+// Isovalue sets for data of range [lo, hi] containing the given values.
+std::vector<std::vector<double>> IsovalueSets(double lo, double hi, const std::vector<double>& data)
+{
+  std::vector<std::vector<double>> sets;
+  // Single isovalues: outside, at the ends, evenly across the range.
+  sets.push_back({ lo - 1.0 });
+  sets.push_back({ lo });
+  sets.push_back({ hi });
+  sets.push_back({ hi + 1.0 });
+  for (int n = 1; n < 12; ++n)
+  {
+    sets.push_back({ lo + (hi - lo) * n / 12.0 });
+  }
+  // Equal to data values, and just beside them.
+  for (std::size_t i = 0; i < data.size(); i += 97)
+  {
+    const double v = data[i];
+    sets.push_back({ v });
+    sets.push_back({ std::nextafter(v, -HUGE_VAL) });
+    sets.push_back({ std::nextafter(v, HUGE_VAL) });
+    if (sets.size() > 40)
+    {
+      break;
+    }
+  }
+  const double q1 = lo + (hi - lo) * 0.25, q2 = lo + (hi - lo) * 0.5, q3 = lo + (hi - lo) * 0.75;
+  // Sets of 2 to 4, in and out of order, with duplicates and NaN; one of 8.
+  sets.push_back({ q1, q3 });
+  sets.push_back({ q3, q1, q2 });
+  sets.push_back({ data[data.size() / 2], q1, hi, lo });
+  sets.push_back({ q2, q2 });
+  sets.push_back({ std::numeric_limits<double>::quiet_NaN(), q2 });
+  sets.push_back({ -1.0e300, q1, 1.0e300 });
+  std::vector<double> eight;
+  for (int n = 0; n < 8; ++n)
+  {
+    eight.push_back(lo + (hi - lo) * (n + 0.5) / 8.0);
+  }
+  sets.push_back(eight);
+  return sets;
+}
+
+// Compares one GPU build with the CPU reference; prints one line.
+template <typename T>
+void CompareBuild(vtkOpenGLHistoPyramid* gpu, const std::string& name, const T* data,
+  const int dims[3], const std::vector<double>& isovalues)
+{
+  const int cells[3] = { dims[0] - 1, dims[1] - 1, dims[2] - 1 };
+  mediso::HistoPyramid cpu;
+  cpu.Build(cells, mediso::HistoPyramid::CountCrossings(data, dims, isovalues));
+
+  const std::string what = name + " " + Describe(isovalues);
+  int mismatches = 0;
+  std::string firstMismatch;
+  const std::uint64_t total = gpu->GetTotal();
+  if (gpu->GetNumberOfLevels() != cpu.GetNumberOfLevels())
+  {
+    Check(false,
+      what + ": " + std::to_string(gpu->GetNumberOfLevels()) + " levels, CPU " +
+        std::to_string(cpu.GetNumberOfLevels()));
+    return;
+  }
+  for (int l = 0; l < cpu.GetNumberOfLevels(); ++l)
+  {
+    std::vector<std::uint32_t> counts;
+    int size[3] = { 0, 0, 0 };
+    if (!gpu->ReadLevel(l, counts, size))
+    {
+      Check(false, what + ": level " + std::to_string(l) + " cannot be read back");
+      return;
+    }
+    const int* expected = cpu.GetLevelSize(l);
+    if (size[0] != expected[0] || size[1] != expected[1] || size[2] != expected[2])
+    {
+      Check(false, what + ": level " + std::to_string(l) + " has a different size");
+      return;
+    }
+    std::size_t id = 0;
+    for (int k = 0; k < size[2]; ++k)
+      for (int j = 0; j < size[1]; ++j)
+        for (int i = 0; i < size[0]; ++i, ++id)
+        {
+          const std::uint32_t want = cpu.GetCount(l, i, j, k);
+          if (counts[id] != want)
+          {
+            if (mismatches++ == 0)
+            {
+              std::ostringstream os;
+              os << "level " << l << " node (" << i << ", " << j << ", " << k << "): GPU "
+                 << counts[id] << ", CPU " << want;
+              firstMismatch = os.str();
+            }
+          }
+        }
+  }
+  std::cout << what << ": total GPU " << total << " CPU " << cpu.GetTotal() << ", "
+            << cpu.GetNumberOfLevels() << " levels, "
+            << (mismatches ? std::to_string(mismatches) + " node mismatches" : "all nodes equal")
+            << "\n";
+  Check(total == cpu.GetTotal(), what + ": totals differ");
+  Check(mismatches == 0, what + ": " + firstMismatch);
+}
+
+// One scalar type: upload, then every isovalue set.
+template <typename T>
+void RunType(vtkOpenGLRenderWindow* win, vtkOpenGLHistoPyramid* gpu, const std::string& name,
+  const std::vector<T>& values, const int dims[3])
+{
+  vtkNew<vtkAOSDataArrayTemplate<T>> array;
+  array->SetNumberOfTuples(static_cast<vtkIdType>(values.size()));
+  std::copy(values.begin(), values.end(), array->GetPointer(0));
+  if (!gpu->UploadVolume(win, array, dims))
+  {
+    Check(false, name + ": UploadVolume failed");
+    return;
+  }
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  std::vector<double> asDouble;
+  asDouble.reserve(values.size());
+  for (T v : values)
+  {
+    const double d = static_cast<double>(v);
+    asDouble.push_back(d);
+    if (!std::isnan(d))
+    {
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
+    }
+  }
+  for (const auto& isovalues : IsovalueSets(lo, hi, asDouble))
+  {
+    if (!gpu->Build(win, isovalues))
+    {
+      Check(false, name + " " + Describe(isovalues) + ": Build failed");
+      continue;
+    }
+    CompareBuild(gpu, name, values.data(), dims, isovalues);
+  }
+}
+
+template <typename T, typename F>
+std::vector<T> Convert(const std::vector<std::int16_t>& hu, F f)
+{
+  std::vector<T> out(hu.size());
+  std::transform(hu.begin(), hu.end(), out.begin(), f);
+  return out;
+}
+
+template <typename T>
+T Clamp(double v)
+{
+  return static_cast<T>(std::min<double>(
+    std::max<double>(v, std::numeric_limits<T>::lowest()), std::numeric_limits<T>::max()));
+}
+} // anonymous namespace
+
+int TestOpenGLHistoPyramid(int, char*[])
+{
+  vtkNew<vtkRenderWindow> renWin;
+  renWin->SetOffScreenRendering(1);
+  renWin->SetSize(64, 64);
+  renWin->SetMultiSamples(0);
+  vtkNew<vtkRenderer> renderer;
+  renWin->AddRenderer(renderer);
+
+  vtkNew<vtkMedicalGLCapabilities> caps;
+  if (!caps->Probe(renWin))
+  {
+    if (caps->GetStatus() == vtkMedicalGLCapabilities::StatusProbeFailed)
+    {
+      std::cout << "GPU path probe failed: " << caps->GetReason() << "\n";
+      return 1;
+    }
+    std::cout << "SKIP: " << caps->GetReason() << "\n";
+    return 125;
+  }
+  auto* win = vtkOpenGLRenderWindow::SafeDownCast(renWin);
+  renWin->Render();
+
+  // The phantom, odd sizes on every axis, with noise so that many values occur.
+  const int dims[3] = { 45, 38, 29 };
+  const std::vector<std::int16_t> hu = MakePhantom(dims, 20.0, 7u);
+
+  vtkNew<vtkOpenGLHistoPyramid> gpu;
+
+  // The OpenGL state around a build: viewport and framebuffer bindings.
+  win->MakeCurrent();
+  GLint viewportBefore[4], viewportAfter[4], drawBefore = 0, drawAfter = 0, readBefore = 0,
+                                             readAfter = 0;
+  glGetIntegerv(GL_VIEWPORT, viewportBefore);
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawBefore);
+  glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readBefore);
+  const GLboolean depthBefore = glIsEnabled(GL_DEPTH_TEST);
+  const GLboolean blendBefore = glIsEnabled(GL_BLEND);
+
+  RunType<std::int16_t>(win, gpu, "int16", hu, dims);
+
+  glGetIntegerv(GL_VIEWPORT, viewportAfter);
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawAfter);
+  glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readAfter);
+  Check(std::equal(viewportBefore, viewportBefore + 4, viewportAfter), "viewport not restored");
+  Check(drawBefore == drawAfter && readBefore == readAfter, "framebuffer bindings not restored");
+  Check(glIsEnabled(GL_DEPTH_TEST) == depthBefore && glIsEnabled(GL_BLEND) == blendBefore,
+    "depth test or blend enable not restored");
+
+  RunType<std::uint8_t>(win, gpu, "uint8",
+    Convert<std::uint8_t>(hu, [](std::int16_t v) { return Clamp<std::uint8_t>((v + 1024) / 9); }),
+    dims);
+  RunType<std::int8_t>(win, gpu, "int8",
+    Convert<std::int8_t>(hu, [](std::int16_t v) { return Clamp<std::int8_t>(v / 9); }), dims);
+  RunType<std::uint16_t>(win, gpu, "uint16",
+    Convert<std::uint16_t>(hu, [](std::int16_t v) { return Clamp<std::uint16_t>(v + 1024); }),
+    dims);
+  // Large 32-bit values: comparisons in float would merge neighbouring values.
+  RunType<std::int32_t>(win, gpu, "int32",
+    Convert<std::int32_t>(hu, [](std::int16_t v) { return static_cast<std::int32_t>(v) * 100003; }),
+    dims);
+  RunType<std::uint32_t>(win, gpu, "uint32",
+    Convert<std::uint32_t>(
+      hu, [](std::int16_t v) { return static_cast<std::uint32_t>(v + 1024) * 1000003u + 7u; }),
+    dims);
+  // Float: non-integer values, and a few NaN points (their cells count 0).
+  std::vector<float> floats =
+    Convert<float>(hu, [](std::int16_t v) { return static_cast<float>(v) * 0.1f + 0.05f; });
+  for (std::size_t i = 1234; i < floats.size(); i += 4567)
+  {
+    floats[i] = std::numeric_limits<float>::quiet_NaN();
+  }
+  RunType<float>(win, gpu, "float", floats, dims);
+  // Double (converted to float on the GPU; these values are exact in float).
+  RunType<double>(win, gpu, "double",
+    Convert<double>(hu, [](std::int16_t v) { return static_cast<double>(v) + 0.5; }), dims);
+
+  // Release everything, then upload and build again.
+  gpu->ReleaseGraphicsResources(win);
+  Check(gpu->GetGPUMemoryBytes() == 0 && gpu->GetNumberOfLevels() == 0 && gpu->GetTotal() == 0,
+    "ReleaseGraphicsResources left resources behind");
+  {
+    vtkNew<vtkAOSDataArrayTemplate<std::int16_t>> array;
+    array->SetNumberOfTuples(static_cast<vtkIdType>(hu.size()));
+    std::copy(hu.begin(), hu.end(), array->GetPointer(0));
+    const std::vector<double> isovalues = { 300.0, -500.0 };
+    const bool ok = gpu->UploadVolume(win, array, dims) && gpu->Build(win, isovalues);
+    Check(ok, "upload and build after ReleaseGraphicsResources failed");
+    if (ok)
+    {
+      CompareBuild(gpu.Get(), "int16 after release", hu.data(), dims, isovalues);
+    }
+  }
+
+  // GPU memory of a 256^3 int16 volume (and its total against the CPU).
+  {
+    const int big[3] = { 256, 256, 256 };
+    const std::vector<std::int16_t> bigHU = MakePhantom(big, 20.0, 11u);
+    vtkNew<vtkAOSDataArrayTemplate<std::int16_t>> array;
+    array->SetNumberOfTuples(static_cast<vtkIdType>(bigHU.size()));
+    std::copy(bigHU.begin(), bigHU.end(), array->GetPointer(0));
+    const std::vector<double> isovalues = { 300.0 };
+    const bool ok = gpu->UploadVolume(win, array, big) && gpu->Build(win, isovalues);
+    Check(ok, "256^3 upload and build failed");
+    if (ok)
+    {
+      const int cells[3] = { 255, 255, 255 };
+      mediso::HistoPyramid cpu;
+      cpu.Build(cells, mediso::HistoPyramid::CountCrossings(bigHU.data(), big, isovalues));
+      std::cout << "256^3 int16, isovalue 300: total GPU " << gpu->GetTotal() << " CPU "
+                << cpu.GetTotal() << ", " << gpu->GetNumberOfLevels() << " levels, GPU memory "
+                << gpu->GetGPUMemoryBytes() << " bytes ("
+                << static_cast<double>(gpu->GetGPUMemoryBytes()) / (1024.0 * 1024.0) << " MiB)\n";
+      Check(gpu->GetTotal() == cpu.GetTotal(), "256^3 totals differ");
+    }
+  }
+  gpu->ReleaseGraphicsResources(win);
+
+  // An object destroyed without ReleaseGraphicsResources() frees its OpenGL
+  // objects itself while the window lives (no error, window still usable).
+  {
+    vtkNew<vtkOpenGLHistoPyramid> scoped;
+    vtkNew<vtkAOSDataArrayTemplate<std::int16_t>> array;
+    array->SetNumberOfTuples(static_cast<vtkIdType>(hu.size()));
+    std::copy(hu.begin(), hu.end(), array->GetPointer(0));
+    Check(scoped->UploadVolume(win, array, dims) && scoped->Build(win, { 100.0 }),
+      "build of a second, unreleased pyramid failed");
+  }
+  renWin->Render(); // the window still renders
+
+  return medical_test::Finish("TestOpenGLHistoPyramid passed");
+}
