@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMedicalGLCapabilities.h"
 
+#include "vtkMedicalGLUtilities.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLFramebufferObject.h"
 #include "vtkOpenGLQuadHelper.h"
@@ -32,6 +33,7 @@ vtkStandardNewMacro(vtkMedicalGLCapabilities);
 
 namespace
 {
+using namespace medical_gl;
 // Size of the functional-probe volume: small, odd, not a power of two, and
 // with distinct extents so that swapped axes show up as mismatches.
 constexpr int ProbeNX = 9;
@@ -111,43 +113,6 @@ std::string GLString(GLenum name)
   return s ? std::string(reinterpret_cast<const char*>(s)) : std::string();
 }
 
-const char* GLErrorName(GLenum err)
-{
-  switch (err)
-  {
-    case GL_INVALID_ENUM:
-      return "GL_INVALID_ENUM";
-    case GL_INVALID_VALUE:
-      return "GL_INVALID_VALUE";
-    case GL_INVALID_OPERATION:
-      return "GL_INVALID_OPERATION";
-    case GL_INVALID_FRAMEBUFFER_OPERATION:
-      return "GL_INVALID_FRAMEBUFFER_OPERATION";
-    case GL_OUT_OF_MEMORY:
-      return "GL_OUT_OF_MEMORY";
-    default:
-      return "unknown OpenGL error";
-  }
-}
-
-// Fetch and clear the OpenGL error flags; empty when there was none. (VTK's
-// own error macros are compiled out in release builds, so check directly.)
-std::string TakeGLErrors()
-{
-  std::string errors;
-  for (int n = 0; n < 16; ++n)
-  {
-    const GLenum err = glGetError();
-    if (err == GL_NO_ERROR)
-    {
-      break;
-    }
-    errors += (errors.empty() ? "" : ", ");
-    errors += GLErrorName(err);
-  }
-  return errors;
-}
-
 // Parse "major.minor" at the start of GL_VERSION (or after "OpenGL ES ").
 bool ParseGLVersion(const std::string& version, int& major, int& minor)
 {
@@ -211,52 +176,6 @@ bool XDisplayReachable(std::string& why)
   return true;
 #endif
 }
-
-// Restores the binding of a buffer target (GL_PIXEL_PACK_BUFFER, ...) and
-// binds 0 meanwhile, so that pixel transfers use client memory.
-class ScopedBufferUnbind
-{
-public:
-  ScopedBufferUnbind(GLenum target, GLenum bindingQuery)
-    : Target(target)
-  {
-    glGetIntegerv(bindingQuery, &this->Saved);
-    if (this->Saved != 0)
-    {
-      glBindBuffer(this->Target, 0);
-    }
-  }
-  ~ScopedBufferUnbind()
-  {
-    if (this->Saved != 0)
-    {
-      glBindBuffer(this->Target, static_cast<GLuint>(this->Saved));
-    }
-  }
-  ScopedBufferUnbind(const ScopedBufferUnbind&) = delete;
-  ScopedBufferUnbind& operator=(const ScopedBufferUnbind&) = delete;
-
-private:
-  GLenum Target;
-  GLint Saved = 0;
-};
-
-// Makes a window's context current and restores the previous one.
-class ScopedContext
-{
-public:
-  explicit ScopedContext(vtkOpenGLRenderWindow* win)
-    : Window(win)
-  {
-    this->Window->PushContext();
-  }
-  ~ScopedContext() { this->Window->PopContext(); }
-  ScopedContext(const ScopedContext&) = delete;
-  ScopedContext& operator=(const ScopedContext&) = delete;
-
-private:
-  vtkOpenGLRenderWindow* Window;
-};
 
 // Saves the framebuffer bindings and draw/read buffers, restores them on exit.
 class ScopedFramebufferBindings

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkOpenGLHistoPyramid.h"
 
+#include "vtkMedicalGLUtilities.h"
 #include "vtkDataArray.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
@@ -31,6 +32,7 @@ vtkStandardNewMacro(vtkOpenGLHistoPyramid);
 
 namespace
 {
+using namespace medical_gl;
 // How the base pass compares values: the GLSL value type of the volume.
 enum class ValueKind
 {
@@ -191,89 +193,6 @@ Thresholds MakeThresholds(const VolumeFormat& f, const std::vector<double>& isov
   }
   return t;
 }
-
-const char* GLErrorName(GLenum err)
-{
-  switch (err)
-  {
-    case GL_INVALID_ENUM:
-      return "GL_INVALID_ENUM";
-    case GL_INVALID_VALUE:
-      return "GL_INVALID_VALUE";
-    case GL_INVALID_OPERATION:
-      return "GL_INVALID_OPERATION";
-    case GL_INVALID_FRAMEBUFFER_OPERATION:
-      return "GL_INVALID_FRAMEBUFFER_OPERATION";
-    case GL_OUT_OF_MEMORY:
-      return "GL_OUT_OF_MEMORY";
-    default:
-      return "unknown OpenGL error";
-  }
-}
-
-// Fetch and clear the OpenGL error flags; empty when there was none (VTK's
-// own error-check macros are compiled out in release builds).
-std::string TakeGLErrors()
-{
-  std::string errors;
-  for (int n = 0; n < 16; ++n)
-  {
-    const GLenum err = glGetError();
-    if (err == GL_NO_ERROR)
-    {
-      break;
-    }
-    errors += (errors.empty() ? "" : ", ");
-    errors += GLErrorName(err);
-  }
-  return errors;
-}
-
-// Makes a window's context current and restores the previous one.
-class ScopedContext
-{
-public:
-  explicit ScopedContext(vtkOpenGLRenderWindow* win)
-    : Window(win)
-  {
-    this->Window->PushContext();
-  }
-  ~ScopedContext() { this->Window->PopContext(); }
-  ScopedContext(const ScopedContext&) = delete;
-  ScopedContext& operator=(const ScopedContext&) = delete;
-
-private:
-  vtkOpenGLRenderWindow* Window;
-};
-
-// Binds 0 to a pixel buffer target (so that transfers use client memory)
-// and restores the previous binding.
-class ScopedBufferUnbind
-{
-public:
-  ScopedBufferUnbind(GLenum target, GLenum bindingQuery)
-    : Target(target)
-  {
-    glGetIntegerv(bindingQuery, &this->Saved);
-    if (this->Saved != 0)
-    {
-      glBindBuffer(this->Target, 0);
-    }
-  }
-  ~ScopedBufferUnbind()
-  {
-    if (this->Saved != 0)
-    {
-      glBindBuffer(this->Target, static_cast<GLuint>(this->Saved));
-    }
-  }
-  ScopedBufferUnbind(const ScopedBufferUnbind&) = delete;
-  ScopedBufferUnbind& operator=(const ScopedBufferUnbind&) = delete;
-
-private:
-  GLenum Target;
-  GLint Saved = 0;
-};
 
 // Saves a glPixelStorei parameter and restores it through vtkOpenGLState.
 class ScopedPixelStore
