@@ -177,23 +177,6 @@ bool XDisplayReachable(std::string& why)
 #endif
 }
 
-// Saves the framebuffer bindings and draw/read buffers, restores them on exit.
-class ScopedFramebufferBindings
-{
-public:
-  explicit ScopedFramebufferBindings(vtkOpenGLFramebufferObject* fbo)
-    : FBO(fbo)
-  {
-    this->FBO->SaveCurrentBindingsAndBuffers();
-  }
-  ~ScopedFramebufferBindings() { this->FBO->RestorePreviousBindingsAndBuffers(); }
-  ScopedFramebufferBindings(const ScopedFramebufferBindings&) = delete;
-  ScopedFramebufferBindings& operator=(const ScopedFramebufferBindings&) = delete;
-
-private:
-  vtkOpenGLFramebufferObject* FBO;
-};
-
 // Every OpenGL object of the functional probe, released on every exit path.
 struct ProbeResources
 {

@@ -3,12 +3,13 @@
  * @file vtkMedicalGLUtilities.h
  * @brief Private OpenGL helpers shared by the Mappers classes (not installed,
  * not wrapped): error flags read directly (VTK's error-check macros are
- * compiled out in release builds) and RAII guards for the current context and
- * pixel-buffer bindings.
+ * compiled out in release builds) and RAII guards for the current context,
+ * pixel-buffer bindings and framebuffer bindings.
  */
 #ifndef vtkMedicalGLUtilities_h
 #define vtkMedicalGLUtilities_h
 
+#include "vtkOpenGLFramebufferObject.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtk_glew.h"
 
@@ -95,6 +96,23 @@ private:
   GLenum Target;
   GLint Saved = 0;
 };
+// Saves the framebuffer bindings and draw/read buffers, restores them on exit.
+class ScopedFramebufferBindings
+{
+public:
+  explicit ScopedFramebufferBindings(vtkOpenGLFramebufferObject* fbo)
+    : FBO(fbo)
+  {
+    this->FBO->SaveCurrentBindingsAndBuffers();
+  }
+  ~ScopedFramebufferBindings() { this->FBO->RestorePreviousBindingsAndBuffers(); }
+  ScopedFramebufferBindings(const ScopedFramebufferBindings&) = delete;
+  ScopedFramebufferBindings& operator=(const ScopedFramebufferBindings&) = delete;
+
+private:
+  vtkOpenGLFramebufferObject* FBO;
+};
+
 } // namespace medical_gl
 
 #endif

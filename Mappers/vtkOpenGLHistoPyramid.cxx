@@ -214,23 +214,6 @@ private:
   GLint Saved = 0;
 };
 
-// Saves the framebuffer bindings and draw/read buffers, restores them on exit.
-class ScopedFramebufferBindings
-{
-public:
-  explicit ScopedFramebufferBindings(vtkOpenGLFramebufferObject* fbo)
-    : FBO(fbo)
-  {
-    this->FBO->SaveCurrentBindingsAndBuffers();
-  }
-  ~ScopedFramebufferBindings() { this->FBO->RestorePreviousBindingsAndBuffers(); }
-  ScopedFramebufferBindings(const ScopedFramebufferBindings&) = delete;
-  ScopedFramebufferBindings& operator=(const ScopedFramebufferBindings&) = delete;
-
-private:
-  vtkOpenGLFramebufferObject* FBO;
-};
-
 // Rebinds, through the shader cache (so that the cache and OpenGL agree), the
 // program that was bound when the scope began.
 class ScopedProgram
