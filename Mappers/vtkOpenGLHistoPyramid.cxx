@@ -19,6 +19,8 @@
 #include "vtk_glew.h"
 
 #include "vtkHistoPyramidBase_fs.h"
+#include "vtkHistoPyramidCommon.h"
+#include "vtkHistoPyramidFirstLevel_fs.h"
 #include "vtkHistoPyramidReduce_fs.h"
 
 #include <array>
@@ -111,7 +113,7 @@ bool ChooseFormat(int vtkType, VolumeFormat& f)
   }
 }
 
-// The #defines that select the value type in vtkHistoPyramidBase_fs.glsl.
+// The #defines that select the value type in vtkHistoPyramidCommon.glsl.
 const char* ValueTypeDefines(ValueKind kind)
 {
   switch (kind)
@@ -136,14 +138,16 @@ struct Thresholds
   std::vector<GLint> Ints;
   std::vector<GLuint> UInts;
   std::vector<GLfloat> Floats;
+  std::vector<int> Indices; // isovalue index of each threshold
   int Count = 0;
 };
 
 Thresholds MakeThresholds(const VolumeFormat& f, const std::vector<double>& isovalues)
 {
   Thresholds t;
-  for (double iso : isovalues)
+  for (std::size_t index = 0; index < isovalues.size(); ++index)
   {
+    const double iso = isovalues[index];
     if (std::isnan(iso))
     {
       continue;
@@ -189,6 +193,7 @@ Thresholds MakeThresholds(const VolumeFormat& f, const std::vector<double>& isov
         t.UInts.push_back(static_cast<GLuint>(c));
       }
     }
+    t.Indices.push_back(static_cast<int>(index));
     ++t.Count;
   }
   return t;
@@ -342,28 +347,53 @@ struct vtkOpenGLHistoPyramid::Internals
   VolumeFormat Format;
   int PointDims[3] = { 0, 0, 0 };
 
-  // The pyramid: one GL_R32UI 3D texture per level, base first.
+  // The pyramid. Sizes[l] is the size of level l (0 = the cell grid padded to
+  // powers of two); Levels[l] its texture, for l >= 1 only (the base level is
+  // never stored). Each stored level has the narrowest unsigned integer
+  // format that holds its largest possible count.
   std::vector<vtkSmartPointer<vtkTextureObject>> Levels;
-  std::vector<std::array<int, 3>> LevelSizes;
+  std::vector<std::array<int, 3>> Sizes;
+  std::vector<int> BytesPerNode;
   bool Built = false;
   std::uint64_t Total = 0;
+  Thresholds Current; // of the last successful Build()
 
   // The passes.
   vtkSmartPointer<vtkOpenGLFramebufferObject> FBO;
-  std::unique_ptr<vtkOpenGLQuadHelper> BaseQuad;
-  ValueKind BaseQuadKind = ValueKind::Float;
+  std::unique_ptr<vtkOpenGLQuadHelper> FirstQuad;
+  std::unique_ptr<vtkOpenGLQuadHelper> BaseQuad; // ReadLevel(0) only
+  ValueKind QuadKind = ValueKind::Float;         // value type of FirstQuad and BaseQuad
   std::unique_ptr<vtkOpenGLQuadHelper> ReduceQuad;
 
   void ReleaseLevels(vtkWindow* win)
   {
     for (auto& level : this->Levels)
     {
-      level->ReleaseGraphicsResources(win);
+      if (level)
+      {
+        level->ReleaseGraphicsResources(win);
+      }
     }
     this->Levels.clear();
-    this->LevelSizes.clear();
+    this->Sizes.clear();
+    this->BytesPerNode.clear();
     this->Built = false;
     this->Total = 0;
+  }
+
+  static void ReleaseQuad(vtkWindow* win, std::unique_ptr<vtkOpenGLQuadHelper>& quad)
+  {
+    if (quad)
+    {
+      // The programs belong to the window's shader cache: free their GL
+      // objects so that the cache recompiles them if they are asked for again.
+      if (quad->Program)
+      {
+        quad->Program->ReleaseGraphicsResources(win);
+      }
+      quad->ReleaseGraphicsResources(win);
+    }
+    quad.reset();
   }
 
   void ReleaseAll(vtkWindow* win)
@@ -375,27 +405,29 @@ struct vtkOpenGLHistoPyramid::Internals
       this->Volume = nullptr;
     }
     this->PointDims[0] = this->PointDims[1] = this->PointDims[2] = 0;
-    // The programs belong to the window's shader cache: free their GL
-    // objects so that the cache recompiles them if they are asked for again.
-    for (auto* quad : { this->BaseQuad.get(), this->ReduceQuad.get() })
-    {
-      if (quad)
-      {
-        if (quad->Program)
-        {
-          quad->Program->ReleaseGraphicsResources(win);
-        }
-        quad->ReleaseGraphicsResources(win);
-      }
-    }
-    this->BaseQuad.reset();
-    this->ReduceQuad.reset();
+    ReleaseQuad(win, this->FirstQuad);
+    ReleaseQuad(win, this->BaseQuad);
+    ReleaseQuad(win, this->ReduceQuad);
     if (this->FBO)
     {
       this->FBO->ReleaseGraphicsResources(win);
       this->FBO = nullptr;
     }
     this->Window = nullptr;
+  }
+
+  // The value-type #defines and the shared crossing code of the volume.
+  std::string Declarations() const
+  {
+    return std::string(ValueTypeDefines(this->Format.Kind)) + vtkHistoPyramidCommon;
+  }
+
+  // A pass fragment shader with the shared declarations put in.
+  std::string PassShader(const char* source) const
+  {
+    std::string fs = source;
+    vtkShaderProgram::Substitute(fs, "//VTK::HistoPyramidCommon::Dec", this->Declarations());
+    return fs;
   }
 
   // Ready (compile or rebind) a pass program, creating its quad helper on
@@ -419,6 +451,45 @@ struct vtkOpenGLHistoPyramid::Internals
       return nullptr;
     }
     return win->GetShaderCache()->ReadyShaderProgram(quad->Program);
+  }
+
+  // Set the uniforms of vtkHistoPyramidCommon.glsl on the bound program; the
+  // volume texture must be active.
+  void SetCommonUniforms(vtkShaderProgram* program, const Thresholds& t) const
+  {
+    program->SetUniformi("volume", this->Volume->GetTextureUnit());
+    program->SetUniformi("numberOfThresholds", t.Count);
+    const int cells[3] = { this->PointDims[0] - 1, this->PointDims[1] - 1,
+      this->PointDims[2] - 1 };
+    SetUniformIVec3(program, "cellDimensions", cells);
+    const GLint location = program->FindUniform("thresholds");
+    if (t.Count > 0 && location >= 0)
+    {
+      switch (this->Format.Kind)
+      {
+        case ValueKind::Signed:
+          glUniform1iv(location, t.Count, t.Ints.data());
+          break;
+        case ValueKind::Unsigned:
+          glUniform1uiv(location, t.Count, t.UInts.data());
+          break;
+        case ValueKind::Float:
+          glUniform1fv(location, t.Count, t.Floats.data());
+          break;
+      }
+    }
+  }
+
+  // Make the quad programs of the volume's value type current (dropping those
+  // of another type).
+  void MatchQuadKind(vtkWindow* win)
+  {
+    if (this->QuadKind != this->Format.Kind)
+    {
+      ReleaseQuad(win, this->FirstQuad);
+      ReleaseQuad(win, this->BaseQuad);
+      this->QuadKind = this->Format.Kind;
+    }
   }
 };
 
@@ -449,7 +520,61 @@ std::uint64_t vtkOpenGLHistoPyramid::GetTotal() const
 //------------------------------------------------------------------------------
 int vtkOpenGLHistoPyramid::GetNumberOfLevels() const
 {
-  return this->Impl->Built ? static_cast<int>(this->Impl->Levels.size()) : 0;
+  return this->Impl->Built ? static_cast<int>(this->Impl->Sizes.size()) : 0;
+}
+
+//------------------------------------------------------------------------------
+bool vtkOpenGLHistoPyramid::GetLevelSize(int level, int size[3]) const
+{
+  const Internals& impl = *this->Impl;
+  if (!impl.Built || level < 0 || level >= static_cast<int>(impl.Sizes.size()))
+  {
+    return false;
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    size[a] = impl.Sizes[level][a];
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+vtkTextureObject* vtkOpenGLHistoPyramid::GetLevelTexture(int level) const
+{
+  const Internals& impl = *this->Impl;
+  if (!impl.Built || level < 1 || level >= static_cast<int>(impl.Levels.size()))
+  {
+    return nullptr;
+  }
+  return impl.Levels[level];
+}
+
+//------------------------------------------------------------------------------
+vtkTextureObject* vtkOpenGLHistoPyramid::GetVolumeTexture() const
+{
+  return this->Impl->Volume;
+}
+
+//------------------------------------------------------------------------------
+std::string vtkOpenGLHistoPyramid::GetShaderDeclarations() const
+{
+  return this->Impl->Declarations();
+}
+
+//------------------------------------------------------------------------------
+void vtkOpenGLHistoPyramid::SetShaderUniforms(vtkShaderProgram* program) const
+{
+  const Internals& impl = *this->Impl;
+  if (program && impl.Volume && impl.Built)
+  {
+    impl.SetCommonUniforms(program, impl.Current);
+  }
+}
+
+//------------------------------------------------------------------------------
+std::vector<int> vtkOpenGLHistoPyramid::GetCountedIsovalues() const
+{
+  return this->Impl->Built ? this->Impl->Current.Indices : std::vector<int>();
 }
 
 //------------------------------------------------------------------------------
@@ -462,9 +587,10 @@ std::uint64_t vtkOpenGLHistoPyramid::GetGPUMemoryBytes() const
     bytes += static_cast<std::uint64_t>(impl.PointDims[0]) * impl.PointDims[1] * impl.PointDims[2] *
       impl.Format.BytesPerTexel;
   }
-  for (const auto& size : impl.LevelSizes)
+  for (std::size_t l = 1; l < impl.Levels.size(); ++l)
   {
-    bytes += static_cast<std::uint64_t>(size[0]) * size[1] * size[2] * sizeof(std::uint32_t);
+    const auto& size = impl.Sizes[l];
+    bytes += static_cast<std::uint64_t>(size[0]) * size[1] * size[2] * impl.BytesPerNode[l];
   }
   return bytes;
 }
@@ -562,6 +688,7 @@ bool vtkOpenGLHistoPyramid::UploadVolume(
     return false;
   }
   impl.Format = format;
+  impl.MatchQuadKind(renWin);
   for (int a = 0; a < 3; ++a)
   {
     impl.PointDims[a] = pointDims[a];
@@ -596,55 +723,70 @@ bool vtkOpenGLHistoPyramid::Build(
   ScopedProgram savedProgram(renWin);
   ScopedPassState savedState(ostate);
 
-  // 1. The level textures, allocated once per volume size.
+  // 1. The level textures, allocated once per volume size. Level 0 (the
+  //    padded cell grid) only has a size; levels 1.. are textures. Even a
+  //    single cell gets a level 1 (1x1x1), so that there is always one.
   const int cells[3] = { impl.PointDims[0] - 1, impl.PointDims[1] - 1, impl.PointDims[2] - 1 };
-  if (impl.Levels.empty())
+  if (impl.Sizes.empty())
   {
     std::array<int, 3> size = { NextPowerOfTwo(cells[0]), NextPowerOfTwo(cells[1]),
       NextPowerOfTwo(cells[2]) };
-    while (true)
+    const std::array<int, 3> base = size;
+    impl.Sizes.push_back(size);
+    impl.Levels.emplace_back(nullptr);
+    impl.BytesPerNode.push_back(0);
+    do
     {
-      auto level = vtkSmartPointer<vtkTextureObject>::New();
-      level->SetContext(renWin);
-      level->SetInternalFormat(GL_R32UI);
-      level->SetFormat(GL_RED_INTEGER);
-      level->SetDataType(GL_UNSIGNED_INT);
-      SetNearestClamp(level);
-      if (!level->Allocate3D(static_cast<unsigned int>(size[0]), static_cast<unsigned int>(size[1]),
-            static_cast<unsigned int>(size[2]), 1, VTK_UNSIGNED_INT))
-      {
-        vtkErrorMacro("Cannot allocate a " << size[0] << "x" << size[1] << "x" << size[2]
-                                           << " GL_R32UI 3D texture: " << TakeGLErrors());
-        impl.ReleaseLevels(renWin);
-        return false;
-      }
-      impl.Levels.push_back(level);
-      impl.LevelSizes.push_back(size);
-      if (size[0] == 1 && size[1] == 1 && size[2] == 1)
-      {
-        break;
-      }
       for (int& s : size)
       {
         s = s > 1 ? s / 2 : 1;
       }
-    }
+      // The largest count of a node: every isovalue crossing every cell under it.
+      const double maxCount = static_cast<double>(MaximumNumberOfIsovalues) * (base[0] / size[0]) *
+        (base[1] / size[1]) * (base[2] / size[2]);
+      GLenum internalFormat = GL_R32UI, dataType = GL_UNSIGNED_INT;
+      int bytes = 4, vtkType = VTK_UNSIGNED_INT;
+      if (maxCount <= 255.0)
+      {
+        internalFormat = GL_R8UI;
+        dataType = GL_UNSIGNED_BYTE;
+        bytes = 1;
+        vtkType = VTK_UNSIGNED_CHAR;
+      }
+      else if (maxCount <= 65535.0)
+      {
+        internalFormat = GL_R16UI;
+        dataType = GL_UNSIGNED_SHORT;
+        bytes = 2;
+        vtkType = VTK_UNSIGNED_SHORT;
+      }
+      auto level = vtkSmartPointer<vtkTextureObject>::New();
+      level->SetContext(renWin);
+      level->SetInternalFormat(internalFormat);
+      level->SetFormat(GL_RED_INTEGER);
+      level->SetDataType(dataType);
+      SetNearestClamp(level);
+      if (!level->Allocate3D(static_cast<unsigned int>(size[0]), static_cast<unsigned int>(size[1]),
+            static_cast<unsigned int>(size[2]), 1, vtkType))
+      {
+        vtkErrorMacro("Cannot allocate a " << size[0] << "x" << size[1] << "x" << size[2]
+                                           << " integer 3D texture: " << TakeGLErrors());
+        impl.ReleaseLevels(renWin);
+        return false;
+      }
+      impl.Levels.push_back(level);
+      impl.Sizes.push_back(size);
+      impl.BytesPerNode.push_back(bytes);
+    } while (size[0] > 1 || size[1] > 1 || size[2] > 1);
   }
+  const int numLevels = static_cast<int>(impl.Sizes.size());
 
   // 2. The programs.
-  if (impl.BaseQuad && impl.BaseQuadKind != impl.Format.Kind)
-  {
-    impl.BaseQuad->ReleaseGraphicsResources(renWin);
-    impl.BaseQuad.reset();
-  }
-  std::string baseFS = vtkHistoPyramidBase_fs;
-  vtkShaderProgram::Substitute(
-    baseFS, "//VTK::HistoPyramidValueType::Dec", ValueTypeDefines(impl.Format.Kind));
-  vtkShaderProgram* baseProgram = Internals::ReadyPass(renWin, impl.BaseQuad, baseFS);
-  impl.BaseQuadKind = impl.Format.Kind;
+  vtkShaderProgram* firstProgram =
+    Internals::ReadyPass(renWin, impl.FirstQuad, impl.PassShader(vtkHistoPyramidFirstLevel_fs));
   vtkShaderProgram* reduceProgram =
     Internals::ReadyPass(renWin, impl.ReduceQuad, vtkHistoPyramidReduce_fs);
-  if (!baseProgram || !reduceProgram)
+  if (!firstProgram || !reduceProgram)
   {
     vtkErrorMacro("The HistoPyramid shaders do not build.");
     return false;
@@ -660,17 +802,17 @@ bool vtkOpenGLHistoPyramid::Build(
   impl.FBO->Bind();
   impl.FBO->ActivateDrawBuffers(1);
   impl.FBO->ActivateReadBuffer(0);
-  auto attach = [&](int level, int slice) -> bool
+  auto attach = [&](vtkTextureObject* texture, int slice) -> bool
   {
     glFramebufferTextureLayer(
-      GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, impl.Levels[level]->GetHandle(), 0, slice);
+      GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, texture->GetHandle(), 0, slice);
     if (slice == 0)
     {
       const char* desc = nullptr;
       if (!vtkOpenGLFramebufferObject::GetFrameBufferStatus(GL_FRAMEBUFFER, desc))
       {
-        vtkErrorMacro("The GL_R32UI render target of level "
-          << level << " is incomplete: " << (desc ? desc : "unknown status"));
+        vtkErrorMacro("An integer render target of the HistoPyramid is incomplete: "
+          << (desc ? desc : "unknown status"));
         return false;
       }
     }
@@ -681,51 +823,36 @@ bool vtkOpenGLHistoPyramid::Build(
     ~Detach() { glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, 0, 0, 0); }
   } detachOnExit;
 
-  // 4. Base pass: one quad per z-slice of level 0.
+  // 4. Level 1 from the volume: one quad per z-slice.
   {
-    renWin->GetShaderCache()->ReadyShaderProgram(baseProgram);
+    renWin->GetShaderCache()->ReadyShaderProgram(firstProgram);
     ScopedTextureActive volumeActive(impl.Volume);
-    const auto& size = impl.LevelSizes[0];
-    baseProgram->SetUniformi("volume", impl.Volume->GetTextureUnit());
-    baseProgram->SetUniformi("numberOfThresholds", thresholds.Count);
-    SetUniformIVec3(baseProgram, "cellDimensions", cells);
+    impl.SetCommonUniforms(firstProgram, thresholds);
+    const auto& size = impl.Sizes[1];
+    const auto& base = impl.Sizes[0];
+    const int factor[3] = { base[0] / size[0], base[1] / size[1], base[2] / size[2] };
+    SetUniformIVec3(firstProgram, "factor", factor);
     const int sliceSize[2] = { size[0], size[1] };
-    baseProgram->SetUniform2i("sliceSize", sliceSize);
-    const GLint location = baseProgram->FindUniform("thresholds");
-    if (thresholds.Count > 0 && location >= 0)
-    {
-      switch (impl.Format.Kind)
-      {
-        case ValueKind::Signed:
-          glUniform1iv(location, thresholds.Count, thresholds.Ints.data());
-          break;
-        case ValueKind::Unsigned:
-          glUniform1uiv(location, thresholds.Count, thresholds.UInts.data());
-          break;
-        case ValueKind::Float:
-          glUniform1fv(location, thresholds.Count, thresholds.Floats.data());
-          break;
-      }
-    }
+    firstProgram->SetUniform2i("sliceSize", sliceSize);
     ostate->vtkglViewport(0, 0, size[0], size[1]);
     for (int z = 0; z < size[2]; ++z)
     {
-      if (!attach(0, z))
+      if (!attach(impl.Levels[1], z))
       {
         return false;
       }
-      baseProgram->SetUniformi("slice", z);
-      impl.BaseQuad->Render();
+      firstProgram->SetUniformi("slice", z);
+      impl.FirstQuad->Render();
     }
   }
 
   // 5. Reduction passes: level l from level l - 1.
   renWin->GetShaderCache()->ReadyShaderProgram(reduceProgram);
-  for (std::size_t l = 1; l < impl.Levels.size(); ++l)
+  for (int l = 2; l < numLevels; ++l)
   {
     ScopedTextureActive lowerActive(impl.Levels[l - 1]);
-    const auto& size = impl.LevelSizes[l];
-    const auto& lower = impl.LevelSizes[l - 1];
+    const auto& size = impl.Sizes[l];
+    const auto& lower = impl.Sizes[l - 1];
     const int factor[3] = { lower[0] / size[0], lower[1] / size[1], lower[2] / size[2] };
     const int sliceSize[2] = { size[0], size[1] };
     reduceProgram->SetUniformi("lowerLevel", impl.Levels[l - 1]->GetTextureUnit());
@@ -734,7 +861,7 @@ bool vtkOpenGLHistoPyramid::Build(
     ostate->vtkglViewport(0, 0, size[0], size[1]);
     for (int z = 0; z < size[2]; ++z)
     {
-      if (!attach(static_cast<int>(l), z))
+      if (!attach(impl.Levels[l], z))
       {
         return false;
       }
@@ -745,7 +872,7 @@ bool vtkOpenGLHistoPyramid::Build(
 
   // 6. Read back the top node only.
   GLuint top = 0;
-  if (!attach(static_cast<int>(impl.Levels.size()) - 1, 0))
+  if (!attach(impl.Levels[numLevels - 1], 0))
   {
     return false;
   }
@@ -757,6 +884,7 @@ bool vtkOpenGLHistoPyramid::Build(
     return false;
   }
   impl.Total = top;
+  impl.Current = thresholds;
   impl.Built = true;
   return true;
 }
@@ -765,11 +893,11 @@ bool vtkOpenGLHistoPyramid::Build(
 bool vtkOpenGLHistoPyramid::ReadLevel(int level, std::vector<std::uint32_t>& counts, int size[3])
 {
   Internals& impl = *this->Impl;
-  if (!impl.Built || level < 0 || level >= static_cast<int>(impl.Levels.size()) || !impl.Window)
+  if (!impl.Built || level < 0 || level >= static_cast<int>(impl.Sizes.size()) || !impl.Window)
   {
     return false;
   }
-  const auto& s = impl.LevelSizes[level];
+  const auto& s = impl.Sizes[level];
   for (int a = 0; a < 3; ++a)
   {
     size[a] = s[a];
@@ -779,18 +907,55 @@ bool vtkOpenGLHistoPyramid::ReadLevel(int level, std::vector<std::uint32_t>& cou
   vtkOpenGLRenderWindow* win = impl.Window;
   ScopedContext context(win);
   TakeGLErrors();
+  ScopedProgram savedProgram(win);
   ScopedPassState savedState(win->GetState());
   ScopedFramebufferBindings savedBindings(impl.FBO);
   impl.FBO->Bind();
+  impl.FBO->ActivateDrawBuffers(1);
   impl.FBO->ActivateReadBuffer(0);
+
+  // The base level is not stored: draw it into a temporary texture first.
+  vtkSmartPointer<vtkTextureObject> texture = level > 0 ? impl.Levels[level] : nullptr;
+  if (level == 0)
+  {
+    vtkShaderProgram* baseProgram =
+      Internals::ReadyPass(win, impl.BaseQuad, impl.PassShader(vtkHistoPyramidBase_fs));
+    texture = vtkSmartPointer<vtkTextureObject>::New();
+    texture->SetContext(win);
+    texture->SetInternalFormat(GL_R32UI);
+    texture->SetFormat(GL_RED_INTEGER);
+    texture->SetDataType(GL_UNSIGNED_INT);
+    SetNearestClamp(texture);
+    if (!baseProgram ||
+      !texture->Allocate3D(static_cast<unsigned int>(s[0]), static_cast<unsigned int>(s[1]),
+        static_cast<unsigned int>(s[2]), 1, VTK_UNSIGNED_INT))
+    {
+      vtkErrorMacro("Cannot draw the base level for reading: " << TakeGLErrors());
+      return false;
+    }
+    ScopedTextureActive volumeActive(impl.Volume);
+    impl.SetCommonUniforms(baseProgram, impl.Current);
+    const int sliceSize[2] = { s[0], s[1] };
+    baseProgram->SetUniform2i("sliceSize", sliceSize);
+    win->GetState()->vtkglViewport(0, 0, s[0], s[1]);
+    for (int z = 0; z < s[2]; ++z)
+    {
+      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, texture->GetHandle(), 0, z);
+      baseProgram->SetUniformi("slice", z);
+      impl.BaseQuad->Render();
+    }
+  }
   const std::size_t sliceCount = static_cast<std::size_t>(s[0]) * s[1];
   for (int z = 0; z < s[2]; ++z)
   {
-    glFramebufferTextureLayer(
-      GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, impl.Levels[level]->GetHandle(), 0, z);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, texture->GetHandle(), 0, z);
     glReadPixels(0, 0, s[0], s[1], GL_RED_INTEGER, GL_UNSIGNED_INT, counts.data() + z * sliceCount);
   }
   glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, 0, 0, 0);
+  if (level == 0)
+  {
+    texture->ReleaseGraphicsResources(win);
+  }
   const std::string errors = TakeGLErrors();
   if (!errors.empty())
   {

@@ -16,18 +16,31 @@
  * (Mappers/Core/HistoPyramid.h), so that both can be compared number for
  * number: level 0 is the cell grid padded to a power of two per axis (padding
  * cells count 0), and each level above halves every axis larger than 1, down
- * to a single 1x1x1 node. Every level is a GL_R32UI 3D texture.
+ * to a single 1x1x1 node (a one-cell volume still gets a level 1).
+ *
+ * Memory. Level 0 is never stored: level 1 is computed straight from the
+ * volume (each node reads the <= 27 corner values of its <= 8 cells once),
+ * and the traversal recounts the cells of the level-1 node it reaches from
+ * the same corner values, which it needs anyway to draw the cell. Each stored
+ * level takes the narrowest unsigned integer format that holds its largest
+ * possible count (8 isovalues times the cells under a node): GL_R8UI for
+ * level 1, GL_R16UI up to level 4, GL_R32UI above. The whole pyramid is then
+ * about 0.16 bytes per padded cell, against 4.6 for R32UI levels from an
+ * R32UI base, so the GPU memory stays close to the volume's own size (a
+ * 256x256x108 int16 CT: 14.2 MB volume + 1.4 MB pyramid).
  *
  * Only OpenGL 3.2 core / GLSL 1.50 is used (no compute shaders, no shader
  * storage buffers, no image load/store). The build is a sequence of
  * full-screen passes (vtkOpenGLQuadHelper), one per z-slice of each level,
  * rendered into that slice (glFramebufferTextureLayer) with an unsigned
  * integer fragment output:
- * -# Base pass (vtkHistoPyramidBase_fs.glsl): fragment (i, j) of slice k is
- *    cell (i, j, k); it reads the cell's eight corners with texelFetch and
- *    writes the number of isovalues with min < iso <= max (the convention of
- *    vtkMarchingCubes). Cells with a NaN corner and padding cells write 0.
- *    The comparisons are exact: isovalues are turned on the CPU into
+ * -# Level-1 pass (vtkHistoPyramidFirstLevel_fs.glsl): fragment (i, j) of
+ *    slice k is node (i, j, k); it sums over its cells the number of
+ *    isovalues with min < iso <= max over the cell's eight corners (the
+ *    convention of vtkMarchingCubes). Cells with a NaN corner and padding
+ *    cells count 0. The test is the one function of
+ *    vtkHistoPyramidCommon.glsl that every pass and the drawing program
+ *    share. The comparisons are exact: isovalues are turned on the CPU into
  *    thresholds of the texture's own value type (ceil(iso) for integer data,
  *    the smallest float >= iso for float data), so that the GPU counts equal
  *    the CPU counts computed in double precision.
@@ -66,10 +79,13 @@
 
 #include <cstdint> // For std::uint32_t
 #include <memory>  // For std::unique_ptr
+#include <string>  // For std::string
 #include <vector>  // For std::vector
 
 class vtkDataArray;
 class vtkOpenGLRenderWindow;
+class vtkShaderProgram;
+class vtkTextureObject;
 class vtkWindow;
 
 class MEDICALISOSURFACESMAPPERS_EXPORT vtkOpenGLHistoPyramid : public vtkObject
@@ -105,10 +121,45 @@ public:
 
   /**
    * Read a whole level back (x fastest) and its size, for tests. Needs the
-   * window of the last Build() to be alive. Returns false when there is no
-   * such level or reading fails.
+   * window of the last Build() to be alive. Level 0, which is not stored, is
+   * drawn into a temporary texture by the same crossing code first
+   * (vtkHistoPyramidBase_fs.glsl). Returns false when there is no such level
+   * or reading fails.
    */
   bool ReadLevel(int level, std::vector<std::uint32_t>& counts, int size[3]);
+
+  /// Size of a level of the last successful Build(); false when there is none.
+  bool GetLevelSize(int level, int size[3]) const;
+
+  ///@{
+  /**
+   * For a drawing program that traverses the pyramid (the isosurface
+   * mapper): the texture of a stored level (1 .. GetNumberOfLevels() - 1;
+   * nullptr otherwise or before Build()) and the volume texture.
+   */
+  vtkTextureObject* GetLevelTexture(int level) const;
+  vtkTextureObject* GetVolumeTexture() const;
+  ///@}
+
+  /**
+   * GLSL for a drawing program: the #defines of the volume's value type
+   * (VALUE_SAMPLER, VALUE_TYPE, VALUE_IS_FLOAT) and vtkHistoPyramidCommon.glsl
+   * (the crossing test the pyramid was built with, and its uniforms).
+   */
+  std::string GetShaderDeclarations() const;
+
+  /**
+   * Set the uniforms of GetShaderDeclarations() on the bound @a program for
+   * the last Build(). The volume texture must be active (Activate()).
+   */
+  void SetShaderUniforms(vtkShaderProgram* program) const;
+
+  /**
+   * Which of the last Build()'s isovalues the pyramid counts, by index, in the
+   * order of bit t of the shaders' crossing masks. Isovalues that can cross
+   * no cell of the volume's value type (and NaN ones) are left out.
+   */
+  std::vector<int> GetCountedIsovalues() const;
 
   /// Bytes of the GPU textures this object owns now (volume and levels).
   std::uint64_t GetGPUMemoryBytes() const;

@@ -43,7 +43,9 @@ void HistoPyramid::Build(const int cells[3], const std::vector<std::uint32_t>& b
   while (true)
   {
     const Level& below = this->Levels.back();
-    if (below.Size[0] == 1 && below.Size[1] == 1 && below.Size[2] == 1)
+    // A single cell still gets a level 1 (as on the GPU, which never stores
+    // level 0 and so always needs one level above it).
+    if (below.Size[0] == 1 && below.Size[1] == 1 && below.Size[2] == 1 && this->Levels.size() > 1)
     {
       break;
     }
