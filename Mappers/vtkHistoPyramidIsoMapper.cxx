@@ -1,0 +1,865 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkHistoPyramidIsoMapper.h"
+
+#include "vtkActor.h"
+#include "vtkBlockLODContour.h"
+#include "vtkCamera.h"
+#include "vtkColorTransferFunction.h"
+#include "vtkContourValues.h"
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkLight.h"
+#include "vtkLightCollection.h"
+#include "vtkMatrix3x3.h"
+#include "vtkMath.h"
+#include "vtkMatrix4x4.h"
+#include "vtkMedicalGLCapabilities.h"
+#include "vtkMedicalGLUtilities.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkOpenGLHistoPyramid.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLShaderCache.h"
+#include "vtkOpenGLState.h"
+#include "vtkOpenGLVertexArrayObject.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkPointData.h"
+#include "vtkPolyData.h"
+#include "vtkPolyDataMapper.h"
+#include "vtkProperty.h"
+#include "vtkRenderer.h"
+#include "vtkShaderProgram.h"
+#include "vtkTextureObject.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+#include "vtkWeakPointer.h"
+#include "vtk_glew.h"
+
+#include "vtkHistoPyramidIso_fs.h"
+#include "vtkHistoPyramidIso_gs.h"
+#include "vtkHistoPyramidIso_vs.h"
+
+#include <algorithm>
+#include <array>
+#include <climits>
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <vector>
+
+vtkStandardNewMacro(vtkHistoPyramidIsoMapper);
+
+namespace
+{
+using namespace medical_gl;
+
+constexpr int MaximumNumberOfLights = 6;
+
+// Uploads a matrix given in VTK's row-major, column-vector convention.
+void SetMatrix4(vtkShaderProgram* program, const char* name, const vtkMatrix4x4* m)
+{
+  const GLint location = program->FindUniform(name);
+  if (location >= 0)
+  {
+    GLfloat values[16];
+    for (int i = 0; i < 16; ++i)
+    {
+      values[i] = static_cast<GLfloat>(m->GetData()[i]);
+    }
+    glUniformMatrix4fv(location, 1, GL_TRUE, values);
+  }
+}
+
+void SetMatrix3(vtkShaderProgram* program, const char* name, const double m[9])
+{
+  const GLint location = program->FindUniform(name);
+  if (location >= 0)
+  {
+    GLfloat values[9];
+    for (int i = 0; i < 9; ++i)
+    {
+      values[i] = static_cast<GLfloat>(m[i]);
+    }
+    glUniformMatrix3fv(location, 1, GL_TRUE, values);
+  }
+}
+
+void SetIVec3(vtkShaderProgram* program, const char* name, const int v[3])
+{
+  const GLint location = program->FindUniform(name);
+  if (location >= 0)
+  {
+    glUniform3i(location, v[0], v[1], v[2]);
+  }
+}
+
+bool SupportedType(int type)
+{
+  switch (type)
+  {
+    case VTK_CHAR:
+    case VTK_SIGNED_CHAR:
+    case VTK_UNSIGNED_CHAR:
+    case VTK_SHORT:
+    case VTK_UNSIGNED_SHORT:
+    case VTK_INT:
+    case VTK_UNSIGNED_INT:
+    case VTK_FLOAT:
+    case VTK_DOUBLE:
+      return true;
+    default:
+      return false;
+  }
+}
+} // anonymous namespace
+
+//------------------------------------------------------------------------------
+// One isovalue to draw and its look.
+struct vtkHistoPyramidIsoMapper::Surface
+{
+  double Value;
+  double Color[3];
+  double Opacity;
+};
+
+//------------------------------------------------------------------------------
+struct vtkHistoPyramidIsoMapper::Internals
+{
+  // GPU path, all in the context of Window.
+  vtkWeakPointer<vtkOpenGLRenderWindow> Window;
+  vtkNew<vtkOpenGLHistoPyramid> Pyramid;
+  vtkNew<vtkOpenGLVertexArrayObject> VAO;
+  bool Probed = false;
+  bool GPUUsable = false;
+  std::string GPUReason;
+  int MaxVertexTextureUnits = 0;
+  int Max3DTextureSize = 0;
+
+  // What the uploaded volume and the built pyramid were made from.
+  vtkDataArray* UploadedArray = nullptr;
+  vtkMTimeType UploadedArrayTime = 0;
+  int UploadedDims[3] = { 0, 0, 0 };
+  std::vector<double> BuiltIsovalues;
+  bool PyramidValid = false;
+
+  // The drawing program of the current pyramid layout.
+  std::string ProgramKey;
+  vtkShaderProgram* Program = nullptr;
+
+  // Fallback path.
+  vtkNew<vtkBlockLODContour> Contour;
+  vtkNew<vtkImageData> IndexImage;
+  vtkNew<vtkPolyData> Colored;
+  vtkNew<vtkPolyDataMapper> PolyMapper;
+  vtkNew<vtkActor> Actor;
+  vtkNew<vtkMatrix4x4> ActorMatrix;
+
+  // Messages already given (each is said once).
+  std::set<std::string> Said;
+
+  void InvalidateGPU()
+  {
+    this->UploadedArray = nullptr;
+    this->UploadedArrayTime = 0;
+    this->UploadedDims[0] = this->UploadedDims[1] = this->UploadedDims[2] = 0;
+    this->BuiltIsovalues.clear();
+    this->PyramidValid = false;
+    this->ProgramKey.clear();
+    this->Program = nullptr;
+  }
+
+  void ReleaseGPU(vtkWindow* win)
+  {
+    this->Pyramid->ReleaseGraphicsResources(win);
+    this->VAO->ReleaseGraphicsResources();
+    if (this->Program)
+    {
+      this->Program->ReleaseGraphicsResources(win);
+    }
+    this->InvalidateGPU();
+    this->Window = nullptr;
+    this->Probed = false;
+  }
+};
+
+//------------------------------------------------------------------------------
+vtkHistoPyramidIsoMapper::vtkHistoPyramidIsoMapper()
+  : Impl(new Internals)
+{
+  Internals& impl = *this->Impl;
+  impl.Contour->SetLOD(3);
+  impl.Contour->SetComputeNormals(true);
+  impl.Contour->SetComputeScalars(true);
+  impl.PolyMapper->SetInputData(impl.Colored);
+  impl.PolyMapper->SetColorModeToDirectScalars();
+  impl.PolyMapper->SetScalarModeToUsePointData();
+  impl.PolyMapper->ScalarVisibilityOn();
+  impl.Actor->SetMapper(impl.PolyMapper);
+  impl.Actor->SetUserMatrix(impl.ActorMatrix);
+}
+
+//------------------------------------------------------------------------------
+vtkHistoPyramidIsoMapper::~vtkHistoPyramidIsoMapper()
+{
+  if (this->Impl->Window)
+  {
+    ScopedContext context(this->Impl->Window);
+    this->Impl->ReleaseGPU(this->Impl->Window);
+  }
+}
+
+//------------------------------------------------------------------------------
+int vtkHistoPyramidIsoMapper::FillInputPortInformation(int vtkNotUsed(port), vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+const char* vtkHistoPyramidIsoMapper::GetLastRenderPathAsString() const
+{
+  switch (this->LastRenderPath)
+  {
+    case GPUPath:
+      return "gpu";
+    case FallbackPath:
+      return "fallback";
+    default:
+      return "none";
+  }
+}
+
+//------------------------------------------------------------------------------
+std::uint64_t vtkHistoPyramidIsoMapper::GetGPUMemoryBytes() const
+{
+  return this->Impl->Pyramid->GetGPUMemoryBytes();
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoMapper::ReleaseGraphicsResources(vtkWindow* win)
+{
+  this->Impl->ReleaseGPU(win);
+  this->Impl->PolyMapper->ReleaseGraphicsResources(win);
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
+{
+  Internals& impl = *this->Impl;
+  this->LastRenderPath = NoPath;
+  this->NumberOfPrimitives = 0;
+  this->NumberOfFallbackTriangles = 0;
+
+  // Say a message once (per distinct text), as an error or a warning.
+  auto sayOnce = [&](bool error, const std::string& text)
+  {
+    if (impl.Said.insert(text).second)
+    {
+      if (error)
+      {
+        vtkErrorMacro(<< text);
+      }
+      else
+      {
+        vtkWarningMacro(<< text);
+      }
+    }
+  };
+
+  // 1. The input. No input at all is normal (a ParaView rank without data).
+  vtkImageData* image = vtkImageData::SafeDownCast(this->GetInputDataObject(0, 0));
+  if (!image || !vol || !ren)
+  {
+    return;
+  }
+  int dims[3];
+  image->GetDimensions(dims);
+  if (dims[0] < 2 || dims[1] < 2 || dims[2] < 2)
+  {
+    std::ostringstream msg;
+    msg << "needs 3D image data (at least 2 points along every axis), not " << dims[0] << "x"
+        << dims[1] << "x" << dims[2] << "; nothing is drawn.";
+    sayOnce(true, msg.str());
+    return;
+  }
+  int cellFlag = 0;
+  vtkDataArray* scalars = vtkDataArray::SafeDownCast(this->GetScalars(
+    image, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag));
+  if (!scalars)
+  {
+    sayOnce(true, "the input has no point scalars to contour; nothing is drawn.");
+    return;
+  }
+  if (cellFlag)
+  {
+    sayOnce(true,
+      std::string("array '") + (scalars->GetName() ? scalars->GetName() : "") +
+        "' is cell data; isosurfaces need point data (apply Cell Data to Point Data first); "
+        "nothing is drawn.");
+    return;
+  }
+  if (scalars->GetNumberOfComponents() != 1 || !SupportedType(scalars->GetDataType()))
+  {
+    std::ostringstream msg;
+    msg << "array '" << (scalars->GetName() ? scalars->GetName() : "") << "' has "
+        << scalars->GetNumberOfComponents() << " components of type "
+        << scalars->GetDataTypeAsString()
+        << "; one component of an 8, 16 or 32-bit integer, float or double type is needed; "
+           "nothing is drawn.";
+    sayOnce(true, msg.str());
+    return;
+  }
+
+  // 2. The isovalues and their looks, in increasing order, invisible ones
+  //    (opacity 0) and NaN ones left out.
+  vtkVolumeProperty* property = vol->GetProperty();
+  vtkContourValues* values = property->GetIsoSurfaceValues();
+  std::vector<double> requested;
+  for (int i = 0; values && i < values->GetNumberOfContours(); ++i)
+  {
+    const double v = values->GetValue(i);
+    if (!std::isnan(v))
+    {
+      requested.push_back(v);
+    }
+  }
+  std::sort(requested.begin(), requested.end());
+  requested.erase(std::unique(requested.begin(), requested.end()), requested.end());
+  if (requested.empty())
+  {
+    sayOnce(false,
+      "no isovalues: set them with vtkVolumeProperty::GetIsoSurfaceValues() "
+      "(ParaView: the representation's Isosurfaces); nothing is drawn.");
+    return;
+  }
+  if (requested.size() > static_cast<std::size_t>(vtkOpenGLHistoPyramid::MaximumNumberOfIsovalues))
+  {
+    std::ostringstream msg;
+    msg << requested.size() << " isovalues requested; only the lowest "
+        << vtkOpenGLHistoPyramid::MaximumNumberOfIsovalues << " are drawn.";
+    sayOnce(false, msg.str());
+    requested.resize(vtkOpenGLHistoPyramid::MaximumNumberOfIsovalues);
+  }
+  std::vector<Surface> surfaces;
+  vtkPiecewiseFunction* opacity = property->GetScalarOpacity(0);
+  for (double v : requested)
+  {
+    Surface s;
+    s.Value = v;
+    if (property->GetColorChannels(0) == 1)
+    {
+      const double gray = property->GetGrayTransferFunction(0)->GetValue(v);
+      s.Color[0] = s.Color[1] = s.Color[2] = gray;
+    }
+    else
+    {
+      property->GetRGBTransferFunction(0)->GetColor(v, s.Color);
+    }
+    s.Opacity = opacity ? std::min(1.0, std::max(0.0, opacity->GetValue(v))) : 1.0;
+    if (s.Opacity > 0.0)
+    {
+      surfaces.push_back(s);
+    }
+  }
+  if (surfaces.empty())
+  {
+    this->LastRenderPath = NoPath;
+    return;
+  }
+
+  // 3. The GPU path, or the fallback when it cannot run.
+  auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  std::string reason;
+  if (this->ForceCPUFallback)
+  {
+    reason = "ForceCPUFallback is on";
+  }
+  else if (!renWin)
+  {
+    reason = "the render window is not an OpenGL window";
+  }
+  else if (this->RenderGPU(ren, vol, image, scalars, surfaces, reason))
+  {
+    this->LastRenderPath = GPUPath;
+    this->FallbackReason.clear();
+    return;
+  }
+  if (!this->ForceCPUFallback)
+  {
+    sayOnce(false,
+      "GPU isosurface path unavailable (" + reason +
+        "); rendering with vtkBlockLODContour and vtkPolyDataMapper instead.");
+  }
+  this->FallbackReason = reason;
+  this->RenderFallback(ren, vol, image, scalars, surfaces);
+  this->LastRenderPath = FallbackPath;
+}
+
+//------------------------------------------------------------------------------
+bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image,
+  vtkDataArray* scalars, const std::vector<Surface>& surfaces, std::string& reason)
+{
+  Internals& impl = *this->Impl;
+  auto* renWin = static_cast<vtkOpenGLRenderWindow*>(ren->GetRenderWindow());
+
+  // 1. Capabilities, once per window.
+  if (impl.Window != renWin)
+  {
+    if (impl.Window)
+    {
+      ScopedContext previous(impl.Window);
+      impl.ReleaseGPU(impl.Window);
+    }
+    impl.Window = renWin;
+  }
+  if (!impl.Probed)
+  {
+    vtkNew<vtkMedicalGLCapabilities> caps;
+    impl.Probed = true;
+    impl.GPUUsable = caps->Probe(renWin);
+    impl.GPUReason = caps->GetReason();
+    impl.Max3DTextureSize = caps->GetMax3DTextureSize();
+    renWin->MakeCurrent();
+    GLint units = 0;
+    glGetIntegerv(GL_MAX_VERTEX_TEXTURE_IMAGE_UNITS, &units);
+    impl.MaxVertexTextureUnits = units;
+  }
+  if (!impl.GPUUsable)
+  {
+    reason = impl.GPUReason;
+    return false;
+  }
+  int dims[3];
+  image->GetDimensions(dims);
+  if (std::max({ dims[0], dims[1], dims[2] }) > impl.Max3DTextureSize)
+  {
+    std::ostringstream msg;
+    msg << "the " << dims[0] << "x" << dims[1] << "x" << dims[2]
+        << " volume exceeds GL_MAX_3D_TEXTURE_SIZE " << impl.Max3DTextureSize;
+    reason = msg.str();
+    return false;
+  }
+
+  renWin->MakeCurrent();
+  vtkOpenGLState* ostate = renWin->GetState();
+
+  // 2. The volume, uploaded again only when the array or its values change.
+  const bool sameVolume = impl.UploadedArray == scalars &&
+    impl.UploadedArrayTime == scalars->GetMTime() && impl.UploadedDims[0] == dims[0] &&
+    impl.UploadedDims[1] == dims[1] && impl.UploadedDims[2] == dims[2];
+  if (!sameVolume)
+  {
+    impl.PyramidValid = false;
+    if (!impl.Pyramid->UploadVolume(renWin, scalars, dims))
+    {
+      impl.InvalidateGPU();
+      reason = "the volume could not be uploaded as a 3D texture";
+      return false;
+    }
+    ++this->NumberOfVolumeUploads;
+    impl.UploadedArray = scalars;
+    impl.UploadedArrayTime = scalars->GetMTime();
+    std::copy(dims, dims + 3, impl.UploadedDims);
+  }
+
+  // 3. The pyramid, rebuilt only when the isovalues or the volume change.
+  std::vector<double> isovalues;
+  for (const Surface& s : surfaces)
+  {
+    isovalues.push_back(s.Value);
+  }
+  if (!impl.PyramidValid || isovalues != impl.BuiltIsovalues)
+  {
+    if (!impl.Pyramid->Build(renWin, isovalues))
+    {
+      impl.InvalidateGPU();
+      reason = "the HistoPyramid could not be built";
+      return false;
+    }
+    ++this->NumberOfPyramidBuilds;
+    impl.BuiltIsovalues = isovalues;
+    impl.PyramidValid = true;
+  }
+  const std::uint64_t total = impl.Pyramid->GetTotal();
+  this->NumberOfPrimitives = total;
+  if (total == 0)
+  {
+    return true; // nothing crosses: an empty, correct picture
+  }
+  if (total > static_cast<std::uint64_t>(INT_MAX))
+  {
+    reason = "more active cells than one draw call can take";
+    return false;
+  }
+
+  // 4. The drawing program of this pyramid layout.
+  const int numLevels = impl.Pyramid->GetNumberOfLevels();
+  std::vector<std::array<int, 3>> sizes(numLevels);
+  for (int l = 0; l < numLevels; ++l)
+  {
+    impl.Pyramid->GetLevelSize(l, sizes[l].data());
+  }
+  // Stored levels read by the vertex stage (1 .. numLevels - 2) and the volume.
+  if (numLevels - 1 > impl.MaxVertexTextureUnits)
+  {
+    std::ostringstream msg;
+    msg << "the pyramid needs " << numLevels - 1 << " vertex texture units, the context has "
+        << impl.MaxVertexTextureUnits;
+    reason = msg.str();
+    return false;
+  }
+  std::ostringstream dec, descend, key;
+  for (int l = 1; l + 1 < numLevels; ++l)
+  {
+    dec << "uniform usampler3D level" << l << ";\n";
+  }
+  for (int l = numLevels - 1; l >= 2; --l)
+  {
+    const int c = l - 1;
+    descend << "  descend(level" << c << ", ivec3(" << sizes[c][0] / sizes[l][0] << ", "
+            << sizes[c][1] / sizes[l][1] << ", " << sizes[c][2] / sizes[l][2] << "), vec3("
+            << sizes[0][0] / sizes[c][0] << ".0, " << sizes[0][1] / sizes[c][1] << ".0, "
+            << sizes[0][2] / sizes[c][2] << ".0), node, index);\n";
+  }
+  const std::string declarations = impl.Pyramid->GetShaderDeclarations();
+  key << declarations.size() << declarations.substr(0, 80) << "|" << dec.str() << descend.str();
+  if (!impl.Program || impl.ProgramKey != key.str())
+  {
+    std::string vs = vtkHistoPyramidIso_vs;
+    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidCommon::Dec", declarations);
+    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Dec", dec.str());
+    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Impl", descend.str());
+    impl.Program = renWin->GetShaderCache()->ReadyShaderProgram(
+      vs.c_str(), vtkHistoPyramidIso_fs, vtkHistoPyramidIso_gs);
+    if (!impl.Program)
+    {
+      impl.ProgramKey.clear();
+      reason = "the isosurface shaders do not build";
+      impl.GPUUsable = false;
+      impl.GPUReason = reason;
+      return false;
+    }
+    impl.ProgramKey = key.str();
+  }
+  else
+  {
+    renWin->GetShaderCache()->ReadyShaderProgram(impl.Program);
+  }
+  vtkShaderProgram* program = impl.Program;
+
+  // 5. Matrices: cell-index space (0-based on the extent) to view and clip.
+  vtkNew<vtkMatrix4x4> indexToModel;
+  {
+    vtkNew<vtkMatrix4x4> shift;
+    const int* extent = image->GetExtent();
+    shift->SetElement(0, 3, extent[0]);
+    shift->SetElement(1, 3, extent[2]);
+    shift->SetElement(2, 3, extent[4]);
+    vtkMatrix4x4::Multiply4x4(image->GetIndexToPhysicalMatrix(), shift, indexToModel);
+  }
+  vtkCamera* camera = ren->GetActiveCamera();
+  const double aspect = ren->GetTiledAspectRatio();
+  vtkNew<vtkMatrix4x4> indexToWorld, indexToView, indexToClip, viewToIndex;
+  vtkMatrix4x4::Multiply4x4(vol->GetMatrix(), indexToModel, indexToWorld);
+  vtkMatrix4x4::Multiply4x4(camera->GetModelViewTransformMatrix(), indexToWorld, indexToView);
+  vtkMatrix4x4::Multiply4x4(
+    camera->GetProjectionTransformMatrix(aspect, -1, 1), indexToView, indexToClip);
+  vtkMatrix4x4::Invert(indexToView, viewToIndex);
+  const bool parallel = camera->GetParallelProjection() != 0;
+  double eye[4] = { 0.0, 0.0, parallel ? 1.0 : 0.0, parallel ? 0.0 : 1.0 };
+  viewToIndex->MultiplyPoint(eye, eye);
+  double gradientToView[9];
+  {
+    double linear[3][3], inverse[3][3];
+    for (int r = 0; r < 3; ++r)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        linear[r][c] = indexToView->GetElement(r, c);
+      }
+    }
+    vtkMath::Invert3x3(linear, inverse);
+    for (int r = 0; r < 3; ++r)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        gradientToView[3 * r + c] = inverse[c][r]; // transpose of the inverse
+      }
+    }
+  }
+
+  // 6. Isovalues in the pyramid's threshold order, their colours, lights.
+  const std::vector<int> counted = impl.Pyramid->GetCountedIsovalues();
+  float isoValues[8] = { 0 };
+  float isoColors[32] = { 0 };
+  bool translucent = false;
+  for (std::size_t t = 0; t < counted.size() && t < 8; ++t)
+  {
+    const Surface& s = surfaces[counted[t]];
+    isoValues[t] = static_cast<float>(s.Value);
+    for (int c = 0; c < 3; ++c)
+    {
+      isoColors[4 * t + c] = static_cast<float>(s.Color[c]);
+    }
+    isoColors[4 * t + 3] = static_cast<float>(s.Opacity);
+    translucent = translucent || s.Opacity < 1.0;
+  }
+  float lightDirections[3 * MaximumNumberOfLights] = { 0 };
+  float lightColors[3 * MaximumNumberOfLights] = { 0 };
+  int numLights = 0;
+  {
+    vtkLightCollection* lights = ren->GetLights();
+    vtkCollectionSimpleIterator it;
+    lights->InitTraversal(it);
+    vtkMatrix4x4* worldToView = camera->GetModelViewTransformMatrix();
+    while (vtkLight* light = lights->GetNextLight(it))
+    {
+      if (!light->GetSwitch() || numLights == MaximumNumberOfLights)
+      {
+        continue;
+      }
+      double position[3], focal[3], toLight[3];
+      light->GetTransformedPosition(position);
+      light->GetTransformedFocalPoint(focal);
+      for (int a = 0; a < 3; ++a)
+      {
+        toLight[a] = position[a] - focal[a];
+      }
+      double view[3];
+      for (int r = 0; r < 3; ++r)
+      {
+        view[r] = worldToView->GetElement(r, 0) * toLight[0] +
+          worldToView->GetElement(r, 1) * toLight[1] + worldToView->GetElement(r, 2) * toLight[2];
+      }
+      if (vtkMath::Normalize(view) == 0.0)
+      {
+        continue;
+      }
+      const double* color = light->GetDiffuseColor();
+      for (int a = 0; a < 3; ++a)
+      {
+        lightDirections[3 * numLights + a] = static_cast<float>(view[a]);
+        lightColors[3 * numLights + a] = static_cast<float>(color[a] * light->GetIntensity());
+      }
+      ++numLights;
+    }
+  }
+
+  // 7. Draw, restoring every piece of state changed.
+  vtkVolumeProperty* property = vol->GetProperty();
+  TakeGLErrors();
+  vtkOpenGLState::ScopedglEnableDisable blend(ostate, GL_BLEND);
+  vtkOpenGLState::ScopedglEnableDisable depthTest(ostate, GL_DEPTH_TEST);
+  vtkOpenGLState::ScopedglEnableDisable cull(ostate, GL_CULL_FACE);
+  vtkOpenGLState::ScopedglDepthMask depthMask(ostate);
+  vtkOpenGLState::ScopedglBlendFuncSeparate blendFunc(ostate);
+  vtkOpenGLState::ScopedglActiveTexture activeTexture(ostate);
+  ostate->vtkglEnable(GL_DEPTH_TEST);
+  ostate->vtkglDisable(GL_CULL_FACE);
+  if (translucent)
+  {
+    ostate->vtkglEnable(GL_BLEND);
+    ostate->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    ostate->vtkglDepthMask(GL_FALSE);
+  }
+  else
+  {
+    ostate->vtkglDisable(GL_BLEND);
+    ostate->vtkglDepthMask(GL_TRUE);
+  }
+
+  std::vector<vtkTextureObject*> active;
+  vtkTextureObject* volumeTexture = impl.Pyramid->GetVolumeTexture();
+  volumeTexture->Activate();
+  active.push_back(volumeTexture);
+  impl.Pyramid->SetShaderUniforms(program);
+  for (int l = 1; l + 1 < numLevels; ++l)
+  {
+    vtkTextureObject* level = impl.Pyramid->GetLevelTexture(l);
+    level->Activate();
+    active.push_back(level);
+    const std::string name = "level" + std::to_string(l);
+    program->SetUniformi(name.c_str(), level->GetTextureUnit());
+  }
+  const int firstFactor[3] = { sizes[0][0] / sizes[1][0], sizes[0][1] / sizes[1][1],
+    sizes[0][2] / sizes[1][2] };
+  SetIVec3(program, "firstFactor", firstFactor);
+  const float eyeIndex[4] = { static_cast<float>(eye[0]), static_cast<float>(eye[1]),
+    static_cast<float>(eye[2]), static_cast<float>(eye[3]) };
+  program->SetUniform4f("eyeIndex", eyeIndex);
+  program->SetUniformi("backToFront", translucent ? 1 : 0);
+  program->SetUniformi("oneRankPerCell", translucent ? 1 : 0);
+  program->SetUniformi("translucent", translucent ? 1 : 0);
+  program->SetUniformi("parallelProjection", parallel ? 1 : 0);
+  SetMatrix4(program, "indexToClip", indexToClip);
+  SetMatrix4(program, "indexToView", indexToView);
+  SetMatrix3(program, "gradientToView", gradientToView);
+  program->SetUniform1fv("isovalues", 8, isoValues);
+  program->SetUniform4fv("isoColors", 8, reinterpret_cast<const float(*)[4]>(isoColors));
+  program->SetUniformf("ambient", static_cast<float>(property->GetAmbient()));
+  program->SetUniformf("diffuse", static_cast<float>(property->GetDiffuse()));
+  program->SetUniformf("specular", static_cast<float>(property->GetSpecular()));
+  program->SetUniformf("specularPower", static_cast<float>(property->GetSpecularPower()));
+  program->SetUniformi("numberOfLights", numLights);
+  program->SetUniform3fv(
+    "lightDirections", MaximumNumberOfLights, reinterpret_cast<const float(*)[3]>(lightDirections));
+  program->SetUniform3fv(
+    "lightColors", MaximumNumberOfLights, reinterpret_cast<const float(*)[3]>(lightColors));
+
+  impl.VAO->Bind();
+  glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(total));
+  impl.VAO->Release();
+  for (vtkTextureObject* texture : active)
+  {
+    texture->Deactivate();
+  }
+  const std::string errors = TakeGLErrors();
+  if (!errors.empty())
+  {
+    reason = "drawing failed: " + errors;
+    impl.GPUUsable = false;
+    impl.GPUReason = reason;
+    return false;
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoMapper::RenderFallback(vtkRenderer* ren, vtkVolume* vol,
+  vtkImageData* image, vtkDataArray* scalars, const std::vector<Surface>& surfaces)
+{
+  Internals& impl = *this->Impl;
+
+  // Contour an index-space copy of the image (origin 0, spacing 1, no
+  // direction: vtkBlockLODContour needs an axis-aligned grid) and place it
+  // with the actor's matrix, which also carries the volume's matrix.
+  const int* extent = image->GetExtent();
+  impl.IndexImage->SetExtent(0, extent[1] - extent[0], 0, extent[3] - extent[2], 0,
+    extent[5] - extent[4]);
+  impl.IndexImage->SetOrigin(0.0, 0.0, 0.0);
+  impl.IndexImage->SetSpacing(1.0, 1.0, 1.0);
+  if (impl.IndexImage->GetPointData()->GetScalars() != scalars)
+  {
+    impl.IndexImage->GetPointData()->Initialize();
+    impl.IndexImage->GetPointData()->SetScalars(scalars);
+    impl.IndexImage->Modified();
+  }
+  {
+    vtkNew<vtkMatrix4x4> shift, indexToModel;
+    shift->SetElement(0, 3, extent[0]);
+    shift->SetElement(1, 3, extent[2]);
+    shift->SetElement(2, 3, extent[4]);
+    vtkMatrix4x4::Multiply4x4(image->GetIndexToPhysicalMatrix(), shift, indexToModel);
+    vtkNew<vtkMatrix4x4> matrix;
+    vtkMatrix4x4::Multiply4x4(vol->GetMatrix(), indexToModel, matrix);
+    bool changed = false;
+    for (int i = 0; i < 16; ++i)
+    {
+      changed = changed || impl.ActorMatrix->GetData()[i] != matrix->GetData()[i];
+    }
+    if (changed)
+    {
+      impl.ActorMatrix->DeepCopy(matrix);
+    }
+  }
+
+  impl.Contour->SetInputData(impl.IndexImage);
+  impl.Contour->SetInputArrayToProcess(
+    0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+  bool valuesChanged = impl.Contour->GetNumberOfContours() != static_cast<vtkIdType>(surfaces.size());
+  for (std::size_t i = 0; i < surfaces.size() && !valuesChanged; ++i)
+  {
+    valuesChanged = impl.Contour->GetValue(static_cast<int>(i)) != surfaces[i].Value;
+  }
+  if (valuesChanged)
+  {
+    impl.Contour->SetNumberOfContours(static_cast<int>(surfaces.size()));
+    for (std::size_t i = 0; i < surfaces.size(); ++i)
+    {
+      impl.Contour->SetValue(static_cast<int>(i), surfaces[i].Value);
+    }
+  }
+  impl.Contour->Update();
+  vtkPolyData* surface = impl.Contour->GetOutput();
+
+  // Colour every point by its isovalue (RGBA, opacity in alpha).
+  bool translucent = false;
+  for (const Surface& s : surfaces)
+  {
+    translucent = translucent || s.Opacity < 1.0;
+  }
+  impl.Colored->ShallowCopy(surface);
+  vtkDataArray* which = surface->GetPointData()->GetArray("Isovalue");
+  vtkNew<vtkUnsignedCharArray> colors;
+  colors->SetName("Colors");
+  colors->SetNumberOfComponents(4);
+  const vtkIdType numPoints = surface->GetNumberOfPoints();
+  colors->SetNumberOfTuples(numPoints);
+  for (vtkIdType p = 0; p < numPoints; ++p)
+  {
+    const double v = which ? which->GetTuple1(p) : surfaces[0].Value;
+    const Surface* match = &surfaces[0];
+    for (const Surface& s : surfaces)
+    {
+      if (std::abs(s.Value - v) < std::abs(match->Value - v))
+      {
+        match = &s;
+      }
+    }
+    unsigned char rgba[4];
+    for (int c = 0; c < 3; ++c)
+    {
+      rgba[c] = static_cast<unsigned char>(std::lround(255.0 * match->Color[c]));
+    }
+    rgba[3] = static_cast<unsigned char>(std::lround(255.0 * match->Opacity));
+    colors->SetTypedTuple(p, rgba);
+  }
+  impl.Colored->GetPointData()->SetScalars(colors);
+  this->NumberOfFallbackTriangles = static_cast<std::uint64_t>(surface->GetNumberOfPolys());
+
+  vtkVolumeProperty* property = vol->GetProperty();
+  vtkProperty* actorProperty = impl.Actor->GetProperty();
+  actorProperty->SetAmbient(property->GetAmbient());
+  actorProperty->SetDiffuse(property->GetDiffuse());
+  actorProperty->SetSpecular(property->GetSpecular());
+  actorProperty->SetSpecularPower(property->GetSpecularPower());
+  actorProperty->BackfaceCullingOff();
+
+  auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  if (!renWin)
+  {
+    return;
+  }
+  vtkOpenGLState* ostate = renWin->GetState();
+  vtkOpenGLState::ScopedglEnableDisable blend(ostate, GL_BLEND);
+  vtkOpenGLState::ScopedglDepthMask depthMask(ostate);
+  vtkOpenGLState::ScopedglBlendFuncSeparate blendFunc(ostate);
+  if (translucent)
+  {
+    ostate->vtkglEnable(GL_BLEND);
+    ostate->vtkglBlendFuncSeparate(
+      GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    ostate->vtkglDepthMask(GL_FALSE);
+  }
+  else
+  {
+    ostate->vtkglDisable(GL_BLEND);
+    ostate->vtkglDepthMask(GL_TRUE);
+  }
+  impl.PolyMapper->Render(ren, impl.Actor);
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoMapper::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "LastRenderPath: " << this->GetLastRenderPathAsString() << "\n";
+  os << indent << "FallbackReason: " << this->FallbackReason << "\n";
+  os << indent << "ForceCPUFallback: " << this->ForceCPUFallback << "\n";
+  os << indent << "NumberOfPrimitives: " << this->NumberOfPrimitives << "\n";
+  os << indent << "NumberOfPyramidBuilds: " << this->NumberOfPyramidBuilds << "\n";
+  os << indent << "NumberOfVolumeUploads: " << this->NumberOfVolumeUploads << "\n";
+  os << indent << "GPUMemoryBytes: " << this->GetGPUMemoryBytes() << "\n";
+}

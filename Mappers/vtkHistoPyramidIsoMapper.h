@@ -1,0 +1,160 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkHistoPyramidIsoMapper
+ * @brief   Exact GPU isosurfaces of image data by HistoPyramid cell rasterisation.
+ *
+ * vtkHistoPyramidIsoMapper renders the isosurfaces of a vtkVolumeProperty
+ * (vtkVolumeProperty::GetIsoSurfaceValues(), up to 8) of a single-component
+ * vtkImageData as the exact surfaces of the trilinear interpolant, with
+ * correct depth, in OpenGL 3.2 core / GLSL 1.50. It implements the GPU path of
+ * "Hardware Accelerated Medical Data Visualisation on the Web" (section 4.1),
+ * which follows Liu, Clapworthy & Dong, "Fast isosurface rendering on a GPU by
+ * cell rasterization" (2009), with the HistoPyramid of Ziegler et al. (2006):
+ *
+ * -# The volume is uploaded once as a 3D texture that keeps its precision
+ *    (int16 stays 16-bit) and kept until the input or its array changes.
+ * -# vtkOpenGLHistoPyramid counts the active cells of the current isovalues
+ *    (min < iso <= max over the 8 corners, as vtkMarchingCubes) in a 3D 8:1
+ *    pyramid built by render-to-texture passes; only the total comes back to
+ *    the CPU. It is rebuilt only when the isovalues or the data change:
+ *    camera moves reuse it (GetNumberOfPyramidBuilds()).
+ * -# One glDrawArrays(GL_POINTS, 0, total) with no vertex attributes draws
+ *    every active (cell, isovalue) pair. The vertex stage
+ *    (vtkHistoPyramidIso_vs.glsl) walks down the pyramid with gl_VertexID to
+ *    its cell, visiting children nearest-first for the current eye, so the
+ *    primitives come out front to back with no sort (back to front for
+ *    translucency); the geometry stage (vtkHistoPyramidIso_gs.glsl) emits
+ *    the faces of the cell box that face the eye, a footprint that covers the
+ *    cell at any zoom in both projections; the fragment stage
+ *    (vtkHistoPyramidIso_fs.glsl) finds the first root of the cubic the
+ *    trilinear interpolant makes along the ray, shades it with Phong (the
+ *    volume property's ambient, diffuse, specular and specular power, the
+ *    renderer's lights) and writes gl_FragDepth.
+ * -# Colour and opacity of each isovalue come from the property's colour and
+ *    scalar opacity transfer functions at that value. When all are opaque,
+ *    each primitive draws one isovalue, front to back, with depth writes.
+ *    Otherwise every cell is drawn once, back to front, and composites all of
+ *    its isovalues' hits in depth order: translucent skin over opaque bone
+ *    in one pass, blended over whatever the scene holds.
+ *
+ * The volume's matrix (position, orientation, scale), the image's spacing,
+ * origin and direction matrix are honoured. Surfaces are always shaded
+ * (an unshaded isosurface shows no shape), regardless of
+ * vtkVolumeProperty::GetShade().
+ *
+ * Capability check and fallback: the first render in a window runs
+ * vtkMedicalGLCapabilities::Probe(); if the context lacks OpenGL 3.2 or
+ * working integer textures, a shader does not build, the volume exceeds
+ * GL_MAX_3D_TEXTURE_SIZE, or the pyramid needs more vertex texture units than
+ * the context has (or MEDISO_DISABLE_GPU_PATH=1, or ForceCPUFallback is on),
+ * the mapper says so once (a warning with the reason) and renders the same
+ * isovalues with vtkBlockLODContour (level 3) and a vtkPolyDataMapper
+ * (translucent surfaces are then blended unsorted). GetLastRenderPath()
+ * tells which path drew the last frame, GetFallbackReason() why.
+ *
+ * GPU memory: GetGPUMemoryBytes() (the volume texture plus about 0.16 bytes
+ * per padded cell for the pyramid) stays the same across isovalue changes;
+ * ReleaseGraphicsResources() frees every OpenGL object.
+ *
+ * Bad input (no scalars, cell scalars, several components, fewer than 2
+ * points along an axis, an unsupported type, no isovalues) gives one error
+ * or warning and nothing drawn, never a crash.
+ *
+ * @sa vtkOpenGLHistoPyramid vtkMedicalGLCapabilities vtkBlockLODContour
+ */
+#ifndef vtkHistoPyramidIsoMapper_h
+#define vtkHistoPyramidIsoMapper_h
+
+#include "MedicalIsosurfacesMappersModule.h" // For export macro
+#include "vtkVolumeMapper.h"
+
+#include <cstdint> // For std::uint64_t
+#include <memory>  // For std::unique_ptr
+#include <string>  // For std::string
+#include <vector>  // For std::vector
+
+class vtkDataArray;
+class vtkImageData;
+
+class MEDICALISOSURFACESMAPPERS_EXPORT vtkHistoPyramidIsoMapper : public vtkVolumeMapper
+{
+public:
+  static vtkHistoPyramidIsoMapper* New();
+  vtkTypeMacro(vtkHistoPyramidIsoMapper, vtkVolumeMapper);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// Which path drew the last frame.
+  enum RenderPathType
+  {
+    NoPath = 0,      ///< Nothing drawn (no input, bad input, no isovalues, nothing active).
+    GPUPath = 1,     ///< HistoPyramid cell rasterisation.
+    FallbackPath = 2 ///< vtkBlockLODContour + vtkPolyDataMapper.
+  };
+
+  ///@{
+  /**
+   * The path of the last Render() (a RenderPathType), as a value and as a
+   * word ("none", "gpu", "fallback").
+   */
+  vtkGetMacro(LastRenderPath, int);
+  const char* GetLastRenderPathAsString() const;
+  ///@}
+
+  /// Why the GPU path is not used (empty while it is).
+  const std::string& GetFallbackReason() const { return this->FallbackReason; }
+
+  ///@{
+  /**
+   * Render through the CPU fallback even when the GPU path works (tests,
+   * comparisons). Default off.
+   */
+  vtkSetMacro(ForceCPUFallback, bool);
+  vtkGetMacro(ForceCPUFallback, bool);
+  vtkBooleanMacro(ForceCPUFallback, bool);
+  ///@}
+
+  /// Primitives (active cell-isovalue pairs) of the last GPU frame.
+  vtkGetMacro(NumberOfPrimitives, std::uint64_t);
+
+  /// Pyramid builds and volume uploads so far (camera moves do neither).
+  vtkGetMacro(NumberOfPyramidBuilds, std::uint64_t);
+  vtkGetMacro(NumberOfVolumeUploads, std::uint64_t);
+
+  /// Bytes of GPU memory the mapper holds now (volume and pyramid).
+  std::uint64_t GetGPUMemoryBytes() const;
+
+  /// Triangles of the last fallback frame (0 on the GPU path).
+  vtkGetMacro(NumberOfFallbackTriangles, std::uint64_t);
+
+  void Render(vtkRenderer* ren, vtkVolume* vol) override;
+  void ReleaseGraphicsResources(vtkWindow* win) override;
+
+protected:
+  vtkHistoPyramidIsoMapper();
+  ~vtkHistoPyramidIsoMapper() override;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+
+private:
+  vtkHistoPyramidIsoMapper(const vtkHistoPyramidIsoMapper&) = delete;
+  void operator=(const vtkHistoPyramidIsoMapper&) = delete;
+
+  int LastRenderPath = NoPath;
+  std::string FallbackReason;
+  bool ForceCPUFallback = false;
+  std::uint64_t NumberOfPrimitives = 0;
+  std::uint64_t NumberOfPyramidBuilds = 0;
+  std::uint64_t NumberOfVolumeUploads = 0;
+  std::uint64_t NumberOfFallbackTriangles = 0;
+
+  struct Surface; // one isovalue and its colour and opacity
+  bool RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image, vtkDataArray* scalars,
+    const std::vector<Surface>& surfaces, std::string& reason);
+  void RenderFallback(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image,
+    vtkDataArray* scalars, const std::vector<Surface>& surfaces);
+
+  struct Internals;
+  std::unique_ptr<Internals> Impl;
+};
+
+#endif

@@ -1,0 +1,332 @@
+//VTK::System::Dec
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// vtkHistoPyramidIso_fs.glsl: fragment stage of vtkHistoPyramidIsoMapper.
+// Ray-casts the exact trilinear isosurface inside one cell (the cell
+// rasterisation of Liu, Clapworthy & Dong 2009; seed paper, section 4.1).
+//
+// 1. The ray. The eye is homogeneous in cell-index space (w = 1 perspective:
+//    its position; w = 0 parallel: the direction towards the viewer), so the
+//    ray through this fragment's point x of the cell box has direction
+//    x w - eye.xyz in both projections. It is clipped to the cell box (and,
+//    in perspective, to start at the eye, at t = -1).
+// 2. The root. Along the ray, the trilinear interpolant minus the isovalue
+//    is a cubic in t. Its derivative's roots split [t0, t1] into at most
+//    three monotonic pieces (Marmitt et al., "Fast and accurate ray-voxel
+//    intersection techniques for iso-surface ray tracing", VMV 2004); the
+//    first piece whose ends differ in sign holds the first root, refined by
+//    regula falsi with the Illinois modification (a bracket is always kept,
+//    so there is no divergence near tangents or at cell faces). No sign
+//    change: the ray misses, the fragment is discarded.
+// 3. Shading: Phong with the gradient at the hit (the corners' central
+//    differences, interpolated trilinearly: continuous across cells; turned
+//    to face the viewer: isosurfaces are two-sided), the volume property's ambient,
+//    diffuse, specular and specular power, and the renderer's lights.
+// 4. Depth: gl_FragDepth from the hit point, so the surface composites
+//    exactly with polygonal geometry in the same scene.
+//
+// Translucent mode (any isovalue with opacity < 1): the mapper draws the
+// cells back to front and only one primitive per cell; this fragment finds
+// every hit of every crossing isovalue along its piece of ray, sorts them by
+// t and composites them front to back, writing premultiplied colour (the
+// blend is ONE, ONE_MINUS_SRC_ALPHA). Cells never overlap, so ordered cells
+// and ordered hits inside each cell give the exact compositing order: an
+// opaque bone behind translucent skin, in one pass.
+
+out vec4 fragOutput0; // colour (premultiplied in translucent mode)
+
+in vec3 gPosition;
+flat in ivec3 gCell;
+flat in int gMask;
+flat in int gIsovalue;
+flat in vec4 gLow;
+flat in vec4 gHigh;
+flat in vec3 gGradients[8]; // central differences at the corners
+
+uniform vec4 eyeIndex;
+uniform mat4 indexToClip;
+uniform mat4 indexToView;
+uniform mat3 gradientToView;     // inverse transpose of indexToView's linear part
+uniform int parallelProjection;
+uniform int translucent;
+uniform float isovalues[8];      // bit t of gMask: isovalues[t]
+uniform vec4 isoColors[8];       // rgb, opacity
+uniform float ambient;
+uniform float diffuse;
+uniform float specular;
+uniform float specularPower;
+uniform int numberOfLights;
+uniform vec3 lightDirections[6]; // view space, from the surface towards the light
+uniform vec3 lightColors[6];
+
+float corner(int i)
+{
+  return i < 4 ? gLow[i] : gHigh[i - 4];
+}
+
+float trilinear(vec3 p)
+{
+  vec4 x0 = vec4(gLow.x, gLow.z, gHigh.x, gHigh.z);  // corners with dx = 0
+  vec4 x1 = vec4(gLow.y, gLow.w, gHigh.y, gHigh.w);  // corners with dx = 1
+  vec4 x = mix(x0, x1, p.x);                          // (y0z0, y1z0, y0z1, y1z1)
+  vec2 y = mix(x.xz, x.yw, p.y);                      // (z0, z1)
+  return mix(y.x, y.y, p.z);
+}
+
+// The corners' central-difference gradients, interpolated trilinearly.
+vec3 gradient(vec3 p)
+{
+  vec3 y0z0 = mix(gGradients[0], gGradients[1], p.x);
+  vec3 y1z0 = mix(gGradients[2], gGradients[3], p.x);
+  vec3 y0z1 = mix(gGradients[4], gGradients[5], p.x);
+  vec3 y1z1 = mix(gGradients[6], gGradients[7], p.x);
+  return mix(mix(y0z0, y1z0, p.y), mix(y0z1, y1z1, p.y), p.z);
+}
+
+// Coefficients of f(t) = trilinear(o + t d) - iso = ((a t + b) t + c) t + e.
+vec4 cubic(vec3 o, vec3 d, float iso)
+{
+  vec4 k = vec4(0.0);
+  for (int i = 0; i < 8; ++i)
+  {
+    vec3 bits = vec3(float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1));
+    // Weight of the corner along each axis: p + q t.
+    vec3 p = mix(1.0 - o, o, bits);
+    vec3 q = mix(-d, d, bits);
+    float v = corner(i) - iso;
+    k.x += v * q.x * q.y * q.z;
+    k.y += v * (q.x * q.y * p.z + q.x * p.y * q.z + p.x * q.y * q.z);
+    k.z += v * (q.x * p.y * p.z + p.x * q.y * p.z + p.x * p.y * q.z);
+    k.w += v * p.x * p.y * p.z;
+  }
+  return k;
+}
+
+float evalCubic(vec4 k, float t)
+{
+  return ((k.x * t + k.y) * t + k.z) * t + k.w;
+}
+
+// The root in [ta, tb], where f(ta) and f(tb) differ in sign.
+float refine(vec4 k, float ta, float tb, float fa, float fb)
+{
+  int side = 0;
+  for (int it = 0; it < 24; ++it)
+  {
+    float t = (fa * tb - fb * ta) / (fa - fb);
+    float ft = evalCubic(k, t);
+    if (ft * fb > 0.0)
+    {
+      tb = t;
+      fb = ft;
+      if (side == -1)
+      {
+        fa *= 0.5;
+      }
+      side = -1;
+    }
+    else if (ft * fa > 0.0)
+    {
+      ta = t;
+      fa = ft;
+      if (side == 1)
+      {
+        fb *= 0.5;
+      }
+      side = 1;
+    }
+    else
+    {
+      return t;
+    }
+    if (abs(tb - ta) <= 1e-6 * max(abs(ta), abs(tb)) + 1e-12)
+    {
+      break;
+    }
+  }
+  return (fa * tb - fb * ta) / (fa - fb);
+}
+
+// The ends of the monotonic pieces of f on [t0, t1]: returns how many (2..4).
+int pieces(vec4 k, float t0, float t1, out float s[4])
+{
+  s[0] = t0;
+  int n = 1;
+  float a = 3.0 * k.x, b = 2.0 * k.y, c = k.z;
+  float r0 = t1, r1 = t1;
+  float scale = abs(a) + abs(b) + abs(c);
+  if (abs(a) > 1e-7 * scale)
+  {
+    float disc = b * b - 4.0 * a * c;
+    if (disc > 0.0)
+    {
+      float q = -0.5 * (b + sign(b) * sqrt(disc));
+      if (b == 0.0)
+      {
+        q = -0.5 * sqrt(disc);
+      }
+      r0 = q / a;
+      r1 = q != 0.0 ? c / q : r0;
+      if (r0 > r1)
+      {
+        float tmp = r0;
+        r0 = r1;
+        r1 = tmp;
+      }
+    }
+  }
+  else if (abs(b) > 0.0)
+  {
+    r0 = -c / b;
+  }
+  if (r0 > t0 && r0 < t1)
+  {
+    s[n++] = r0;
+  }
+  if (r1 > t0 && r1 < t1 && r1 != r0)
+  {
+    s[n++] = r1;
+  }
+  s[n++] = t1;
+  return n;
+}
+
+vec3 shade(vec3 p, vec3 color)
+{
+  vec3 hit = vec3(gCell) + p;
+  vec3 n = gradientToView * gradient(p);
+  float len = length(n);
+  n = len > 0.0 ? n / len : vec3(0.0, 0.0, 1.0);
+  vec3 toViewer = parallelProjection == 1 ? vec3(0.0, 0.0, 1.0)
+                                          : -normalize((indexToView * vec4(hit, 1.0)).xyz);
+  if (dot(n, toViewer) < 0.0)
+  {
+    n = -n;
+  }
+  vec3 result = ambient * color;
+  for (int l = 0; l < numberOfLights; ++l)
+  {
+    vec3 toLight = lightDirections[l];
+    float lambert = max(dot(n, toLight), 0.0);
+    result += diffuse * lambert * color * lightColors[l];
+    if (lambert > 0.0 && specular > 0.0)
+    {
+      vec3 r = reflect(-toLight, n);
+      result += specular * pow(max(dot(r, toViewer), 0.0), specularPower) * lightColors[l];
+    }
+  }
+  return result;
+}
+
+float depthOf(vec3 p)
+{
+  vec4 clip = indexToClip * vec4(vec3(gCell) + p, 1.0);
+  float ndc = clip.z / clip.w;
+  return 0.5 * (gl_DepthRange.diff * ndc + gl_DepthRange.near + gl_DepthRange.far);
+}
+
+void main()
+{
+  // 1. The ray in the cell's local coordinates: p(t) = o + t d, cell [0, 1]^3.
+  vec3 o = gPosition - vec3(gCell);
+  vec3 d = gPosition * eyeIndex.w - eyeIndex.xyz;
+  vec3 safe = mix(d, vec3(1e-30), equal(d, vec3(0.0)));
+  vec3 ta = -o / safe;
+  vec3 tb = (1.0 - o) / safe;
+  vec3 tlo = min(ta, tb);
+  vec3 thi = max(ta, tb);
+  float t0 = max(max(tlo.x, tlo.y), tlo.z);
+  float t1 = min(min(thi.x, thi.y), thi.z);
+  if (parallelProjection == 0)
+  {
+    t0 = max(t0, -1.0); // the eye
+  }
+  if (!(t0 <= t1))
+  {
+    discard;
+  }
+
+  if (translucent == 0)
+  {
+    // 2. First root of the one isovalue of this primitive.
+    float iso = isovalues[gIsovalue];
+    vec4 k = cubic(o, d, iso);
+    float s[4];
+    int n = pieces(k, t0, t1, s);
+    float fa = evalCubic(k, s[0]);
+    float hitT = 0.0;
+    bool found = false;
+    for (int i = 0; i + 1 < n && !found; ++i)
+    {
+      float fb = evalCubic(k, s[i + 1]);
+      if (fa == 0.0)
+      {
+        hitT = s[i];
+        found = true;
+      }
+      else if (fa * fb <= 0.0)
+      {
+        hitT = fb == 0.0 ? s[i + 1] : refine(k, s[i], s[i + 1], fa, fb);
+        found = true;
+      }
+      fa = fb;
+    }
+    if (!found)
+    {
+      discard;
+    }
+    vec3 p = clamp(o + hitT * d, 0.0, 1.0);
+    fragOutput0 = vec4(shade(p, isoColors[gIsovalue].rgb), 1.0);
+    gl_FragDepth = depthOf(p);
+    return;
+  }
+
+  // Translucent: every hit of every crossing isovalue, sorted, composited.
+  float hitTs[8];
+  int hitIso[8];
+  int hits = 0;
+  for (int t = 0; t < 8; ++t)
+  {
+    if (((gMask >> t) & 1) == 0)
+    {
+      continue;
+    }
+    vec4 k = cubic(o, d, isovalues[t]);
+    float s[4];
+    int n = pieces(k, t0, t1, s);
+    float fa = evalCubic(k, s[0]);
+    for (int i = 0; i + 1 < n && hits < 8; ++i)
+    {
+      float fb = evalCubic(k, s[i + 1]);
+      if (fa == 0.0 || (fa * fb < 0.0))
+      {
+        float root = fa == 0.0 ? s[i] : refine(k, s[i], s[i + 1], fa, fb);
+        // Insertion into the sorted list.
+        int j = hits;
+        while (j > 0 && hitTs[j - 1] > root)
+        {
+          hitTs[j] = hitTs[j - 1];
+          hitIso[j] = hitIso[j - 1];
+          --j;
+        }
+        hitTs[j] = root;
+        hitIso[j] = t;
+        ++hits;
+      }
+      fa = fb;
+    }
+  }
+  if (hits == 0)
+  {
+    discard;
+  }
+  vec4 sum = vec4(0.0);
+  for (int h = 0; h < hits; ++h)
+  {
+    vec3 p = clamp(o + hitTs[h] * d, 0.0, 1.0);
+    vec4 c = isoColors[hitIso[h]];
+    sum += (1.0 - sum.a) * c.a * vec4(shade(p, c.rgb), 1.0);
+  }
+  fragOutput0 = sum;
+  gl_FragDepth = depthOf(clamp(o + hitTs[0] * d, 0.0, 1.0));
+}

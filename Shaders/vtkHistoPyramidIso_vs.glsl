@@ -1,0 +1,182 @@
+//VTK::System::Dec
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// vtkHistoPyramidIso_vs.glsl: vertex stage of vtkHistoPyramidIsoMapper. The
+// mapper draws GetTotal() points with no vertex attributes (one glDrawArrays
+// call, no per-cell CPU work); vertex number gl_VertexID walks down the
+// HistoPyramid of vtkOpenGLHistoPyramid to find its cell and which of the
+// cell's crossing isovalues it draws (Ziegler et al. 2006; the
+// cell-rasterisation scheme of Liu, Clapworthy & Dong 2009, section 4.1 of
+// the seed paper).
+//
+// Front-to-back order without sorting: at every node the children are
+// visited nearest first, the near half along each axis being the one on the
+// eye's side of the node's split plane (the layout and order of
+// mediso::HistoPyramid::Traverse, tested on the CPU). Primitive k is then
+// never in front of primitive k + 1 along a ray from the eye, so early depth
+// rejection works with no per-frame sort; backToFront = 1 reverses the order
+// for translucent compositing. The eye is homogeneous, in cell-index space:
+// w = 1 for a perspective camera (its position), w = 0 for a parallel one
+// (the direction towards the viewer), so both projections share one test.
+//
+// The levels are separate 3D textures (each level has its own size), and
+// GLSL 1.50 cannot index an array of samplers with a variable: the mapper
+// puts one uniform per stored level in place of the HistoPyramidLevels Dec
+// tag and one descend() call per level, with that level's constant factors,
+// in place of the HistoPyramidLevels Impl tag. Level 0 is not stored: the last step
+// recounts the up-to-8 cells of the level-1 node from their <= 27 corner
+// values, which are needed anyway for the fragment stage.
+
+//VTK::HistoPyramidCommon::Dec
+
+//VTK::HistoPyramidLevels::Dec
+
+uniform vec4 eyeIndex;       // eye, homogeneous, in cell-index space
+uniform int backToFront;     // 0: nearest cells first; 1: farthest first
+uniform int oneRankPerCell;  // 1: only the first primitive of a cell is drawn
+uniform ivec3 firstFactor;   // level-1 node size in cells (1 or 2 per axis)
+
+flat out ivec3 vCell;        // the cell
+flat out int vMask;          // crossing isovalues of the cell (bit t: threshold t)
+flat out int vIsovalue;      // the isovalue this primitive draws (-1: none)
+flat out vec4 vLow;          // corner values 0..3 (dx + 2 dy + 4 dz)
+flat out vec4 vHigh;         // corner values 4..7
+out CornerGradients          // central-difference gradient at each corner
+{
+  flat vec3 g[8];
+} vGradients;
+
+// Children of a node in visiting order: bit a of the returned mask flips
+// axis a, so that child (order ^ mask) is the order-th one visited.
+int orderMask(ivec3 node, ivec3 factor, vec3 childSpan)
+{
+  vec3 split = (2.0 * vec3(node) + 1.0) * childSpan;
+  bvec3 plusSide = greaterThanEqual(eyeIndex.xyz - split * eyeIndex.w, vec3(0.0));
+  int mask = (factor.x == 2 && plusSide.x ? 1 : 0) | (factor.y == 2 && plusSide.y ? 2 : 0) |
+    (factor.z == 2 && plusSide.z ? 4 : 0);
+  if (backToFront == 1)
+  {
+    mask ^= (factor.x == 2 ? 1 : 0) | (factor.y == 2 ? 2 : 0) | (factor.z == 2 ? 4 : 0);
+  }
+  return mask;
+}
+
+// One step down: from node (of the level above `lower`) to the child whose
+// running sum covers index.
+void descend(usampler3D lower, ivec3 factor, vec3 childSpan, inout ivec3 node, inout uint index)
+{
+  int mask = orderMask(node, factor, childSpan);
+  ivec3 chosen = node * factor;
+  for (int order = 0; order < 8; ++order)
+  {
+    int c = order ^ mask;
+    ivec3 d = ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+    if (any(greaterThanEqual(d, factor)))
+    {
+      continue;
+    }
+    ivec3 child = node * factor + d;
+    uint count = texelFetch(lower, child, 0).r;
+    if (index < count)
+    {
+      chosen = child;
+      break;
+    }
+    index -= count;
+  }
+  node = chosen;
+}
+
+// Central differences of the volume at the 8 corners of cell c (one-sided
+// at the volume's border), from the 4x4x4 points around the cell. The
+// fragment stage shades with their trilinear interpolation: the exact
+// trilinear surface, lit with gradients that are continuous from cell to
+// cell (the interpolant's own gradient jumps at cell faces, and shows every
+// cell layer as a terrace).
+void cornerGradients(ivec3 c)
+{
+  float b[64];
+  for (int i = 0; i < 64; ++i)
+  {
+    ivec3 d = ivec3(i & 3, (i >> 2) & 3, i >> 4) - 1;
+    b[i] = float(texelFetch(volume, clamp(c + d, ivec3(0), cellDimensions), 0).r);
+  }
+  for (int i = 0; i < 8; ++i)
+  {
+    ivec3 q = ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1) + 1; // corner in the 4x4x4 block
+    ivec3 p = c + q - 1;                                      // its point index
+    ivec3 lo = q - ivec3(greaterThan(p, ivec3(0)));
+    ivec3 hi = q + ivec3(lessThan(p, cellDimensions));
+    vec3 span = max(vec3(hi - lo), vec3(1.0));
+    vGradients.g[i] = vec3(b[hi.x + 4 * q.y + 16 * q.z] - b[lo.x + 4 * q.y + 16 * q.z],
+                      b[q.x + 4 * hi.y + 16 * q.z] - b[q.x + 4 * lo.y + 16 * q.z],
+                      b[q.x + 4 * q.y + 16 * hi.z] - b[q.x + 4 * q.y + 16 * lo.z]) / span;
+  }
+}
+
+void main()
+{
+  uint index = uint(gl_VertexID);
+  ivec3 node = ivec3(0);
+
+//VTK::HistoPyramidLevels::Impl
+
+  // Last step: the cells of the level-1 node, counted from the volume.
+  ivec3 first = node * firstFactor;
+  VALUE_TYPE p[27];
+  for (int i = 0; i < 27; ++i)
+  {
+    ivec3 d = ivec3(i % 3, (i / 3) % 3, i / 9);
+    p[i] = texelFetch(volume, min(first + d, cellDimensions), 0).r;
+  }
+  int mask = orderMask(node, firstFactor, vec3(1.0));
+  vCell = first;
+  vMask = 0;
+  vIsovalue = -1;
+  VALUE_TYPE v[8];
+  for (int order = 0; order < 8; ++order)
+  {
+    int c = order ^ mask;
+    ivec3 d = ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+    if (any(greaterThanEqual(d, firstFactor)))
+    {
+      continue;
+    }
+    for (int i = 0; i < 8; ++i)
+    {
+      ivec3 e = d + ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+      v[i] = p[e.x + 3 * e.y + 9 * e.z];
+    }
+    int crossing = cellMask(first + d, v);
+    uint count = bitCount8(crossing);
+    if (index < count)
+    {
+      vCell = first + d;
+      vMask = crossing;
+      // The index-th crossing isovalue, in increasing threshold order.
+      int rank = int(index);
+      for (int t = 0; t < 8; ++t)
+      {
+        if (((crossing >> t) & 1) == 1)
+        {
+          if (rank == 0)
+          {
+            vIsovalue = t;
+            break;
+          }
+          --rank;
+        }
+      }
+      if (oneRankPerCell == 1 && index != 0u)
+      {
+        vIsovalue = -1;
+      }
+      vLow = vec4(float(v[0]), float(v[1]), float(v[2]), float(v[3]));
+      vHigh = vec4(float(v[4]), float(v[5]), float(v[6]), float(v[7]));
+      cornerGradients(vCell);
+      break;
+    }
+    index -= count;
+  }
+  gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
+}
