@@ -1,0 +1,508 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// vtkHistoPyramidIsoMapper checks, one ctest test per case (the argument):
+//  Counts    - the pyramid's total (the primitives drawn) equals the CPU count
+//              of active cell-isovalue pairs, for 40 single isovalues and 6
+//              isovalue sets, in int16, uint8, float and double data; camera
+//              moves reuse the pyramid (no rebuild, no re-upload).
+//  Memory    - GPU memory against volume bytes (<= 1.5x for a 256x256x108
+//              int16 volume, the head CT's size); it stays the same across
+//              1000 isovalue changes (48^3 phantom); ReleaseGraphicsResources()
+//              frees it all.
+//  Reference - the GPU image matches the full-resolution CPU marching-cubes
+//              image (the mapper's fallback: vtkBlockLODContour level 3 and a
+//              vtkPolyDataMapper) of the same isovalues: covered-pixel masks
+//              agree on >= 98.5% of the pixels covered by either, and the
+//              mean colour difference over pixels covered by both is <= 12
+//              (of 255) per channel; opaque and translucent.
+//  Fallback  - MEDISO_DISABLE_GPU_PATH=1 makes the mapper render through the
+//              fallback, report it (path, reason) and warn exactly once.
+//  BadInput  - no scalars, cell scalars, 3 components, 64-bit integers, 2D
+//              data, no isovalues, more than 8 isovalues, NaN values, an
+//              isovalue outside the range: one clear message each (said once
+//              over several renders) and nothing drawn, never a crash.
+#include "HistoPyramid.h"
+#include "IsoMapperTestScenes.h"
+#include "MedicalTestUtilities.h"
+#include "vtkMedicalGLCapabilities.h"
+
+#include "vtkCallbackCommand.h"
+#include "vtkCamera.h"
+#include "vtkCellData.h"
+#include "vtkDoubleArray.h"
+#include "vtkFloatArray.h"
+#include "vtkRenderWindow.h"
+#include "vtkRenderer.h"
+#include "vtkShortArray.h"
+#include "vtkTypeInt64Array.h"
+#include "vtkUnsignedCharArray.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace
+{
+using medical_test::Check;
+
+// Counts the error and warning events of an object and keeps their texts.
+class MessageCounter
+{
+public:
+  explicit MessageCounter(vtkObject* object)
+  {
+    this->Callback->SetClientData(this);
+    this->Callback->SetCallback(
+      [](vtkObject*, unsigned long event, void* clientData, void* callData)
+      {
+        auto* self = static_cast<MessageCounter*>(clientData);
+        const std::string text = callData ? static_cast<const char*>(callData) : "";
+        if (event == vtkCommand::ErrorEvent)
+        {
+          ++self->Errors;
+        }
+        else
+        {
+          ++self->Warnings;
+        }
+        // Keep the message, not the "ERROR: In file, line" header line.
+        std::string message = text;
+        const std::size_t newline = message.find('\n');
+        if (newline != std::string::npos)
+        {
+          message = message.substr(newline + 1);
+        }
+        while (!message.empty() && message.back() == '\n')
+        {
+          message.pop_back();
+        }
+        self->Text += message + "\n";
+      });
+    object->AddObserver(vtkCommand::ErrorEvent, this->Callback);
+    object->AddObserver(vtkCommand::WarningEvent, this->Callback);
+  }
+  int Errors = 0;
+  int Warnings = 0;
+  std::string Text;
+
+private:
+  vtkNew<vtkCallbackCommand> Callback;
+};
+
+struct Scene
+{
+  vtkNew<vtkRenderWindow> Window;
+  vtkNew<vtkRenderer> Renderer;
+  explicit Scene(int width = 300, int height = 300)
+  {
+    this->Window->SetSize(width, height);
+    this->Window->SetMultiSamples(0);
+    this->Window->AddRenderer(this->Renderer);
+    this->Renderer->SetBackground(0, 0, 0);
+  }
+  void Show(vtkVolume* volume)
+  {
+    this->Renderer->AddVolume(volume);
+    vtkCamera* camera = this->Renderer->GetActiveCamera();
+    camera->SetPosition(-0.4, 1.0, 0.3);
+    camera->SetFocalPoint(0, 0, 0);
+    camera->SetViewUp(0, 0, 1);
+    this->Renderer->ResetCamera();
+  }
+};
+
+template <typename T>
+std::uint64_t CPUCount(vtkImageData* image, const std::vector<double>& isovalues)
+{
+  int dims[3];
+  image->GetDimensions(dims);
+  const T* data = static_cast<const T*>(image->GetPointData()->GetScalars()->GetVoidPointer(0));
+  std::uint64_t total = 0;
+  for (std::uint32_t c : mediso::HistoPyramid::CountCrossings(data, dims, isovalues))
+  {
+    total += c;
+  }
+  return total;
+}
+
+template <typename T, typename ArrayT>
+vtkSmartPointer<vtkImageData> Convert(vtkImageData* source, double scale, double shift)
+{
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->CopyStructure(source);
+  vtkDataArray* in = source->GetPointData()->GetScalars();
+  vtkNew<ArrayT> out;
+  out->SetNumberOfTuples(in->GetNumberOfTuples());
+  for (vtkIdType i = 0; i < in->GetNumberOfTuples(); ++i)
+  {
+    out->SetValue(i, static_cast<T>(in->GetTuple1(i) * scale + shift));
+  }
+  image->GetPointData()->SetScalars(out);
+  return image;
+}
+
+template <typename T>
+void CountCase(const std::string& name, vtkImageData* image)
+{
+  double range[2];
+  image->GetPointData()->GetScalars()->GetRange(range);
+  vtkNew<vtkHistoPyramidIsoMapper> mapper;
+  auto volume = iso_test::MakeVolume(image, { { 0.5 * (range[0] + range[1]), { 1, 1, 1 }, 1 } }, mapper);
+  Scene scene(200, 200);
+  scene.Show(volume);
+  std::vector<std::vector<double>> sets;
+  for (int i = 0; i < 40; ++i)
+  {
+    sets.push_back({ range[0] + (range[1] - range[0]) * (i + 0.5) / 40.0 });
+  }
+  sets.push_back({ range[0] + 0.2 * (range[1] - range[0]), range[0] + 0.7 * (range[1] - range[0]) });
+  sets.push_back({ range[0], range[1] });                 // the ends: nothing crosses at the minimum
+  sets.push_back({ range[0] - 10.0, range[1] + 10.0 });   // outside the range
+  std::vector<double> eight;
+  for (int i = 0; i < 8; ++i)
+  {
+    eight.push_back(range[0] + (range[1] - range[0]) * (i + 1) / 9.0);
+  }
+  sets.push_back(eight);
+  sets.push_back({ std::floor(range[0] + 0.3 * (range[1] - range[0])) }); // an integer value
+  sets.push_back({ std::floor(range[0] + 0.3 * (range[1] - range[0])) + 0.5 });
+  int mismatches = 0;
+  for (const auto& isovalues : sets)
+  {
+    vtkContourValues* values = volume->GetProperty()->GetIsoSurfaceValues();
+    values->SetNumberOfContours(0);
+    for (std::size_t i = 0; i < isovalues.size(); ++i)
+    {
+      values->SetValue(static_cast<int>(i), isovalues[i]);
+    }
+    // Opacity 1 everywhere so that no isovalue is left out as invisible.
+    volume->GetProperty()->GetScalarOpacity()->RemoveAllPoints();
+    volume->GetProperty()->GetScalarOpacity()->AddPoint(range[0] - 100, 1.0);
+    volume->GetProperty()->GetScalarOpacity()->AddPoint(range[1] + 100, 1.0);
+    scene.Window->Render();
+    const std::uint64_t cpu = CPUCount<T>(image, isovalues);
+    const std::uint64_t gpu = mapper->GetNumberOfPrimitives();
+    if (gpu != cpu || mapper->GetLastRenderPath() != vtkHistoPyramidIsoMapper::GPUPath)
+    {
+      ++mismatches;
+      std::printf("  %s: isovalue %g (+%zu more): GPU %llu, CPU %llu, path %s\n", name.c_str(),
+        isovalues[0], isovalues.size() - 1, static_cast<unsigned long long>(gpu),
+        static_cast<unsigned long long>(cpu), mapper->GetLastRenderPathAsString());
+    }
+  }
+  std::printf("%s: %zu isovalue sets, %d mismatches\n", name.c_str(), sets.size(), mismatches);
+  Check(mismatches == 0, name + ": primitives equal the CPU count of active cells");
+
+  // Camera moves reuse the pyramid and the uploaded volume.
+  const auto builds = mapper->GetNumberOfPyramidBuilds();
+  const auto uploads = mapper->GetNumberOfVolumeUploads();
+  for (int i = 0; i < 10; ++i)
+  {
+    scene.Renderer->GetActiveCamera()->Azimuth(10.0);
+    scene.Window->Render();
+  }
+  Check(mapper->GetNumberOfPyramidBuilds() == builds && mapper->GetNumberOfVolumeUploads() == uploads,
+    name + ": camera moves neither rebuild the pyramid nor upload the volume");
+  Check(uploads == 1, name + ": one volume upload for all isovalue changes");
+}
+
+void Counts()
+{
+  auto phantom = iso_test::Phantom(45);
+  CountCase<short>("int16 phantom", phantom);
+  CountCase<unsigned char>(
+    "uint8", Convert<unsigned char, vtkUnsignedCharArray>(phantom, 0.08, 90.0));
+  auto torus = iso_test::Torus(33, 9.0);
+  CountCase<float>("float torus", torus);
+  CountCase<double>("double", Convert<double, vtkDoubleArray>(phantom, 1.0, 0.25));
+}
+
+void Memory()
+{
+  // The ratio on a 256x256x108 int16 volume, as the head CT.
+  {
+    vtkNew<vtkMedicalPhantomSource> source;
+    source->SetDimensions(256, 256, 108);
+    source->SetSpacing(0.957, 0.957, 1.5);
+    source->Update();
+    vtkNew<vtkHistoPyramidIsoMapper> mapper;
+    auto volume =
+      iso_test::MakeVolume(source->GetOutput(), { { -500.0, { 1, 1, 1 }, 1.0 } }, mapper);
+    Scene scene(64, 64);
+    scene.Show(volume);
+    scene.Window->Render();
+    const double volumeBytes = 256.0 * 256.0 * 108.0 * 2.0;
+    const std::uint64_t bytes = mapper->GetGPUMemoryBytes();
+    std::printf("256x256x108 int16: GPU memory %.2f MB for a %.2f MB volume: %.3fx\n", bytes / 1e6,
+      volumeBytes / 1e6, bytes / volumeBytes);
+    Check(bytes > volumeBytes && bytes <= 1.5 * volumeBytes, "GPU memory <= 1.5x the volume bytes");
+  }
+
+  // Flat across 1000 isovalue changes (a smaller volume keeps this quick).
+  auto phantom = iso_test::Phantom(48);
+  vtkNew<vtkHistoPyramidIsoMapper> mapper;
+  auto volume = iso_test::MakeVolume(phantom, { { -900.0, { 1, 1, 1 }, 1.0 } }, mapper);
+  volume->GetProperty()->GetScalarOpacity()->AddPoint(2000.0, 1.0);
+  volume->GetProperty()->GetScalarOpacity()->AddPoint(-1100.0, 1.0);
+  Scene scene(64, 64);
+  scene.Show(volume);
+  scene.Window->Render();
+  const std::uint64_t first = mapper->GetGPUMemoryBytes();
+  std::uint64_t low = first, high = first;
+  for (int i = 0; i < 1000; ++i)
+  {
+    volume->GetProperty()->GetIsoSurfaceValues()->SetValue(0, -899.0 + 2.0 * i);
+    scene.Window->Render();
+    low = std::min(low, mapper->GetGPUMemoryBytes());
+    high = std::max(high, mapper->GetGPUMemoryBytes());
+  }
+  std::printf("1000 isovalue changes: GPU memory %llu..%llu bytes, %llu builds, %llu uploads\n",
+    static_cast<unsigned long long>(low), static_cast<unsigned long long>(high),
+    static_cast<unsigned long long>(mapper->GetNumberOfPyramidBuilds()),
+    static_cast<unsigned long long>(mapper->GetNumberOfVolumeUploads()));
+  Check(first > 0 && low == first && high == first, "GPU memory flat across 1000 isovalue changes");
+  Check(mapper->GetNumberOfPyramidBuilds() == 1001 && mapper->GetNumberOfVolumeUploads() == 1,
+    "one pyramid build per isovalue change, one upload");
+  mapper->ReleaseGraphicsResources(scene.Window);
+  Check(mapper->GetGPUMemoryBytes() == 0, "ReleaseGraphicsResources frees all GPU memory");
+  scene.Window->Render(); // everything is made again
+  Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
+      mapper->GetGPUMemoryBytes() == first,
+    "renders again after a release");
+}
+
+// Renders a scene with the GPU path and with the fallback; compares.
+void CompareWithCPU(const std::string& name, vtkImageData* image, const std::vector<iso_test::Look>& looks)
+{
+  std::vector<unsigned char> pixels[2];
+  const int size = 300;
+  for (int pass = 0; pass < 2; ++pass)
+  {
+    vtkNew<vtkHistoPyramidIsoMapper> mapper;
+    mapper->SetForceCPUFallback(pass == 1);
+    auto volume = iso_test::MakeVolume(image, looks, mapper);
+    Scene scene(size, size);
+    scene.Show(volume);
+    scene.Window->Render();
+    Check(mapper->GetLastRenderPath() ==
+        (pass == 0 ? vtkHistoPyramidIsoMapper::GPUPath : vtkHistoPyramidIsoMapper::FallbackPath),
+      name + ": path " + mapper->GetLastRenderPathAsString());
+    vtkNew<vtkUnsignedCharArray> rgb;
+    scene.Window->GetPixelData(0, 0, size - 1, size - 1, 1, rgb);
+    pixels[pass].assign(rgb->GetPointer(0), rgb->GetPointer(0) + 3 * size * size);
+  }
+  int either = 0, both = 0, disagree = 0;
+  double diff = 0.0;
+  for (int p = 0; p < size * size; ++p)
+  {
+    const unsigned char* a = &pixels[0][3 * p];
+    const unsigned char* b = &pixels[1][3 * p];
+    const bool ca = a[0] > 0 || a[1] > 0 || a[2] > 0;
+    const bool cb = b[0] > 0 || b[1] > 0 || b[2] > 0;
+    either += ca || cb;
+    disagree += ca != cb;
+    if (ca && cb)
+    {
+      ++both;
+      for (int c = 0; c < 3; ++c)
+      {
+        diff += std::abs(static_cast<int>(a[c]) - static_cast<int>(b[c]));
+      }
+    }
+  }
+  const double agreement = either ? 1.0 - static_cast<double>(disagree) / either : 0.0;
+  const double meanDiff = both ? diff / (3.0 * both) : 255.0;
+  std::printf("%s: %d pixels covered by either, masks agree on %.2f%%, mean colour difference "
+              "%.2f\n",
+    name.c_str(), either, 100.0 * agreement, meanDiff);
+  Check(either > 5000, name + ": the surface covers a good part of the image");
+  Check(agreement >= 0.985, name + ": covered pixels agree with the CPU marching-cubes image");
+  Check(meanDiff <= 12.0, name + ": colours agree with the CPU marching-cubes image");
+}
+
+void Reference()
+{
+  auto phantom = iso_test::Phantom(96);
+  const iso_test::Look skin{ -500.0, { 0.93, 0.75, 0.62 }, 1.0 };
+  const iso_test::Look bone{ 400.0, { 0.97, 0.95, 0.88 }, 1.0 };
+  CompareWithCPU("phantom skin", phantom, { skin });
+  CompareWithCPU("phantom bone", phantom, { bone });
+  CompareWithCPU("torus", iso_test::Torus(40, 11.0), { { 4.2, { 0.5, 0.85, 0.45 }, 1.0 } });
+}
+
+void Fallback()
+{
+  auto phantom = iso_test::Phantom(48);
+  vtkNew<vtkHistoPyramidIsoMapper> mapper;
+  MessageCounter messages(mapper);
+  auto volume = iso_test::MakeVolume(phantom, { { -500.0, { 1, 1, 1 }, 1.0 } }, mapper);
+  Scene scene;
+  scene.Show(volume);
+  for (int i = 0; i < 3; ++i)
+  {
+    scene.Window->Render();
+    scene.Renderer->GetActiveCamera()->Azimuth(20);
+  }
+  volume->GetProperty()->GetIsoSurfaceValues()->SetValue(0, 400.0);
+  scene.Window->Render();
+  std::printf("path %s, reason '%s', %llu triangles, %d warnings:\n%s",
+    mapper->GetLastRenderPathAsString(), mapper->GetFallbackReason().c_str(),
+    static_cast<unsigned long long>(mapper->GetNumberOfFallbackTriangles()), messages.Warnings,
+    messages.Text.c_str());
+  Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::FallbackPath, "fallback path taken");
+  Check(mapper->GetFallbackReason().find("MEDISO_DISABLE_GPU_PATH") != std::string::npos,
+    "the reason names the switch");
+  Check(messages.Warnings == 1 && messages.Errors == 0 &&
+      messages.Text.find("GPU isosurface path unavailable") != std::string::npos,
+    "one warning says so, once over several renders");
+  Check(mapper->GetNumberOfFallbackTriangles() > 1000 && mapper->GetNumberOfPrimitives() == 0,
+    "the fallback drew triangles, the GPU path nothing");
+  Check(mapper->GetGPUMemoryBytes() == 0, "no GPU volume held by the fallback");
+}
+
+vtkSmartPointer<vtkImageData> SmallImage(int nx, int ny, int nz, vtkDataArray* scalars, bool cells = false)
+{
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(nx, ny, nz);
+  if (scalars)
+  {
+    const vtkIdType n = cells ? image->GetNumberOfCells() : image->GetNumberOfPoints();
+    scalars->SetNumberOfTuples(n);
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      for (int c = 0; c < scalars->GetNumberOfComponents(); ++c)
+      {
+        scalars->SetComponent(i, c, static_cast<double>(i % 97));
+      }
+    }
+    if (cells)
+    {
+      image->GetCellData()->SetScalars(scalars);
+    }
+    else
+    {
+      image->GetPointData()->SetScalars(scalars);
+    }
+  }
+  return image;
+}
+
+void ExpectMessage(const std::string& name, vtkImageData* image, std::vector<double> isovalues,
+  bool error, const std::string& needle, vtkHistoPyramidIsoMapper::RenderPathType path)
+{
+  vtkNew<vtkHistoPyramidIsoMapper> mapper;
+  MessageCounter messages(mapper);
+  std::vector<iso_test::Look> looks;
+  for (double v : isovalues)
+  {
+    looks.push_back({ v, { 1, 1, 1 }, 1.0 });
+  }
+  auto volume = iso_test::MakeVolume(image, looks.empty() ? std::vector<iso_test::Look>{ { 10.0, { 1, 1, 1 }, 1.0 } } : looks, mapper);
+  if (looks.empty())
+  {
+    volume->GetProperty()->GetIsoSurfaceValues()->SetNumberOfContours(0);
+  }
+  Scene scene(100, 100);
+  scene.Show(volume);
+  scene.Window->Render();
+  scene.Window->Render();
+  scene.Renderer->GetActiveCamera()->Azimuth(30);
+  scene.Window->Render();
+  const int count = error ? messages.Errors : messages.Warnings;
+  const int other = error ? messages.Warnings : messages.Errors;
+  std::printf("%s: path %s, %d errors, %d warnings: %s", name.c_str(),
+    mapper->GetLastRenderPathAsString(), messages.Errors, messages.Warnings,
+    messages.Text.empty() ? "(none)\n" : messages.Text.c_str());
+  Check(path == vtkHistoPyramidIsoMapper::NoPath ? mapper->GetLastRenderPath() == path
+                                                 : mapper->GetLastRenderPath() == path,
+    name + ": path " + mapper->GetLastRenderPathAsString());
+  if (needle.empty())
+  {
+    Check(messages.Errors == 0 && messages.Warnings == 0, name + ": no message");
+  }
+  else
+  {
+    Check(count == 1 && other == 0 && messages.Text.find(needle) != std::string::npos,
+      name + ": one message containing '" + needle + "'");
+  }
+}
+
+void BadInput()
+{
+  ExpectMessage("no scalars", SmallImage(8, 8, 8, nullptr), { 10.0 }, true, "no point scalars",
+    vtkHistoPyramidIsoMapper::NoPath);
+  vtkNew<vtkFloatArray> cellValues;
+  cellValues->SetName("cells");
+  ExpectMessage("cell scalars", SmallImage(8, 8, 8, cellValues, true), { 10.0 }, true,
+    "is cell data", vtkHistoPyramidIsoMapper::NoPath);
+  vtkNew<vtkFloatArray> three;
+  three->SetNumberOfComponents(3);
+  ExpectMessage("3 components", SmallImage(8, 8, 8, three), { 10.0 }, true, "3 components",
+    vtkHistoPyramidIsoMapper::NoPath);
+  vtkNew<vtkTypeInt64Array> wide;
+  ExpectMessage("int64", SmallImage(8, 8, 8, wide), { 10.0 }, true, "one component of an 8, 16 or 32-bit",
+    vtkHistoPyramidIsoMapper::NoPath);
+  vtkNew<vtkFloatArray> flat;
+  ExpectMessage("2D", SmallImage(8, 8, 1, flat), { 10.0 }, true, "needs 3D image data",
+    vtkHistoPyramidIsoMapper::NoPath);
+  vtkNew<vtkFloatArray> plain;
+  auto image = SmallImage(8, 8, 8, plain);
+  ExpectMessage("no isovalues", image, {}, false, "no isovalues", vtkHistoPyramidIsoMapper::NoPath);
+  ExpectMessage("nine isovalues", image, { 1, 2, 3, 4, 5, 6, 7, 8, 9 }, false,
+    "only the lowest 8 are drawn", vtkHistoPyramidIsoMapper::GPUPath);
+  ExpectMessage("isovalue outside the range", image, { 1000.0 }, false, "",
+    vtkHistoPyramidIsoMapper::GPUPath);
+  // NaN values: their cells are never active; no NaN reaches the picture.
+  vtkNew<vtkFloatArray> withNaN;
+  auto nanImage = SmallImage(8, 8, 8, withNaN);
+  for (vtkIdType i = 0; i < withNaN->GetNumberOfTuples(); i += 5)
+  {
+    withNaN->SetValue(i, std::numeric_limits<float>::quiet_NaN());
+  }
+  ExpectMessage("NaN values", nanImage, { 40.0 }, false, "", vtkHistoPyramidIsoMapper::GPUPath);
+}
+} // namespace
+
+int TestHistoPyramidIsoMapperChecks(int argc, char* argv[])
+{
+  const std::string which = argc > 1 ? argv[1] : "";
+  if (which == "Fallback")
+  {
+    // Before any window exists: the capability probe reads it.
+    setenv("MEDISO_DISABLE_GPU_PATH", "1", 1);
+    Fallback();
+    return medical_test::Finish("TestHistoPyramidIsoMapperChecks Fallback");
+  }
+  vtkNew<vtkRenderWindow> probeWindow;
+  probeWindow->SetSize(64, 64);
+  vtkNew<vtkMedicalGLCapabilities> caps;
+  if (!caps->Probe(probeWindow))
+  {
+    std::printf("SKIP: %s (%s)\n", caps->GetReason().c_str(), caps->GetStatusAsString());
+    return caps->GetStatus() == vtkMedicalGLCapabilities::StatusProbeFailed ? 1 : 125;
+  }
+  if (which == "Counts")
+  {
+    Counts();
+  }
+  else if (which == "Memory")
+  {
+    Memory();
+  }
+  else if (which == "Reference")
+  {
+    Reference();
+  }
+  else if (which == "BadInput")
+  {
+    BadInput();
+  }
+  else
+  {
+    std::printf("unknown case '%s'\n", which.c_str());
+    return 1;
+  }
+  return medical_test::Finish(("TestHistoPyramidIsoMapperChecks " + which).c_str());
+}
