@@ -6,8 +6,7 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLFramebufferObject.h"
-#include "vtkOpenGLQuadHelper.h"
-#include "vtkOpenGLRenderUtilities.h"
+#include "vtkOpenGLVertexArrayObject.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
@@ -21,6 +20,8 @@
 #include "vtkHistoPyramidBase_fs.h"
 #include "vtkHistoPyramidCommon.h"
 #include "vtkHistoPyramidFirstLevel_fs.h"
+#include "vtkHistoPyramidLayer_gs.h"
+#include "vtkHistoPyramidLayer_vs.h"
 #include "vtkHistoPyramidReduce_fs.h"
 
 #include <array>
@@ -360,10 +361,13 @@ struct vtkOpenGLHistoPyramid::Internals
 
   // The passes.
   vtkSmartPointer<vtkOpenGLFramebufferObject> FBO;
-  std::unique_ptr<vtkOpenGLQuadHelper> FirstQuad;
-  std::unique_ptr<vtkOpenGLQuadHelper> BaseQuad; // ReadLevel(0) only
-  ValueKind QuadKind = ValueKind::Float;         // value type of FirstQuad and BaseQuad
-  std::unique_ptr<vtkOpenGLQuadHelper> ReduceQuad;
+  // The passes' programs (owned by the window's shader cache) and the empty
+  // vertex array their attribute-less layered draws need.
+  vtkShaderProgram* FirstQuad = nullptr;
+  vtkShaderProgram* BaseQuad = nullptr;  // ReadLevel(0) only
+  ValueKind QuadKind = ValueKind::Float; // value type of FirstQuad and BaseQuad
+  vtkShaderProgram* ReduceQuad = nullptr;
+  vtkNew<vtkOpenGLVertexArrayObject> VAO;
 
   void ReleaseLevels(vtkWindow* win)
   {
@@ -381,19 +385,15 @@ struct vtkOpenGLHistoPyramid::Internals
     this->Total = 0;
   }
 
-  static void ReleaseQuad(vtkWindow* win, std::unique_ptr<vtkOpenGLQuadHelper>& quad)
+  static void ReleaseQuad(vtkWindow* win, vtkShaderProgram*& program)
   {
-    if (quad)
+    // The programs belong to the window's shader cache: free their GL
+    // objects so that the cache recompiles them if they are asked for again.
+    if (program)
     {
-      // The programs belong to the window's shader cache: free their GL
-      // objects so that the cache recompiles them if they are asked for again.
-      if (quad->Program)
-      {
-        quad->Program->ReleaseGraphicsResources(win);
-      }
-      quad->ReleaseGraphicsResources(win);
+      program->ReleaseGraphicsResources(win);
     }
-    quad.reset();
+    program = nullptr;
   }
 
   void ReleaseAll(vtkWindow* win)
@@ -408,6 +408,7 @@ struct vtkOpenGLHistoPyramid::Internals
     ReleaseQuad(win, this->FirstQuad);
     ReleaseQuad(win, this->BaseQuad);
     ReleaseQuad(win, this->ReduceQuad);
+    this->VAO->ReleaseGraphicsResources();
     if (this->FBO)
     {
       this->FBO->ReleaseGraphicsResources(win);
@@ -430,27 +431,23 @@ struct vtkOpenGLHistoPyramid::Internals
     return fs;
   }
 
-  // Ready (compile or rebind) a pass program, creating its quad helper on
-  // first use. Returns the bound program, or nullptr when it does not build.
+  // Ready (compile or rebind) a pass program: the layered full-screen quads
+  // with fragment shader `fs`. Returns the bound program, or nullptr when it
+  // does not build.
   static vtkShaderProgram* ReadyPass(
-    vtkOpenGLRenderWindow* win, std::unique_ptr<vtkOpenGLQuadHelper>& quad, const std::string& fs)
+    vtkOpenGLRenderWindow* win, vtkShaderProgram*& program, const std::string& fs)
   {
-    if (!quad)
-    {
-      // Ready it through the cache first so that a compile failure is caught
-      // here rather than inside the quad helper's vertex array set-up.
-      const std::string vs = vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader();
-      if (!win->GetShaderCache()->ReadyShaderProgram(vs.c_str(), fs.c_str(), ""))
-      {
-        return nullptr;
-      }
-      quad = std::make_unique<vtkOpenGLQuadHelper>(win, vs.c_str(), fs.c_str(), "");
-    }
-    if (!quad->Program)
-    {
-      return nullptr;
-    }
-    return win->GetShaderCache()->ReadyShaderProgram(quad->Program);
+    program = win->GetShaderCache()->ReadyShaderProgram(
+      vtkHistoPyramidLayer_vs, fs.c_str(), vtkHistoPyramidLayer_gs);
+    return program;
+  }
+
+  // All `slices` z-slices of the layered attachment, in one draw call.
+  void DrawSlices(int slices)
+  {
+    this->VAO->Bind();
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, slices);
+    this->VAO->Release();
   }
 
   // Set the uniforms of vtkHistoPyramidCommon.glsl on the bound program; the
@@ -792,7 +789,8 @@ bool vtkOpenGLHistoPyramid::Build(
     return false;
   }
 
-  // 3. The framebuffer: one slice of one level attached at a time.
+  // 3. The framebuffer: one level attached at a time, all its slices as
+  //    layers (gl_Layer selects the slice).
   if (!impl.FBO)
   {
     impl.FBO = vtkSmartPointer<vtkOpenGLFramebufferObject>::New();
@@ -802,11 +800,9 @@ bool vtkOpenGLHistoPyramid::Build(
   impl.FBO->Bind();
   impl.FBO->ActivateDrawBuffers(1);
   impl.FBO->ActivateReadBuffer(0);
-  auto attach = [&](vtkTextureObject* texture, int slice) -> bool
+  auto attach = [&](vtkTextureObject* texture) -> bool
   {
-    glFramebufferTextureLayer(
-      GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, texture->GetHandle(), 0, slice);
-    if (slice == 0)
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, texture->GetHandle(), 0);
     {
       const char* desc = nullptr;
       if (!vtkOpenGLFramebufferObject::GetFrameBufferStatus(GL_FRAMEBUFFER, desc))
@@ -820,10 +816,10 @@ bool vtkOpenGLHistoPyramid::Build(
   };
   struct Detach
   {
-    ~Detach() { glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, 0, 0, 0); }
+    ~Detach() { glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, 0, 0); }
   } detachOnExit;
 
-  // 4. Level 1 from the volume: one quad per z-slice.
+  // 4. Level 1 from the volume: one layered draw.
   {
     renWin->GetShaderCache()->ReadyShaderProgram(firstProgram);
     ScopedTextureActive volumeActive(impl.Volume);
@@ -835,15 +831,11 @@ bool vtkOpenGLHistoPyramid::Build(
     const int sliceSize[2] = { size[0], size[1] };
     firstProgram->SetUniform2i("sliceSize", sliceSize);
     ostate->vtkglViewport(0, 0, size[0], size[1]);
-    for (int z = 0; z < size[2]; ++z)
+    if (!attach(impl.Levels[1]))
     {
-      if (!attach(impl.Levels[1], z))
-      {
-        return false;
-      }
-      firstProgram->SetUniformi("slice", z);
-      impl.FirstQuad->Render();
+      return false;
     }
+    impl.DrawSlices(size[2]);
   }
 
   // 5. Reduction passes: level l from level l - 1.
@@ -859,20 +851,16 @@ bool vtkOpenGLHistoPyramid::Build(
     SetUniformIVec3(reduceProgram, "factor", factor);
     reduceProgram->SetUniform2i("sliceSize", sliceSize);
     ostate->vtkglViewport(0, 0, size[0], size[1]);
-    for (int z = 0; z < size[2]; ++z)
+    if (!attach(impl.Levels[l]))
     {
-      if (!attach(impl.Levels[l], z))
-      {
-        return false;
-      }
-      reduceProgram->SetUniformi("slice", z);
-      impl.ReduceQuad->Render();
+      return false;
     }
+    impl.DrawSlices(size[2]);
   }
 
   // 6. Read back the top node only.
   GLuint top = 0;
-  if (!attach(impl.Levels[numLevels - 1], 0))
+  if (!attach(impl.Levels[numLevels - 1]))
   {
     return false;
   }
@@ -938,12 +926,8 @@ bool vtkOpenGLHistoPyramid::ReadLevel(int level, std::vector<std::uint32_t>& cou
     const int sliceSize[2] = { s[0], s[1] };
     baseProgram->SetUniform2i("sliceSize", sliceSize);
     win->GetState()->vtkglViewport(0, 0, s[0], s[1]);
-    for (int z = 0; z < s[2]; ++z)
-    {
-      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, texture->GetHandle(), 0, z);
-      baseProgram->SetUniformi("slice", z);
-      impl.BaseQuad->Render();
-    }
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, texture->GetHandle(), 0);
+    impl.DrawSlices(s[2]);
   }
   const std::size_t sliceCount = static_cast<std::size_t>(s[0]) * s[1];
   for (int z = 0; z < s[2]; ++z)

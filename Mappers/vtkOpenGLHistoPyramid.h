@@ -30,10 +30,13 @@
  * 256x256x108 int16 CT: 14.2 MB volume + 1.4 MB pyramid).
  *
  * Only OpenGL 3.2 core / GLSL 1.50 is used (no compute shaders, no shader
- * storage buffers, no image load/store). The build is a sequence of
- * full-screen passes (vtkOpenGLQuadHelper), one per z-slice of each level,
- * rendered into that slice (glFramebufferTextureLayer) with an unsigned
- * integer fragment output:
+ * storage buffers, no image load/store). The build is one draw call per
+ * level: the level's 3D texture is attached whole as a layered framebuffer
+ * attachment, and an instanced full-screen quad per z-slice
+ * (vtkHistoPyramidLayer_vs.glsl) is routed to its slice by a geometry shader
+ * setting gl_Layer (vtkHistoPyramidLayer_gs.glsl); the fragment stages write
+ * an unsigned integer output (a handful of draw calls per rebuild instead of
+ * one per slice and level).
  * -# Level-1 pass (vtkHistoPyramidFirstLevel_fs.glsl): fragment (i, j) of
  *    slice k is node (i, j, k); it sums over its cells the number of
  *    isovalues with min < iso <= max over the cell's eight corners (the

@@ -7,7 +7,7 @@
 // cells itself, and the traversal recounts the cells of its last node from
 // the volume): vtkOpenGLHistoPyramid::ReadLevel(0) draws this pass into a
 // temporary texture so that tests can compare every cell with the CPU.
-// Drawn as one full-screen quad per z-slice: fragment (i, j) of slice k is
+// Drawn as one full-screen quad per z-slice (all slices in one layered draw): fragment (i, j) of slice k is
 // cell (i, j, k) and writes the number of isovalues crossing it (0 for the
 // padding cells beyond the real cell grid).
 //
@@ -21,7 +21,7 @@
 in vec2 texCoord;
 
 uniform ivec2 sliceSize; // level-0 size in x and y (powers of two)
-uniform int slice;       // z of the slice being written
+flat in int slice;       // z of the slice being written (vtkHistoPyramidLayer_gs.glsl)
 
 out uvec4 fragOutput0;
 

@@ -20,7 +20,7 @@ in vec2 texCoord;
 
 uniform ivec3 factor;    // 1 or 2 per axis (base level to level 1)
 uniform ivec2 sliceSize; // size of level 1 in x and y
-uniform int slice;       // z of the slice being written
+flat in int slice;       // z of the slice being written (vtkHistoPyramidLayer_gs.glsl)
 
 out uvec4 fragOutput0;
 

@@ -16,7 +16,7 @@ in vec2 texCoord;
 uniform usampler3D lowerLevel; // GL_R32UI, texelFetch only
 uniform ivec3 factor;          // 1 or 2 per axis
 uniform ivec2 sliceSize;       // size of the level being written, x and y
-uniform int slice;             // z of the slice being written
+flat in int slice;       // z of the slice being written (vtkHistoPyramidLayer_gs.glsl)
 
 out uvec4 fragOutput0;
 
