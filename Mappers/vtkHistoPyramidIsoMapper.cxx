@@ -135,6 +135,7 @@ struct vtkHistoPyramidIsoMapper::Internals
   bool GPUUsable = false;
   std::string GPUReason;
   int MaxVertexTextureUnits = 0;
+  bool ConservativeDepth = false;
   int Max3DTextureSize = 0;
 
   // What the uploaded volume and the built pyramid were made from.
@@ -425,6 +426,19 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     GLint units = 0;
     glGetIntegerv(GL_MAX_VERTEX_TEXTURE_IMAGE_UNITS, &units);
     impl.MaxVertexTextureUnits = units;
+    // Early depth rejection with gl_FragDepth written (see the fragment shader).
+    impl.ConservativeDepth = false;
+    GLint numExtensions = 0;
+    glGetIntegerv(GL_NUM_EXTENSIONS, &numExtensions);
+    for (GLint e = 0; e < numExtensions; ++e)
+    {
+      const char* name = reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, e));
+      if (name && std::string(name) == "GL_ARB_conservative_depth")
+      {
+        impl.ConservativeDepth = true;
+      }
+    }
+    TakeGLErrors();
   }
   if (!impl.GPUUsable)
   {
@@ -524,15 +538,21 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
             << sizes[0][2] / sizes[c][2] << ".0), node, index);\n";
   }
   const std::string declarations = impl.Pyramid->GetShaderDeclarations();
-  key << declarations.size() << declarations.substr(0, 80) << "|" << dec.str() << descend.str();
+  key << declarations.size() << declarations.substr(0, 80) << "|" << dec.str() << descend.str()
+      << impl.ConservativeDepth;
   if (!impl.Program || impl.ProgramKey != key.str())
   {
     std::string vs = vtkHistoPyramidIso_vs;
     vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidCommon::Dec", declarations);
     vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Dec", dec.str());
     vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Impl", descend.str());
-    impl.Program = renWin->GetShaderCache()->ReadyShaderProgram(
-      vs.c_str(), vtkHistoPyramidIso_fs, vtkHistoPyramidIso_gs);
+    std::string fs = vtkHistoPyramidIso_fs;
+    vtkShaderProgram::Substitute(fs, "//VTK::ConservativeDepth::Dec",
+      impl.ConservativeDepth
+        ? "#extension GL_ARB_conservative_depth : require\nlayout(depth_greater) out float gl_FragDepth;\n"
+        : "");
+    impl.Program =
+      renWin->GetShaderCache()->ReadyShaderProgram(vs.c_str(), fs.c_str(), vtkHistoPyramidIso_gs);
     if (!impl.Program)
     {
       impl.ProgramKey.clear();

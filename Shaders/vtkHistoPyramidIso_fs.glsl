@@ -1,4 +1,5 @@
 //VTK::System::Dec
+//VTK::ConservativeDepth::Dec
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // vtkHistoPyramidIso_fs.glsl: fragment stage of vtkHistoPyramidIsoMapper.
@@ -23,7 +24,15 @@
 //    to face the viewer: isosurfaces are two-sided), the volume property's ambient,
 //    diffuse, specular and specular power, and the renderer's lights.
 // 4. Depth: gl_FragDepth from the hit point, so the surface composites
-//    exactly with polygonal geometry in the same scene.
+//    exactly with polygonal geometry in the same scene. Where the context
+//    has GL_ARB_conservative_depth (or OpenGL 4.2), the mapper declares
+//    gl_FragDepth depth_greater in place of the ConservativeDepth tag above:
+//    the hit lies behind the cell face being rasterised, so the depth test
+//    may run before this shader, and with the cells drawn front to back the
+//    cells hidden behind a surface already drawn cost no ray casting (the
+//    paper's reason for sorting). The one exception, the cell holding a
+//    perspective eye (drawn from inside, by its back faces), only arises
+//    when the surface touches the near plane.
 //
 // Translucent mode (any isovalue with opacity < 1): the mapper draws the
 // cells back to front and only one primitive per cell; this fragment finds
@@ -59,20 +68,6 @@ uniform int numberOfLights;
 uniform vec3 lightDirections[6]; // view space, from the surface towards the light
 uniform vec3 lightColors[6];
 
-float corner(int i)
-{
-  return i < 4 ? gLow[i] : gHigh[i - 4];
-}
-
-float trilinear(vec3 p)
-{
-  vec4 x0 = vec4(gLow.x, gLow.z, gHigh.x, gHigh.z);  // corners with dx = 0
-  vec4 x1 = vec4(gLow.y, gLow.w, gHigh.y, gHigh.w);  // corners with dx = 1
-  vec4 x = mix(x0, x1, p.x);                          // (y0z0, y1z0, y0z1, y1z1)
-  vec2 y = mix(x.xz, x.yw, p.y);                      // (z0, z1)
-  return mix(y.x, y.y, p.z);
-}
-
 // The corners' central-difference gradients, interpolated trilinearly.
 vec3 gradient(vec3 p)
 {
@@ -84,22 +79,28 @@ vec3 gradient(vec3 p)
 }
 
 // Coefficients of f(t) = trilinear(o + t d) - iso = ((a t + b) t + c) t + e.
+// The interpolant in monomial form, m0 + m1 x + m2 y + m3 z + m4 xy + m5 yz
+// + m6 xz + m7 xyz, makes them a few products per fragment.
 vec4 cubic(vec3 o, vec3 d, float iso)
 {
-  vec4 k = vec4(0.0);
-  for (int i = 0; i < 8; ++i)
-  {
-    vec3 bits = vec3(float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1));
-    // Weight of the corner along each axis: p + q t.
-    vec3 p = mix(1.0 - o, o, bits);
-    vec3 q = mix(-d, d, bits);
-    float v = corner(i) - iso;
-    k.x += v * q.x * q.y * q.z;
-    k.y += v * (q.x * q.y * p.z + q.x * p.y * q.z + p.x * q.y * q.z);
-    k.z += v * (q.x * p.y * p.z + p.x * q.y * p.z + p.x * p.y * q.z);
-    k.w += v * p.x * p.y * p.z;
-  }
-  return k;
+  float c000 = gLow.x, c100 = gLow.y, c010 = gLow.z, c110 = gLow.w;
+  float c001 = gHigh.x, c101 = gHigh.y, c011 = gHigh.z, c111 = gHigh.w;
+  float m1 = c100 - c000;
+  float m2 = c010 - c000;
+  float m3 = c001 - c000;
+  float m4 = c110 - c100 - c010 + c000;
+  float m5 = c011 - c010 - c001 + c000;
+  float m6 = c101 - c100 - c001 + c000;
+  float m7 = c111 - c110 - c101 - c011 + c100 + c010 + c001 - c000;
+  // Gradient of the interpolant at o, and its second-order terms along d.
+  vec3 g = vec3(m1 + m4 * o.y + m6 * o.z + m7 * o.y * o.z,
+                m2 + m4 * o.x + m5 * o.z + m7 * o.x * o.z,
+                m3 + m5 * o.y + m6 * o.x + m7 * o.x * o.y);
+  float value = c000 - iso + m1 * o.x + m2 * o.y + m3 * o.z + m4 * o.x * o.y + m5 * o.y * o.z +
+    m6 * o.x * o.z + m7 * o.x * o.y * o.z;
+  float quadratic = m4 * d.x * d.y + m5 * d.y * d.z + m6 * d.x * d.z +
+    m7 * (o.x * d.y * d.z + o.y * d.x * d.z + o.z * d.x * d.y);
+  return vec4(m7 * d.x * d.y * d.z, quadratic, dot(g, d), value);
 }
 
 float evalCubic(vec4 k, float t)
@@ -107,11 +108,13 @@ float evalCubic(vec4 k, float t)
   return ((k.x * t + k.y) * t + k.z) * t + k.w;
 }
 
-// The root in [ta, tb], where f(ta) and f(tb) differ in sign.
-float refine(vec4 k, float ta, float tb, float fa, float fb)
+// The root in [ta, tb], where f(ta) and f(tb) differ in sign, to within
+// `tolerance` in t (1e-4 voxel: far below what a pixel or the depth buffer
+// resolves; fragments run in SIMD groups, so every iteration saved counts).
+float refine(vec4 k, float ta, float tb, float fa, float fb, float tolerance)
 {
   int side = 0;
-  for (int it = 0; it < 24; ++it)
+  for (int it = 0; it < 16; ++it)
   {
     float t = (fa * tb - fb * ta) / (fa - fb);
     float ft = evalCubic(k, t);
@@ -139,7 +142,7 @@ float refine(vec4 k, float ta, float tb, float fa, float fb)
     {
       return t;
     }
-    if (abs(tb - ta) <= 1e-6 * max(abs(ta), abs(tb)) + 1e-12)
+    if (abs(tb - ta) <= tolerance)
     {
       break;
     }
@@ -245,6 +248,7 @@ void main()
   {
     discard;
   }
+  float tolerance = 1e-4 / max(length(d), 1e-30);
 
   if (translucent == 0)
   {
@@ -266,7 +270,7 @@ void main()
       }
       else if (fa * fb <= 0.0)
       {
-        hitT = fb == 0.0 ? s[i + 1] : refine(k, s[i], s[i + 1], fa, fb);
+        hitT = fb == 0.0 ? s[i + 1] : refine(k, s[i], s[i + 1], fa, fb, tolerance);
         found = true;
       }
       fa = fb;
@@ -300,7 +304,7 @@ void main()
       float fb = evalCubic(k, s[i + 1]);
       if (fa == 0.0 || (fa * fb < 0.0))
       {
-        float root = fa == 0.0 ? s[i] : refine(k, s[i], s[i + 1], fa, fb);
+        float root = fa == 0.0 ? s[i] : refine(k, s[i], s[i + 1], fa, fb, tolerance);
         // Insertion into the sorted list.
         int j = hits;
         while (j > 0 && hitTs[j - 1] > root)

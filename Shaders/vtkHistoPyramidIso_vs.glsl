@@ -88,30 +88,45 @@ void descend(usampler3D lower, ivec3 factor, vec3 childSpan, inout ivec3 node, i
 }
 
 // Central differences of the volume at the 8 corners of cell c (one-sided
-// at the volume's border), from the 4x4x4 points around the cell. The
-// fragment stage shades with their trilinear interpolation: the exact
-// trilinear surface, lit with gradients that are continuous from cell to
-// cell (the interpolant's own gradient jumps at cell faces, and shows every
-// cell layer as a terrace).
-void cornerGradients(ivec3 c)
+// at the volume's border). The fragment stage shades with their trilinear
+// interpolation: the exact trilinear surface, lit with gradients that are
+// continuous from cell to cell (the interpolant's own gradient jumps at cell
+// faces and shows every cell layer as a terrace). Along each axis a corner's
+// one neighbour inside the cell is another corner (v), so only the 24
+// outside neighbours are fetched; every index below is a constant, which
+// keeps software rasterisers (llvmpipe) from spilling arrays to memory.
+float outside(ivec3 p)
 {
-  float b[64];
-  for (int i = 0; i < 64; ++i)
-  {
-    ivec3 d = ivec3(i & 3, (i >> 2) & 3, i >> 4) - 1;
-    b[i] = float(texelFetch(volume, clamp(c + d, ivec3(0), cellDimensions), 0).r);
+  return float(texelFetch(volume, clamp(p, ivec3(0), cellDimensions), 0).r);
+}
+
+#define MEDISO_GRADIENT(I, DX, DY, DZ)                                                      \
+  {                                                                                        \
+    ivec3 p = c + ivec3(DX, DY, DZ);                                                       \
+    ivec3 lo = p - ivec3(1 - DX, 1 - DY, 1 - DZ) * ivec3(greaterThan(p, ivec3(0)));         \
+    ivec3 hi = p + ivec3(DX, DY, DZ) * ivec3(lessThan(p, cellDimensions));                  \
+    float ox = DX == 0 ? outside(ivec3(lo.x, p.y, p.z)) : outside(ivec3(hi.x, p.y, p.z));   \
+    float oy = DY == 0 ? outside(ivec3(p.x, lo.y, p.z)) : outside(ivec3(p.x, hi.y, p.z));   \
+    float oz = DZ == 0 ? outside(ivec3(p.x, p.y, lo.z)) : outside(ivec3(p.x, p.y, hi.z));   \
+    vec3 inside = vec3(v[I ^ 1], v[I ^ 2], v[I ^ 4]);                                      \
+    vec3 outer = vec3(ox, oy, oz);                                                         \
+    vec3 sgn = vec3(DX == 0 ? 1.0 : -1.0, DY == 0 ? 1.0 : -1.0, DZ == 0 ? 1.0 : -1.0);       \
+    vec3 span = vec3(1.0) + vec3(DX == 0 ? p.x > 0 : p.x < cellDimensions.x,               \
+                               DY == 0 ? p.y > 0 : p.y < cellDimensions.y,                 \
+                               DZ == 0 ? p.z > 0 : p.z < cellDimensions.z);                \
+    vGradients.g[I] = sgn * (inside - outer) / span;                                       \
   }
-  for (int i = 0; i < 8; ++i)
-  {
-    ivec3 q = ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1) + 1; // corner in the 4x4x4 block
-    ivec3 p = c + q - 1;                                      // its point index
-    ivec3 lo = q - ivec3(greaterThan(p, ivec3(0)));
-    ivec3 hi = q + ivec3(lessThan(p, cellDimensions));
-    vec3 span = max(vec3(hi - lo), vec3(1.0));
-    vGradients.g[i] = vec3(b[hi.x + 4 * q.y + 16 * q.z] - b[lo.x + 4 * q.y + 16 * q.z],
-                      b[q.x + 4 * hi.y + 16 * q.z] - b[q.x + 4 * lo.y + 16 * q.z],
-                      b[q.x + 4 * q.y + 16 * hi.z] - b[q.x + 4 * q.y + 16 * lo.z]) / span;
-  }
+
+void cornerGradients(ivec3 c, float v[8])
+{
+  MEDISO_GRADIENT(0, 0, 0, 0)
+  MEDISO_GRADIENT(1, 1, 0, 0)
+  MEDISO_GRADIENT(2, 0, 1, 0)
+  MEDISO_GRADIENT(3, 1, 1, 0)
+  MEDISO_GRADIENT(4, 0, 0, 1)
+  MEDISO_GRADIENT(5, 1, 0, 1)
+  MEDISO_GRADIENT(6, 0, 1, 1)
+  MEDISO_GRADIENT(7, 1, 1, 1)
 }
 
 void main()
@@ -121,7 +136,9 @@ void main()
 
 //VTK::HistoPyramidLevels::Impl
 
-  // Last step: the cells of the level-1 node, counted from the volume.
+  // Last step: the cells of the level-1 node, counted from the volume: the
+  // node's <= 27 points are read once and each child cell's crossing mask is
+  // made from them with constant indices.
   ivec3 first = node * firstFactor;
   VALUE_TYPE p[27];
   for (int i = 0; i < 27; ++i)
@@ -129,29 +146,41 @@ void main()
     ivec3 d = ivec3(i % 3, (i / 3) % 3, i / 9);
     p[i] = texelFetch(volume, min(first + d, cellDimensions), 0).r;
   }
+  int masks[8];
+#define MEDISO_CHILD(C, X, Y, Z)                                                             \
+  {                                                                                         \
+    VALUE_TYPE w[8];                                                                        \
+    w[0] = p[X + 3 * Y + 9 * Z];                                                            \
+    w[1] = p[X + 1 + 3 * Y + 9 * Z];                                                        \
+    w[2] = p[X + 3 * (Y + 1) + 9 * Z];                                                      \
+    w[3] = p[X + 1 + 3 * (Y + 1) + 9 * Z];                                                  \
+    w[4] = p[X + 3 * Y + 9 * (Z + 1)];                                                      \
+    w[5] = p[X + 1 + 3 * Y + 9 * (Z + 1)];                                                  \
+    w[6] = p[X + 3 * (Y + 1) + 9 * (Z + 1)];                                                \
+    w[7] = p[X + 1 + 3 * (Y + 1) + 9 * (Z + 1)];                                            \
+    masks[C] = any(greaterThanEqual(ivec3(X, Y, Z), firstFactor)) ? 0                      \
+                                                                  : cellMask(first + ivec3(X, Y, Z), w); \
+  }
+  MEDISO_CHILD(0, 0, 0, 0)
+  MEDISO_CHILD(1, 1, 0, 0)
+  MEDISO_CHILD(2, 0, 1, 0)
+  MEDISO_CHILD(3, 1, 1, 0)
+  MEDISO_CHILD(4, 0, 0, 1)
+  MEDISO_CHILD(5, 1, 0, 1)
+  MEDISO_CHILD(6, 0, 1, 1)
+  MEDISO_CHILD(7, 1, 1, 1)
   int mask = orderMask(node, firstFactor, vec3(1.0));
   vCell = first;
   vMask = 0;
   vIsovalue = -1;
-  VALUE_TYPE v[8];
   for (int order = 0; order < 8; ++order)
   {
     int c = order ^ mask;
-    ivec3 d = ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-    if (any(greaterThanEqual(d, firstFactor)))
-    {
-      continue;
-    }
-    for (int i = 0; i < 8; ++i)
-    {
-      ivec3 e = d + ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1);
-      v[i] = p[e.x + 3 * e.y + 9 * e.z];
-    }
-    int crossing = cellMask(first + d, v);
+    int crossing = masks[c];
     uint count = bitCount8(crossing);
     if (index < count)
     {
-      vCell = first + d;
+      vCell = first + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
       vMask = crossing;
       // The index-th crossing isovalue, in increasing threshold order.
       int rank = int(index);
@@ -171,12 +200,20 @@ void main()
       {
         vIsovalue = -1;
       }
-      vLow = vec4(float(v[0]), float(v[1]), float(v[2]), float(v[3]));
-      vHigh = vec4(float(v[4]), float(v[5]), float(v[6]), float(v[7]));
-      cornerGradients(vCell);
       break;
     }
     index -= count;
+  }
+  if (vIsovalue >= 0)
+  {
+    float v[8];
+    for (int i = 0; i < 8; ++i)
+    {
+      v[i] = float(texelFetch(volume, vCell + ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1), 0).r);
+    }
+    vLow = vec4(v[0], v[1], v[2], v[3]);
+    vHigh = vec4(v[4], v[5], v[6], v[7]);
+    cornerGradients(vCell, v);
   }
   gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
 }
