@@ -241,8 +241,14 @@ std::uint64_t vtkHistoPyramidIsoMapper::GetGPUMemoryBytes() const
 //------------------------------------------------------------------------------
 void vtkHistoPyramidIsoMapper::ReleaseGraphicsResources(vtkWindow* win)
 {
-  this->Impl->ReleaseGPU(win);
-  this->Impl->PolyMapper->ReleaseGraphicsResources(win);
+  Internals& impl = *this->Impl;
+  // The GPU objects live in the context of the window they were made in; a
+  // call for another window (a prop shown in several views) leaves them.
+  if (!impl.Window || win == impl.Window)
+  {
+    impl.ReleaseGPU(win);
+  }
+  impl.PolyMapper->ReleaseGraphicsResources(win);
 }
 
 //------------------------------------------------------------------------------
