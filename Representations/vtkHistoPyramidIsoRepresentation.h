@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkHistoPyramidIsoRepresentation
+ * @brief   ParaView representation of image data as exact GPU isosurfaces.
+ *
+ * vtkHistoPyramidIsoRepresentation is ParaView's vtkImageVolumeRepresentation
+ * with its volume mapper replaced by a vtkHistoPyramidIsoMapper (the swap is
+ * made once, in the constructor). Everything else is inherited: data
+ * delivery, bounds, the outline on ranks without data, ordered compositing,
+ * and the vtkVolumeProperty the volume representation's properties fill. The
+ * mapper reads from that property what it needs:
+ *
+ * - the isovalues, from IsosurfaceValues (SetIsosurfaceValue /
+ *   SetNumberOfIsosurfaces fill vtkVolumeProperty::GetIsoSurfaceValues());
+ * - the colour and opacity of each isovalue, from the colour map
+ *   (LookupTable) and the opacity map (ScalarOpacityFunction) at that value;
+ * - the lighting, from Ambient, Diffuse, Specular and SpecularPower.
+ *
+ * In the ServerManager XML it is the "HistoPyramid Isosurface" type of
+ * UniformGridRepresentation and shares the volume representation's
+ * properties, so switching between "Volume" and this type keeps the colour
+ * map, opacity and isovalues.
+ *
+ * What the mapper did in the last frame is readable through the information
+ * getters (GetRenderPath(), GetFallbackReason(), GetNumberOfPrimitives(), ...).
+ * They describe the last render *on this process*: in client/server mode
+ * with remote rendering that is the server's representation, which is the
+ * one ParaView's information properties are pulled from.
+ *
+ * When no colour array is chosen (Solid Color), the base class would hide the
+ * volume; this representation contours the input's active point scalars
+ * instead, so the type shows a surface as soon as it is selected.
+ *
+ * @sa vtkHistoPyramidIsoMapper vtkImageVolumeRepresentation
+ */
+#ifndef vtkHistoPyramidIsoRepresentation_h
+#define vtkHistoPyramidIsoRepresentation_h
+
+#include "MedicalIsosurfacesRepresentationsModule.h" // For export macro
+#include "vtkImageVolumeRepresentation.h"
+#include "vtkNew.h" // For vtkNew
+
+class vtkHistoPyramidIsoMapper;
+
+class MEDICALISOSURFACESREPRESENTATIONS_EXPORT vtkHistoPyramidIsoRepresentation
+  : public vtkImageVolumeRepresentation
+{
+public:
+  static vtkHistoPyramidIsoRepresentation* New();
+  vtkTypeMacro(vtkHistoPyramidIsoRepresentation, vtkImageVolumeRepresentation);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// The mapper that draws the isosurfaces (owned by the representation).
+  vtkHistoPyramidIsoMapper* GetIsoMapper();
+
+  ///@{
+  /**
+   * Draw with the CPU fallback (vtkBlockLODContour + vtkPolyDataMapper) even
+   * where the GPU path works: comparisons, tests. Default off.
+   */
+  void SetForceCPUFallback(bool force);
+  bool GetForceCPUFallback();
+  ///@}
+
+  ///@{
+  /**
+   * What the last frame rendered on this process did: the path ("gpu",
+   * "fallback", or "none" before the first frame and when nothing was drawn),
+   * why the GPU path is not used (empty while it is), the primitives (active
+   * cell-isovalue pairs) of a GPU frame, the triangles of a fallback frame,
+   * the pyramid builds so far and the GPU memory held, in bytes.
+   * Counts are doubles for the ServerManager's information helpers.
+   */
+  const char* GetRenderPath();
+  const char* GetFallbackReason();
+  double GetNumberOfPrimitives();
+  double GetNumberOfFallbackTriangles();
+  double GetNumberOfPyramidBuilds();
+  double GetGPUMemoryBytes();
+  ///@}
+
+protected:
+  vtkHistoPyramidIsoRepresentation();
+  ~vtkHistoPyramidIsoRepresentation() override;
+
+  /**
+   * The base class's settings (array, scalar mode, cropping, transfer
+   * function mode; its vtkSmartVolumeMapper/vtkMultiBlockVolumeMapper-only
+   * settings find no such mapper and do nothing), then the active point
+   * scalars when no colour array is chosen.
+   */
+  void UpdateMapperParameters() override;
+
+private:
+  vtkHistoPyramidIsoRepresentation(const vtkHistoPyramidIsoRepresentation&) = delete;
+  void operator=(const vtkHistoPyramidIsoRepresentation&) = delete;
+
+  vtkNew<vtkHistoPyramidIsoMapper> IsoMapper;
+};
+
+#endif

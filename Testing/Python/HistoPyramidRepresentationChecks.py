@@ -1,0 +1,132 @@
+"""Shared by the HistoPyramid Isosurface representation tests (builtin and client/server).
+
+A scene (MedicalPhantom shown as 'HistoPyramid Isosurface', skin -500 HU
+translucent over bone 400 HU opaque, colours and opacities from the HU colour
+and opacity maps), reading the representation's read-only properties from the
+process that rendered, and image checks on saved screenshots.
+"""
+import os
+
+from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
+from paraview.modules.vtkRemotingCore import vtkPVSession
+from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow, vtkStringOutputWindow
+from vtkmodules.vtkIOImage import vtkPNGReader
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+REPRESENTATION = "HistoPyramid Isosurface"
+SIZE = [400, 400]
+BACKGROUND = [0.1, 0.1, 0.15]
+SKIN, BONE = -500.0, 400.0
+
+
+class Checker:
+    def __init__(self):
+        self.failures = []
+
+    def __call__(self, ok, what):
+        if not ok:
+            self.failures.append(what)
+            print("FAILED: " + what)
+        return ok
+
+
+def make_scene(source):
+    """Render view + the source shown as the HistoPyramid Isosurface representation."""
+    view = CreateView("RenderView")
+    view.ViewSize = SIZE
+    view.OrientationAxesVisibility = 0
+    view.UseColorPaletteForBackground = 0
+    view.Background = BACKGROUND
+    view.EnableRenderOnInteraction = 0
+    display = Show(source, view)
+    display.SetRepresentationType(REPRESENTATION)
+    ColorBy(display, ("POINTS", "HU"))
+    display.IsosurfaceValues = [SKIN, BONE]
+    lut = GetColorTransferFunction("HU")
+    lut.RGBPoints = [-1000.0, 0.93, 0.75, 0.62, -100.0, 0.93, 0.75, 0.62,
+                     100.0, 0.96, 0.94, 0.86, 3000.0, 0.96, 0.94, 0.86]
+    pwf = GetOpacityTransferFunction("HU")
+    # skin 0.35, bone 1 (x, value, midpoint, sharpness)
+    pwf.Points = [-1000.0, 0.35, 0.5, 0.0, -100.0, 0.35, 0.5, 0.0,
+                  100.0, 1.0, 0.5, 0.0, 3000.0, 1.0, 0.5, 0.0]
+    display.Ambient = 0.1
+    display.Diffuse = 0.9
+    display.Specular = 0.2
+    # Front view of the face (anterior is +y), head up (+z).
+    bounds = source.GetDataInformation().GetBounds()
+    centre = [(bounds[2 * i] + bounds[2 * i + 1]) / 2.0 for i in range(3)]
+    view.CameraFocalPoint = centre
+    view.CameraPosition = [centre[0] - 0.35, centre[1] + 1.0, centre[2] + 0.15]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
+    view.ResetCamera()
+    return view, display
+
+
+def render_info(display, location=vtkPVSession.RENDER_SERVER):
+    """The representation's read-only properties, as the rendering process has them.
+
+    ParaView pulls information properties of a proxy that also lives on the
+    client from the client's copy; with remote rendering the server's copy is
+    the one that drew, so the pull is pointed at the render server (the same
+    process in builtin mode). location=vtkPVSession.CLIENT reads the client's.
+    """
+    sub = display.SMProxy.GetProperty("HistoPyramidRenderPath").GetParent()
+    previous = sub.GetLocation()
+    sub.SetLocation(location)
+    try:
+        sub.UpdatePropertyInformation()
+    finally:
+        sub.SetLocation(previous)
+    value = lambda name: display.GetProperty(name)[0]  # noqa: E731
+    return {
+        "path": value("HistoPyramidRenderPath"),
+        "reason": value("HistoPyramidFallbackReason"),
+        "primitives": int(value("HistoPyramidPrimitives")),
+        "triangles": int(value("HistoPyramidFallbackTriangles")),
+        "builds": int(value("HistoPyramidBuilds")),
+        "gpu_bytes": int(value("HistoPyramidGPUMemoryBytes")),
+    }
+
+
+def captured(function):
+    """Run function with VTK errors and warnings captured instead of printed.
+
+    Returns (result, captured text). Used only around a step that must emit a
+    known warning, so that the test checks it instead of failing on it.
+    """
+    capture = vtkStringOutputWindow()
+    previous = vtkOutputWindow.GetInstance()
+    verbosity = vtkLogger.GetCurrentVerbosityCutoff()
+    vtkOutputWindow.SetInstance(capture)
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
+    try:
+        result = function()
+    finally:
+        vtkOutputWindow.SetInstance(previous)
+        vtkLogger.SetStderrVerbosity(verbosity)
+    return result, capture.GetOutput()
+
+
+def screenshot(view, path):
+    """Save the view and read the PNG back as an (h, w, 3) array."""
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    SaveScreenshot(path, view, ImageResolution=SIZE, TransparentBackground=0)
+    reader = vtkPNGReader()
+    reader.SetFileName(path)
+    reader.Update()
+    image = reader.GetOutput()
+    w, h, _ = image.GetDimensions()
+    pixels = vtk_to_numpy(image.GetPointData().GetScalars())
+    return pixels.reshape(h, w, -1)[:, :, :3].astype(int)
+
+
+def foreground_fraction(pixels):
+    """Fraction of pixels that differ from the background colour."""
+    background = [round(255 * c) for c in BACKGROUND]
+    differs = (abs(pixels - background) > 8).any(axis=2)
+    return float(differs.mean())
+
+
+def changed_fraction(a, b):
+    """Fraction of pixels that differ between two images."""
+    return float((abs(a - b) > 8).any(axis=2).mean())

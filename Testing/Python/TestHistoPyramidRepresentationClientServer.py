@@ -1,0 +1,79 @@
+"""Client/server test of the 'HistoPyramid Isosurface' representation
+(run by Testing/Scripts/client-server.sh: pvserver in a loopback-only namespace).
+
+The plugin is loaded on both sides (the representation has a client-side copy,
+as every ParaView representation). With remote rendering forced
+(RemoteRenderThreshold 0) the server renders and the image comes back:
+- the data is produced by the pvserver process;
+- the server's representation reports RenderPath "gpu" with active cells drawn,
+  while the client's copy drew nothing ("none"): the frame was the server's;
+- the screenshot taken by the client is not empty;
+- an isovalue change (only the value travels) rebuilds the pyramid on the
+  server and changes the image that comes back.
+Skips (125) when the server's GL lacks what the GPU path needs.
+"""
+import argparse
+import os
+import sys
+
+from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
+from paraview.modules.vtkRemotingCore import vtkPVSession
+
+import HistoPyramidRepresentationChecks as hp
+
+parser = argparse.ArgumentParser()
+parser.add_argument("--host", default="localhost")
+parser.add_argument("--port", type=int, required=True)
+parser.add_argument("--server-pid", type=int, required=True)
+parser.add_argument("--plugin", required=True)
+args = parser.parse_args()
+check = hp.Checker()
+out = os.environ.get("MEDISO_TEST_OUTPUT", os.path.join(os.getcwd(), "cs-output"))
+
+if Connect(args.host, args.port, timeout=30) is None:
+    print("FAILED: could not connect to %s:%d" % (args.host, args.port))
+    sys.exit(1)
+check(servermanager.ActiveConnection.IsRemote(), "the connection is remote")
+LoadPlugin(args.plugin, remote=False, ns=globals())
+LoadPlugin(args.plugin, remote=True, ns=globals())
+
+phantom = MedicalPhantom(Dimensions=[64, 64, 64], Spacing=[3.0, 3.0, 3.0])
+phantom.UpdatePipeline()
+producer = phantom.FieldData["ProducerProcessId"]
+check(producer is not None and int(producer.GetRange()[0]) == args.server_pid,
+      "data produced by pvserver pid %d" % args.server_pid)
+
+view, display = hp.make_scene(phantom)
+view.RemoteRenderThreshold = 0  # MB: always render on the server
+Render(view)
+server = hp.render_info(display)
+client = hp.render_info(display, vtkPVSession.CLIENT)
+print("server: %s\nclient: %s" % (server, client))
+if server["path"] == "fallback" and "MEDISO_DISABLE_GPU_PATH" not in server["reason"]:
+    print("SKIP: the GPU path is not available on the server: %s" % server["reason"])
+    sys.exit(125)
+check(server["path"] == "gpu", "server RenderPath is 'gpu' (got %r)" % server["path"])
+check(server["primitives"] > 1000 and server["builds"] == 1,
+      "server drew %d primitives after 1 build (%d)" % (server["primitives"], server["builds"]))
+check(client["path"] == "none" and client["primitives"] == 0,
+      "the client's copy drew nothing (got %r)" % client["path"])
+
+first = hp.screenshot(view, os.path.join(out, "TestHistoPyramidRepresentationClientServer.png"))
+fraction = hp.foreground_fraction(first)
+check(0.05 < fraction < 0.9, "the image from the server shows the surface (%.1f%%)" % (100 * fraction))
+
+display.IsosurfaceValues = [hp.BONE]
+Render(view)
+bone = hp.render_info(display)
+check(bone["path"] == "gpu" and bone["builds"] == 2 and 0 < bone["primitives"] < server["primitives"],
+      "isovalue change: rebuilt on the server, fewer primitives (%s)" % bone)
+second = hp.screenshot(view, os.path.join(out, "TestHistoPyramidRepresentationClientServerBone.png"))
+check(hp.changed_fraction(first, second) > 0.02, "the image from the server changes")
+print("client/server: server pid %d drew %d then %d primitives; image %.1f%% covered"
+      % (args.server_pid, server["primitives"], bone["primitives"], 100 * fraction))
+
+Disconnect()
+if check.failures:
+    print("%d check(s) failed" % len(check.failures))
+    sys.exit(1)
+print("HistoPyramid representation client/server: all checks passed")
