@@ -246,7 +246,15 @@ void vtkHistoPyramidIsoMapper::ReleaseGraphicsResources(vtkWindow* win)
   // call for another window (a prop shown in several views) leaves them.
   if (!impl.Window || win == impl.Window)
   {
-    impl.ReleaseGPU(win);
+    if (impl.Window)
+    {
+      ScopedContext context(impl.Window);
+      impl.ReleaseGPU(impl.Window);
+    }
+    else
+    {
+      impl.ReleaseGPU(win);
+    }
   }
   impl.PolyMapper->ReleaseGraphicsResources(win);
 }

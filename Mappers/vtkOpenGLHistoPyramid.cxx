@@ -595,7 +595,16 @@ std::uint64_t vtkOpenGLHistoPyramid::GetGPUMemoryBytes() const
 //------------------------------------------------------------------------------
 void vtkOpenGLHistoPyramid::ReleaseGraphicsResources(vtkWindow* win)
 {
-  this->Impl->ReleaseAll(win);
+  // Release in the context the objects were made in, whatever is current.
+  if (this->Impl->Window)
+  {
+    ScopedContext context(this->Impl->Window);
+    this->Impl->ReleaseAll(this->Impl->Window);
+  }
+  else
+  {
+    this->Impl->ReleaseAll(win);
+  }
   this->Modified();
 }
 
