@@ -35,21 +35,30 @@ void main()
     ivec3 d = ivec3(i % 3, (i / 3) % 3, i / 9);
     p[i] = texelFetch(volume, min(first + d, pointMax), 0).r;
   }
+  // Each child cell's corners by constant indices (arrays indexed by
+  // variables are spilled to memory by software rasterisers such as llvmpipe).
   uint sum = 0u;
-  for (int c = 0; c < 8; ++c)
-  {
-    ivec3 d = ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-    if (any(greaterThanEqual(d, factor)))
-    {
-      continue;
-    }
-    VALUE_TYPE v[8];
-    for (int i = 0; i < 8; ++i)
-    {
-      ivec3 e = d + ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1);
-      v[i] = p[e.x + 3 * e.y + 9 * e.z];
-    }
-    sum += bitCount8(cellMask(first + d, v));
+#define MEDISO_CHILD(X, Y, Z)                                                                \
+  if (X < factor.x && Y < factor.y && Z < factor.z)                                         \
+  {                                                                                         \
+    VALUE_TYPE w[8];                                                                        \
+    w[0] = p[X + 3 * Y + 9 * Z];                                                            \
+    w[1] = p[X + 1 + 3 * Y + 9 * Z];                                                        \
+    w[2] = p[X + 3 * (Y + 1) + 9 * Z];                                                      \
+    w[3] = p[X + 1 + 3 * (Y + 1) + 9 * Z];                                                  \
+    w[4] = p[X + 3 * Y + 9 * (Z + 1)];                                                      \
+    w[5] = p[X + 1 + 3 * Y + 9 * (Z + 1)];                                                  \
+    w[6] = p[X + 3 * (Y + 1) + 9 * (Z + 1)];                                                \
+    w[7] = p[X + 1 + 3 * (Y + 1) + 9 * (Z + 1)];                                            \
+    sum += bitCount8(cellMask(first + ivec3(X, Y, Z), w));                                  \
   }
+  MEDISO_CHILD(0, 0, 0)
+  MEDISO_CHILD(1, 0, 0)
+  MEDISO_CHILD(0, 1, 0)
+  MEDISO_CHILD(1, 1, 0)
+  MEDISO_CHILD(0, 0, 1)
+  MEDISO_CHILD(1, 0, 1)
+  MEDISO_CHILD(0, 1, 1)
+  MEDISO_CHILD(1, 1, 1)
   fragOutput0 = uvec4(sum, 0u, 0u, 0u);
 }
