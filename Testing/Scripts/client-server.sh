@@ -47,6 +47,7 @@ cleanup() {
 }
 trap cleanup EXIT
 
+: >"$log"
 server_env=()
 if [ "${MEDISO_SERVER_PLUGIN_PATH:-0}" = 1 ]; then
   server_env=(env "PV_PLUGIN_PATH=$(dirname "${MEDISO_PLUGIN:?MEDISO_PLUGIN is not set}")")
