@@ -659,6 +659,22 @@ vtkBlockLODContour::vtkBlockLODContour()
 vtkBlockLODContour::~vtkBlockLODContour() = default;
 
 //------------------------------------------------------------------------------
+void vtkBlockLODContour::SetLOD(int level)
+{
+  if (level < 0 || level >= mediso::NumberOfLevels)
+  {
+    vtkErrorMacro("LOD " << level << " is outside 0.." << mediso::NumberOfLevels - 1
+                         << ": rejected, the level stays " << this->LOD << ".");
+    return;
+  }
+  if (this->LOD != level)
+  {
+    this->LOD = level;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
 vtkMTimeType vtkBlockLODContour::GetMTime()
 {
   return std::max(this->Superclass::GetMTime(), this->ContourValues->GetMTime());

@@ -123,9 +123,11 @@ public:
   ///@{
   /**
    * Level of detail 0..3 (cube edges of 8, 4, 2, 1 voxels) used when AutoLOD
-   * is off. Default 3 (full resolution).
+   * is off. Default 3 (full resolution). A value outside 0..3 is rejected
+   * with an error and the level stays as it was (a client of a pvserver sees
+   * the error instead of a silently clamped level).
    */
-  vtkSetClampMacro(LOD, int, 0, 3);
+  void SetLOD(int level);
   vtkGetMacro(LOD, int);
   ///@}
 
