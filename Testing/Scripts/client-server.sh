@@ -40,9 +40,20 @@ server_port=11111
 relay_port=11112
 work=$(mktemp -d)
 log=$work/pvserver.log
+# pvserver ignores SIGTERM while it waits for a client: TERM, then KILL after 5 s.
+stop() {
+  local pid=$1
+  kill "$pid" 2>/dev/null || return 0
+  for _ in $(seq 1 50); do
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.1
+  done
+  kill -9 "$pid" 2>/dev/null
+  wait "$pid" 2>/dev/null
+}
 cleanup() {
-  [ -n "${relay_pid:-}" ] && kill "$relay_pid" 2>/dev/null && wait "$relay_pid" 2>/dev/null
-  [ -n "${server_pid:-}" ] && kill "$server_pid" 2>/dev/null && wait "$server_pid" 2>/dev/null
+  [ -n "${relay_pid:-}" ] && stop "$relay_pid"
+  [ -n "${server_pid:-}" ] && stop "$server_pid"
   rm -rf "$work"
 }
 trap cleanup EXIT
