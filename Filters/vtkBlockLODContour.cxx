@@ -7,6 +7,7 @@
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
+#include "vtkExtentTranslator.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -15,6 +16,7 @@
 #include "vtkIntArray.h"
 #include "vtkMarchingCubesTriangleCases.h"
 #include "vtkMatrix3x3.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
@@ -254,6 +256,7 @@ struct vtkBlockLODContour::vtkInternals
   vtkDataArray* Array = nullptr;
   vtkMTimeType ArrayMTime = 0;
   int Extent[6] = { 0, -1, 0, -1, 0, -1 };
+  int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
   double Origin[3] = { 0, 0, 0 };
   double Spacing[3] = { 1, 1, 1 };
   int ScalarType = -1;
@@ -289,7 +292,28 @@ struct vtkBlockLODContour::vtkInternals
       v.OwnedCells[2 * a] = this->OwnedCells[2 * a];
       v.OwnedCells[2 * a + 1] = this->OwnedCells[2 * a + 1];
     }
+    if (this->IsPiece())
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        v.GlobalOffset[a] = this->Extent[2 * a] - this->WholeExtent[2 * a];
+        v.GlobalDims[a] = this->WholeExtent[2 * a + 1] - this->WholeExtent[2 * a] + 1;
+      }
+    }
     return v;
+  }
+
+  // True when the input is a part of a larger whole extent (a parallel piece).
+  bool IsPiece() const
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      if (this->WholeExtent[2 * a] > this->WholeExtent[2 * a + 1])
+      {
+        return false; // no whole extent known
+      }
+    }
+    return !std::equal(this->Extent, this->Extent + 6, this->WholeExtent);
   }
 
   template <typename F>
@@ -316,8 +340,11 @@ struct vtkBlockLODContour::vtkInternals
   }
 
   // Cells that are not ghosts, as an inclusive cell index range per axis:
-  // ghost layers of a structured piece are whole slabs at its faces.
-  static void FindOwnedCells(vtkImageData* input, const int dims[3], int owned[6])
+  // ghost layers of a structured piece are whole slabs at its faces. Without
+  // a ghost array (a filter upstream dropped it), the piece's extent without
+  // ghost layers (`zeroExtent`, when given) tells them.
+  static void FindOwnedCells(
+    vtkImageData* input, const int dims[3], const int* zeroExtent, int owned[6])
   {
     for (int a = 0; a < 3; ++a)
     {
@@ -327,6 +354,15 @@ struct vtkBlockLODContour::vtkInternals
     vtkUnsignedCharArray* ghosts = input->GetCellGhostArray();
     if (!ghosts)
     {
+      if (zeroExtent)
+      {
+        const int* extent = input->GetExtent();
+        for (int a = 0; a < 3; ++a)
+        {
+          owned[2 * a] = std::max(0, zeroExtent[2 * a] - extent[2 * a]);
+          owned[2 * a + 1] = std::min(dims[a] - 2, zeroExtent[2 * a + 1] - 1 - extent[2 * a]);
+        }
+      }
       return;
     }
     const int cells[3] = { dims[0] - 1, dims[1] - 1, dims[2] - 1 };
@@ -361,20 +397,22 @@ struct vtkBlockLODContour::vtkInternals
   }
 
   // Brings block ranges up to date with the input; returns true when they were recomputed.
-  bool Refresh(vtkImageData* input, vtkDataArray* array)
+  bool Refresh(
+    vtkImageData* input, vtkDataArray* array, const int wholeExtent[6], const int* zeroExtent)
   {
     int extent[6];
     input->GetExtent(extent);
     int dims[3] = { extent[1] - extent[0] + 1, extent[3] - extent[2] + 1, extent[5] - extent[4] + 1 };
     int owned[6];
-    FindOwnedCells(input, dims, owned);
+    FindOwnedCells(input, dims, zeroExtent, owned);
     double origin[3], spacing[3];
     input->GetOrigin(origin);
     input->GetSpacing(spacing);
     const bool same = this->RangesValid && input == this->Input && array == this->Array &&
       array->GetMTime() == this->ArrayMTime && std::equal(extent, extent + 6, this->Extent) &&
       std::equal(origin, origin + 3, this->Origin) && std::equal(spacing, spacing + 3, this->Spacing) &&
-      std::equal(owned, owned + 6, this->OwnedCells) && array->GetVoidPointer(0) == this->Data;
+      std::equal(owned, owned + 6, this->OwnedCells) && array->GetVoidPointer(0) == this->Data &&
+      std::equal(wholeExtent, wholeExtent + 6, this->WholeExtent);
     if (same)
     {
       return false;
@@ -384,6 +422,7 @@ struct vtkBlockLODContour::vtkInternals
     this->Array = array;
     this->ArrayMTime = array->GetMTime();
     std::copy(extent, extent + 6, this->Extent);
+    std::copy(wholeExtent, wholeExtent + 6, this->WholeExtent);
     std::copy(origin, origin + 3, this->Origin);
     std::copy(spacing, spacing + 3, this->Spacing);
     std::copy(owned, owned + 6, this->OwnedCells);
@@ -620,6 +659,22 @@ vtkBlockLODContour::vtkBlockLODContour()
 vtkBlockLODContour::~vtkBlockLODContour() = default;
 
 //------------------------------------------------------------------------------
+void vtkBlockLODContour::SetLOD(int level)
+{
+  if (level < 0 || level >= mediso::NumberOfLevels)
+  {
+    vtkErrorMacro("LOD " << level << " is outside 0.." << mediso::NumberOfLevels - 1
+                         << ": rejected, the level stays " << this->LOD << ".");
+    return;
+  }
+  if (this->LOD != level)
+  {
+    this->LOD = level;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
 vtkMTimeType vtkBlockLODContour::GetMTime()
 {
   return std::max(this->Superclass::GetMTime(), this->ContourValues->GetMTime());
@@ -632,12 +687,20 @@ int vtkBlockLODContour::RequestUpdateExtent(
   {
     return 0;
   }
-  // One ghost layer more than asked: gradients at a piece's faces see the
-  // neighbour's data, and the ghost cells themselves make no triangles.
+  // Ghost layers beyond those asked for; the ghost cells make no triangles.
+  // Level 3 needs one: gradients at a piece's faces see the neighbour's data.
+  // A coarse level samples the whole volume's grid (every piece the same
+  // samples); an owned cube of stride s reaches s points past the piece and
+  // its normals s more, so a piece needs 2 * 8 - 1 layers for level 0. A
+  // parallel run always asks for that many, whatever the level: changing the
+  // level then keeps the input (and every cached surface). One piece asks for
+  // one layer, which its whole extent ignores.
   vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
   vtkInformation* outInfo = outputVector->GetInformationObject(0);
   const int ghosts = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS());
-  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), ghosts + 1);
+  const int pieces = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES());
+  const int extra = pieces > 1 ? 2 * mediso::LevelStride(0) - 1 : 1;
+  inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), ghosts + extra);
   return 1;
 }
 
@@ -766,7 +829,30 @@ int vtkBlockLODContour::RequestData(
   }
 
   // --- Block ranges (once per input) --------------------------------------------
-  if (in.Refresh(input, array))
+  int wholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
+  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
+  if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+  {
+    inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), wholeExtent);
+  }
+  // The piece without ghost layers, for an input that lost its ghost array.
+  int zeroExtent[6];
+  const int* zero = nullptr;
+  const int numPieces = inInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
+    ? inInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
+    : 1;
+  if (numPieces > 1 && !input->GetCellGhostArray() && wholeExtent[0] <= wholeExtent[1])
+  {
+    vtkNew<vtkExtentTranslator> translator;
+    translator->SetWholeExtent(wholeExtent);
+    translator->SetPiece(inInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()));
+    translator->SetNumberOfPieces(numPieces);
+    translator->SetGhostLevel(0);
+    translator->PieceToExtent();
+    translator->GetExtent(zeroExtent);
+    zero = zeroExtent;
+  }
+  if (in.Refresh(input, array, wholeExtent, zero))
   {
     ++this->NumberOfBlockRangeComputations;
   }
@@ -777,9 +863,19 @@ int vtkBlockLODContour::RequestData(
     in.WarnedNaN = true;
   }
   const double* range = in.Ranges.ValueRange;
+  // A parallel piece may well lie outside an isovalue (all air, say): only a
+  // whole volume warns about its range.
+  const bool piece = in.IsPiece();
   if (!(range[0] < range[1]))
   {
-    vtkWarningMacro("The input is constant (" << range[0] << "): there is no isosurface.");
+    if (piece)
+    {
+      vtkDebugMacro("This piece is constant (" << range[0] << "): no surface here.");
+    }
+    else
+    {
+      vtkWarningMacro("The input is constant (" << range[0] << "): there is no isosurface.");
+    }
     return 1;
   }
   const OutputFlags flags{ this->ComputeNormals, this->ComputeScalars, this->GenerateBlockIds };
@@ -795,6 +891,11 @@ int vtkBlockLODContour::RequestData(
     const double v = this->ContourValues->GetValue(static_cast<int>(i));
     if (!(v > range[0] && v <= range[1]))
     {
+      if (piece)
+      {
+        vtkDebugMacro("Isovalue " << v << " is outside this piece's range.");
+        continue;
+      }
       vtkWarningMacro("Isovalue " << v << " is outside the data range (" << range[0] << ", "
                                   << range[1] << "]: it has no surface.");
       continue;

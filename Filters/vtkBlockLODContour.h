@@ -58,11 +58,19 @@
  * "BlockLODEstimatedMB" and "BlockLODEstimatedSeconds" (4 values each, levels
  * 0..3, for the first isovalue).
  *
- * Parallel pieces: the filter asks its input for one ghost layer more than
- * its output needs and makes no triangle in ghost cells (vtkGhostType), so at
- * level 3 pieces join without duplicate triangles or cracks and their normals
- * match the one-process result. (Coarse levels sample each piece on its own
- * grid; joining them across pieces is left to the MPI work.)
+ * Parallel pieces: every level samples the whole volume's grid (multiples of
+ * the level's stride from the whole extent's origin, and the whole extent's
+ * last point), not the piece's. A piece of a parallel run asks its input for
+ * 2 * 8 - 1 ghost layers more than its output needs (enough for a level-0
+ * cube past the piece and the normals at its far corner; one layer when the
+ * run has one piece) and makes no triangle in ghost cells (vtkGhostType, or
+ * the piece's extent without ghosts when a filter upstream dropped that
+ * array). So at every level the pieces' triangles are exactly the
+ * one-process triangles (no duplicates, no cracks), with the same normals,
+ * and "BlockId" numbers the whole volume's blocks.
+ * @warning With AutoLOD each piece picks its level from its own estimate: in
+ * a parallel run set LOD explicitly for one seamless surface. In a piece an
+ * isovalue outside that piece's range is not a warning (the piece is empty).
  *
  * Inputs: vtkImageData with a one-component point array of type char, signed
  * char, unsigned char, short, unsigned short, int, unsigned int, float or
@@ -115,9 +123,11 @@ public:
   ///@{
   /**
    * Level of detail 0..3 (cube edges of 8, 4, 2, 1 voxels) used when AutoLOD
-   * is off. Default 3 (full resolution).
+   * is off. Default 3 (full resolution). A value outside 0..3 is rejected
+   * with an error and the level stays as it was (a client of a pvserver sees
+   * the error instead of a silently clamped level).
    */
-  vtkSetClampMacro(LOD, int, 0, 3);
+  void SetLOD(int level);
   vtkGetMacro(LOD, int);
   ///@}
 

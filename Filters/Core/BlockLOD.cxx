@@ -153,7 +153,10 @@ void Classify(const Volume<T>& v, const BlockSamples& s, double iso, std::vector
 struct OwnedSamples
 {
   bool Any = false; // false: every cube is owned
-  bool Starts[3][BlockCells + 1];
+  // Starts[a][l + 1] for samples l = -1 .. Count - 1: sample -1 is the last
+  // sample of the block below, whose cubes use the edges on this block's
+  // lower face (which this block owns).
+  bool Starts[3][BlockCells + 2];
 
   template <typename T>
   OwnedSamples(const Volume<T>& v, const BlockSamples& s)
@@ -161,16 +164,17 @@ struct OwnedSamples
   {
     for (int a = 0; a < 3; ++a)
     {
-      for (int l = 0; l < s.Count[a]; ++l)
+      for (int l = -1; l < s.Count[a]; ++l)
       {
-        const int p = s.Point(a, l);
-        this->Starts[a][l] = p >= v.OwnedCells[2 * a] && p <= v.OwnedCells[2 * a + 1];
+        const int p = l < 0 ? s.First[a] - s.Stride : s.Point(a, l);
+        this->Starts[a][l + 1] = p >= 0 && p >= v.OwnedCells[2 * a] && p <= v.OwnedCells[2 * a + 1];
       }
     }
   }
   bool Cube(int i, int j, int k) const
   {
-    return !this->Any || (this->Starts[0][i] && this->Starts[1][j] && this->Starts[2][k]);
+    return !this->Any ||
+      (this->Starts[0][i + 1] && this->Starts[1][j + 1] && this->Starts[2][k + 1]);
   }
   // An edge from sample l along `axis` is used by an owned cube: the cube
   // starting at l along the axis, and at l - 1 or l along the other two.
@@ -182,8 +186,8 @@ struct OwnedSamples
     }
     for (int b = 0; b < 3; ++b)
     {
-      const bool here = this->Starts[b][l[b]];
-      const bool before = b != axis && l[b] > 0 && this->Starts[b][l[b] - 1];
+      const bool here = this->Starts[b][l[b] + 1];
+      const bool before = b != axis && this->Starts[b][l[b]];
       if (!(here || before))
       {
         return false;
@@ -352,18 +356,34 @@ Volume<T> MakeCoarseCopy(const Volume<T>& full, int level, std::vector<T>& stora
   std::vector<int> points[3];
   for (int a = 0; a < 3; ++a)
   {
-    coarse.FullDims[a] = full.Dims[a];
-    coarse.Dims[a] = (full.Dims[a] - 1 + stride - 1) / stride + 1;
+    const int n = full.Dims[a];
+    const int offset = full.GlobalOffset[a];
+    const int whole = full.IsPiece() ? full.GlobalDims[a] : n;
+    // First local point on the whole volume's grid of the level, the number
+    // of grid points here, and the whole volume's last point when this
+    // volume holds it off the grid.
+    const int first = (stride - offset % stride) % stride;
+    const int onGrid = first <= n - 1 ? (n - 1 - first) / stride + 1 : 0;
+    const bool lastOffGrid = offset + n == whole && (onGrid == 0 || (n - 1 - first) % stride != 0);
+    coarse.SampleFirst[a] = first;
+    coarse.FullDims[a] = n;
+    coarse.Dims[a] = onGrid + (lastOffGrid ? 1 : 0);
     points[a].resize(coarse.Dims[a]);
     for (int c = 0; c < coarse.Dims[a]; ++c)
     {
-      points[a][c] = std::min(c * stride, full.Dims[a] - 1);
+      points[a][c] = std::min(first + c * stride, n - 1);
     }
     // Owned cells: those whose lower sample lies in the full volume's owned range.
-    const int lo = full.OwnedCells[2 * a];
+    const int lo = full.OwnedCells[2 * a] - first;
     const int hi = full.OwnedCells[2 * a + 1];
-    coarse.OwnedCells[2 * a] = (std::max(lo, 0) + stride - 1) / stride;
-    coarse.OwnedCells[2 * a + 1] = hi >= (1 << 29) ? hi : hi / stride;
+    coarse.OwnedCells[2 * a] = lo <= 0 ? 0 : (lo + stride - 1) / stride;
+    coarse.OwnedCells[2 * a + 1] =
+      hi >= (1 << 29) ? hi : (hi < first ? -1 : (hi - first) / stride);
+    if (full.IsPiece())
+    {
+      coarse.GlobalOffset[a] = (offset + first) / stride;
+      coarse.GlobalDims[a] = (whole - 1 + stride - 1) / stride + 1;
+    }
   }
   storage.resize(static_cast<std::size_t>(coarse.Dims[0]) * coarse.Dims[1] * coarse.Dims[2]);
   const std::int64_t sx = full.Dims[0];
@@ -395,6 +415,15 @@ void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const Para
     ranges.Blocks[a] = (volume.Dims[a] - 1 + BlockCells - 1) / BlockCells;
   }
   const std::int64_t numBlocks = ranges.GetNumberOfBlocks();
+  if (numBlocks <= 0)
+  {
+    // A piece too thin to hold one cube of a coarse level.
+    ranges.Min.clear();
+    ranges.Max.clear();
+    ranges.NaNCount = 0;
+    ranges.ValueRange[0] = ranges.ValueRange[1] = 0;
+    return;
+  }
   ranges.Min.assign(numBlocks, std::numeric_limits<double>::infinity());
   ranges.Max.assign(numBlocks, -std::numeric_limits<double>::infinity());
   std::vector<std::int64_t> nanPerSlab(ranges.Blocks[2], 0);
@@ -626,6 +655,26 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
         (block / ranges.Blocks[0]) % ranges.Blocks[1],
         block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]) };
       const std::uint8_t* cubeCase = plan.CubeCases.data() + a * plan.CubesPerBlock;
+      // Block ids on the whole volume's grid for a piece (extraction runs at
+      // stride 1 on the level's volume, so cube (i, j, k) starts at sample
+      // First + (i, j, k)); the local block otherwise.
+      const bool globalIds = out.BlockIds && volume.IsPiece() && stride == 1;
+      std::int64_t globalBlocks[2] = { 0, 0 };
+      if (globalIds)
+      {
+        globalBlocks[0] = (volume.GlobalDims[0] - 1 + BlockCells - 1) / BlockCells;
+        globalBlocks[1] = (volume.GlobalDims[1] - 1 + BlockCells - 1) / BlockCells;
+      }
+      auto blockId = [&](int i, int j, int k) -> std::int32_t {
+        if (!globalIds)
+        {
+          return static_cast<std::int32_t>(block);
+        }
+        const std::int64_t g[3] = { (volume.GlobalOffset[0] + s.First[0] + i) / BlockCells,
+          (volume.GlobalOffset[1] + s.First[1] + j) / BlockCells,
+          (volume.GlobalOffset[2] + s.First[2] + k) / BlockCells };
+        return static_cast<std::int32_t>((g[2] * globalBlocks[1] + g[1]) * globalBlocks[0] + g[0]);
+      };
       auto pointId = [&](int i, int j, int k, int edge) -> IdType {
         int l[3] = { i + edgeOrigin[edge][0], j + edgeOrigin[edge][1], k + edgeOrigin[edge][2] };
         if (!((l[0] == n[0] - 1 && !s.LastBlock[0]) || (l[1] == n[1] - 1 && !s.LastBlock[1]) ||
@@ -666,6 +715,7 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
               continue;
             }
             const int* edges = cases[c];
+            const std::int32_t id = out.BlockIds ? blockId(i, j, k) : 0;
             for (int e = 0; e < 15 && edges[e] >= 0; e += 3, ++tid)
             {
               IdType* tri = out.Connectivity + 3 * tid;
@@ -674,7 +724,7 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
               tri[2] = pointId(i, j, k, edges[e + 2]);
               if (out.BlockIds)
               {
-                out.BlockIds[tid] = static_cast<std::int32_t>(block);
+                out.BlockIds[tid] = id;
               }
             }
           }

@@ -92,16 +92,26 @@ struct Volume
   double Origin[3] = { 0, 0, 0 }; ///< World position of point (0, 0, 0).
   double Spacing[3] = { 1, 1, 1 };
   /// For a coarse copy of a volume (see MakeCoarseCopy): sample c along an
-  /// axis stands for point min(c * SampleStride, FullDims - 1) of the full
-  /// volume, whose Origin and Spacing these are. 1 for a full volume.
+  /// axis stands for point min(SampleFirst + c * SampleStride, FullDims - 1)
+  /// of the full volume, whose Origin and Spacing these are. 1 for a full volume.
   int SampleStride = 1;
+  int SampleFirst[3] = { 0, 0, 0 };
   int FullDims[3] = { 0, 0, 0 };
   /// Full-volume index of sample c along an axis.
   int FullIndex(int axis, int c) const
   {
-    return this->SampleStride == 1 ? c
-                                   : std::min(c * this->SampleStride, this->FullDims[axis] - 1);
+    return this->SampleStride == 1
+      ? c
+      : std::min(this->SampleFirst[axis] + c * this->SampleStride, this->FullDims[axis] - 1);
   }
+  /// Where a parallel piece lies in the whole volume, in this volume's own
+  /// samples: the whole grid's index of sample 0, and the whole grid's sample
+  /// counts. GlobalDims of zero (the default) means the volume is the whole.
+  /// Pieces sample coarse levels on the whole grid (MakeCoarseCopy) and number
+  /// blocks in "BlockIds" on it, so they join like one volume.
+  int GlobalOffset[3] = { 0, 0, 0 };
+  int GlobalDims[3] = { 0, 0, 0 };
+  bool IsPiece() const { return this->GlobalDims[0] > 0; }
   /// Cells (by lower corner index) whose cubes make triangles: {x0, x1, y0,
   /// y1, z0, z1}, inclusive. A parallel piece passes the range without its
   /// ghost layers, so pieces join without duplicate triangles while their
@@ -143,6 +153,11 @@ struct BlockRanges
 
 /// The samples of a level of detail as a volume of their own: the points whose
 /// index is a multiple of LevelStride(level), plus the last point of each axis.
+/// For a piece (Volume::IsPiece) the index is the whole volume's and the last
+/// point is the whole volume's: every piece samples the same global grid, so
+/// coarse cubes of neighbouring pieces coincide. A piece then needs ghost
+/// layers of 2 * stride - 1 points for its owned cubes and their normals to be
+/// exactly those of one process (see vtkBlockLODContour::RequestUpdateExtent).
 /// Marching cubes at stride 1 on it gives exactly the level's surface, but
 /// reads a small contiguous array instead of scattered samples of the full one
 /// (1/512, 1/64, 1/8 of the data for levels 0, 1, 2). `storage` receives the
@@ -196,7 +211,8 @@ struct SurfaceBuffers
   float* Normals = nullptr;        ///< 3 per point, or null.
   float* Scalars = nullptr;        ///< 1 per point (the isovalue), or null.
   IdType* Connectivity = nullptr;  ///< 3 per triangle.
-  std::int32_t* BlockIds = nullptr; ///< 1 per triangle (linear block index), or null.
+  std::int32_t* BlockIds = nullptr; ///< 1 per triangle (linear block index, on the whole
+                                    ///< volume's grid for a piece), or null.
   IdType FirstPointId = 0;         ///< Added to every point id (several isovalues in one output).
 };
 

@@ -17,7 +17,7 @@ parser.add_argument("--host", default="localhost")
 parser.add_argument("--port", type=int, required=True)
 parser.add_argument("--server-pid", type=int, required=True)
 parser.add_argument("--plugin", required=True)
-args = parser.parse_args()
+args, _ = parser.parse_known_args()  # client-server.sh also passes relay arguments
 
 failures = []
 

@@ -26,7 +26,7 @@ parser.add_argument("--host", default="localhost")
 parser.add_argument("--port", type=int, required=True)
 parser.add_argument("--server-pid", type=int, required=True)
 parser.add_argument("--plugin", required=True)
-args = parser.parse_args()
+args, _ = parser.parse_known_args()  # client-server.sh also passes relay and log options
 check = hp.Checker()
 out = os.environ.get("MEDISO_TEST_OUTPUT", os.path.join(os.getcwd(), "cs-output"))
 
