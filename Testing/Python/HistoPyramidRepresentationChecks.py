@@ -130,3 +130,27 @@ def foreground_fraction(pixels):
 def changed_fraction(a, b):
     """Fraction of pixels that differ between two images."""
     return float((abs(a - b) > 8).any(axis=2).mean())
+
+
+def read_png(path):
+    """A PNG as an (h, w, 3) int array."""
+    reader = vtkPNGReader()
+    reader.SetFileName(path)
+    reader.Update()
+    image = reader.GetOutput()
+    w, h, _ = image.GetDimensions()
+    pixels = vtk_to_numpy(image.GetPointData().GetScalars())
+    return pixels.reshape(h, w, -1)[:, :, :3].astype(int)
+
+
+def compare_images(a, b):
+    """(mask agreement, mean colour difference over pixels covered by both,
+    pixels covered by either) of two screenshots of the same scene."""
+    background = [round(255 * c) for c in BACKGROUND]
+    ca = (abs(a - background) > 8).any(axis=2)
+    cb = (abs(b - background) > 8).any(axis=2)
+    either = int((ca | cb).sum())
+    both = ca & cb
+    agreement = 1.0 - float((ca != cb).sum()) / either if either else 0.0
+    diff = float(abs(a - b)[both].mean()) if both.any() else 255.0
+    return agreement, diff, either
