@@ -1,0 +1,311 @@
+#!/usr/bin/env python3
+"""vtkHistoPyramidIsoMapper benchmark (issue 4): GPU isosurface rendering against its peers.
+
+    python3 Python/benchmark_isomapper.py [--inputs ct,ct512,phantom256] [--frames 360]
+        [--sweep 95] [--windows 1920x1080,1024x768] [--isovalues=-500,400]
+        [--rc-factors 0.5[,1.0]] [--methods hp,rc,fe] [--images DIR] [--out FILE.md]
+        [--json FILE.json] [--binary build/bin/BenchmarkHistoPyramidIsoMapper]
+
+Runs the C++ program BenchmarkHistoPyramidIsoMapper (the plugin's classes are not Python-wrapped)
+under its own Xvfb (Testing/Scripts/with-xvfb.sh), one process per input, with
+VTK_SMP_BACKEND_IN_USE=STDThread, and turns its "bench-result:" lines into markdown tables:
+
+1. Rotation: the surface at one isovalue, the camera turned 1 degree (azimuth) per frame, after a
+   first render and one warm-up render; every frame is Render() + glFinish. Per frame min and
+   median seconds, fps = 1 / median, and our median / the ray caster's.
+2. Isovalue sweep: --sweep isovalues equidistant across the data range with its ends left out
+   (lo + (hi - lo) * i / (N + 1), i = 1..N); time per change + frame (FlyingEdges: re-extract +
+   render; the volume mappers: set the isovalue + render), our median / FlyingEdges + PolyDataMapper's.
+3. GPU memory of vtkHistoPyramidIsoMapper (GetGPUMemoryBytes) against the volume's bytes, and
+   whether camera moves rebuilt the pyramid.
+
+Methods, in the same process: vtkHistoPyramidIsoMapper (GetLastRenderPath() must be the GPU path),
+vtkGPUVolumeRayCastMapper in isosurface blend mode (shading on, AutoAdjustSampleDistances off,
+SampleDistance = factor x the smallest spacing), vtkFlyingEdges3D (normals on) + vtkPolyDataMapper.
+Ends with the issue's targets: rotation frame time <= 0.5x the ray caster's, isovalue change+frame
+<= 0.5x FlyingEdges + PolyDataMapper's, GPU memory <= 1.5x the volume's bytes.
+"""
+import argparse
+import json
+import os
+import platform
+import shlex
+import statistics
+import subprocess
+import sys
+import time
+
+ALL_INPUTS = ("ct", "ct512", "phantom256")
+TARGET_ROTATION = 0.5
+TARGET_SWEEP = 0.5
+TARGET_MEMORY = 1.5
+RESULT_TAG = "bench-result: "
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+
+def progress(message):
+    print("bench: " + message, flush=True)
+
+
+def ct_path():
+    folder = os.environ.get("MEDISO_DATA_DIR") or os.path.expanduser("~/.cache/medical-isosurfaces")
+    return os.path.join(folder, "ct_head.mha")
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--inputs", default=",".join(ALL_INPUTS),
+                   help="comma list of ct, ct512, phantom256 (or phantomN); default all")
+    p.add_argument("--frames", type=int, default=360,
+                   help="rotation frames of 1 degree (default 360, the paper's)")
+    p.add_argument("--sweep", type=int, default=95, help="isovalues in the sweep (default 95)")
+    p.add_argument("--windows", default="1920x1080,1024x768")
+    p.add_argument("--isovalues", default="-500,400",
+                   help="rotation isovalues (write --isovalues=-500,400)")
+    p.add_argument("--methods", default="hp,rc,fe")
+    p.add_argument("--rc-factors", default="0.5",
+                   help="ray caster SampleDistance as factors of the smallest spacing (default 0.5)")
+    p.add_argument("--images", default="", help="save the first rotation frame of each method here")
+    p.add_argument("--binary", default=os.path.join(ROOT, "build", "bin",
+                                                    "BenchmarkHistoPyramidIsoMapper"))
+    p.add_argument("--out", default="", help="write the tables (markdown) to this file")
+    p.add_argument("--json", default="", help="write the raw records to this file")
+    return p.parse_args(argv)
+
+
+def cpu_model():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
+def load_average():
+    try:
+        return "%.2f %.2f %.2f" % os.getloadavg()
+    except OSError:
+        return "unknown"
+
+
+def run_input(args, name):
+    command = [os.path.join(ROOT, "Testing", "Scripts", "with-xvfb.sh"), args.binary,
+               "--input", name, "--ct", ct_path(), "--frames", str(args.frames),
+               "--sweep", str(args.sweep), "--windows", args.windows,
+               "--isovalues=" + args.isovalues, "--methods", args.methods,
+               "--rc-factors", args.rc_factors]
+    if args.images:
+        os.makedirs(args.images, exist_ok=True)
+        command += ["--images", args.images]
+    env = dict(os.environ, VTK_SMP_BACKEND_IN_USE="STDThread")
+    records = []
+    start = time.perf_counter()
+    with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                          env=env) as child:
+        for line in child.stdout:
+            line = line.rstrip("\n")
+            if line.startswith(RESULT_TAG):
+                records.append(json.loads(line[len(RESULT_TAG):]))
+            else:
+                progress("[%s] %s" % (name, line))
+    wall = time.perf_counter() - start
+    progress("[%s] exit status %d after %.0f s" % (name, child.returncode, wall))
+    return child.returncode, records, wall
+
+
+def fmt_s(v):
+    return "%.3f" % v if v >= 0.1 else "%.4f" % v
+
+
+def fmt_ratio(v):
+    return "%.2fx" % v
+
+
+def margin(ratio, limit):
+    if ratio <= limit:
+        return "%.0f%% under the limit" % (100.0 * (1.0 - ratio / limit))
+    return "%.2fx the limit" % (ratio / limit)
+
+
+def table(header, rows):
+    lines = ["| " + " | ".join(header) + " |",
+             "|" + "|".join(["---"] + ["---:"] * (len(header) - 1)) + "|"]
+    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    return lines
+
+
+def method_name(r):
+    if r["method"] == "hp":
+        return "HistoPyramid (ours)"
+    if r["method"] == "rc":
+        return "GPU ray caster, sample %gx" % r["factor"]
+    return "FlyingEdges + PolyDataMapper"
+
+
+def report(args, command, records, failed, started, wall, load_before, load_after):
+    lines = []
+    out = lines.append
+    inputs = [r for r in records if r["kind"] == "input"]
+    machine = next((r for r in records if r["kind"] == "machine"), {})
+    out("# vtkHistoPyramidIsoMapper benchmark")
+    out("")
+    out("- Command: `%s`" % command)
+    out("- Started %s, %.0f s wall; load average %s before, %s after (shared machine)"
+        % (started, wall, load_before, load_after))
+    out("- Machine: %s, nproc %d (%s)" % (platform.platform(), os.cpu_count() or 0, cpu_model()))
+    out("- OpenGL: %s / %s / %s%s" % (machine.get("gl_vendor", "?"), machine.get("gl_renderer", "?"),
+                                       machine.get("gl_version", "?"),
+                                       " (software rasteriser: NOT measured on a GPU)"
+                                       if "llvmpipe" in machine.get("gl_renderer", "") else ""))
+    if inputs:
+        i0 = inputs[0]
+        out("- VTK %s; vtkSMPTools backend %s, %d threads (VTK_SMP_BACKEND_IN_USE=STDThread)"
+            % (i0["vtk"], i0["smp_backend"], i0["smp_threads"]))
+    out("- Rotation: %d frames of 1 degree per (input, window, method, isovalue)%s; sweep: %d "
+        "isovalues" % (args.frames, "" if args.frames == 360 else
+                       " (the paper's protocol is 360: reduced with --frames to fit the run time)",
+                       args.sweep) + ("" if args.sweep == 95 else " (the paper's is 95: reduced with --sweep)"))
+    for i in inputs:
+        out("- Input %s: %s, %s %s, range %g..%g, spacing %s mm, %.1f MB"
+            % (i["input"], i["label"], i["dims"], i["type"], i["range"][0], i["range"][1],
+               "x".join("%.4g" % s for s in i["spacing"]), i["volume_bytes"] / 2**20))
+    for name, why in failed:
+        out("- %s: %s" % (name, why))
+    dims = {i["input"]: i["dims"] for i in inputs}
+
+    # 1. rotation
+    out("")
+    out("## Rotation (seconds per frame, Render + glFinish)")
+    out("")
+    rot = [r for r in records if r["kind"] == "rotation"]
+    rows = []
+    targets = []
+    for r in rot:
+        peer = [p for p in rot if p["method"] == "rc" and p["input"] == r["input"]
+                and p["window"] == r["window"] and p["iso"] == r["iso"]]
+        ratios = " / ".join(fmt_ratio(r["median_s"] / p["median_s"]) for p in peer) \
+            if r["method"] == "hp" else ""
+        el = "%d %s" % (r["elements"], "triangles" if r["method"] == "fe" else "cells") \
+            if r["elements"] >= 0 else "-"
+        rows.append(["%s %s" % (r["input"], dims.get(r["input"], "")), r["window"], "%g" % r["iso"],
+                     method_name(r) + (" [%s path]" % r["path"] if r["method"] == "hp" else ""),
+                     r["frames"], fmt_s(r["min_s"]), fmt_s(r["median_s"]),
+                     "%.2f" % (1.0 / r["median_s"]), "%.1f" % r["total_s"], el, ratios])
+        if r["method"] == "hp":
+            for p in peer:
+                ratio = r["median_s"] / p["median_s"]
+                targets.append(["rotation <= 0.5x ray caster (sample %gx)" % p["factor"],
+                                "%s, %s, iso %g" % (r["input"], r["window"], r["iso"]),
+                                fmt_ratio(ratio), "yes" if ratio <= TARGET_ROTATION else "no",
+                                margin(ratio, TARGET_ROTATION)])
+    lines.extend(table(["input", "window", "iso", "method", "frames", "min s", "median s",
+                        "fps (1/median)", "total s", "primitives", "ours / ray caster (median)"],
+                       rows))
+
+    # 2. sweep
+    out("")
+    out("## Isovalue sweep (seconds per change + frame)")
+    out("")
+    sw = [r for r in records if r["kind"] == "sweep"]
+    rows = []
+    for r in sw:
+        peer = next((p for p in sw if p["method"] == "fe" and p["input"] == r["input"]
+                     and p["window"] == r["window"]), None)
+        ratio = r["median_s"] / peer["median_s"] if peer and r["method"] != "fe" else None
+        rows.append(["%s %s" % (r["input"], dims.get(r["input"], "")), r["window"], method_name(r),
+                     "%d (%g..%g)" % (r["n"], r["first_iso"], r["last_iso"]), fmt_s(r["min_s"]),
+                     fmt_s(r["median_s"]), fmt_s(r["max_s"]), "%.1f" % r["total_s"],
+                     fmt_s(r["extract_median_s"]) if r["method"] == "fe" else "-",
+                     ("%d..%d" % (r["min_elements"], r["max_elements"]))
+                     if r["min_elements"] >= 0 else "-",
+                     fmt_ratio(ratio) if ratio is not None else ""])
+        if r["method"] == "hp" and peer:
+            targets.append(["change+frame <= 0.5x FlyingEdges + PolyDataMapper (median)",
+                            "%s, %s, sweep of %d" % (r["input"], r["window"], r["n"]),
+                            fmt_ratio(ratio), "yes" if ratio <= TARGET_SWEEP else "no",
+                            margin(ratio, TARGET_SWEEP)])
+    lines.extend(table(["input", "window", "method", "isovalues", "min s", "median s", "max s",
+                        "total s", "FE extract median s", "primitives", "ours / FE+PDM (median)"],
+                       rows))
+
+    # 3. memory
+    out("")
+    out("## GPU memory of vtkHistoPyramidIsoMapper")
+    out("")
+    rows = []
+    seen = set()
+    for r in rot:
+        if r["method"] != "hp" or (r["input"], r["iso"]) in seen:
+            continue
+        seen.add((r["input"], r["iso"]))
+        ratio = r["gpu_bytes"] / r["volume_bytes"]
+        s = next((x for x in sw if x["method"] == "hp" and x["input"] == r["input"]), None)
+        rows.append(["%s %s" % (r["input"], dims.get(r["input"], "")), "%g" % r["iso"],
+                     "%.1f" % (r["volume_bytes"] / 2**20), "%.1f" % (r["gpu_bytes"] / 2**20),
+                     fmt_ratio(ratio), int(r["builds_during_rotation"]),
+                     ("%.1f / %.1f" % (s["gpu_bytes_before"] / 2**20, s["gpu_bytes_after"] / 2**20))
+                     if s else "-"])
+        targets.append(["GPU memory <= 1.5x volume bytes", "%s, iso %g" % (r["input"], r["iso"]),
+                        fmt_ratio(ratio), "yes" if ratio <= TARGET_MEMORY else "no",
+                        margin(ratio, TARGET_MEMORY)])
+    lines.extend(table(["input", "iso", "volume MB", "GPU MB", "GPU / volume",
+                        "pyramid builds during rotation", "GPU MB before / after sweep"], rows))
+    ends = [r for r in records if r["kind"] == "end"]
+    if ends:
+        out("")
+        out("Peak RSS per child process: " + ", ".join(
+            "%s %.0f MB" % (i["input"], e["peak_rss_mb"]) for i, e in zip(inputs, ends)) + ".")
+
+    out("")
+    out("## Targets")
+    out("")
+    lines.extend(table(["target", "where", "measured", "met", "by how much"], targets))
+    return lines
+
+
+def main():
+    argv = sys.argv[1:]
+    args = parse_args(argv)
+    command = "python3 " + " ".join(shlex.quote(a) for a in ["Python/benchmark_isomapper.py"] + argv)
+    if not os.path.exists(args.binary):
+        progress("no %s: build it (Scripts/bootstrap.sh or ninja -C build "
+                 "BenchmarkHistoPyramidIsoMapper)" % args.binary)
+        return 2
+    started = time.strftime("%Y-%m-%d %H:%M:%S")
+    load_before = load_average()
+    progress("command: " + command)
+    progress("machine: nproc %d, %s, load average %s" % (os.cpu_count() or 0, cpu_model(),
+                                                          load_before))
+    t0 = time.perf_counter()
+    records, failed = [], []
+    for name in [s.strip() for s in args.inputs.split(",") if s.strip()]:
+        if name.startswith("ct") and not os.path.exists(ct_path()):
+            failed.append((name, "skipped: no CT at %s (run Python/fetch_data.py)" % ct_path()))
+            continue
+        rc, recs, wall = run_input(args, name)
+        records += recs
+        if rc != 0:
+            failed.append((name, "child exit status %d (a frame not drawn by the GPU path, or a "
+                                 "crash: see the log)" % rc))
+    lines = report(args, command, records, failed, started, time.perf_counter() - t0, load_before,
+                   load_average())
+    text = "\n".join(lines) + "\n"
+    sys.stdout.write("\n" + text)
+    if args.out:
+        with open(args.out, "w") as f:
+            f.write(text)
+        progress("wrote " + args.out)
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(dict(command=command, records=records, failed=failed), f)
+        progress("wrote " + args.json)
+    return 0 if records and not failed else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

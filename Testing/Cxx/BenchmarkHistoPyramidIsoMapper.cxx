@@ -1,0 +1,765 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Benchmark of vtkHistoPyramidIsoMapper (issue 4) against its peers, in one
+// process and one input per run:
+//   hp  vtkHistoPyramidIsoMapper (the GPU path is checked and reported),
+//   rc  vtkGPUVolumeRayCastMapper in isosurface blend mode, shading on,
+//       AutoAdjustSampleDistances off, SampleDistance = factor x min spacing,
+//   fe  vtkFlyingEdges3D (normals on) drawn by vtkPolyDataMapper.
+// Measures, for every window size: the paper's rotation (1-degree camera
+// azimuth steps after two warm-up renders, per isovalue) and the isovalue
+// sweep (equidistant isovalues strictly inside the data range, time per
+// change + frame), plus the HistoPyramid mapper's GPU memory against the
+// volume's bytes. Every frame is vtkRenderWindow::Render() followed by
+// WaitForCompletion() (glFinish), so a time includes the drawing itself.
+//
+// Not a ctest test: Python/benchmark_isomapper.py runs it under Xvfb once per
+// input and turns its "bench-result: {json}" lines into tables.
+//
+//   BenchmarkHistoPyramidIsoMapper --input ct|ct512|phantom256|phantomN
+//     [--ct FILE.mha] [--windows 1920x1080,1024x768] [--frames 360] [--sweep 95]
+//     [--isovalues -500,400] [--methods hp,rc,fe] [--rc-factors 0.5,1.0]
+//     [--images DIR]
+#include "MedicalTestUtilities.h"
+#include "vtkHistoPyramidIsoMapper.h"
+#include "vtkMedicalPhantomSource.h"
+
+#include "vtkActor.h"
+#include "vtkCamera.h"
+#include "vtkColorTransferFunction.h"
+#include "vtkContourValues.h"
+#include "vtkDataArray.h"
+#include "vtkFlyingEdges3D.h"
+#include "vtkGPUVolumeRayCastMapper.h"
+#include "vtkImageData.h"
+#include "vtkImageReslice.h"
+#include "vtkMetaImageReader.h"
+#include "vtkNew.h"
+#include "vtkPNGWriter.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkPointData.h"
+#include "vtkPolyData.h"
+#include "vtkPolyDataMapper.h"
+#include "vtkProperty.h"
+#include "vtkRenderWindow.h"
+#include "vtkRenderer.h"
+#include "vtkSMPTools.h"
+#include "vtkSmartPointer.h"
+#include "vtkVersion.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+#include "vtkWindowToImageFilter.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace
+{
+// ---------------------------------------------------------------------------
+// Options
+struct Options
+{
+  std::string Input = "ct";
+  std::string CTFile = medical_test::DataFile("ct_head.mha");
+  std::vector<std::pair<int, int>> Windows = { { 1920, 1080 }, { 1024, 768 } };
+  int Frames = 360;
+  int Sweep = 95;
+  std::vector<double> Isovalues = { -500.0, 400.0 };
+  std::vector<std::string> Methods = { "hp", "rc", "fe" };
+  std::vector<double> RayCastFactors = { 0.5 };
+  std::string ImageDir;
+};
+
+std::vector<std::string> Split(const std::string& text, char sep)
+{
+  std::vector<std::string> parts;
+  std::stringstream stream(text);
+  std::string part;
+  while (std::getline(stream, part, sep))
+  {
+    if (!part.empty())
+    {
+      parts.push_back(part);
+    }
+  }
+  return parts;
+}
+
+std::vector<double> Numbers(const std::string& text)
+{
+  std::vector<double> values;
+  for (const std::string& s : Split(text, ','))
+  {
+    values.push_back(std::stod(s));
+  }
+  return values;
+}
+
+bool Parse(int argc, char* argv[], Options& opt)
+{
+  for (int i = 1; i < argc; ++i)
+  {
+    const std::string arg = argv[i];
+    // Options take "--name value" or "--name=value" (the latter for lists
+    // starting with a minus sign).
+    std::string name = arg;
+    std::string value;
+    const auto eq = arg.find('=');
+    if (eq != std::string::npos)
+    {
+      name = arg.substr(0, eq);
+      value = arg.substr(eq + 1);
+    }
+    else if (i + 1 < argc)
+    {
+      value = argv[++i];
+    }
+    else
+    {
+      std::fprintf(stderr, "missing value for %s\n", arg.c_str());
+      return false;
+    }
+    if (name == "--input")
+      opt.Input = value;
+    else if (name == "--ct")
+      opt.CTFile = value;
+    else if (name == "--frames")
+      opt.Frames = std::max(1, std::stoi(value));
+    else if (name == "--sweep")
+      opt.Sweep = std::max(0, std::stoi(value));
+    else if (name == "--isovalues")
+      opt.Isovalues = Numbers(value);
+    else if (name == "--methods")
+      opt.Methods = Split(value, ',');
+    else if (name == "--rc-factors")
+      opt.RayCastFactors = Numbers(value);
+    else if (name == "--images")
+      opt.ImageDir = value;
+    else if (name == "--windows")
+    {
+      opt.Windows.clear();
+      for (const std::string& w : Split(value, ','))
+      {
+        int width = 0, height = 0;
+        if (std::sscanf(w.c_str(), "%dx%d", &width, &height) != 2 || width < 1 || height < 1)
+        {
+          std::fprintf(stderr, "bad window size %s\n", w.c_str());
+          return false;
+        }
+        opt.Windows.emplace_back(width, height);
+      }
+    }
+    else
+    {
+      std::fprintf(stderr, "unknown option %s\n", name.c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// One JSON object per line, prefixed so that the wrapper finds it.
+class Record
+{
+public:
+  explicit Record(const std::string& kind) { this->Add("kind", kind); }
+  Record& Add(const std::string& key, const std::string& value)
+  {
+    std::string escaped;
+    for (char c : value)
+    {
+      if (c == '"' || c == '\\')
+        escaped += '\\';
+      if (c == '\n')
+      {
+        escaped += "\\n";
+        continue;
+      }
+      escaped += c;
+    }
+    this->Fields.push_back("\"" + key + "\": \"" + escaped + "\"");
+    return *this;
+  }
+  Record& Add(const std::string& key, double value)
+  {
+    char text[64];
+    std::snprintf(text, sizeof(text), "%.9g", value);
+    this->Fields.push_back("\"" + key + "\": " + text);
+    return *this;
+  }
+  Record& Add(const std::string& key, const std::vector<double>& values)
+  {
+    std::string text = "[";
+    for (std::size_t i = 0; i < values.size(); ++i)
+    {
+      char number[64];
+      std::snprintf(number, sizeof(number), "%s%.9g", i ? ", " : "", values[i]);
+      text += number;
+    }
+    this->Fields.push_back("\"" + key + "\": " + text + "]");
+    return *this;
+  }
+  void Print() const
+  {
+    std::string line = "bench-result: {";
+    for (std::size_t i = 0; i < this->Fields.size(); ++i)
+    {
+      line += (i ? ", " : "") + this->Fields[i];
+    }
+    std::printf("%s}\n", line.c_str());
+    std::fflush(stdout);
+  }
+
+private:
+  std::vector<std::string> Fields;
+};
+
+double Now()
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+    .count();
+}
+
+double PeakRSSMB()
+{
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+  {
+    if (line.rfind("VmHWM:", 0) == 0)
+    {
+      return std::atof(line.c_str() + 6) / 1024.0;
+    }
+  }
+  return 0.0;
+}
+
+// ---------------------------------------------------------------------------
+// Inputs
+vtkSmartPointer<vtkImageData> LoadInput(const Options& opt, std::string& label)
+{
+  if (opt.Input.rfind("phantom", 0) == 0)
+  {
+    const int n = std::atoi(opt.Input.c_str() + 7);
+    if (n < 2)
+    {
+      return nullptr;
+    }
+    // As Python/benchmark_blocklod.py and the demo: 240 mm across, seed 1, no noise.
+    vtkNew<vtkMedicalPhantomSource> source;
+    source->SetDimensions(n, n, n);
+    const double h = 240.0 / (n - 1);
+    source->SetSpacing(h, h, h);
+    source->Update();
+    label = "MedicalPhantom " + std::to_string(n) + "^3 (int16 HU, seed 1, no noise)";
+    return source->GetOutput();
+  }
+  if (opt.Input != "ct" && opt.Input != "ct512")
+  {
+    return nullptr;
+  }
+  vtkNew<vtkMetaImageReader> reader;
+  reader->SetFileName(opt.CTFile.c_str());
+  reader->Update();
+  vtkImageData* ct = reader->GetOutput();
+  if (!ct || !ct->GetPointData()->GetScalars())
+  {
+    return nullptr;
+  }
+  if (opt.Input == "ct")
+  {
+    label = "head CT (" + opt.CTFile.substr(opt.CTFile.find_last_of('/') + 1) + ")";
+    return ct;
+  }
+  // Exactly 512x512x216 over the same bounds, linear, as the CPU benchmark
+  // (vtkImageResample with magnification 2 would give 511x511x215).
+  int dimsIn[3];
+  double spacingIn[3];
+  ct->GetDimensions(dimsIn);
+  ct->GetSpacing(spacingIn);
+  const int dimsOut[3] = { 512, 512, 216 };
+  vtkNew<vtkImageReslice> reslice;
+  reslice->SetInputData(ct);
+  reslice->SetInterpolationModeToLinear();
+  reslice->SetOutputOrigin(ct->GetOrigin());
+  reslice->SetOutputSpacing(spacingIn[0] * (dimsIn[0] - 1) / (dimsOut[0] - 1),
+    spacingIn[1] * (dimsIn[1] - 1) / (dimsOut[1] - 1),
+    spacingIn[2] * (dimsIn[2] - 1) / (dimsOut[2] - 1));
+  reslice->SetOutputExtent(0, dimsOut[0] - 1, 0, dimsOut[1] - 1, 0, dimsOut[2] - 1);
+  reslice->Update();
+  label = "head CT resampled (linear, vtkImageReslice) to 512x512x216";
+  return reslice->GetOutput();
+}
+
+// ---------------------------------------------------------------------------
+// Scenes: one window per method, the same camera, light and material.
+struct Scene
+{
+  std::string Method; // hp, rc or fe
+  std::string Label;  // as printed in tables
+  double SampleFactor = 0.0;
+  vtkSmartPointer<vtkRenderWindow> Window;
+  vtkSmartPointer<vtkRenderer> Renderer;
+  vtkSmartPointer<vtkVolumeProperty> VolumeProperty;
+  vtkSmartPointer<vtkHistoPyramidIsoMapper> HistoPyramid;
+  vtkSmartPointer<vtkFlyingEdges3D> FlyingEdges;
+  vtkSmartPointer<vtkPolyDataMapper> PolyMapper;
+  double Bounds[6];
+
+  void SetIsovalue(double value)
+  {
+    if (this->FlyingEdges)
+    {
+      this->FlyingEdges->SetValue(0, value);
+    }
+    else
+    {
+      this->VolumeProperty->GetIsoSurfaceValues()->SetValue(0, value);
+    }
+  }
+
+  /// Extraction time (FlyingEdges only; the others extract while drawing).
+  double Extract()
+  {
+    if (!this->FlyingEdges)
+    {
+      return 0.0;
+    }
+    const double t0 = Now();
+    this->FlyingEdges->Update();
+    return Now() - t0;
+  }
+
+  double Frame()
+  {
+    const double t0 = Now();
+    this->Window->Render();
+    this->Window->WaitForCompletion(); // glFinish
+    return Now() - t0;
+  }
+
+  void ResetView()
+  {
+    vtkCamera* camera = this->Renderer->GetActiveCamera();
+    const double c[3] = { 0.5 * (this->Bounds[0] + this->Bounds[1]),
+      0.5 * (this->Bounds[2] + this->Bounds[3]), 0.5 * (this->Bounds[4] + this->Bounds[5]) };
+    camera->SetFocalPoint(c);
+    camera->SetPosition(c[0], c[1] - 1.0, c[2]); // from the front (-y), head up (+z)
+    camera->SetViewUp(0.0, 0.0, 1.0);
+    camera->SetViewAngle(30.0);
+    this->Renderer->ResetCamera(this->Bounds); // the image's bounds for every method
+    this->Renderer->ResetCameraClippingRange(this->Bounds);
+  }
+
+  void Rotate(double degrees)
+  {
+    this->Renderer->GetActiveCamera()->Azimuth(degrees);
+    this->Renderer->ResetCameraClippingRange(this->Bounds);
+  }
+
+  /// Triangles (FlyingEdges) or primitives (HistoPyramid) of the last frame.
+  double Elements() const
+  {
+    if (this->FlyingEdges)
+    {
+      return static_cast<double>(this->FlyingEdges->GetOutput()->GetNumberOfPolys());
+    }
+    if (this->HistoPyramid)
+    {
+      return static_cast<double>(this->HistoPyramid->GetNumberOfPrimitives());
+    }
+    return -1.0;
+  }
+};
+
+void SetLook(vtkVolumeProperty* property)
+{
+  vtkNew<vtkColorTransferFunction> color;
+  color->AddRGBPoint(0.0, 0.93, 0.85, 0.75);
+  vtkNew<vtkPiecewiseFunction> opacity;
+  opacity->AddPoint(0.0, 1.0); // opaque at every isovalue
+  property->SetColor(color);
+  property->SetScalarOpacity(opacity);
+  property->SetInterpolationTypeToLinear();
+  property->SetAmbient(0.15);
+  property->SetDiffuse(0.8);
+  property->SetSpecular(0.25);
+  property->SetSpecularPower(30.0);
+  property->ShadeOn();
+}
+
+Scene MakeScene(const std::string& method, double factor, vtkImageData* image, int width,
+  int height, double isovalue)
+{
+  Scene scene;
+  scene.Method = method;
+  scene.SampleFactor = factor;
+  image->GetBounds(scene.Bounds);
+  scene.Window = vtkSmartPointer<vtkRenderWindow>::New();
+  scene.Window->SetSize(width, height);
+  scene.Window->SetPosition(0, 0);
+  scene.Window->SetMultiSamples(0);
+  scene.Renderer = vtkSmartPointer<vtkRenderer>::New();
+  scene.Renderer->SetBackground(0.1, 0.12, 0.16);
+  scene.Window->AddRenderer(scene.Renderer);
+
+  if (method == "fe")
+  {
+    scene.Label = "vtkFlyingEdges3D + vtkPolyDataMapper";
+    scene.FlyingEdges = vtkSmartPointer<vtkFlyingEdges3D>::New();
+    scene.FlyingEdges->SetInputData(image);
+    scene.FlyingEdges->ComputeNormalsOn();
+    scene.FlyingEdges->ComputeScalarsOff();
+    scene.FlyingEdges->ComputeGradientsOff();
+    scene.FlyingEdges->SetValue(0, isovalue);
+    scene.PolyMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+    scene.PolyMapper->SetInputConnection(scene.FlyingEdges->GetOutputPort());
+    scene.PolyMapper->ScalarVisibilityOff();
+    vtkNew<vtkActor> actor;
+    actor->SetMapper(scene.PolyMapper);
+    vtkProperty* p = actor->GetProperty();
+    p->SetColor(0.93, 0.85, 0.75);
+    p->SetAmbient(0.15);
+    p->SetDiffuse(0.8);
+    p->SetSpecular(0.25);
+    p->SetSpecularPower(30.0);
+    scene.Renderer->AddActor(actor);
+  }
+  else
+  {
+    scene.VolumeProperty = vtkSmartPointer<vtkVolumeProperty>::New();
+    SetLook(scene.VolumeProperty);
+    scene.VolumeProperty->GetIsoSurfaceValues()->SetValue(0, isovalue);
+    vtkNew<vtkVolume> volume;
+    volume->SetProperty(scene.VolumeProperty);
+    if (method == "hp")
+    {
+      scene.Label = "vtkHistoPyramidIsoMapper";
+      scene.HistoPyramid = vtkSmartPointer<vtkHistoPyramidIsoMapper>::New();
+      scene.HistoPyramid->SetInputData(image);
+      volume->SetMapper(scene.HistoPyramid);
+    }
+    else
+    {
+      double spacing[3];
+      image->GetSpacing(spacing);
+      const double minSpacing = std::min({ spacing[0], spacing[1], spacing[2] });
+      char label[128];
+      std::snprintf(label, sizeof(label),
+        "vtkGPUVolumeRayCastMapper iso, sample %.2g x min spacing", factor);
+      scene.Label = label;
+      vtkNew<vtkGPUVolumeRayCastMapper> mapper;
+      mapper->SetInputData(image);
+      mapper->SetBlendModeToIsoSurface();
+      mapper->SetAutoAdjustSampleDistances(0);
+      mapper->SetSampleDistance(static_cast<float>(factor * minSpacing));
+      mapper->SetImageSampleDistance(1.0f);
+      volume->SetMapper(mapper);
+    }
+    scene.Renderer->AddVolume(volume);
+  }
+  scene.ResetView();
+  return scene;
+}
+
+void SaveImage(Scene& scene, const std::string& file)
+{
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(scene.Window);
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  grab->Update();
+  vtkNew<vtkPNGWriter> writer;
+  writer->SetFileName(file.c_str());
+  writer->SetInputConnection(grab->GetOutputPort());
+  writer->Write();
+}
+
+std::string Field(const std::string& report, const std::string& key)
+{
+  const auto at = report.find(key);
+  if (at == std::string::npos)
+  {
+    return "unknown";
+  }
+  const auto start = at + key.size();
+  const auto end = report.find('\n', start);
+  std::string value = report.substr(start, end == std::string::npos ? end : end - start);
+  value.erase(0, value.find_first_not_of(" :"));
+  return value;
+}
+
+struct Stats
+{
+  double Min, Median, Mean, Total;
+};
+
+Stats Summarise(std::vector<double> t)
+{
+  Stats s{ 0, 0, 0, 0 };
+  if (t.empty())
+  {
+    return s;
+  }
+  std::sort(t.begin(), t.end());
+  s.Min = t.front();
+  const std::size_t n = t.size();
+  s.Median = n % 2 ? t[n / 2] : 0.5 * (t[n / 2 - 1] + t[n / 2]);
+  for (double v : t)
+  {
+    s.Total += v;
+  }
+  s.Mean = s.Total / n;
+  return s;
+}
+
+std::string WindowText(int w, int h)
+{
+  return std::to_string(w) + "x" + std::to_string(h);
+}
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  Options opt;
+  if (!Parse(argc, argv, opt))
+  {
+    return 2;
+  }
+  // vtkFlyingEdges3D's threads: the STDThread backend, whatever the build's default.
+  vtkSMPTools::SetBackend("STDThread");
+  vtkSMPTools::Initialize(0);
+
+  std::string label;
+  const double loadStart = Now();
+  vtkSmartPointer<vtkImageData> image = LoadInput(opt, label);
+  if (!image)
+  {
+    std::fprintf(stderr, "could not load input %s\n", opt.Input.c_str());
+    return 2;
+  }
+  const double loadSeconds = Now() - loadStart;
+  vtkDataArray* scalars = image->GetPointData()->GetScalars();
+  double range[2];
+  scalars->GetRange(range);
+  int dims[3];
+  image->GetDimensions(dims);
+  const double volumeBytes =
+    static_cast<double>(scalars->GetNumberOfValues()) * scalars->GetDataTypeSize();
+  const std::string dimsText =
+    std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" + std::to_string(dims[2]);
+  double spacing[3];
+  image->GetSpacing(spacing);
+  Record("input")
+    .Add("input", opt.Input)
+    .Add("label", label)
+    .Add("dims", dimsText)
+    .Add("type", scalars->GetDataTypeAsString())
+    .Add("range", std::vector<double>{ range[0], range[1] })
+    .Add("spacing", std::vector<double>{ spacing[0], spacing[1], spacing[2] })
+    .Add("volume_bytes", volumeBytes)
+    .Add("load_s", loadSeconds)
+    .Add("smp_backend", vtkSMPTools::GetBackend())
+    .Add("smp_threads", vtkSMPTools::GetEstimatedNumberOfThreads())
+    .Add("vtk", vtkVersion::GetVTKVersion())
+    .Add("frames", opt.Frames)
+    .Add("sweep", opt.Sweep)
+    .Print();
+  std::printf("input %s: %s, %s %s, range %g..%g, loaded in %.2f s; SMP %s, %d threads\n",
+    opt.Input.c_str(), label.c_str(), dimsText.c_str(), scalars->GetDataTypeAsString(), range[0],
+    range[1], loadSeconds, vtkSMPTools::GetBackend(),
+    vtkSMPTools::GetEstimatedNumberOfThreads());
+
+  // The sweep: equidistant, the range's ends left out so that every isovalue crosses.
+  std::vector<double> sweep;
+  for (int i = 0; i < opt.Sweep; ++i)
+  {
+    sweep.push_back(range[0] + (range[1] - range[0]) * (i + 1) / (opt.Sweep + 1));
+  }
+
+  bool reportedGL = false;
+  int failures = 0;
+  for (const auto& window : opt.Windows)
+  {
+    const std::string windowText = WindowText(window.first, window.second);
+    for (const std::string& method : opt.Methods)
+    {
+      const std::vector<double> factors =
+        method == "rc" ? opt.RayCastFactors : std::vector<double>{ 0.0 };
+      for (double factor : factors)
+      {
+        // --- rotation, per isovalue: a fresh scene each, so every one starts cold.
+        for (double iso : opt.Isovalues)
+        {
+          Scene scene = MakeScene(method, factor, image, window.first, window.second, iso);
+          double extract = scene.Extract();
+          const double first = scene.Frame();
+          if (!reportedGL)
+          {
+            const std::string caps = scene.Window->ReportCapabilities();
+            Record("machine")
+              .Add("gl_vendor", Field(caps, "OpenGL vendor string"))
+              .Add("gl_renderer", Field(caps, "OpenGL renderer string"))
+              .Add("gl_version", Field(caps, "OpenGL version string"))
+              .Print();
+            std::printf("GL: %s | %s\n", Field(caps, "OpenGL renderer string").c_str(),
+              Field(caps, "OpenGL version string").c_str());
+            reportedGL = true;
+          }
+          scene.Frame(); // warm-up
+          std::string path = "-";
+          std::string reason;
+          double buildsBefore = 0.0;
+          if (scene.HistoPyramid)
+          {
+            path = scene.HistoPyramid->GetLastRenderPathAsString();
+            reason = scene.HistoPyramid->GetFallbackReason();
+            buildsBefore = static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds());
+            if (scene.HistoPyramid->GetLastRenderPath() != vtkHistoPyramidIsoMapper::GPUPath)
+            {
+              std::printf("WARNING: vtkHistoPyramidIsoMapper drew with path %s (%s)\n",
+                path.c_str(), reason.c_str());
+              ++failures;
+            }
+          }
+          if (!opt.ImageDir.empty())
+          {
+            char name[256];
+            std::snprintf(name, sizeof(name), "%s/%s_%s_%s%s_iso%g.png", opt.ImageDir.c_str(),
+              opt.Input.c_str(), windowText.c_str(), method.c_str(),
+              method == "rc" ? ("_" + std::to_string(factor)).substr(0, 5).c_str() : "", iso);
+            SaveImage(scene, name);
+          }
+          std::vector<double> times;
+          times.reserve(opt.Frames);
+          const double rotationStart = Now();
+          for (int f = 0; f < opt.Frames; ++f)
+          {
+            scene.Rotate(1.0);
+            times.push_back(scene.Frame());
+          }
+          const double wall = Now() - rotationStart;
+          const Stats s = Summarise(times);
+          Record r("rotation");
+          r.Add("input", opt.Input)
+            .Add("window", windowText)
+            .Add("method", method)
+            .Add("label", scene.Label)
+            .Add("factor", factor)
+            .Add("iso", iso)
+            .Add("frames", opt.Frames)
+            .Add("min_s", s.Min)
+            .Add("median_s", s.Median)
+            .Add("mean_s", s.Mean)
+            .Add("total_s", wall)
+            .Add("first_frame_s", first + extract)
+            .Add("elements", scene.Elements())
+            .Add("path", path);
+          if (scene.HistoPyramid)
+          {
+            r.Add("reason", reason)
+              .Add("gpu_bytes", static_cast<double>(scene.HistoPyramid->GetGPUMemoryBytes()))
+              .Add("volume_bytes", volumeBytes)
+              .Add("builds_during_rotation",
+                static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds()) - buildsBefore)
+              .Add("uploads", static_cast<double>(scene.HistoPyramid->GetNumberOfVolumeUploads()));
+          }
+          if (scene.FlyingEdges)
+          {
+            r.Add("output_mb",
+              scene.FlyingEdges->GetOutput()->GetActualMemorySize() / 1024.0);
+          }
+          r.Print();
+          std::printf("%s %s %s iso %g: %d frames, median %.4f s (%.1f fps), min %.4f s, "
+                      "total %.1f s, %.0f elements, path %s\n",
+            opt.Input.c_str(), windowText.c_str(), scene.Label.c_str(), iso, opt.Frames,
+            s.Median, 1.0 / s.Median, s.Min, wall, scene.Elements(), path.c_str());
+          std::fflush(stdout);
+          scene.Window->Finalize();
+        }
+
+        // --- isovalue sweep: change + frame (FlyingEdges: extract + frame).
+        if (sweep.empty())
+        {
+          continue;
+        }
+        Scene scene =
+          MakeScene(method, factor, image, window.first, window.second, opt.Isovalues.front());
+        scene.Extract();
+        scene.Frame();
+        scene.Frame();
+        const double buildsBefore =
+          scene.HistoPyramid ? static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds())
+                             : 0.0;
+        const double bytesBefore =
+          scene.HistoPyramid ? static_cast<double>(scene.HistoPyramid->GetGPUMemoryBytes()) : 0.0;
+        std::vector<double> changes, extracts, elements;
+        int notGPU = 0;
+        for (double v : sweep)
+        {
+          const double t0 = Now();
+          scene.SetIsovalue(v);
+          const double e = scene.Extract();
+          scene.Frame();
+          changes.push_back(Now() - t0);
+          extracts.push_back(e);
+          elements.push_back(scene.Elements());
+          if (scene.HistoPyramid &&
+            scene.HistoPyramid->GetLastRenderPath() != vtkHistoPyramidIsoMapper::GPUPath)
+          {
+            ++notGPU;
+          }
+        }
+        const Stats s = Summarise(changes);
+        const Stats se = Summarise(extracts);
+        Record r("sweep");
+        r.Add("input", opt.Input)
+          .Add("window", windowText)
+          .Add("method", method)
+          .Add("label", scene.Label)
+          .Add("factor", factor)
+          .Add("n", static_cast<double>(sweep.size()))
+          .Add("first_iso", sweep.front())
+          .Add("last_iso", sweep.back())
+          .Add("min_s", s.Min)
+          .Add("median_s", s.Median)
+          .Add("mean_s", s.Mean)
+          .Add("total_s", s.Total)
+          .Add("max_s", *std::max_element(changes.begin(), changes.end()))
+          .Add("extract_median_s", se.Median)
+          .Add("min_elements", *std::min_element(elements.begin(), elements.end()))
+          .Add("max_elements", *std::max_element(elements.begin(), elements.end()));
+        if (scene.HistoPyramid)
+        {
+          r.Add("builds", static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds()) -
+                  buildsBefore)
+            .Add("gpu_bytes_before", bytesBefore)
+            .Add("gpu_bytes_after", static_cast<double>(scene.HistoPyramid->GetGPUMemoryBytes()))
+            .Add("volume_bytes", volumeBytes)
+            .Add("frames_not_gpu", notGPU);
+          if (notGPU)
+          {
+            ++failures;
+          }
+        }
+        r.Print();
+        std::printf("%s %s %s sweep of %zu: median %.4f s per change+frame (min %.4f, total "
+                    "%.1f s), elements %.0f..%.0f\n",
+          opt.Input.c_str(), windowText.c_str(), scene.Label.c_str(), sweep.size(), s.Median,
+          s.Min, s.Total, *std::min_element(elements.begin(), elements.end()),
+          *std::max_element(elements.begin(), elements.end()));
+        std::fflush(stdout);
+        scene.Window->Finalize();
+      }
+    }
+  }
+  Record("end").Add("peak_rss_mb", PeakRSSMB()).Add("failures", failures).Print();
+  return failures ? 1 : 0;
+}
