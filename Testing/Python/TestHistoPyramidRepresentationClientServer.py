@@ -3,7 +3,9 @@
 
 The plugin is loaded on both sides (the representation has a client-side copy,
 as every ParaView representation). With remote rendering forced
-(RemoteRenderThreshold 0) the server renders and the image comes back:
+(RemoteRenderThreshold 0) the server renders and the image comes back (with
+local rendering asked for, ParaView keeps volume representations on the
+server: checked too):
 - the data is produced by the pvserver process;
 - the server's representation reports RenderPath "gpu" with active cells drawn,
   while the client's copy drew nothing ("none"): the frame was the server's;
@@ -71,6 +73,26 @@ second = hp.screenshot(view, os.path.join(out, "TestHistoPyramidRepresentationCl
 check(hp.changed_fraction(first, second) > 0.02, "the image from the server changes")
 print("client/server: server pid %d drew %d then %d primitives; image %.1f%% covered"
       % (args.server_pid, server["primitives"], bone["primitives"], 100 * fraction))
+
+# Local rendering asked for: ParaView 5.11 still renders volume
+# representations where the data is (vtkImageVolumeRepresentation requires
+# distributed rendering), so the volume never travels to the client; the
+# server keeps drawing and the client's copy draws nothing. (The paper's
+# local-rendering mode, coarse geometry rotated on the client, is
+# BlockLODContour's: TestBlockLODContourRemoteSession*.)
+view.RemoteRenderThreshold = 1.0e9  # MB: local rendering wherever ParaView allows it
+Render(view)
+builds = hp.render_info(display)["builds"]
+for _ in range(3):
+    view.CameraPosition = [-p for p in view.CameraPosition]
+    Render(view)
+after = hp.render_info(display)
+client_after = hp.render_info(display, vtkPVSession.CLIENT)
+check(after["path"] == "gpu" and after["builds"] == builds and client_after["path"] == "none",
+      "local rendering asked for: the server still draws, camera moves reuse its pyramid, "
+      "the client draws nothing (%s / %s)" % (after, client_after))
+third = hp.screenshot(view, os.path.join(out, "TestHistoPyramidRepresentationClientServerLocal.png"))
+check(hp.foreground_fraction(third) > 0.05, "the image still shows the surface")
 
 Disconnect()
 if check.failures:
