@@ -62,9 +62,20 @@ for n in args.sizes:
               % (tag, c2s_property))
         check(c2s_render < 2048, "%s: the render after it sends %d B client->server (limit 2048)"
               % (tag, c2s_render))
-    info = contour.GetDataInformation()
-    geometry = info.GetMemorySize() * 1024
-    triangles = info.GetNumberOfCells()
+    if args.representation == cs.SURFACE:
+        info = contour.GetDataInformation()
+        geometry = info.GetMemorySize() * 1024
+        triangles = info.GetNumberOfCells()
+    else:
+        # The GPU representation: its active cells and GPU bytes on the server.
+        import HistoPyramidRepresentationChecks as hp
+        drawn = hp.render_info(display)
+        check(drawn["path"] == "gpu", "%s: the server drew on the GPU path (%s)" % (tag, drawn))
+        geometry = drawn["gpu_bytes"]
+        triangles = drawn["primitives"]
+        for c in changes:
+            check(c < 2048, "%s: changing the isovalue and rendering sends %d B client->server "
+                  "(limit 2048)" % (tag, c))
     frames = []
     for i in range(3):
         GetActiveCamera().Azimuth(10)
@@ -74,7 +85,8 @@ for n in args.sizes:
     for c in changes:
         check(c < 2560, "%s: changing the isovalue and rendering sends %d B client->server "
               "(limit 2560)" % (tag, c))
-    check(triangles > 1000, "%s: the new isovalue has a surface (%d triangles)" % (tag, triangles))
+    check(triangles > 1000, "%s: the new isovalue has a surface (%d triangles or cells)"
+          % (tag, triangles))
     frame_s2c = sorted(f[1] for f in frames)[1]
     check(frame_s2c < 800 * 600 * 4, "%s: a frame is at most one raw image (%d B)"
           % (tag, frame_s2c))

@@ -132,6 +132,10 @@ def load_plugin(args):
         simple._add_functions(ns)
     else:
         simple.LoadPlugin(args.plugin, remote=True, ns=ns)
+    if getattr(args, "representation", SURFACE) != SURFACE:
+        # A representation has a client-side object too (ParaView creates it
+        # on every process of the view): the client needs the library as well.
+        simple.LoadPlugin(args.plugin, remote=False, ns=ns)
     return ns
 
 
@@ -147,11 +151,13 @@ def surface_representation(view, contour, volume, name, isovalue):
         display.Representation = SURFACE
         display.ColorArrayName = ["POINTS", ""]
         return display
-    # The GPU representation draws the volume's isosurface itself.
+    # The GPU representation draws the volume's isosurface itself, opaque,
+    # coloured by the volume's HU array.
     display = simple.Show(volume, view)
-    display.Representation = name
-    if display.GetProperty("Isosurfaces") is not None:
-        display.Isosurfaces = [isovalue]
+    display.SetRepresentationType(name)
+    simple.ColorBy(display, ("POINTS", "HU"))
+    simple.GetOpacityTransferFunction("HU").Points = [-3000.0, 1.0, 0.5, 0.0, 3000.0, 1.0, 0.5, 0.0]
+    display.IsosurfaceValues = [isovalue]
     return display
 
 
@@ -159,7 +165,7 @@ def set_isovalue(display, contour, name, isovalue):
     if name == SURFACE:
         contour.Isosurfaces = [isovalue]
     else:
-        display.Isosurfaces = [isovalue]
+        display.IsosurfaceValues = [isovalue]
 
 
 def image_coverage(view):
