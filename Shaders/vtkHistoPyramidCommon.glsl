@@ -85,3 +85,16 @@ void fetchCorners(ivec3 c, out VALUE_TYPE v[8])
     v[i] = texelFetch(volume, c + ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1), 0).r;
   }
 }
+
+// The 8 corner values w[0..7] of child cell (X, Y, Z) (each 0 or 1, literal)
+// of a 2x2x2 node whose 27 point values are p[i + 3 j + 9 k]. A macro with
+// literal indices: software rasterisers spill variably indexed arrays.
+#define MEDISO_CHILD_CORNERS(w, p, X, Y, Z)                                                 \
+  w[0] = p[X + 3 * Y + 9 * Z];                                                              \
+  w[1] = p[X + 1 + 3 * Y + 9 * Z];                                                          \
+  w[2] = p[X + 3 * (Y + 1) + 9 * Z];                                                        \
+  w[3] = p[X + 1 + 3 * (Y + 1) + 9 * Z];                                                    \
+  w[4] = p[X + 3 * Y + 9 * (Z + 1)];                                                        \
+  w[5] = p[X + 1 + 3 * Y + 9 * (Z + 1)];                                                    \
+  w[6] = p[X + 3 * (Y + 1) + 9 * (Z + 1)];                                                  \
+  w[7] = p[X + 1 + 3 * (Y + 1) + 9 * (Z + 1)];

@@ -150,14 +150,7 @@ void main()
 #define MEDISO_CHILD(C, X, Y, Z)                                                             \
   {                                                                                         \
     VALUE_TYPE w[8];                                                                        \
-    w[0] = p[X + 3 * Y + 9 * Z];                                                            \
-    w[1] = p[X + 1 + 3 * Y + 9 * Z];                                                        \
-    w[2] = p[X + 3 * (Y + 1) + 9 * Z];                                                      \
-    w[3] = p[X + 1 + 3 * (Y + 1) + 9 * Z];                                                  \
-    w[4] = p[X + 3 * Y + 9 * (Z + 1)];                                                      \
-    w[5] = p[X + 1 + 3 * Y + 9 * (Z + 1)];                                                  \
-    w[6] = p[X + 3 * (Y + 1) + 9 * (Z + 1)];                                                \
-    w[7] = p[X + 1 + 3 * (Y + 1) + 9 * (Z + 1)];                                            \
+    MEDISO_CHILD_CORNERS(w, p, X, Y, Z)                                                     \
     masks[C] = any(greaterThanEqual(ivec3(X, Y, Z), firstFactor)) ? 0                      \
                                                                   : cellMask(first + ivec3(X, Y, Z), w); \
   }

@@ -5,6 +5,7 @@
 #define IsoMapperTestScenes_h
 
 #include "vtkHistoPyramidIsoMapper.h"
+#include "vtkMedicalGLCapabilities.h"
 #include "vtkMedicalPhantomSource.h"
 
 #include "vtkColorTransferFunction.h"
@@ -14,17 +15,35 @@
 #include "vtkNew.h"
 #include "vtkPiecewiseFunction.h"
 #include "vtkPointData.h"
+#include "vtkRenderWindow.h"
 #include "vtkSmartPointer.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <utility>
 #include <vector>
 
 namespace iso_test
 {
+// Probes the GPU path in `window` (a small one of its own when null): 0 when
+// it can run; else prints why and returns the test's exit code, 125 (skip)
+// for a machine without the features, 1 for a failed probe (a bug).
+inline int ProbeOrSkip(vtkRenderWindow* window = nullptr)
+{
+  vtkNew<vtkRenderWindow> own;
+  own->SetSize(64, 64);
+  vtkNew<vtkMedicalGLCapabilities> caps;
+  if (caps->Probe(window ? window : own.Get()))
+  {
+    return 0;
+  }
+  std::printf("SKIP: %s (%s)\n", caps->GetReason().c_str(), caps->GetStatusAsString());
+  return caps->GetStatus() == vtkMedicalGLCapabilities::StatusProbeFailed ? 1 : 125;
+}
+
 // A float image sampling f(x, y, z) at its points (world coordinates).
 inline vtkSmartPointer<vtkImageData> SampleField(const int dims[3], const double spacing[3],
   const double origin[3], const std::function<double(double, double, double)>& f)

@@ -475,13 +475,9 @@ int TestHistoPyramidIsoMapperChecks(int argc, char* argv[])
     Fallback();
     return medical_test::Finish("TestHistoPyramidIsoMapperChecks Fallback");
   }
-  vtkNew<vtkRenderWindow> probeWindow;
-  probeWindow->SetSize(64, 64);
-  vtkNew<vtkMedicalGLCapabilities> caps;
-  if (!caps->Probe(probeWindow))
+  if (const int skip = iso_test::ProbeOrSkip())
   {
-    std::printf("SKIP: %s (%s)\n", caps->GetReason().c_str(), caps->GetStatusAsString());
-    return caps->GetStatus() == vtkMedicalGLCapabilities::StatusProbeFailed ? 1 : 125;
+    return skip;
   }
   if (which == "Counts")
   {

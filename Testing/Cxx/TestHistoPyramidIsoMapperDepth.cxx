@@ -242,13 +242,9 @@ void PlaneOcclusion(bool parallel)
 
 int TestHistoPyramidIsoMapperDepth(int, char*[])
 {
-  vtkNew<vtkRenderWindow> probeWindow;
-  probeWindow->SetSize(64, 64);
-  vtkNew<vtkMedicalGLCapabilities> caps;
-  if (!caps->Probe(probeWindow))
+  if (const int skip = iso_test::ProbeOrSkip())
   {
-    std::printf("SKIP: %s (%s)\n", caps->GetReason().c_str(), caps->GetStatusAsString());
-    return caps->GetStatus() == vtkMedicalGLCapabilities::StatusProbeFailed ? 1 : 125;
+    return skip;
   }
   AnalyticDepth(false);
   AnalyticDepth(true);

@@ -111,13 +111,7 @@ def screenshot(view, path):
     """Save the view and read the PNG back as an (h, w, 3) array."""
     os.makedirs(os.path.dirname(path), exist_ok=True)
     SaveScreenshot(path, view, ImageResolution=SIZE, TransparentBackground=0)
-    reader = vtkPNGReader()
-    reader.SetFileName(path)
-    reader.Update()
-    image = reader.GetOutput()
-    w, h, _ = image.GetDimensions()
-    pixels = vtk_to_numpy(image.GetPointData().GetScalars())
-    return pixels.reshape(h, w, -1)[:, :, :3].astype(int)
+    return read_png(path)
 
 
 def foreground_fraction(pixels):
