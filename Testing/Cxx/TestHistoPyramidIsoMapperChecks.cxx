@@ -6,7 +6,7 @@
 //              moves reuse the pyramid (no rebuild, no re-upload).
 //  Memory    - GPU memory against volume bytes (<= 1.5x for a 256x256x108
 //              int16 volume, the head CT's size); it stays the same across
-//              1000 isovalue changes (48^3 phantom); ReleaseGraphicsResources()
+//              1000 isovalue changes (24^3 phantom); ReleaseGraphicsResources()
 //              frees it all.
 //  Reference - the GPU image matches the full-resolution CPU marching-cubes
 //              image (the mapper's fallback: vtkBlockLODContour level 3 and a
@@ -240,8 +240,8 @@ void Memory()
     Check(bytes > volumeBytes && bytes <= 1.5 * volumeBytes, "GPU memory <= 1.5x the volume bytes");
   }
 
-  // Flat across 1000 isovalue changes (a smaller volume keeps this quick).
-  auto phantom = iso_test::Phantom(48);
+  // Flat across 1000 isovalue changes (a small volume keeps this quick).
+  auto phantom = iso_test::Phantom(24);
   vtkNew<vtkHistoPyramidIsoMapper> mapper;
   auto volume = iso_test::MakeVolume(phantom, { { -900.0, { 1, 1, 1 }, 1.0 } }, mapper);
   volume->GetProperty()->GetScalarOpacity()->AddPoint(2000.0, 1.0);
