@@ -43,6 +43,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from machine_info import cpu_model, load_average  # noqa: E402
+
 ALL_INPUTS = ("ct", "ct512", "phantom256", "phantom512")
 LARGE_INPUTS = ("ct512", "phantom512")
 DEFAULT_ISOVALUES = (-500.0, 400.0)  # skin and bone, HU, for the CT and the phantom alike
@@ -828,17 +831,6 @@ def build_text(plugin):
     return "%s (libraries built %s; source %s)" % (plugin, built, rev)
 
 
-def cpu_model():
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown CPU"
-
-
 def mem_total_gb():
     try:
         with open("/proc/meminfo") as f:
@@ -848,13 +840,6 @@ def mem_total_gb():
     except OSError:
         pass
     return 0.0
-
-
-def load_average():
-    try:
-        return "%.2f %.2f %.2f" % os.getloadavg()
-    except OSError:
-        return "unknown"
 
 
 def run_parent(args, argv):

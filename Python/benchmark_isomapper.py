@@ -35,6 +35,9 @@ import subprocess
 import sys
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from machine_info import cpu_model, load_average  # noqa: E402
+
 ALL_INPUTS = ("ct", "ct512", "phantom256")
 TARGET_ROTATION = 0.5
 TARGET_SWEEP = 0.5
@@ -73,24 +76,6 @@ def parse_args(argv):
     p.add_argument("--out", default="", help="write the tables (markdown) to this file")
     p.add_argument("--json", default="", help="write the raw records to this file")
     return p.parse_args(argv)
-
-
-def cpu_model():
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown CPU"
-
-
-def load_average():
-    try:
-        return "%.2f %.2f %.2f" % os.getloadavg()
-    except OSError:
-        return "unknown"
 
 
 def run_input(args, name):

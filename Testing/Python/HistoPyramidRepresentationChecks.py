@@ -19,15 +19,8 @@ BACKGROUND = [0.1, 0.1, 0.15]
 SKIN, BONE = -500.0, 400.0
 
 
-class Checker:
-    def __init__(self):
-        self.failures = []
-
-    def __call__(self, ok, what):
-        if not ok:
-            self.failures.append(what)
-            print("FAILED: " + what)
-        return ok
+# The checks collector of the client/server tests (records and prints failures).
+from clientserver import Checks as Checker  # noqa: E402,F401
 
 
 def make_scene(source):
