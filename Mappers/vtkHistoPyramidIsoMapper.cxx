@@ -153,6 +153,8 @@ struct vtkHistoPyramidIsoMapper::Internals
   vtkNew<vtkBlockLODContour> Contour;
   vtkNew<vtkImageData> IndexImage;
   vtkNew<vtkPolyData> Colored;
+  vtkMTimeType ColoredSurfaceTime = 0; // Colored was made from this surface
+  std::vector<double> ColoredLooks;    // and these values, colours, opacities
   vtkNew<vtkPolyDataMapper> PolyMapper;
   vtkNew<vtkActor> Actor;
   vtkNew<vtkMatrix4x4> ActorMatrix;
@@ -819,38 +821,46 @@ void vtkHistoPyramidIsoMapper::RenderFallback(vtkRenderer* ren, vtkVolume* vol,
   vtkPolyData* surface = impl.Contour->GetOutput();
 
   // Colour every point by its isovalue (RGBA, opacity in alpha).
+  // Recoloured only when the surface or the looks change (not every frame).
   bool translucent = false;
+  std::vector<double> looks;
   for (const Surface& s : surfaces)
   {
     translucent = translucent || s.Opacity < 1.0;
+    looks.insert(looks.end(), { s.Value, s.Color[0], s.Color[1], s.Color[2], s.Opacity });
   }
-  impl.Colored->ShallowCopy(surface);
-  vtkDataArray* which = surface->GetPointData()->GetArray("Isovalue");
-  vtkNew<vtkUnsignedCharArray> colors;
-  colors->SetName("Colors");
-  colors->SetNumberOfComponents(4);
-  const vtkIdType numPoints = surface->GetNumberOfPoints();
-  colors->SetNumberOfTuples(numPoints);
-  for (vtkIdType p = 0; p < numPoints; ++p)
+  if (surface->GetMTime() != impl.ColoredSurfaceTime || looks != impl.ColoredLooks)
   {
-    const double v = which ? which->GetTuple1(p) : surfaces[0].Value;
-    const Surface* match = &surfaces[0];
-    for (const Surface& s : surfaces)
+    impl.Colored->ShallowCopy(surface);
+    vtkDataArray* which = surface->GetPointData()->GetArray("Isovalue");
+    vtkNew<vtkUnsignedCharArray> colors;
+    colors->SetName("Colors");
+    colors->SetNumberOfComponents(4);
+    const vtkIdType numPoints = surface->GetNumberOfPoints();
+    colors->SetNumberOfTuples(numPoints);
+    for (vtkIdType p = 0; p < numPoints; ++p)
     {
-      if (std::abs(s.Value - v) < std::abs(match->Value - v))
+      const double v = which ? which->GetTuple1(p) : surfaces[0].Value;
+      const Surface* match = &surfaces[0];
+      for (const Surface& s : surfaces)
       {
-        match = &s;
+        if (std::abs(s.Value - v) < std::abs(match->Value - v))
+        {
+          match = &s;
+        }
       }
+      unsigned char rgba[4];
+      for (int c = 0; c < 3; ++c)
+      {
+        rgba[c] = static_cast<unsigned char>(std::lround(255.0 * match->Color[c]));
+      }
+      rgba[3] = static_cast<unsigned char>(std::lround(255.0 * match->Opacity));
+      colors->SetTypedTuple(p, rgba);
     }
-    unsigned char rgba[4];
-    for (int c = 0; c < 3; ++c)
-    {
-      rgba[c] = static_cast<unsigned char>(std::lround(255.0 * match->Color[c]));
-    }
-    rgba[3] = static_cast<unsigned char>(std::lround(255.0 * match->Opacity));
-    colors->SetTypedTuple(p, rgba);
+    impl.Colored->GetPointData()->SetScalars(colors);
+    impl.ColoredSurfaceTime = surface->GetMTime();
+    impl.ColoredLooks = looks;
   }
-  impl.Colored->GetPointData()->SetScalars(colors);
   this->NumberOfFallbackTriangles = static_cast<std::uint64_t>(surface->GetNumberOfPolys());
 
   vtkVolumeProperty* property = vol->GetProperty();
