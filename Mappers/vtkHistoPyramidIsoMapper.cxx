@@ -95,6 +95,60 @@ void SetIVec3(vtkShaderProgram* program, const char* name, const int v[3])
   }
 }
 
+// Whether point sprites cover every cell this frame (see the vertex shader):
+// the index box [0, cells] lies wholly beyond the near plane, and no cell can
+// project to more than maxPointSize - 3 pixels. The bound on a cell's
+// projected extent: with d >= dmin the depth of every point of the volume and
+// L the longest cell diagonal in view space, two points of a cell differ in
+// x/d by at most L/dmin (1 + |x/d|), and |x/d| <= (1 + |P02|)/|P00| on screen
+// (NDC x = P00 x/d - P02 in perspective; NDC x = P00 x + P03 in parallel).
+bool PointsCoverCells(vtkMatrix4x4* indexToView, vtkMatrix4x4* projection,
+  const int cells[3], double nearPlane, bool parallel, const int viewport[4], float maxPointSize)
+{
+  double dmin = VTK_DOUBLE_MAX;
+  for (int i = 0; i < 8; ++i)
+  {
+    const double p[4] = { (i & 1) ? double(cells[0]) : 0.0, (i & 2) ? double(cells[1]) : 0.0,
+      (i & 4) ? double(cells[2]) : 0.0, 1.0 };
+    double v[4];
+    indexToView->MultiplyPoint(p, v);
+    dmin = std::min(dmin, -v[2]); // the camera looks down -z
+  }
+  if (!(dmin > nearPlane * 1.0001 && dmin > 0.0))
+  {
+    return false;
+  }
+  double diagonal = 0.0;
+  for (int i = 0; i < 4; ++i)
+  {
+    const double d[3] = { (i & 1) ? -1.0 : 1.0, (i & 2) ? -1.0 : 1.0, 1.0 };
+    double v[3] = { 0.0, 0.0, 0.0 };
+    for (int r = 0; r < 3; ++r)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        v[r] += indexToView->GetElement(r, c) * d[c];
+      }
+    }
+    diagonal = std::max(diagonal, vtkMath::Norm(v));
+  }
+  const double p00 = std::abs(projection->GetElement(0, 0));
+  const double p11 = std::abs(projection->GetElement(1, 1));
+  double ndcX, ndcY; // largest NDC extent of a cell
+  if (parallel)
+  {
+    ndcX = diagonal * p00;
+    ndcY = diagonal * p11;
+  }
+  else
+  {
+    ndcX = diagonal / dmin * (p00 + 1.0 + std::abs(projection->GetElement(0, 2)));
+    ndcY = diagonal / dmin * (p11 + 1.0 + std::abs(projection->GetElement(1, 2)));
+  }
+  const double pixels = std::max(0.5 * ndcX * viewport[2], 0.5 * ndcY * viewport[3]);
+  return pixels + 3.0 <= maxPointSize;
+}
+
 bool SupportedType(int type)
 {
   switch (type)
@@ -135,6 +189,7 @@ struct vtkHistoPyramidIsoMapper::Internals
   bool GPUUsable = false;
   std::string GPUReason;
   int MaxVertexTextureUnits = 0;
+  float MaxPointSize = 1.0f;
   bool ConservativeDepth = false;
   int Max3DTextureSize = 0;
 
@@ -145,9 +200,9 @@ struct vtkHistoPyramidIsoMapper::Internals
   std::vector<double> BuiltIsovalues;
   bool PyramidValid = false;
 
-  // The drawing program of the current pyramid layout.
-  std::string ProgramKey;
-  vtkShaderProgram* Program = nullptr;
+  // The drawing programs of the current pyramid layout, per FootprintType.
+  std::string ProgramKey[2];
+  vtkShaderProgram* Program[2] = { nullptr, nullptr };
 
   // Fallback path.
   vtkNew<vtkBlockLODContour> Contour;
@@ -169,17 +224,23 @@ struct vtkHistoPyramidIsoMapper::Internals
     this->UploadedDims[0] = this->UploadedDims[1] = this->UploadedDims[2] = 0;
     this->BuiltIsovalues.clear();
     this->PyramidValid = false;
-    this->ProgramKey.clear();
-    this->Program = nullptr;
+    for (int f = 0; f < 2; ++f)
+    {
+      this->ProgramKey[f].clear();
+      this->Program[f] = nullptr;
+    }
   }
 
   void ReleaseGPU(vtkWindow* win)
   {
     this->Pyramid->ReleaseGraphicsResources(win);
     this->VAO->ReleaseGraphicsResources();
-    if (this->Program)
+    for (vtkShaderProgram* program : this->Program)
     {
-      this->Program->ReleaseGraphicsResources(win);
+      if (program)
+      {
+        program->ReleaseGraphicsResources(win);
+      }
     }
     this->InvalidateGPU();
     this->Window = nullptr;
@@ -218,6 +279,12 @@ int vtkHistoPyramidIsoMapper::FillInputPortInformation(int vtkNotUsed(port), vtk
 {
   info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
   return 1;
+}
+
+//------------------------------------------------------------------------------
+const char* vtkHistoPyramidIsoMapper::GetLastFootprintAsString() const
+{
+  return this->LastFootprint == PointFootprint ? "points" : "boxes";
 }
 
 //------------------------------------------------------------------------------
@@ -442,6 +509,9 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     GLint units = 0;
     glGetIntegerv(GL_MAX_VERTEX_TEXTURE_IMAGE_UNITS, &units);
     impl.MaxVertexTextureUnits = units;
+    GLfloat pointSizes[2] = { 1.0f, 1.0f };
+    glGetFloatv(GL_POINT_SIZE_RANGE, pointSizes);
+    impl.MaxPointSize = pointSizes[1];
     // Early depth rejection with gl_FragDepth written (see the fragment shader).
     impl.ConservativeDepth = false;
     GLint numExtensions = 0;
@@ -554,36 +624,6 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
             << sizes[0][2] / sizes[c][2] << ".0), node, index);\n";
   }
   const std::string declarations = impl.Pyramid->GetShaderDeclarations();
-  key << declarations.size() << declarations.substr(0, 80) << "|" << dec.str() << descend.str()
-      << impl.ConservativeDepth;
-  if (!impl.Program || impl.ProgramKey != key.str())
-  {
-    std::string vs = vtkHistoPyramidIso_vs;
-    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidCommon::Dec", declarations);
-    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Dec", dec.str());
-    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Impl", descend.str());
-    std::string fs = vtkHistoPyramidIso_fs;
-    vtkShaderProgram::Substitute(fs, "//VTK::ConservativeDepth::Dec",
-      impl.ConservativeDepth
-        ? "#extension GL_ARB_conservative_depth : require\nlayout(depth_greater) out float gl_FragDepth;\n"
-        : "");
-    impl.Program =
-      renWin->GetShaderCache()->ReadyShaderProgram(vs.c_str(), fs.c_str(), vtkHistoPyramidIso_gs);
-    if (!impl.Program)
-    {
-      impl.ProgramKey.clear();
-      reason = "the isosurface shaders do not build";
-      impl.GPUUsable = false;
-      impl.GPUReason = reason;
-      return false;
-    }
-    impl.ProgramKey = key.str();
-  }
-  else
-  {
-    renWin->GetShaderCache()->ReadyShaderProgram(impl.Program);
-  }
-  vtkShaderProgram* program = impl.Program;
 
   // 5. Matrices: cell-index space (0-based on the extent) to view and clip.
   vtkNew<vtkMatrix4x4> indexToModel;
@@ -625,6 +665,50 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
       }
     }
   }
+
+  // The footprint of this frame (see AllowPointFootprint) and its program.
+  GLint viewport[4] = { 0, 0, 1, 1 };
+  glGetIntegerv(GL_VIEWPORT, viewport);
+  const int cells[3] = { dims[0] - 1, dims[1] - 1, dims[2] - 1 };
+  const int footprint = this->AllowPointFootprint &&
+      PointsCoverCells(indexToView, camera->GetProjectionTransformMatrix(aspect, -1, 1), cells,
+        camera->GetClippingRange()[0], parallel, viewport, impl.MaxPointSize)
+    ? PointFootprint
+    : BoxFootprint;
+  key << declarations.size() << declarations.substr(0, 80) << "|" << dec.str() << descend.str()
+      << impl.ConservativeDepth;
+  if (!impl.Program[footprint] || impl.ProgramKey[footprint] != key.str())
+  {
+    const std::string footprintDec =
+      footprint == PointFootprint ? "#define MEDISO_POINT_FOOTPRINT\n" : "";
+    std::string vs = vtkHistoPyramidIso_vs;
+    vtkShaderProgram::Substitute(vs, "//VTK::Footprint::Dec", footprintDec);
+    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidCommon::Dec", declarations);
+    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Dec", dec.str());
+    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Impl", descend.str());
+    std::string fs = vtkHistoPyramidIso_fs;
+    vtkShaderProgram::Substitute(fs, "//VTK::Footprint::Dec", footprintDec);
+    vtkShaderProgram::Substitute(fs, "//VTK::ConservativeDepth::Dec",
+      impl.ConservativeDepth
+        ? "#extension GL_ARB_conservative_depth : require\nlayout(depth_greater) out float gl_FragDepth;\n"
+        : "");
+    impl.Program[footprint] = renWin->GetShaderCache()->ReadyShaderProgram(
+      vs.c_str(), fs.c_str(), footprint == PointFootprint ? "" : vtkHistoPyramidIso_gs);
+    if (!impl.Program[footprint])
+    {
+      impl.ProgramKey[footprint].clear();
+      reason = "the isosurface shaders do not build";
+      impl.GPUUsable = false;
+      impl.GPUReason = reason;
+      return false;
+    }
+    impl.ProgramKey[footprint] = key.str();
+  }
+  else
+  {
+    renWin->GetShaderCache()->ReadyShaderProgram(impl.Program[footprint]);
+  }
+  vtkShaderProgram* program = impl.Program[footprint];
 
   // 6. Isovalues in the pyramid's threshold order, their colours, lights.
   const std::vector<int> counted = impl.Pyramid->GetCountedIsovalues();
@@ -744,9 +828,33 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   program->SetUniform3fv(
     "lightColors", MaximumNumberOfLights, reinterpret_cast<const float(*)[3]>(lightColors));
 
+  if (footprint == PointFootprint)
+  {
+    vtkNew<vtkMatrix4x4> clipToIndex;
+    vtkMatrix4x4::Invert(indexToClip, clipToIndex);
+    SetMatrix4(program, "clipToIndex", clipToIndex);
+    const float viewportSize[2] = { static_cast<float>(viewport[2]),
+      static_cast<float>(viewport[3]) };
+    program->SetUniform2f("viewportSize", viewportSize);
+    const float viewportF[4] = { static_cast<float>(viewport[0]), static_cast<float>(viewport[1]),
+      static_cast<float>(viewport[2]), static_cast<float>(viewport[3]) };
+    program->SetUniform4f("viewport", viewportF);
+    program->SetUniformf("maxPointSize", impl.MaxPointSize);
+  }
+  // The point size comes from the vertex stage (not tracked by vtkOpenGLState).
+  const GLboolean programPointSize = glIsEnabled(GL_PROGRAM_POINT_SIZE);
+  if (footprint == PointFootprint && !programPointSize)
+  {
+    glEnable(GL_PROGRAM_POINT_SIZE);
+  }
   impl.VAO->Bind();
   glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(total));
   impl.VAO->Release();
+  if (footprint == PointFootprint && !programPointSize)
+  {
+    glDisable(GL_PROGRAM_POINT_SIZE);
+  }
+  this->LastFootprint = footprint;
   for (vtkTextureObject* texture : active)
   {
     texture->Deactivate();

@@ -23,9 +23,14 @@
  *    (vtkHistoPyramidIso_vs.glsl) walks down the pyramid with gl_VertexID to
  *    its cell, visiting children nearest-first for the current eye, so the
  *    primitives come out front to back with no sort (back to front for
- *    translucency); the geometry stage (vtkHistoPyramidIso_gs.glsl) emits
+ *    translucency) and, on frames where that provably covers every cell
+ *    (the volume beyond the near plane, no cell wider than the largest
+ *    point), makes the cell's footprint a point sprite over the bounding
+ *    square of its projected corners; on other frames (close zooms, the eye
+ *    in the volume) the geometry stage (vtkHistoPyramidIso_gs.glsl) emits
  *    the faces of the cell box that face the eye, a footprint that covers the
- *    cell at any zoom in both projections; the fragment stage
+ *    cell at any zoom in both projections (see AllowPointFootprint,
+ *    GetLastFootprint()); the fragment stage
  *    (vtkHistoPyramidIso_fs.glsl) finds the first root of the cubic the
  *    trilinear interpolant makes along the ray, shades it with Phong (the
  *    volume property's ambient, diffuse, specular and specular power, the
@@ -113,6 +118,34 @@ public:
   vtkBooleanMacro(ForceCPUFallback, bool);
   ///@}
 
+  /// How the GPU path covers each cell on screen.
+  enum FootprintType
+  {
+    BoxFootprint = 0,  ///< The cell box's front faces, from a geometry shader.
+    PointFootprint = 1 ///< One point sprite over the cell's projected bounding square.
+  };
+
+  ///@{
+  /**
+   * Let the GPU path draw each cell as one point sprite (no geometry shader)
+   * on frames where that provably covers every cell: the whole volume lies
+   * beyond the near plane and no cell can project to more pixels than
+   * GL_POINT_SIZE_RANGE allows. Other frames (close zooms, the eye in or near
+   * the volume) draw the cell box's front faces. Both footprints feed the
+   * same ray casting, so they give the same image; points are much cheaper
+   * where primitives are costly (software rasterisers). Default on.
+   */
+  vtkSetMacro(AllowPointFootprint, bool);
+  vtkGetMacro(AllowPointFootprint, bool);
+  vtkBooleanMacro(AllowPointFootprint, bool);
+  ///@}
+
+  ///@{
+  /// The footprint of the last GPU frame (a FootprintType; "boxes" or "points").
+  vtkGetMacro(LastFootprint, int);
+  const char* GetLastFootprintAsString() const;
+  ///@}
+
   /// Primitives (active cell-isovalue pairs) of the last GPU frame.
   vtkGetMacro(NumberOfPrimitives, std::uint64_t);
 
@@ -142,6 +175,8 @@ private:
   int LastRenderPath = NoPath;
   std::string FallbackReason;
   bool ForceCPUFallback = false;
+  bool AllowPointFootprint = true;
+  int LastFootprint = BoxFootprint;
   std::uint64_t NumberOfPrimitives = 0;
   std::uint64_t NumberOfPyramidBuilds = 0;
   std::uint64_t NumberOfVolumeUploads = 0;

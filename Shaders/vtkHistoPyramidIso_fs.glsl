@@ -1,4 +1,5 @@
 //VTK::System::Dec
+//VTK::Footprint::Dec
 //VTK::ConservativeDepth::Dec
 // SPDX-License-Identifier: BSD-3-Clause
 //
@@ -44,6 +45,37 @@
 
 out vec4 fragOutput0; // colour (premultiplied in translucent mode)
 
+#ifdef MEDISO_POINT_FOOTPRINT
+// Point footprint: the vertex stage's outputs come straight here, and the
+// point on the ray is unprojected from the fragment's window position (at
+// the depth of the cell's nearest corner, to stay close to the cell).
+flat in ivec3 vCell;
+flat in int vMask;
+flat in int vIsovalue;
+flat in vec4 vLow;
+flat in vec4 vHigh;
+in CornerGradients
+{
+  flat vec3 g[8];
+} vGradients;
+flat in float vNearDepth;
+uniform mat4 clipToIndex;
+uniform vec4 viewport; // x, y, width, height in pixels
+#define gCell vCell
+#define gMask vMask
+#define gIsovalue vIsovalue
+#define gLow vLow
+#define gHigh vHigh
+#define gGradients vGradients.g
+vec3 rayPoint()
+{
+  vec2 ndc = 2.0 * (gl_FragCoord.xy - viewport.xy) / viewport.zw - 1.0;
+  vec4 p = clipToIndex * vec4(ndc, vNearDepth, 1.0);
+  return p.xyz / p.w;
+}
+#else
+// Box footprint: a point of a front face of the cell box, from the geometry
+// stage.
 in vec3 gPosition;
 flat in ivec3 gCell;
 flat in int gMask;
@@ -51,6 +83,11 @@ flat in int gIsovalue;
 flat in vec4 gLow;
 flat in vec4 gHigh;
 flat in vec3 gGradients[8]; // central differences at the corners
+vec3 rayPoint()
+{
+  return gPosition;
+}
+#endif
 
 uniform vec4 eyeIndex;
 uniform mat4 indexToClip;
@@ -194,6 +231,61 @@ int pieces(vec4 k, float t0, float t1, out float s[4])
   return n;
 }
 
+// The first root of f on [t0, t1], if any: the same monotonic pieces as
+// pieces(), written without arrays or data-dependent loops over them (a
+// software rasteriser runs fragments in SIMD groups, where indexing a local
+// array with a varying index becomes per-lane memory traffic).
+bool firstRoot(vec4 k, float t0, float t1, float tolerance, out float hit)
+{
+  float a = 3.0 * k.x, b = 2.0 * k.y, c = k.z;
+  float r0 = t1, r1 = t1;
+  float scale = abs(a) + abs(b) + abs(c);
+  if (abs(a) > 1e-7 * scale)
+  {
+    float disc = b * b - 4.0 * a * c;
+    if (disc > 0.0)
+    {
+      float q = b == 0.0 ? -0.5 * sqrt(disc) : -0.5 * (b + sign(b) * sqrt(disc));
+      float x0 = q / a;
+      float x1 = q != 0.0 ? c / q : x0;
+      r0 = min(x0, x1);
+      r1 = max(x0, x1);
+    }
+  }
+  else if (abs(b) > 0.0)
+  {
+    r0 = -c / b;
+  }
+  // Piece ends t0 <= s1 <= s2 <= t1 (a root of f' outside [t0, t1] collapses
+  // onto an end: an empty piece, whose ends have one value, so it only
+  // counts when that value is exactly 0, a root at the end).
+  float s1 = clamp(r0, t0, t1);
+  float s2 = clamp(r1, s1, t1);
+  float f0 = evalCubic(k, t0);
+  float f1 = evalCubic(k, s1);
+  float f2 = evalCubic(k, s2);
+  float f3 = evalCubic(k, t1);
+  float ta, tb, fa, fb;
+  if (f0 * f1 <= 0.0)
+  {
+    ta = t0; tb = s1; fa = f0; fb = f1;
+  }
+  else if (f1 * f2 <= 0.0)
+  {
+    ta = s1; tb = s2; fa = f1; fb = f2;
+  }
+  else if (f2 * f3 <= 0.0)
+  {
+    ta = s2; tb = t1; fa = f2; fb = f3;
+  }
+  else
+  {
+    return false;
+  }
+  hit = fa == 0.0 ? ta : (fb == 0.0 ? tb : refine(k, ta, tb, fa, fb, tolerance));
+  return true;
+}
+
 vec3 shade(vec3 p, vec3 color)
 {
   vec3 hit = vec3(gCell) + p;
@@ -231,8 +323,9 @@ float depthOf(vec3 p)
 void main()
 {
   // 1. The ray in the cell's local coordinates: p(t) = o + t d, cell [0, 1]^3.
-  vec3 o = gPosition - vec3(gCell);
-  vec3 d = gPosition * eyeIndex.w - eyeIndex.xyz;
+  vec3 position = rayPoint();
+  vec3 o = position - vec3(gCell);
+  vec3 d = position * eyeIndex.w - eyeIndex.xyz;
   vec3 safe = mix(d, vec3(1e-30), equal(d, vec3(0.0)));
   vec3 ta = -o / safe;
   vec3 tb = (1.0 - o) / safe;
@@ -255,27 +348,8 @@ void main()
     // 2. First root of the one isovalue of this primitive.
     float iso = isovalues[gIsovalue];
     vec4 k = cubic(o, d, iso);
-    float s[4];
-    int n = pieces(k, t0, t1, s);
-    float fa = evalCubic(k, s[0]);
-    float hitT = 0.0;
-    bool found = false;
-    for (int i = 0; i + 1 < n && !found; ++i)
-    {
-      float fb = evalCubic(k, s[i + 1]);
-      if (fa == 0.0)
-      {
-        hitT = s[i];
-        found = true;
-      }
-      else if (fa * fb <= 0.0)
-      {
-        hitT = fb == 0.0 ? s[i + 1] : refine(k, s[i], s[i + 1], fa, fb, tolerance);
-        found = true;
-      }
-      fa = fb;
-    }
-    if (!found)
+    float hitT;
+    if (!firstRoot(k, t0, t1, tolerance, hitT))
     {
       discard;
     }

@@ -1,4 +1,5 @@
 //VTK::System::Dec
+//VTK::Footprint::Dec
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // vtkHistoPyramidIso_vs.glsl: vertex stage of vtkHistoPyramidIsoMapper. The
@@ -26,6 +27,19 @@
 // in place of the HistoPyramidLevels Impl tag. Level 0 is not stored: the last step
 // recounts the up-to-8 cells of the level-1 node from their <= 27 corner
 // values, which are needed anyway for the fragment stage.
+//
+// Footprint. With MEDISO_POINT_FOOTPRINT defined (the mapper does so when
+// every cell of the volume projects to fewer pixels than the largest point
+// size and the volume lies wholly beyond the near plane), this stage also
+// makes the cell's footprint itself: a point sprite centred on the bounding
+// rectangle of the cell's 8 projected corners (cut to the viewport, so the
+// point's centre is always inside the clip volume), as wide as its longer
+// side, at the depth of its nearest corner (so the hit, which lies inside the
+// cell, is never in front of it: early depth rejection stays valid). One
+// vertex and no geometry stage per cell: on software rasterisers the
+// geometry stage's output and the triangle setup of up to six triangles
+// per cell cost far more than the ray casting. Otherwise the geometry stage
+// (vtkHistoPyramidIso_gs.glsl) draws the cell box's front faces.
 
 //VTK::HistoPyramidCommon::Dec
 
@@ -41,6 +55,12 @@ flat out int vMask;          // crossing isovalues of the cell (bit t: threshold
 flat out int vIsovalue;      // the isovalue this primitive draws (-1: none)
 flat out vec4 vLow;          // corner values 0..3 (dx + 2 dy + 4 dz)
 flat out vec4 vHigh;         // corner values 4..7
+#ifdef MEDISO_POINT_FOOTPRINT
+uniform mat4 indexToClip;    // cell-index space to clip coordinates
+uniform vec2 viewportSize;   // pixels
+uniform float maxPointSize;  // GL_POINT_SIZE_RANGE's upper end
+flat out float vNearDepth;   // NDC depth of the nearest corner
+#endif
 out CornerGradients          // central-difference gradient at each corner
 {
   flat vec3 g[8];
@@ -129,6 +149,45 @@ void cornerGradients(ivec3 c, float v[8])
   MEDISO_GRADIENT(7, 1, 1, 1)
 }
 
+#ifdef MEDISO_POINT_FOOTPRINT
+// The point sprite covering cell c (see the header); off the clip volume if
+// the cell is not on screen or reaches behind the eye.
+void pointFootprint(ivec3 c)
+{
+  vec4 origin = indexToClip * vec4(vec3(c), 1.0);
+  vec2 lo = vec2(1e30);
+  vec2 hi = vec2(-1e30);
+  float nearest = 1e30;
+  bool behind = false;
+  for (int i = 0; i < 8; ++i)
+  {
+    vec4 corner = origin + float(i & 1) * indexToClip[0] + float((i >> 1) & 1) * indexToClip[1] +
+      float((i >> 2) & 1) * indexToClip[2];
+    behind = behind || corner.w <= 0.0;
+    vec3 ndc = corner.xyz / corner.w;
+    lo = min(lo, ndc.xy);
+    hi = max(hi, ndc.xy);
+    nearest = min(nearest, ndc.z);
+  }
+  lo = max(lo, vec2(-1.0));
+  hi = min(hi, vec2(1.0));
+  if (behind || any(greaterThan(lo, hi)) || nearest > 1.0)
+  {
+    gl_Position = vec4(0.0, 0.0, 2.0, 1.0); // clipped
+    gl_PointSize = 1.0;
+    vNearDepth = 1.0;
+    return;
+  }
+  vec2 pixels = 0.5 * (hi - lo) * viewportSize;
+  // A point covers the pixels whose centres lie in its square; the square
+  // holds the rectangle, and one pixel of margin keeps the pixels whose
+  // centres lie on its edges, whatever the rasteriser's tie rule.
+  gl_PointSize = min(max(pixels.x, pixels.y) + 1.0, maxPointSize);
+  vNearDepth = max(nearest, -1.0);
+  gl_Position = vec4(0.5 * (lo + hi), vNearDepth, 1.0);
+}
+#endif
+
 void main()
 {
   uint index = uint(gl_VertexID);
@@ -208,5 +267,18 @@ void main()
     vHigh = vec4(v[4], v[5], v[6], v[7]);
     cornerGradients(vCell, v);
   }
+#ifdef MEDISO_POINT_FOOTPRINT
+  if (vIsovalue >= 0)
+  {
+    pointFootprint(vCell);
+  }
+  else
+  {
+    gl_Position = vec4(0.0, 0.0, 2.0, 1.0);
+    gl_PointSize = 1.0;
+    vNearDepth = 1.0;
+  }
+#else
   gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
+#endif
 }

@@ -14,6 +14,12 @@
 //              agree on >= 98.5% of the pixels covered by either, and the
 //              mean colour difference over pixels covered by both is <= 12
 //              (of 255) per channel; opaque and translucent.
+//  Footprint - point sprites and cell boxes give the same image (masks agree
+//              on >= 99.8% of the covered pixels, mean colour difference
+//              <= 1 of 255) for opaque and translucent surfaces in
+//              perspective and parallel projection; the mapper picks points
+//              for a whole-volume view and boxes for a close zoom and for an
+//              eye inside the volume, and says which it used.
 //  Fallback  - MEDISO_DISABLE_GPU_PATH=1 makes the mapper render through the
 //              fallback, report it (path, reason) and warn exactly once.
 //  BadInput  - no scalars, cell scalars, 3 components, 64-bit integers, 2D
@@ -39,6 +45,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -332,6 +339,111 @@ void Reference()
   CompareWithCPU("torus", iso_test::Torus(40, 11.0), { { 4.2, { 0.5, 0.85, 0.45 }, 1.0 } });
 }
 
+// Compares two RGB images: share of the pixels covered by either that both
+// cover, and the mean colour difference over the pixels both cover.
+struct ImageAgreement
+{
+  int Either = 0;
+  double Agreement = 0.0;
+  double MeanDifference = 255.0;
+};
+
+ImageAgreement Compare(const std::vector<unsigned char>& a, const std::vector<unsigned char>& b)
+{
+  int either = 0, both = 0, disagree = 0;
+  double diff = 0.0;
+  for (std::size_t p = 0; p + 2 < a.size() && p + 2 < b.size(); p += 3)
+  {
+    const bool ca = a[p] > 0 || a[p + 1] > 0 || a[p + 2] > 0;
+    const bool cb = b[p] > 0 || b[p + 1] > 0 || b[p + 2] > 0;
+    either += ca || cb;
+    disagree += ca != cb;
+    if (ca && cb)
+    {
+      ++both;
+      for (int c = 0; c < 3; ++c)
+      {
+        diff += std::abs(static_cast<int>(a[p + c]) - static_cast<int>(b[p + c]));
+      }
+    }
+  }
+  ImageAgreement result;
+  result.Either = either;
+  result.Agreement = either ? 1.0 - static_cast<double>(disagree) / either : 0.0;
+  result.MeanDifference = both ? diff / (3.0 * both) : 255.0;
+  return result;
+}
+
+// Renders `image` with points allowed and with boxes only, from a camera set
+// by `place`; checks the footprint the mapper chose and that both agree.
+void CompareFootprints(const std::string& name, vtkImageData* image,
+  const std::vector<iso_test::Look>& looks, const std::function<void(vtkCamera*)>& place,
+  int expected)
+{
+  const int size = 300;
+  std::vector<unsigned char> pixels[2];
+  for (int pass = 0; pass < 2; ++pass)
+  {
+    vtkNew<vtkHistoPyramidIsoMapper> mapper;
+    mapper->SetAllowPointFootprint(pass == 0);
+    MessageCounter messages(mapper);
+    auto volume = iso_test::MakeVolume(image, looks, mapper);
+    Scene scene(size, size);
+    scene.Show(volume);
+    place(scene.Renderer->GetActiveCamera());
+    scene.Renderer->ResetCameraClippingRange();
+    scene.Window->Render();
+    const int footprint = pass == 0 ? expected : vtkHistoPyramidIsoMapper::BoxFootprint;
+    Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
+        mapper->GetLastFootprint() == footprint && messages.Errors + messages.Warnings == 0,
+      name + ": drawn on the GPU with " + (footprint ? "points" : "boxes") + " (got " +
+        mapper->GetLastRenderPathAsString() + ", " + mapper->GetLastFootprintAsString() + ")");
+    vtkNew<vtkUnsignedCharArray> rgb;
+    scene.Window->GetPixelData(0, 0, size - 1, size - 1, 1, rgb);
+    pixels[pass].assign(rgb->GetPointer(0), rgb->GetPointer(0) + 3 * size * size);
+  }
+  const ImageAgreement a = Compare(pixels[0], pixels[1]);
+  std::printf("%s: %d pixels covered by either, masks agree on %.3f%%, mean colour difference "
+              "%.3f\n",
+    name.c_str(), a.Either, 100.0 * a.Agreement, a.MeanDifference);
+  Check(a.Either > 3000, name + ": the surface covers a good part of the image");
+  Check(a.Agreement >= 0.998, name + ": covered pixels agree between the footprints");
+  Check(a.MeanDifference <= 1.0, name + ": colours agree between the footprints");
+}
+
+void Footprint()
+{
+  auto phantom = iso_test::Phantom(64);
+  const iso_test::Look skin{ -500.0, { 0.93, 0.75, 0.62 }, 1.0 };
+  const iso_test::Look glass{ -500.0, { 0.93, 0.75, 0.62 }, 0.35 };
+  const iso_test::Look bone{ 400.0, { 0.97, 0.95, 0.88 }, 1.0 };
+  const auto whole = [](vtkCamera*) {};
+  const auto parallel = [](vtkCamera* camera) { camera->ParallelProjectionOn(); };
+  // Cells of the 64^3 phantom about 400 pixels wide: beyond any point size
+  // llvmpipe (255) or common GPUs (256..2047, with the bound's margin) allow.
+  const auto close = [](vtkCamera* camera) { camera->Zoom(150.0); };
+  double centre[3];
+  phantom->GetCenter(centre);
+  const auto inside = [&centre](vtkCamera* camera)
+  {
+    // The eye at the centre of the phantom's head, looking at the skull.
+    camera->SetFocalPoint(centre[0], centre[1] - 10.0, centre[2]);
+    camera->SetPosition(centre);
+    camera->SetViewUp(0.0, 0.0, 1.0);
+    camera->SetViewAngle(60.0);
+  };
+  const int points = vtkHistoPyramidIsoMapper::PointFootprint;
+  const int boxes = vtkHistoPyramidIsoMapper::BoxFootprint;
+  CompareFootprints("skin, perspective", phantom, { skin }, whole, points);
+  CompareFootprints("bone, parallel", phantom, { bone }, parallel, points);
+  CompareFootprints("translucent skin over bone", phantom, { glass, bone }, whole, points);
+  CompareFootprints(
+    "torus, parallel", iso_test::Torus(40, 11.0), { { 4.2, { 0.5, 0.85, 0.45 }, 1.0 } }, parallel,
+    points);
+  CompareFootprints("skin, close zoom", phantom, { skin }, close, boxes);
+  CompareFootprints("bone, eye inside the volume", phantom, { bone }, inside, boxes);
+}
+
 void Fallback()
 {
   auto phantom = iso_test::Phantom(48);
@@ -490,6 +602,10 @@ int TestHistoPyramidIsoMapperChecks(int argc, char* argv[])
   else if (which == "Reference")
   {
     Reference();
+  }
+  else if (which == "Footprint")
+  {
+    Footprint();
   }
   else if (which == "BadInput")
   {

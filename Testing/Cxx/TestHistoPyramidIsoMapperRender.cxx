@@ -100,12 +100,18 @@ int TestHistoPyramidIsoMapperRender(int argc, char* argv[])
   renWin->Render();
   for (std::size_t i = 0; i < mappers.size(); ++i)
   {
-    std::printf("view %zu: path %s, %llu primitives, %llu GPU bytes\n", i,
-      mappers[i]->GetLastRenderPathAsString(),
+    std::printf("view %zu: path %s, footprint %s, %llu primitives, %llu GPU bytes\n", i,
+      mappers[i]->GetLastRenderPathAsString(), mappers[i]->GetLastFootprintAsString(),
       static_cast<unsigned long long>(mappers[i]->GetNumberOfPrimitives()),
       static_cast<unsigned long long>(mappers[i]->GetGPUMemoryBytes()));
     medical_test::Check(mappers[i]->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath,
       "view " + std::to_string(i) + " drawn by the GPU path");
+    // The close-up's cells exceed the largest point: boxes; the other views'
+    // cells are a few pixels: points.
+    const int footprint =
+      i == 4 ? vtkHistoPyramidIsoMapper::BoxFootprint : vtkHistoPyramidIsoMapper::PointFootprint;
+    medical_test::Check(mappers[i]->GetLastFootprint() == footprint,
+      "view " + std::to_string(i) + " drawn with the expected footprint");
   }
 
   const int result = vtkRegressionTestImage(renWin);
