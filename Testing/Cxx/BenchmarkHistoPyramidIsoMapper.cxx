@@ -17,7 +17,7 @@
 //
 //   BenchmarkHistoPyramidIsoMapper --input ct|ct512|phantom256|phantomN
 //     [--ct FILE.mha] [--windows 1920x1080,1024x768] [--frames 360] [--sweep 95]
-//     [--isovalues -500,400] [--methods hp,rc,fe] [--rc-factors 0.5,1.0]
+//     [--isovalues -500,400] [--methods hp,rc,fe[,hpbox]] [--rc-factors 0.5,1.0]
 //     [--images DIR]
 #include "MedicalTestUtilities.h"
 #include "vtkHistoPyramidIsoMapper.h"
@@ -439,10 +439,14 @@ Scene MakeScene(const std::string& method, double factor, vtkImageData* image, i
     scene.VolumeProperty->GetIsoSurfaceValues()->SetValue(0, isovalue);
     vtkNew<vtkVolume> volume;
     volume->SetProperty(scene.VolumeProperty);
-    if (method == "hp")
+    if (method == "hp" || method == "hpbox")
     {
-      scene.Label = "vtkHistoPyramidIsoMapper";
+      // hpbox: the cell boxes of the geometry stage on every frame (no point
+      // sprites), to compare the two footprints in one run.
+      scene.Label = method == "hp" ? "vtkHistoPyramidIsoMapper"
+                                   : "vtkHistoPyramidIsoMapper, boxes only";
       scene.HistoPyramid = vtkSmartPointer<vtkHistoPyramidIsoMapper>::New();
+      scene.HistoPyramid->SetAllowPointFootprint(method == "hp");
       scene.HistoPyramid->SetInputData(image);
       volume->SetMapper(scene.HistoPyramid);
     }
@@ -620,6 +624,10 @@ int main(int argc, char* argv[])
           if (scene.HistoPyramid)
           {
             path = scene.HistoPyramid->GetLastRenderPathAsString();
+            if (scene.HistoPyramid->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath)
+            {
+              path = path + "/" + scene.HistoPyramid->GetLastFootprintAsString();
+            }
             reason = scene.HistoPyramid->GetFallbackReason();
             buildsBefore = static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds());
             if (scene.HistoPyramid->GetLastRenderPath() != vtkHistoPyramidIsoMapper::GPUPath)
