@@ -37,9 +37,8 @@
 //
 // Translucent mode (any isovalue with opacity < 1): the mapper draws the
 // cells back to front and only one primitive per cell; this fragment finds
-// every hit of every crossing isovalue along its piece of ray in depth order
-// (no sorting: see the end of main()) and composites them front to back,
-// writing premultiplied colour (the
+// every hit of every crossing isovalue along its piece of ray, sorts them by
+// t and composites them front to back, writing premultiplied colour (the
 // blend is ONE, ONE_MINUS_SRC_ALPHA). Cells never overlap, so ordered cells
 // and ordered hits inside each cell give the exact compositing order: an
 // opaque bone behind translucent skin, in one pass.
@@ -188,10 +187,55 @@ float refine(vec4 k, float ta, float tb, float fa, float fb, float tolerance)
   return (fa * tb - fb * ta) / (fa - fb);
 }
 
-// The inner ends t0 <= s1 <= s2 <= t1 of the monotonic pieces of f on
-// [t0, t1]: the roots of f' (a root outside [t0, t1] collapses onto an end,
-// leaving an empty piece). f' depends on the ray only, not on the isovalue.
-void pieceEnds(vec4 k, float t0, float t1, out float s1, out float s2)
+// The ends of the monotonic pieces of f on [t0, t1]: returns how many (2..4).
+int pieces(vec4 k, float t0, float t1, out float s[4])
+{
+  s[0] = t0;
+  int n = 1;
+  float a = 3.0 * k.x, b = 2.0 * k.y, c = k.z;
+  float r0 = t1, r1 = t1;
+  float scale = abs(a) + abs(b) + abs(c);
+  if (abs(a) > 1e-7 * scale)
+  {
+    float disc = b * b - 4.0 * a * c;
+    if (disc > 0.0)
+    {
+      float q = -0.5 * (b + sign(b) * sqrt(disc));
+      if (b == 0.0)
+      {
+        q = -0.5 * sqrt(disc);
+      }
+      r0 = q / a;
+      r1 = q != 0.0 ? c / q : r0;
+      if (r0 > r1)
+      {
+        float tmp = r0;
+        r0 = r1;
+        r1 = tmp;
+      }
+    }
+  }
+  else if (abs(b) > 0.0)
+  {
+    r0 = -c / b;
+  }
+  if (r0 > t0 && r0 < t1)
+  {
+    s[n++] = r0;
+  }
+  if (r1 > t0 && r1 < t1 && r1 != r0)
+  {
+    s[n++] = r1;
+  }
+  s[n++] = t1;
+  return n;
+}
+
+// The first root of f on [t0, t1], if any: the same monotonic pieces as
+// pieces(), written without arrays or data-dependent loops over them (a
+// software rasteriser runs fragments in SIMD groups, where indexing a local
+// array with a varying index becomes per-lane memory traffic).
+bool firstRoot(vec4 k, float t0, float t1, float tolerance, out float hit)
 {
   float a = 3.0 * k.x, b = 2.0 * k.y, c = k.z;
   float r0 = t1, r1 = t1;
@@ -212,20 +256,11 @@ void pieceEnds(vec4 k, float t0, float t1, out float s1, out float s2)
   {
     r0 = -c / b;
   }
-  s1 = clamp(r0, t0, t1);
-  s2 = clamp(r1, s1, t1);
-}
-
-// The first root of f on [t0, t1], if any, from the first monotonic piece
-// whose ends differ in sign. No local arrays: a software rasteriser runs
-// fragments in SIMD groups, where indexing a local array with a varying index
-// becomes per-lane memory traffic.
-bool firstRoot(vec4 k, float t0, float t1, float tolerance, out float hit)
-{
-  // An empty piece's ends have one value: it only counts when that value is
-  // exactly 0, a root at the end.
-  float s1, s2;
-  pieceEnds(k, t0, t1, s1, s2);
+  // Piece ends t0 <= s1 <= s2 <= t1 (a root of f' outside [t0, t1] collapses
+  // onto an end: an empty piece, whose ends have one value, so it only
+  // counts when that value is exactly 0, a root at the end).
+  float s1 = clamp(r0, t0, t1);
+  float s2 = clamp(r1, s1, t1);
   float f0 = evalCubic(k, t0);
   float f1 = evalCubic(k, s1);
   float f2 = evalCubic(k, s2);
@@ -285,43 +320,6 @@ float depthOf(vec3 p)
   return 0.5 * (gl_DepthRange.diff * ndc + gl_DepthRange.near + gl_DepthRange.far);
 }
 
-// Composites (front to back, premultiplied) the hits of the crossing
-// isovalues in the monotonic piece [ta, tb] of the interpolant k along the
-// ray. A root at ta counts, one at tb belongs to the next piece (or cell).
-void compositePiece(vec4 k, float ta, float tb, float tolerance, vec3 o, vec3 d, inout vec4 sum,
-  inout float firstHit, inout bool anyHit)
-{
-  if (!(tb > ta))
-  {
-    return;
-  }
-  float ga = evalCubic(k, ta);
-  float gb = evalCubic(k, tb);
-  bool rising = gb >= ga;
-  for (int i = 0; i < 8; ++i)
-  {
-    int t = rising ? i : 7 - i;
-    if (((gMask >> t) & 1) == 0)
-    {
-      continue;
-    }
-    float fa = ga - isovalues[t];
-    float fb = gb - isovalues[t];
-    if (fa == 0.0 || fa * fb < 0.0)
-    {
-      float root = fa == 0.0 ? ta : refine(k - vec4(0.0, 0.0, 0.0, isovalues[t]), ta, tb, fa, fb,
-                                        tolerance);
-      vec4 c = isoColors[t];
-      sum += (1.0 - sum.a) * c.a * vec4(shade(clamp(o + root * d, 0.0, 1.0), c.rgb), 1.0);
-      if (!anyHit)
-      {
-        firstHit = root;
-        anyHit = true;
-      }
-    }
-  }
-}
-
 void main()
 {
   // 1. The ray in the cell's local coordinates: p(t) = o + t d, cell [0, 1]^3.
@@ -361,25 +359,52 @@ void main()
     return;
   }
 
-  // Translucent: every hit of every crossing isovalue, front to back. The
-  // isovalues change the cubic's constant term only, so its monotonic pieces
-  // are the same for all of them; inside a piece each isovalue has at most one
-  // root, and the roots come in the isovalues' order (ascending, as the mapper
-  // sorts them) where the interpolant rises along the ray, in reverse where it
-  // falls. So the hits are composited in depth order with no sorting.
-  vec4 k = cubic(o, d, 0.0); // the interpolant along the ray
-  float s1, s2;
-  pieceEnds(k, t0, t1, s1, s2);
-  vec4 sum = vec4(0.0);
-  float firstHit = t1;
-  bool anyHit = false;
-  compositePiece(k, t0, s1, tolerance, o, d, sum, firstHit, anyHit);
-  compositePiece(k, s1, s2, tolerance, o, d, sum, firstHit, anyHit);
-  compositePiece(k, s2, t1, tolerance, o, d, sum, firstHit, anyHit);
-  if (!anyHit)
+  // Translucent: every hit of every crossing isovalue, sorted, composited.
+  float hitTs[8];
+  int hitIso[8];
+  int hits = 0;
+  for (int t = 0; t < 8; ++t)
+  {
+    if (((gMask >> t) & 1) == 0)
+    {
+      continue;
+    }
+    vec4 k = cubic(o, d, isovalues[t]);
+    float s[4];
+    int n = pieces(k, t0, t1, s);
+    float fa = evalCubic(k, s[0]);
+    for (int i = 0; i + 1 < n && hits < 8; ++i)
+    {
+      float fb = evalCubic(k, s[i + 1]);
+      if (fa == 0.0 || (fa * fb < 0.0))
+      {
+        float root = fa == 0.0 ? s[i] : refine(k, s[i], s[i + 1], fa, fb, tolerance);
+        // Insertion into the sorted list.
+        int j = hits;
+        while (j > 0 && hitTs[j - 1] > root)
+        {
+          hitTs[j] = hitTs[j - 1];
+          hitIso[j] = hitIso[j - 1];
+          --j;
+        }
+        hitTs[j] = root;
+        hitIso[j] = t;
+        ++hits;
+      }
+      fa = fb;
+    }
+  }
+  if (hits == 0)
   {
     discard;
   }
+  vec4 sum = vec4(0.0);
+  for (int h = 0; h < hits; ++h)
+  {
+    vec3 p = clamp(o + hitTs[h] * d, 0.0, 1.0);
+    vec4 c = isoColors[hitIso[h]];
+    sum += (1.0 - sum.a) * c.a * vec4(shade(p, c.rgb), 1.0);
+  }
   fragOutput0 = sum;
-  gl_FragDepth = depthOf(clamp(o + firstHit * d, 0.0, 1.0));
+  gl_FragDepth = depthOf(clamp(o + hitTs[0] * d, 0.0, 1.0));
 }

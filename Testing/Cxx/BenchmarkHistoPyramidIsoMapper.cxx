@@ -18,6 +18,7 @@
 //   BenchmarkHistoPyramidIsoMapper --input ct|ct512|phantom256|phantomN
 //     [--ct FILE.mha] [--windows 1920x1080,1024x768] [--frames 360] [--sweep 95]
 //     [--isovalues -500,400] [--methods hp,rc,fe[,hpbox]] [--rc-factors 0.5,1.0]
+//     [--opacity 1]
 //     [--images DIR]
 #include "MedicalTestUtilities.h"
 #include "vtkHistoPyramidIsoMapper.h"
@@ -73,6 +74,7 @@ struct Options
   std::vector<double> Isovalues = { -500.0, 400.0 };
   std::vector<std::string> Methods = { "hp", "rc", "fe" };
   std::vector<double> RayCastFactors = { 0.5 };
+  double Opacity = 1.0; // of every isovalue (< 1: the mapper's translucent mode)
   std::string ImageDir;
 };
 
@@ -139,6 +141,8 @@ bool Parse(int argc, char* argv[], Options& opt)
       opt.Methods = Split(value, ',');
     else if (name == "--rc-factors")
       opt.RayCastFactors = Numbers(value);
+    else if (name == "--opacity")
+      opt.Opacity = std::min(1.0, std::max(0.01, std::stod(value)));
     else if (name == "--images")
       opt.ImageDir = value;
     else if (name == "--windows")
@@ -379,12 +383,14 @@ struct Scene
   }
 };
 
+double SurfaceOpacity = 1.0; // --opacity
+
 void SetLook(vtkVolumeProperty* property)
 {
   vtkNew<vtkColorTransferFunction> color;
   color->AddRGBPoint(0.0, 0.93, 0.85, 0.75);
   vtkNew<vtkPiecewiseFunction> opacity;
-  opacity->AddPoint(0.0, 1.0); // opaque at every isovalue
+  opacity->AddPoint(0.0, SurfaceOpacity); // the same at every isovalue
   property->SetColor(color);
   property->SetScalarOpacity(opacity);
   property->SetInterpolationTypeToLinear();
@@ -537,6 +543,7 @@ int main(int argc, char* argv[])
   {
     return 2;
   }
+  SurfaceOpacity = opt.Opacity;
   // vtkFlyingEdges3D's threads: the STDThread backend, whatever the build's default.
   vtkSMPTools::SetBackend("STDThread");
   vtkSMPTools::Initialize(0);
