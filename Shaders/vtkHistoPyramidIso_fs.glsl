@@ -187,38 +187,38 @@ float refine(vec4 k, float ta, float tb, float fa, float fb, float tolerance)
   return (fa * tb - fb * ta) / (fa - fb);
 }
 
-// The ends of the monotonic pieces of f on [t0, t1]: returns how many (2..4).
-int pieces(vec4 k, float t0, float t1, out float s[4])
+// The roots r0 <= r1 of f' (3a t^2 + 2b t + c), each t1 where there is none.
+void derivativeRoots(vec4 k, float t1, out float r0, out float r1)
 {
-  s[0] = t0;
-  int n = 1;
   float a = 3.0 * k.x, b = 2.0 * k.y, c = k.z;
-  float r0 = t1, r1 = t1;
+  r0 = t1;
+  r1 = t1;
   float scale = abs(a) + abs(b) + abs(c);
   if (abs(a) > 1e-7 * scale)
   {
     float disc = b * b - 4.0 * a * c;
     if (disc > 0.0)
     {
-      float q = -0.5 * (b + sign(b) * sqrt(disc));
-      if (b == 0.0)
-      {
-        q = -0.5 * sqrt(disc);
-      }
-      r0 = q / a;
-      r1 = q != 0.0 ? c / q : r0;
-      if (r0 > r1)
-      {
-        float tmp = r0;
-        r0 = r1;
-        r1 = tmp;
-      }
+      float q = b == 0.0 ? -0.5 * sqrt(disc) : -0.5 * (b + sign(b) * sqrt(disc));
+      float x0 = q / a;
+      float x1 = q != 0.0 ? c / q : x0;
+      r0 = min(x0, x1);
+      r1 = max(x0, x1);
     }
   }
   else if (abs(b) > 0.0)
   {
     r0 = -c / b;
   }
+}
+
+// The ends of the monotonic pieces of f on [t0, t1]: returns how many (2..4).
+int pieces(vec4 k, float t0, float t1, out float s[4])
+{
+  float r0, r1;
+  derivativeRoots(k, t1, r0, r1);
+  s[0] = t0;
+  int n = 1;
   if (r0 > t0 && r0 < t1)
   {
     s[n++] = r0;
@@ -237,28 +237,8 @@ int pieces(vec4 k, float t0, float t1, out float s[4])
 // array with a varying index becomes per-lane memory traffic).
 bool firstRoot(vec4 k, float t0, float t1, float tolerance, out float hit)
 {
-  float a = 3.0 * k.x, b = 2.0 * k.y, c = k.z;
-  float r0 = t1, r1 = t1;
-  float scale = abs(a) + abs(b) + abs(c);
-  if (abs(a) > 1e-7 * scale)
-  {
-    float disc = b * b - 4.0 * a * c;
-    if (disc > 0.0)
-    {
-      float q = b == 0.0 ? -0.5 * sqrt(disc) : -0.5 * (b + sign(b) * sqrt(disc));
-      float x0 = q / a;
-      float x1 = q != 0.0 ? c / q : x0;
-      r0 = min(x0, x1);
-      r1 = max(x0, x1);
-    }
-  }
-  else if (abs(b) > 0.0)
-  {
-    r0 = -c / b;
-  }
-  // Piece ends t0 <= s1 <= s2 <= t1 (a root of f' outside [t0, t1] collapses
-  // onto an end: an empty piece, whose ends have one value, so it only
-  // counts when that value is exactly 0, a root at the end).
+  float r0, r1;
+  derivativeRoots(k, t1, r0, r1);
   float s1 = clamp(r0, t0, t1);
   float s2 = clamp(r1, s1, t1);
   float f0 = evalCubic(k, t0);
