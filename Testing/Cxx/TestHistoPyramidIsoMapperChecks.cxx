@@ -280,65 +280,6 @@ void Memory()
     "renders again after a release");
 }
 
-// Renders a scene with the GPU path and with the fallback; compares.
-void CompareWithCPU(const std::string& name, vtkImageData* image, const std::vector<iso_test::Look>& looks)
-{
-  std::vector<unsigned char> pixels[2];
-  const int size = 300;
-  for (int pass = 0; pass < 2; ++pass)
-  {
-    vtkNew<vtkHistoPyramidIsoMapper> mapper;
-    mapper->SetForceCPUFallback(pass == 1);
-    auto volume = iso_test::MakeVolume(image, looks, mapper);
-    Scene scene(size, size);
-    scene.Show(volume);
-    scene.Window->Render();
-    Check(mapper->GetLastRenderPath() ==
-        (pass == 0 ? vtkHistoPyramidIsoMapper::GPUPath : vtkHistoPyramidIsoMapper::FallbackPath),
-      name + ": path " + mapper->GetLastRenderPathAsString());
-    vtkNew<vtkUnsignedCharArray> rgb;
-    scene.Window->GetPixelData(0, 0, size - 1, size - 1, 1, rgb);
-    pixels[pass].assign(rgb->GetPointer(0), rgb->GetPointer(0) + 3 * size * size);
-  }
-  int either = 0, both = 0, disagree = 0;
-  double diff = 0.0;
-  for (int p = 0; p < size * size; ++p)
-  {
-    const unsigned char* a = &pixels[0][3 * p];
-    const unsigned char* b = &pixels[1][3 * p];
-    const bool ca = a[0] > 0 || a[1] > 0 || a[2] > 0;
-    const bool cb = b[0] > 0 || b[1] > 0 || b[2] > 0;
-    either += ca || cb;
-    disagree += ca != cb;
-    if (ca && cb)
-    {
-      ++both;
-      for (int c = 0; c < 3; ++c)
-      {
-        diff += std::abs(static_cast<int>(a[c]) - static_cast<int>(b[c]));
-      }
-    }
-  }
-  const double agreement = either ? 1.0 - static_cast<double>(disagree) / either : 0.0;
-  const double meanDiff = both ? diff / (3.0 * both) : 255.0;
-  std::printf("%s: %d pixels covered by either, masks agree on %.2f%%, mean colour difference "
-              "%.2f\n",
-    name.c_str(), either, 100.0 * agreement, meanDiff);
-  Check(either > 5000, name + ": the surface covers a good part of the image");
-  Check(agreement >= 0.985, name + ": covered pixels agree with the CPU marching-cubes image");
-  Check(meanDiff <= 12.0, name + ": colours agree with the CPU marching-cubes image");
-}
-
-void Reference()
-{
-  auto phantom = iso_test::Phantom(96);
-  const iso_test::Look skin{ -500.0, { 0.93, 0.75, 0.62 }, 1.0 };
-  const iso_test::Look bone{ 400.0, { 0.97, 0.95, 0.88 }, 1.0 };
-  CompareWithCPU("phantom skin", phantom, { skin });
-  CompareWithCPU("phantom bone", phantom, { bone });
-  CompareWithCPU("torus", iso_test::Torus(40, 11.0), { { 4.2, { 0.5, 0.85, 0.45 }, 1.0 } });
-}
-
 // Compares two RGB images: share of the pixels covered by either that both
 // cover, and the mean colour difference over the pixels both cover.
 struct ImageAgreement
@@ -374,33 +315,77 @@ ImageAgreement Compare(const std::vector<unsigned char>& a, const std::vector<un
   return result;
 }
 
+// Renders `image` with `looks` through `mapper` in a 300x300 window from the
+// standard view (changed by `place`, if given); returns the RGB pixels.
+std::vector<unsigned char> RenderPixels(vtkHistoPyramidIsoMapper* mapper, vtkImageData* image,
+  const std::vector<iso_test::Look>& looks,
+  const std::function<void(vtkCamera*)>& place = nullptr)
+{
+  const int size = 300;
+  auto volume = iso_test::MakeVolume(image, looks, mapper);
+  Scene scene(size, size);
+  scene.Show(volume);
+  if (place)
+  {
+    place(scene.Renderer->GetActiveCamera());
+    scene.Renderer->ResetCameraClippingRange();
+  }
+  scene.Window->Render();
+  vtkNew<vtkUnsignedCharArray> rgb;
+  scene.Window->GetPixelData(0, 0, size - 1, size - 1, 1, rgb);
+  return std::vector<unsigned char>(rgb->GetPointer(0), rgb->GetPointer(0) + 3 * size * size);
+}
+
+// Renders a scene with the GPU path and with the fallback; compares.
+void CompareWithCPU(const std::string& name, vtkImageData* image, const std::vector<iso_test::Look>& looks)
+{
+  std::vector<unsigned char> pixels[2];
+  for (int pass = 0; pass < 2; ++pass)
+  {
+    vtkNew<vtkHistoPyramidIsoMapper> mapper;
+    mapper->SetForceCPUFallback(pass == 1);
+    pixels[pass] = RenderPixels(mapper, image, looks);
+    Check(mapper->GetLastRenderPath() ==
+        (pass == 0 ? vtkHistoPyramidIsoMapper::GPUPath : vtkHistoPyramidIsoMapper::FallbackPath),
+      name + ": path " + mapper->GetLastRenderPathAsString());
+  }
+  const ImageAgreement a = Compare(pixels[0], pixels[1]);
+  std::printf("%s: %d pixels covered by either, masks agree on %.2f%%, mean colour difference "
+              "%.2f\n",
+    name.c_str(), a.Either, 100.0 * a.Agreement, a.MeanDifference);
+  Check(a.Either > 5000, name + ": the surface covers a good part of the image");
+  Check(a.Agreement >= 0.985, name + ": covered pixels agree with the CPU marching-cubes image");
+  Check(a.MeanDifference <= 12.0, name + ": colours agree with the CPU marching-cubes image");
+}
+
+void Reference()
+{
+  auto phantom = iso_test::Phantom(96);
+  const iso_test::Look skin{ -500.0, { 0.93, 0.75, 0.62 }, 1.0 };
+  const iso_test::Look bone{ 400.0, { 0.97, 0.95, 0.88 }, 1.0 };
+  CompareWithCPU("phantom skin", phantom, { skin });
+  CompareWithCPU("phantom bone", phantom, { bone });
+  CompareWithCPU("torus", iso_test::Torus(40, 11.0), { { 4.2, { 0.5, 0.85, 0.45 }, 1.0 } });
+}
+
 // Renders `image` with points allowed and with boxes only, from a camera set
 // by `place`; checks the footprint the mapper chose and that both agree.
 void CompareFootprints(const std::string& name, vtkImageData* image,
   const std::vector<iso_test::Look>& looks, const std::function<void(vtkCamera*)>& place,
   int expected)
 {
-  const int size = 300;
   std::vector<unsigned char> pixels[2];
   for (int pass = 0; pass < 2; ++pass)
   {
     vtkNew<vtkHistoPyramidIsoMapper> mapper;
     mapper->SetAllowPointFootprint(pass == 0);
     MessageCounter messages(mapper);
-    auto volume = iso_test::MakeVolume(image, looks, mapper);
-    Scene scene(size, size);
-    scene.Show(volume);
-    place(scene.Renderer->GetActiveCamera());
-    scene.Renderer->ResetCameraClippingRange();
-    scene.Window->Render();
+    pixels[pass] = RenderPixels(mapper, image, looks, place);
     const int footprint = pass == 0 ? expected : vtkHistoPyramidIsoMapper::BoxFootprint;
     Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
         mapper->GetLastFootprint() == footprint && messages.Errors + messages.Warnings == 0,
       name + ": drawn on the GPU with " + (footprint ? "points" : "boxes") + " (got " +
         mapper->GetLastRenderPathAsString() + ", " + mapper->GetLastFootprintAsString() + ")");
-    vtkNew<vtkUnsignedCharArray> rgb;
-    scene.Window->GetPixelData(0, 0, size - 1, size - 1, 1, rgb);
-    pixels[pass].assign(rgb->GetPointer(0), rgb->GetPointer(0) + 3 * size * size);
   }
   const ImageAgreement a = Compare(pixels[0], pixels[1]);
   std::printf("%s: %d pixels covered by either, masks agree on %.3f%%, mean colour difference "
