@@ -127,9 +127,16 @@ def table(header, rows):
 def method_name(r):
     if r["method"] == "hp":
         return "HistoPyramid (ours)"
+    if r["method"] == "hpbox":
+        return "HistoPyramid, boxes only"
     if r["method"] == "rc":
         return "GPU ray caster, sample %gx" % r["factor"]
     return "FlyingEdges + PolyDataMapper"
+
+
+def target_row(name, where, ratio, limit):
+    """A row of the targets table: measured ratio, met or not, by how much."""
+    return [name, where, fmt_ratio(ratio), "yes" if ratio <= limit else "no", margin(ratio, limit)]
 
 
 def report(args, command, records, failed, started, wall, load_before, load_after):
@@ -184,10 +191,9 @@ def report(args, command, records, failed, started, wall, load_before, load_afte
         if r["method"] == "hp":
             for p in peer:
                 ratio = r["median_s"] / p["median_s"]
-                targets.append(["rotation <= 0.5x ray caster (sample %gx)" % p["factor"],
-                                "%s, %s, iso %g" % (r["input"], r["window"], r["iso"]),
-                                fmt_ratio(ratio), "yes" if ratio <= TARGET_ROTATION else "no",
-                                margin(ratio, TARGET_ROTATION)])
+                targets.append(target_row(
+                    "rotation <= 0.5x ray caster (sample %gx)" % p["factor"],
+                    "%s, %s, iso %g" % (r["input"], r["window"], r["iso"]), ratio, TARGET_ROTATION))
     lines.extend(table(["input", "window", "iso", "method", "frames", "min s", "median s",
                         "fps (1/median)", "total s", "primitives", "ours / ray caster (median)"],
                        rows))
@@ -210,10 +216,9 @@ def report(args, command, records, failed, started, wall, load_before, load_afte
                      if r["min_elements"] >= 0 else "-",
                      fmt_ratio(ratio) if ratio is not None else ""])
         if r["method"] == "hp" and peer:
-            targets.append(["change+frame <= 0.5x FlyingEdges + PolyDataMapper (median)",
-                            "%s, %s, sweep of %d" % (r["input"], r["window"], r["n"]),
-                            fmt_ratio(ratio), "yes" if ratio <= TARGET_SWEEP else "no",
-                            margin(ratio, TARGET_SWEEP)])
+            targets.append(target_row(
+                "change+frame <= 0.5x FlyingEdges + PolyDataMapper (median)",
+                "%s, %s, sweep of %d" % (r["input"], r["window"], r["n"]), ratio, TARGET_SWEEP))
     lines.extend(table(["input", "window", "method", "isovalues", "min s", "median s", "max s",
                         "total s", "FE extract median s", "primitives", "ours / FE+PDM (median)"],
                        rows))
@@ -235,9 +240,8 @@ def report(args, command, records, failed, started, wall, load_before, load_afte
                      fmt_ratio(ratio), int(r["builds_during_rotation"]),
                      ("%.1f / %.1f" % (s["gpu_bytes_before"] / 2**20, s["gpu_bytes_after"] / 2**20))
                      if s else "-"])
-        targets.append(["GPU memory <= 1.5x volume bytes", "%s, iso %g" % (r["input"], r["iso"]),
-                        fmt_ratio(ratio), "yes" if ratio <= TARGET_MEMORY else "no",
-                        margin(ratio, TARGET_MEMORY)])
+        targets.append(target_row("GPU memory <= 1.5x volume bytes",
+                                  "%s, iso %g" % (r["input"], r["iso"]), ratio, TARGET_MEMORY))
     lines.extend(table(["input", "iso", "volume MB", "GPU MB", "GPU / volume",
                         "pyramid builds during rotation", "GPU MB before / after sweep"], rows))
     ends = [r for r in records if r["kind"] == "end"]
