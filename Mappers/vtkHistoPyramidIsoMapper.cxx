@@ -45,6 +45,7 @@
 #include <array>
 #include <climits>
 #include <cmath>
+#include <map>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -200,9 +201,10 @@ struct vtkHistoPyramidIsoMapper::Internals
   std::vector<double> BuiltIsovalues;
   bool PyramidValid = false;
 
-  // The drawing programs of the current pyramid layout, per FootprintType.
-  std::string ProgramKey[2];
-  vtkShaderProgram* Program[2] = { nullptr, nullptr };
+  // The drawing programs of the current pyramid layout, one per variant
+  // (footprint, opaque or translucent, number of lights: see Variant()),
+  // each with the layout key it was built for.
+  std::map<int, std::pair<std::string, vtkShaderProgram*>> Programs;
 
   // Fallback path.
   vtkNew<vtkBlockLODContour> Contour;
@@ -224,22 +226,18 @@ struct vtkHistoPyramidIsoMapper::Internals
     this->UploadedDims[0] = this->UploadedDims[1] = this->UploadedDims[2] = 0;
     this->BuiltIsovalues.clear();
     this->PyramidValid = false;
-    for (int f = 0; f < 2; ++f)
-    {
-      this->ProgramKey[f].clear();
-      this->Program[f] = nullptr;
-    }
+    this->Programs.clear();
   }
 
   void ReleaseGPU(vtkWindow* win)
   {
     this->Pyramid->ReleaseGraphicsResources(win);
     this->VAO->ReleaseGraphicsResources();
-    for (vtkShaderProgram* program : this->Program)
+    for (auto& entry : this->Programs)
     {
-      if (program)
+      if (entry.second.second)
       {
-        program->ReleaseGraphicsResources(win);
+        entry.second.second->ReleaseGraphicsResources(win);
       }
     }
     this->InvalidateGPU();
@@ -666,50 +664,6 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     }
   }
 
-  // The footprint of this frame (see AllowPointFootprint) and its program.
-  GLint viewport[4] = { 0, 0, 1, 1 };
-  glGetIntegerv(GL_VIEWPORT, viewport);
-  const int cells[3] = { dims[0] - 1, dims[1] - 1, dims[2] - 1 };
-  const int footprint = this->AllowPointFootprint &&
-      PointsCoverCells(indexToView, camera->GetProjectionTransformMatrix(aspect, -1, 1), cells,
-        camera->GetClippingRange()[0], parallel, viewport, impl.MaxPointSize)
-    ? PointFootprint
-    : BoxFootprint;
-  key << declarations.size() << declarations.substr(0, 80) << "|" << dec.str() << descend.str()
-      << impl.ConservativeDepth;
-  if (!impl.Program[footprint] || impl.ProgramKey[footprint] != key.str())
-  {
-    const std::string footprintDec =
-      footprint == PointFootprint ? "#define MEDISO_POINT_FOOTPRINT\n" : "";
-    std::string vs = vtkHistoPyramidIso_vs;
-    vtkShaderProgram::Substitute(vs, "//VTK::Footprint::Dec", footprintDec);
-    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidCommon::Dec", declarations);
-    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Dec", dec.str());
-    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Impl", descend.str());
-    std::string fs = vtkHistoPyramidIso_fs;
-    vtkShaderProgram::Substitute(fs, "//VTK::Footprint::Dec", footprintDec);
-    vtkShaderProgram::Substitute(fs, "//VTK::ConservativeDepth::Dec",
-      impl.ConservativeDepth
-        ? "#extension GL_ARB_conservative_depth : require\nlayout(depth_greater) out float gl_FragDepth;\n"
-        : "");
-    impl.Program[footprint] = renWin->GetShaderCache()->ReadyShaderProgram(
-      vs.c_str(), fs.c_str(), footprint == PointFootprint ? "" : vtkHistoPyramidIso_gs);
-    if (!impl.Program[footprint])
-    {
-      impl.ProgramKey[footprint].clear();
-      reason = "the isosurface shaders do not build";
-      impl.GPUUsable = false;
-      impl.GPUReason = reason;
-      return false;
-    }
-    impl.ProgramKey[footprint] = key.str();
-  }
-  else
-  {
-    renWin->GetShaderCache()->ReadyShaderProgram(impl.Program[footprint]);
-  }
-  vtkShaderProgram* program = impl.Program[footprint];
-
   // 6. Isovalues in the pyramid's threshold order, their colours, lights.
   const std::vector<int> counted = impl.Pyramid->GetCountedIsovalues();
   float isoValues[8] = { 0 };
@@ -767,6 +721,64 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     }
   }
 
+  // The footprint of this frame (see AllowPointFootprint) and the program of
+  // this variant. The variants are compiled apart because a software
+  // rasteriser runs every branch of a fragment shader under SIMD masks: an
+  // opaque frame must not pay for the translucent code, nor for a loop over
+  // lights with a uniform bound (which llvmpipe cannot unroll).
+  GLint viewport[4] = { 0, 0, 1, 1 };
+  glGetIntegerv(GL_VIEWPORT, viewport);
+  const int cells[3] = { dims[0] - 1, dims[1] - 1, dims[2] - 1 };
+  const int footprint = this->AllowPointFootprint &&
+      PointsCoverCells(indexToView, camera->GetProjectionTransformMatrix(aspect, -1, 1), cells,
+        camera->GetClippingRange()[0], parallel, viewport, impl.MaxPointSize)
+    ? PointFootprint
+    : BoxFootprint;
+  key << declarations.size() << declarations.substr(0, 80) << "|" << dec.str() << descend.str()
+      << impl.ConservativeDepth;
+  const int variant = footprint + 2 * (translucent ? 1 : 0) + 4 * numLights;
+  auto& cached = impl.Programs[variant];
+  if (!cached.second || cached.first != key.str())
+  {
+    std::ostringstream defines;
+    if (footprint == PointFootprint)
+    {
+      defines << "#define MEDISO_POINT_FOOTPRINT\n";
+    }
+    if (translucent)
+    {
+      defines << "#define MEDISO_TRANSLUCENT\n";
+    }
+    defines << "#define MEDISO_LIGHTS " << numLights << "\n";
+    std::string vs = vtkHistoPyramidIso_vs;
+    vtkShaderProgram::Substitute(vs, "//VTK::Variant::Dec", defines.str());
+    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidCommon::Dec", declarations);
+    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Dec", dec.str());
+    vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Impl", descend.str());
+    std::string fs = vtkHistoPyramidIso_fs;
+    vtkShaderProgram::Substitute(fs, "//VTK::Variant::Dec", defines.str());
+    vtkShaderProgram::Substitute(fs, "//VTK::ConservativeDepth::Dec",
+      impl.ConservativeDepth
+        ? "#extension GL_ARB_conservative_depth : require\nlayout(depth_greater) out float gl_FragDepth;\n"
+        : "");
+    cached.second = renWin->GetShaderCache()->ReadyShaderProgram(
+      vs.c_str(), fs.c_str(), footprint == PointFootprint ? "" : vtkHistoPyramidIso_gs);
+    if (!cached.second)
+    {
+      impl.Programs.erase(variant);
+      reason = "the isosurface shaders do not build";
+      impl.GPUUsable = false;
+      impl.GPUReason = reason;
+      return false;
+    }
+    cached.first = key.str();
+  }
+  else
+  {
+    renWin->GetShaderCache()->ReadyShaderProgram(cached.second);
+  }
+  vtkShaderProgram* program = cached.second;
+
   // 7. Draw, restoring every piece of state changed.
   vtkVolumeProperty* property = vol->GetProperty();
   TakeGLErrors();
@@ -811,7 +823,6 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   program->SetUniform4f("eyeIndex", eyeIndex);
   program->SetUniformi("backToFront", translucent ? 1 : 0);
   program->SetUniformi("oneRankPerCell", translucent ? 1 : 0);
-  program->SetUniformi("translucent", translucent ? 1 : 0);
   program->SetUniformi("parallelProjection", parallel ? 1 : 0);
   SetMatrix4(program, "indexToClip", indexToClip);
   SetMatrix4(program, "indexToView", indexToView);
@@ -822,7 +833,6 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   program->SetUniformf("diffuse", static_cast<float>(property->GetDiffuse()));
   program->SetUniformf("specular", static_cast<float>(property->GetSpecular()));
   program->SetUniformf("specularPower", static_cast<float>(property->GetSpecularPower()));
-  program->SetUniformi("numberOfLights", numLights);
   program->SetUniform3fv(
     "lightDirections", MaximumNumberOfLights, reinterpret_cast<const float(*)[3]>(lightDirections));
   program->SetUniform3fv(

@@ -26,7 +26,9 @@
  *    translucency) and, on frames where that provably covers every cell
  *    (the volume beyond the near plane, no cell wider than the largest
  *    point), makes the cell's footprint a point sprite over the bounding
- *    square of its projected corners; on other frames (close zooms, the eye
+ *    square of the projected box that holds the surface in that cell (the
+ *    crossings on its edges and the faces that straddle the isovalue bound
+ *    it; often much less than the cell); on other frames (close zooms, the eye
  *    in the volume) the geometry stage (vtkHistoPyramidIso_gs.glsl) emits
  *    the faces of the cell box that face the eye, a footprint that covers the
  *    cell at any zoom in both projections (see AllowPointFootprint,
@@ -41,6 +43,10 @@
  *    Otherwise every cell is drawn once, back to front, and composites all of
  *    its isovalues' hits in depth order: translucent skin over opaque bone
  *    in one pass, blended over whatever the scene holds.
+ * -# The drawing program is compiled per variant (footprint, opaque or
+ *    translucent, number of lights): a software rasteriser such as llvmpipe
+ *    runs every branch of a fragment shader under SIMD masks, so a mode's
+ *    code left in another mode's shader costs every fragment.
  *
  * The volume's matrix (position, orientation, scale), the image's spacing,
  * origin and direction matrix are honoured. Surfaces are always shaded
@@ -122,7 +128,7 @@ public:
   enum FootprintType
   {
     BoxFootprint = 0,  ///< The cell box's front faces, from a geometry shader.
-    PointFootprint = 1 ///< One point sprite over the cell's projected bounding square.
+    PointFootprint = 1 ///< One point sprite over the projected bounding square of the surface's box in the cell.
   };
 
   ///@{

@@ -1,5 +1,5 @@
 //VTK::System::Dec
-//VTK::Footprint::Dec
+//VTK::Variant::Dec
 //VTK::ConservativeDepth::Dec
 // SPDX-License-Identifier: BSD-3-Clause
 //
@@ -35,7 +35,13 @@
 //    perspective eye (drawn from inside, by its back faces), only arises
 //    when the surface touches the near plane.
 //
-// Translucent mode (any isovalue with opacity < 1): the mapper draws the
+// Variants: the mapper defines MEDISO_POINT_FOOTPRINT (see below),
+// MEDISO_TRANSLUCENT (any isovalue with opacity < 1) and MEDISO_LIGHTS (the
+// number of lights) and compiles each combination apart: a software
+// rasteriser runs every branch under SIMD masks, so code for another mode or
+// a loop with a uniform bound costs every fragment.
+//
+// Translucent mode (MEDISO_TRANSLUCENT): the mapper draws the
 // cells back to front and only one primitive per cell; this fragment finds
 // every hit of every crossing isovalue along its piece of ray, sorts them by
 // t and composites them front to back, writing premultiplied colour (the
@@ -52,6 +58,7 @@ out vec4 fragOutput0; // colour (premultiplied in translucent mode)
 flat in ivec3 vCell;
 flat in int vMask;
 flat in int vIsovalue;
+flat in vec4 vLook;
 flat in vec4 vLow;
 flat in vec4 vHigh;
 in CornerGradients
@@ -64,6 +71,7 @@ uniform vec4 viewport; // x, y, width, height in pixels
 #define gCell vCell
 #define gMask vMask
 #define gIsovalue vIsovalue
+#define gLook vLook
 #define gLow vLow
 #define gHigh vHigh
 #define gGradients vGradients.g
@@ -80,6 +88,7 @@ in vec3 gPosition;
 flat in ivec3 gCell;
 flat in int gMask;
 flat in int gIsovalue;
+flat in vec4 gLook;
 flat in vec4 gLow;
 flat in vec4 gHigh;
 flat in vec3 gGradients[8]; // central differences at the corners
@@ -94,14 +103,12 @@ uniform mat4 indexToClip;
 uniform mat4 indexToView;
 uniform mat3 gradientToView;     // inverse transpose of indexToView's linear part
 uniform int parallelProjection;
-uniform int translucent;
 uniform float isovalues[8];      // bit t of gMask: isovalues[t]
 uniform vec4 isoColors[8];       // rgb, opacity
 uniform float ambient;
 uniform float diffuse;
 uniform float specular;
 uniform float specularPower;
-uniform int numberOfLights;
 uniform vec3 lightDirections[6]; // view space, from the surface towards the light
 uniform vec3 lightColors[6];
 
@@ -279,7 +286,7 @@ vec3 shade(vec3 p, vec3 color)
     n = -n;
   }
   vec3 result = ambient * color;
-  for (int l = 0; l < numberOfLights; ++l)
+  for (int l = 0; l < MEDISO_LIGHTS; ++l)
   {
     vec3 toLight = lightDirections[l];
     float lambert = max(dot(n, toLight), 0.0);
@@ -323,22 +330,19 @@ void main()
   }
   float tolerance = 1e-4 / max(length(d), 1e-30);
 
-  if (translucent == 0)
+#ifndef MEDISO_TRANSLUCENT
+  // 2. First root of the one isovalue of this primitive (gLook: its colour
+  //    and value, looked up once per cell by the vertex stage).
+  vec4 k = cubic(o, d, gLook.w);
+  float hitT;
+  if (!firstRoot(k, t0, t1, tolerance, hitT))
   {
-    // 2. First root of the one isovalue of this primitive.
-    float iso = isovalues[gIsovalue];
-    vec4 k = cubic(o, d, iso);
-    float hitT;
-    if (!firstRoot(k, t0, t1, tolerance, hitT))
-    {
-      discard;
-    }
-    vec3 p = clamp(o + hitT * d, 0.0, 1.0);
-    fragOutput0 = vec4(shade(p, isoColors[gIsovalue].rgb), 1.0);
-    gl_FragDepth = depthOf(p);
-    return;
+    discard;
   }
-
+  vec3 p = clamp(o + hitT * d, 0.0, 1.0);
+  fragOutput0 = vec4(shade(p, gLook.rgb), 1.0);
+  gl_FragDepth = depthOf(p);
+#else
   // Translucent: every hit of every crossing isovalue, sorted, composited.
   float hitTs[8];
   int hitIso[8];
@@ -387,4 +391,5 @@ void main()
   }
   fragOutput0 = sum;
   gl_FragDepth = depthOf(clamp(o + hitTs[0] * d, 0.0, 1.0));
+#endif
 }

@@ -23,6 +23,7 @@ uniform vec4 eyeIndex;    // eye, homogeneous, in cell-index space
 flat in ivec3 vCell[];
 flat in int vMask[];
 flat in int vIsovalue[];
+flat in vec4 vLook[];
 flat in vec4 vLow[];
 flat in vec4 vHigh[];
 in CornerGradients
@@ -34,6 +35,7 @@ out vec3 gPosition;       // cell-index space
 flat out ivec3 gCell;
 flat out int gMask;
 flat out int gIsovalue;
+flat out vec4 gLook;
 flat out vec4 gLow;
 flat out vec4 gHigh;
 flat out vec3 gGradients[8];
@@ -44,6 +46,7 @@ void emitCorner(vec3 position)
   gCell = vCell[0];
   gMask = vMask[0];
   gIsovalue = vIsovalue[0];
+  gLook = vLook[0];
   gLow = vLow[0];
   gHigh = vHigh[0];
   for (int i = 0; i < 8; ++i)

@@ -1,5 +1,5 @@
 //VTK::System::Dec
-//VTK::Footprint::Dec
+//VTK::Variant::Dec
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // vtkHistoPyramidIso_vs.glsl: vertex stage of vtkHistoPyramidIsoMapper. The
@@ -32,10 +32,13 @@
 // every cell of the volume projects to fewer pixels than the largest point
 // size and the volume lies wholly beyond the near plane), this stage also
 // makes the cell's footprint itself: a point sprite centred on the bounding
-// rectangle of the cell's 8 projected corners (cut to the viewport, so the
-// point's centre is always inside the clip volume), as wide as its longer
-// side, at the depth of its nearest corner (so the hit, which lies inside the
-// cell, is never in front of it: early depth rejection stays valid). One
+// rectangle of the 8 projected corners of the surface's box in the cell (see
+// surfaceBox(); cut to the viewport, so the point's centre is always inside
+// the clip volume), as wide as its longer side, at the depth of its nearest
+// corner (so the hit, which lies inside that box, is never in front of it:
+// early depth rejection stays valid). The box is often much smaller than the
+// cell (a surface cutting off a corner), and on a software rasteriser every
+// fragment costs a full ray cast, hit or miss. One
 // vertex and no geometry stage per cell: on software rasterisers the
 // geometry stage's output and the triangle setup of up to six triangles
 // per cell cost far more than the ray casting. Otherwise the geometry stage
@@ -49,10 +52,13 @@ uniform vec4 eyeIndex;       // eye, homogeneous, in cell-index space
 uniform int backToFront;     // 0: nearest cells first; 1: farthest first
 uniform int oneRankPerCell;  // 1: only the first primitive of a cell is drawn
 uniform ivec3 firstFactor;   // level-1 node size in cells (1 or 2 per axis)
+uniform float isovalues[8];  // the fragment stage's isovalues and looks
+uniform vec4 isoColors[8];
 
 flat out ivec3 vCell;        // the cell
 flat out int vMask;          // crossing isovalues of the cell (bit t: threshold t)
 flat out int vIsovalue;      // the isovalue this primitive draws (-1: none)
+flat out vec4 vLook;         // its colour (rgb) and value (w)
 flat out vec4 vLow;          // corner values 0..3 (dx + 2 dy + 4 dz)
 flat out vec4 vHigh;         // corner values 4..7
 #ifdef MEDISO_POINT_FOOTPRINT
@@ -150,19 +156,70 @@ void cornerGradients(ivec3 c, float v[8])
 }
 
 #ifdef MEDISO_POINT_FOOTPRINT
-// The point sprite covering cell c (see the header); off the clip volume if
-// the cell is not on screen or reaches behind the eye.
-void pointFootprint(ivec3 c)
+// Where, along one axis, the surface f = iso can meet the cell: a (b) holds
+// the values of the 4 cell edges along that axis at its low (high) end. On a
+// plane across the axis the interpolant is bilinear, with corners that vary
+// linearly along those edges, so it takes the value iso on the plane only if
+// those corners straddle iso. The planes where they do form a set whose
+// bounds are edge crossings or an end whose face straddles iso, so that hull
+// is returned (with a margin for rounding; the whole [0, 1] if anything is
+// not finite).
+vec2 axisRange(vec4 a, vec4 b, float iso)
 {
-  vec4 origin = indexToClip * vec4(vec3(c), 1.0);
+  vec4 fa = a - iso;
+  vec4 fb = b - iso;
+  vec4 denominator = fa - fb;
+  bvec4 crosses = lessThanEqual(fa * fb, vec4(0.0));
+  bvec4 level = equal(denominator, vec4(0.0)); // crossing and flat: on the surface
+  vec4 s = fa / mix(denominator, vec4(1.0), level);
+  vec4 sLo = mix(vec4(2.0), mix(s, vec4(0.0), level), crosses);
+  vec4 sHi = mix(vec4(-1.0), mix(s, vec4(1.0), level), crosses);
+  float lo = min(min(sLo.x, sLo.y), min(sLo.z, sLo.w));
+  float hi = max(max(sHi.x, sHi.y), max(sHi.z, sHi.w));
+  if (min(min(fa.x, fa.y), min(fa.z, fa.w)) <= 0.0 && max(max(fa.x, fa.y), max(fa.z, fa.w)) >= 0.0)
+  {
+    lo = 0.0;
+    hi = max(hi, 0.0);
+  }
+  if (min(min(fb.x, fb.y), min(fb.z, fb.w)) <= 0.0 && max(max(fb.x, fb.y), max(fb.z, fb.w)) >= 0.0)
+  {
+    lo = min(lo, 1.0);
+    hi = 1.0;
+  }
+  if (!(lo >= 0.0 && hi <= 1.0 && lo <= hi))
+  {
+    return vec2(0.0, 1.0);
+  }
+  return clamp(vec2(lo - 1e-3, hi + 1e-3), 0.0, 1.0);
+}
+
+// The box, in the cell's [0, 1]^3, that holds the surface f = iso in it.
+void surfaceBox(vec4 low, vec4 high, float iso, inout vec3 boxLo, inout vec3 boxHi)
+{
+  vec2 x = axisRange(vec4(low.x, low.z, high.x, high.z), vec4(low.y, low.w, high.y, high.w), iso);
+  vec2 y = axisRange(vec4(low.x, low.y, high.x, high.y), vec4(low.z, low.w, high.z, high.w), iso);
+  vec2 z = axisRange(low, high, iso);
+  boxLo = min(boxLo, vec3(x.x, y.x, z.x));
+  boxHi = max(boxHi, vec3(x.y, y.y, z.y));
+}
+
+// The point sprite covering the box [c + boxLo, c + boxHi] (see the
+// header); off the clip volume if the box is not on screen or reaches behind
+// the eye.
+void pointFootprint(ivec3 c, vec3 boxLo, vec3 boxHi)
+{
+  vec3 size = boxHi - boxLo;
+  vec4 origin = indexToClip * vec4(vec3(c) + boxLo, 1.0);
+  vec4 dx = size.x * indexToClip[0];
+  vec4 dy = size.y * indexToClip[1];
+  vec4 dz = size.z * indexToClip[2];
   vec2 lo = vec2(1e30);
   vec2 hi = vec2(-1e30);
   float nearest = 1e30;
   bool behind = false;
   for (int i = 0; i < 8; ++i)
   {
-    vec4 corner = origin + float(i & 1) * indexToClip[0] + float((i >> 1) & 1) * indexToClip[1] +
-      float((i >> 2) & 1) * indexToClip[2];
+    vec4 corner = origin + float(i & 1) * dx + float((i >> 1) & 1) * dy + float((i >> 2) & 1) * dz;
     behind = behind || corner.w <= 0.0;
     vec3 ndc = corner.xyz / corner.w;
     lo = min(lo, ndc.xy);
@@ -265,12 +322,26 @@ void main()
     }
     vLow = vec4(v[0], v[1], v[2], v[3]);
     vHigh = vec4(v[4], v[5], v[6], v[7]);
+    vLook = vec4(isoColors[vIsovalue].rgb, isovalues[vIsovalue]);
     cornerGradients(vCell, v);
   }
 #ifdef MEDISO_POINT_FOOTPRINT
   if (vIsovalue >= 0)
   {
-    pointFootprint(vCell);
+    vec3 boxLo = vec3(1.0);
+    vec3 boxHi = vec3(0.0);
+#ifdef MEDISO_TRANSLUCENT
+    for (int t = 0; t < 8; ++t) // the one primitive of the cell draws them all
+    {
+      if (((vMask >> t) & 1) == 1)
+      {
+        surfaceBox(vLow, vHigh, isovalues[t], boxLo, boxHi);
+      }
+    }
+#else
+    surfaceBox(vLow, vHigh, vLook.w, boxLo, boxHi);
+#endif
+    pointFootprint(vCell, boxLo, boxHi);
   }
   else
   {

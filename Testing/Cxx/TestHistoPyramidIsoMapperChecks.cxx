@@ -17,7 +17,8 @@
 //  Footprint - point sprites and cell boxes give the same image (masks agree
 //              on >= 99.8% of the covered pixels, mean colour difference
 //              <= 1 of 255) for opaque and translucent surfaces in
-//              perspective and parallel projection; the mapper picks points
+//              perspective and parallel projection, and for random values
+//              (every kind of cell); the mapper picks points
 //              for a whole-volume view and boxes for a close zoom and for an
 //              eye inside the volume, and says which it used.
 //  Fallback  - MEDISO_DISABLE_GPU_PATH=1 makes the mapper render through the
@@ -47,6 +48,7 @@
 #include <cstdlib>
 #include <functional>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -425,6 +427,29 @@ void Footprint()
   CompareFootprints(
     "torus, parallel", iso_test::Torus(40, 11.0), { { 4.2, { 0.5, 0.85, 0.45 }, 1.0 } }, parallel,
     points);
+  // Random values: every kind of cell (saddles, tunnels, corners cut off,
+  // several sheets) with cells about 30 pixels wide, so the point footprint's
+  // box around the surface in each cell must be right to the pixel.
+  const int n = 10;
+  std::vector<double> noise(n * n * n);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (double& v : noise)
+  {
+    v = uniform(random);
+  }
+  const int noiseDims[3] = { n, n, n };
+  const double unit[3] = { 1.0, 1.0, 1.0 };
+  const double zero[3] = { 0.0, 0.0, 0.0 };
+  auto field = iso_test::SampleField(noiseDims, unit, zero,
+    [&noise, n](double x, double y, double z)
+    {
+      return noise[static_cast<int>(std::lround(x)) + n * static_cast<int>(std::lround(y)) +
+        n * n * static_cast<int>(std::lround(z))];
+    });
+  CompareFootprints("random values", field, { { 0.5, { 0.5, 0.7, 0.9 }, 1.0 } }, whole, points);
+  CompareFootprints("random values, two translucent", field,
+    { { 0.3, { 0.9, 0.6, 0.4 }, 0.5 }, { 0.7, { 0.5, 0.7, 0.9 }, 1.0 } }, parallel, points);
   CompareFootprints("skin, close zoom", phantom, { skin }, close, boxes);
   CompareFootprints("bone, eye inside the volume", phantom, { bone }, inside, boxes);
 }
