@@ -191,6 +191,7 @@ struct vtkHistoPyramidIsoMapper::Internals
   std::string GPUReason;
   int MaxVertexTextureUnits = 0;
   float MaxPointSize = 1.0f;
+  float PointSizeGranularity = 0.0f;
   bool ConservativeDepth = false;
   int Max3DTextureSize = 0;
 
@@ -510,6 +511,9 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     GLfloat pointSizes[2] = { 1.0f, 1.0f };
     glGetFloatv(GL_POINT_SIZE_RANGE, pointSizes);
     impl.MaxPointSize = pointSizes[1];
+    GLfloat granularity = 0.0f;
+    glGetFloatv(GL_POINT_SIZE_GRANULARITY, &granularity);
+    impl.PointSizeGranularity = std::max(0.0f, std::min(granularity, 1.0f));
     // Early depth rejection with gl_FragDepth written (see the fragment shader).
     impl.ConservativeDepth = false;
     GLint numExtensions = 0;
@@ -850,6 +854,9 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
       static_cast<float>(viewport[2]), static_cast<float>(viewport[3]) };
     program->SetUniform4f("viewport", viewportF);
     program->SetUniformf("maxPointSize", impl.MaxPointSize);
+    // Pixels whose centres lie on the square's edges stay covered whatever the
+    // tie rule, and a size rounded down to the granularity still covers.
+    program->SetUniformf("pointMargin", 0.1f + impl.PointSizeGranularity);
   }
   // The point size comes from the vertex stage (not tracked by vtkOpenGLState).
   const GLboolean programPointSize = glIsEnabled(GL_PROGRAM_POINT_SIZE);

@@ -313,6 +313,14 @@ void main()
   vec3 position = rayPoint();
   vec3 o = position - vec3(gCell);
   vec3 d = position * eyeIndex.w - eyeIndex.xyz;
+  // A ray parallel to a face of the cell (an axis-aligned parallel view)
+  // that runs in that face, up to the rounding of the point unprojected
+  // from the window, belongs to the cell: inside the volume a neighbour would
+  // take it, but on the volume's own faces none does.
+  float rounding = 1e-5 + 1e-6 * max(max(abs(position.x), abs(position.y)), abs(position.z));
+  bvec3 inFace = lessThanEqual(abs(o - 0.5), vec3(0.5 + rounding));
+  o = mix(o, clamp(o, 0.0, 1.0), bvec3(inFace.x && d.x == 0.0, inFace.y && d.y == 0.0,
+                                       inFace.z && d.z == 0.0));
   vec3 safe = mix(d, vec3(1e-30), equal(d, vec3(0.0)));
   vec3 ta = -o / safe;
   vec3 tb = (1.0 - o) / safe;

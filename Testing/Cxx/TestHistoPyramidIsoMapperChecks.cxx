@@ -450,6 +450,20 @@ void Footprint()
   CompareFootprints("random values", field, { { 0.5, { 0.5, 0.7, 0.9 }, 1.0 } }, whole, points);
   CompareFootprints("random values, two translucent", field,
     { { 0.3, { 0.9, 0.6, 0.4 }, 0.5 }, { 0.7, { 0.5, 0.7, 0.9 }, 1.0 } }, parallel, points);
+  // Ties: looking down z in parallel projection with 20 pixels per cell and
+  // the grid's points on pixel centres, so the projected cell edges run
+  // through pixel centres (the case a point's margin is there for).
+  const auto aligned = [](vtkCamera* camera)
+  {
+    const double half = 0.5 / 20.0; // half a pixel, in cells
+    camera->ParallelProjectionOn();
+    camera->SetFocalPoint(4.5 - half, 4.5 - half, 4.5);
+    camera->SetPosition(4.5 - half, 4.5 - half, 40.0);
+    camera->SetViewUp(0.0, 1.0, 0.0);
+    camera->SetParallelScale(150.0 / 20.0);
+  };
+  CompareFootprints("random values, cell edges on pixel centres", field,
+    { { 0.5, { 0.5, 0.7, 0.9 }, 1.0 } }, aligned, points);
   CompareFootprints("skin, close zoom", phantom, { skin }, close, boxes);
   CompareFootprints("bone, eye inside the volume", phantom, { bone }, inside, boxes);
 }
