@@ -740,7 +740,10 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     : BoxFootprint;
   key << declarations.size() << declarations.substr(0, 80) << "|" << dec.str() << descend.str()
       << impl.ConservativeDepth;
-  const int variant = footprint + 2 * (translucent ? 1 : 0) + 4 * numLights;
+  // Translucent frames loop over the isovalues: their number is part of the variant too.
+  const int numIsovalues = static_cast<int>(std::min<std::size_t>(counted.size(), 8));
+  const int variant =
+    footprint + 2 * (translucent ? 1 : 0) + 4 * numLights + 32 * (translucent ? numIsovalues : 0);
   auto& cached = impl.Programs[variant];
   if (!cached.second || cached.first != key.str())
   {
@@ -754,6 +757,7 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
       defines << "#define MEDISO_TRANSLUCENT\n";
     }
     defines << "#define MEDISO_LIGHTS " << numLights << "\n";
+    defines << "#define MEDISO_ISOVALUES " << (translucent ? numIsovalues : 8) << "\n";
     std::string vs = vtkHistoPyramidIso_vs;
     vtkShaderProgram::Substitute(vs, "//VTK::Variant::Dec", defines.str());
     vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidCommon::Dec", declarations);

@@ -36,8 +36,9 @@
 //    when the surface touches the near plane.
 //
 // Variants: the mapper defines MEDISO_POINT_FOOTPRINT (see below),
-// MEDISO_TRANSLUCENT (any isovalue with opacity < 1) and MEDISO_LIGHTS (the
-// number of lights) and compiles each combination apart: a software
+// MEDISO_TRANSLUCENT (any isovalue with opacity < 1), MEDISO_LIGHTS (the
+// number of lights) and MEDISO_ISOVALUES (the number of isovalues, for the
+// translucent loop) and compiles each combination apart: a software
 // rasteriser runs every branch under SIMD masks, so code for another mode or
 // a loop with a uniform bound costs every fragment.
 //
@@ -355,7 +356,7 @@ void main()
   float hitTs[8];
   int hitIso[8];
   int hits = 0;
-  for (int t = 0; t < 8; ++t)
+  for (int t = 0; t < MEDISO_ISOVALUES; ++t)
   {
     if (((gMask >> t) & 1) == 0)
     {
