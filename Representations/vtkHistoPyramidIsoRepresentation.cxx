@@ -37,6 +37,26 @@ bool vtkHistoPyramidIsoRepresentation::GetForceCPUFallback()
 }
 
 //------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetAllowPointFootprint(bool allow)
+{
+  this->IsoMapper->SetAllowPointFootprint(allow);
+}
+
+//------------------------------------------------------------------------------
+bool vtkHistoPyramidIsoRepresentation::GetAllowPointFootprint()
+{
+  return this->IsoMapper->GetAllowPointFootprint();
+}
+
+//------------------------------------------------------------------------------
+const char* vtkHistoPyramidIsoRepresentation::GetFootprint()
+{
+  return this->IsoMapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath
+    ? this->IsoMapper->GetLastFootprintAsString()
+    : "none";
+}
+
+//------------------------------------------------------------------------------
 const char* vtkHistoPyramidIsoRepresentation::GetRenderPath()
 {
   return this->IsoMapper->GetLastRenderPathAsString();
@@ -94,6 +114,7 @@ void vtkHistoPyramidIsoRepresentation::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "RenderPath: " << this->GetRenderPath() << "\n";
+  os << indent << "Footprint: " << this->GetFootprint() << "\n";
   os << indent << "FallbackReason: " << this->IsoMapper->GetFallbackReason() << "\n";
   os << indent << "NumberOfPrimitives: " << this->IsoMapper->GetNumberOfPrimitives() << "\n";
   os << indent << "IsoMapper:\n";

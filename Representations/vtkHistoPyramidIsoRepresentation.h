@@ -64,14 +64,27 @@ public:
 
   ///@{
   /**
+   * Let the GPU path draw cells as point sprites where they provably cover
+   * them (vtkHistoPyramidIsoMapper::SetAllowPointFootprint); off: always the
+   * geometry stage's cell boxes. Same image either way. Default on.
+   */
+  void SetAllowPointFootprint(bool allow);
+  bool GetAllowPointFootprint();
+  ///@}
+
+  ///@{
+  /**
    * What the last frame rendered on this process did: the path ("gpu",
    * "fallback", or "none" before the first frame and when nothing was drawn),
    * why the GPU path is not used (empty while it is), the primitives (active
    * cell-isovalue pairs) of a GPU frame, the triangles of a fallback frame,
-   * the pyramid builds so far and the GPU memory held, in bytes.
+   * the pyramid builds so far and the GPU memory held, in bytes, and the
+   * footprint of the last GPU frame ("points", "boxes"; "none" when the
+   * last frame was not a GPU one).
    * Counts are doubles for the ServerManager's information helpers.
    */
   const char* GetRenderPath();
+  const char* GetFootprint();
   const char* GetFallbackReason();
   double GetNumberOfPrimitives();
   double GetNumberOfFallbackTriangles();

@@ -73,6 +73,7 @@ def render_info(display, location=vtkPVSession.RENDER_SERVER):
     value = lambda name: display.GetProperty(name)[0]  # noqa: E731
     return {
         "path": value("HistoPyramidRenderPath"),
+        "footprint": value("HistoPyramidFootprint"),
         "reason": value("HistoPyramidFallbackReason"),
         "primitives": int(value("HistoPyramidPrimitives")),
         "triangles": int(value("HistoPyramidFallbackTriangles")),

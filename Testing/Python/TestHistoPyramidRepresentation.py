@@ -10,7 +10,9 @@ GPU run (default):
 - a camera move re-renders without rebuilding the pyramid;
 - a new isovalue rebuilds it, draws other cells and changes the image;
 - HistoPyramidForceCPUFallback switches to the fallback (one warning, checked)
-  and back.
+  and back;
+- the whole-head view draws point footprints (HistoPyramidFootprint "points"),
+  HistoPyramidAllowPointFootprint off draws boxes and gives the same image.
 A machine whose GL lacks what the GPU path needs skips (exit 125) with the reason.
 
 Fallback run (--expect-fallback, under MEDISO_DISABLE_GPU_PATH=1): the first
@@ -121,8 +123,26 @@ else:
     Render(view)
     back = hp.render_info(display)
     check(back["path"] == "gpu" and back["reason"] == "", "back on the GPU path (%s)" % back)
-    print("gpu: %d primitives (skin+bone), %d (bone); fallback %d triangles; %.1f%% covered"
-          % (info["primitives"], bone["primitives"], forced["triangles"], 100 * fraction))
+    check(info["footprint"] == "points" and forced["footprint"] == "none",
+          "footprint: points on the GPU (got %r), none on the fallback (got %r)"
+          % (info["footprint"], forced["footprint"]))
+
+    # Boxes on request: the same picture.
+    points = hp.screenshot(view, os.path.join(args.out, "TestHistoPyramidRepresentationPoints.png"))
+    display.HistoPyramidAllowPointFootprint = 0
+    Render(view)
+    boxed = hp.render_info(display)
+    check(boxed["path"] == "gpu" and boxed["footprint"] == "boxes",
+          "AllowPointFootprint off: boxes on the GPU (%s)" % boxed)
+    boxes = hp.screenshot(view, os.path.join(args.out, "TestHistoPyramidRepresentationBoxes.png"))
+    differing = hp.changed_fraction(points, boxes)
+    check(differing < 0.002, "points and boxes give the same image (%.3f%% of pixels differ)"
+          % (100 * differing))
+    display.HistoPyramidAllowPointFootprint = 1
+    print("gpu: %d primitives (skin+bone), %d (bone); fallback %d triangles; %.1f%% covered; "
+          "points vs boxes: %.3f%% of pixels differ"
+          % (info["primitives"], bone["primitives"], forced["triangles"], 100 * fraction,
+             100 * differing))
 
 if check.failures:
     print("%d check(s) failed" % len(check.failures))
