@@ -203,8 +203,8 @@ struct vtkHistoPyramidIsoMapper::Internals
   bool PyramidValid = false;
 
   // The drawing programs of the current pyramid layout, one per variant
-  // (footprint, opaque or translucent, number of lights: see Variant()),
-  // each with the layout key it was built for.
+  // (footprint, opaque or translucent, number of lights and of translucent
+  // isovalues: see RenderGPU), each with the layout key it was built for.
   std::map<int, std::pair<std::string, vtkShaderProgram*>> Programs;
 
   // Fallback path.
