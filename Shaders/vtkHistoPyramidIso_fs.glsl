@@ -58,7 +58,6 @@ out vec4 fragOutput0; // colour (premultiplied in translucent mode)
 // the depth of the cell's nearest corner, to stay close to the cell).
 flat in ivec3 vCell;
 flat in int vMask;
-flat in int vIsovalue;
 flat in vec4 vLook;
 flat in vec4 vLow;
 flat in vec4 vHigh;
@@ -71,7 +70,6 @@ uniform mat4 clipToIndex;
 uniform vec4 viewport; // x, y, width, height in pixels
 #define gCell vCell
 #define gMask vMask
-#define gIsovalue vIsovalue
 #define gLook vLook
 #define gLow vLow
 #define gHigh vHigh
@@ -88,7 +86,6 @@ vec3 rayPoint()
 in vec3 gPosition;
 flat in ivec3 gCell;
 flat in int gMask;
-flat in int gIsovalue;
 flat in vec4 gLook;
 flat in vec4 gLow;
 flat in vec4 gHigh;

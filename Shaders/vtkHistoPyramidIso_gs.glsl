@@ -34,7 +34,6 @@ in CornerGradients
 out vec3 gPosition;       // cell-index space
 flat out ivec3 gCell;
 flat out int gMask;
-flat out int gIsovalue;
 flat out vec4 gLook;
 flat out vec4 gLow;
 flat out vec4 gHigh;
@@ -45,7 +44,6 @@ void emitCorner(vec3 position)
   gPosition = position;
   gCell = vCell[0];
   gMask = vMask[0];
-  gIsovalue = vIsovalue[0];
   gLook = vLook[0];
   gLow = vLow[0];
   gHigh = vHigh[0];
