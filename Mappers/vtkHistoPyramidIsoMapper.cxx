@@ -7,6 +7,7 @@
 #include "vtkColorTransferFunction.h"
 #include "vtkContourValues.h"
 #include "vtkDataArray.h"
+#include "vtkDepthSortPolyData.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkLight.h"
@@ -213,6 +214,11 @@ struct vtkHistoPyramidIsoMapper::Internals
   vtkNew<vtkPolyData> Colored;
   vtkMTimeType ColoredSurfaceTime = 0; // Colored was made from this surface
   std::vector<double> ColoredLooks;    // and these values, colours, opacities
+  // Translucent surfaces: the triangles sorted back to front for the current
+  // camera (blending in drawing order is only right in that order; the
+  // renderer's depth peeling does not reach geometry that a volume mapper
+  // draws).
+  vtkNew<vtkDepthSortPolyData> Sort;
   vtkNew<vtkPolyDataMapper> PolyMapper;
   vtkNew<vtkActor> Actor;
   vtkNew<vtkMatrix4x4> ActorMatrix;
@@ -255,6 +261,11 @@ vtkHistoPyramidIsoMapper::vtkHistoPyramidIsoMapper()
   impl.Contour->SetLOD(3);
   impl.Contour->SetComputeNormals(true);
   impl.Contour->SetComputeScalars(true);
+  impl.Sort->SetInputData(impl.Colored);
+  impl.Sort->SetDirectionToBackToFront();
+  impl.Sort->SetDepthSortModeToParametricCenter();
+  impl.Sort->SortScalarsOff();
+  impl.Sort->SetProp3D(impl.Actor);
   impl.PolyMapper->SetInputData(impl.Colored);
   impl.PolyMapper->SetColorModeToDirectScalars();
   impl.PolyMapper->SetScalarModeToUsePointData();
@@ -1011,6 +1022,11 @@ void vtkHistoPyramidIsoMapper::RenderFallback(vtkRenderer* ren, vtkVolume* vol,
   vtkOpenGLState::ScopedglBlendFuncSeparate blendFunc(ostate);
   if (translucent)
   {
+    impl.Sort->SetCamera(ren->GetActiveCamera());
+    if (impl.PolyMapper->GetInputAlgorithm() != impl.Sort.GetPointer())
+    {
+      impl.PolyMapper->SetInputConnection(impl.Sort->GetOutputPort());
+    }
     ostate->vtkglEnable(GL_BLEND);
     ostate->vtkglBlendFuncSeparate(
       GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
@@ -1018,6 +1034,10 @@ void vtkHistoPyramidIsoMapper::RenderFallback(vtkRenderer* ren, vtkVolume* vol,
   }
   else
   {
+    if (impl.PolyMapper->GetInputAlgorithm() == impl.Sort.GetPointer())
+    {
+      impl.PolyMapper->SetInputData(impl.Colored);
+    }
     ostate->vtkglDisable(GL_BLEND);
     ostate->vtkglDepthMask(GL_TRUE);
   }
