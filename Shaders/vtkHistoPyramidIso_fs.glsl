@@ -43,9 +43,10 @@
 // a loop with a uniform bound costs every fragment.
 //
 // Translucent mode (MEDISO_TRANSLUCENT): the mapper draws the
-// cells back to front and only one primitive per cell; this fragment finds
-// every hit of every crossing isovalue along its piece of ray, sorts them by
-// t and composites them front to back, writing premultiplied colour (the
+// cells back to front and only one primitive per cell; this fragment takes
+// the hits of every crossing isovalue along its piece of ray in order of t
+// (a merge of the isovalues' hit sequences) and composites them front to
+// back, writing premultiplied colour (the
 // blend is ONE, ONE_MINUS_SRC_ALPHA). Cells never overlap, so ordered cells
 // and ordered hits inside each cell give the exact compositing order: an
 // opaque bone behind translucent skin, in one pass.
@@ -217,29 +218,12 @@ void derivativeRoots(vec4 k, float t1, out float r0, out float r1)
   }
 }
 
-// The ends of the monotonic pieces of f on [t0, t1]: returns how many (2..4).
-int pieces(vec4 k, float t0, float t1, out float s[4])
-{
-  float r0, r1;
-  derivativeRoots(k, t1, r0, r1);
-  s[0] = t0;
-  int n = 1;
-  if (r0 > t0 && r0 < t1)
-  {
-    s[n++] = r0;
-  }
-  if (r1 > t0 && r1 < t1 && r1 != r0)
-  {
-    s[n++] = r1;
-  }
-  s[n++] = t1;
-  return n;
-}
-
-// The first root of f on [t0, t1], if any: the same monotonic pieces as
-// pieces(), written without arrays or data-dependent loops over them (a
-// software rasteriser runs fragments in SIMD groups, where indexing a local
-// array with a varying index becomes per-lane memory traffic).
+// The first root of f on [t0, t1], if any: f' has at most two roots, which
+// split [t0, t1] into at most three monotonic pieces; the first piece whose
+// ends differ in sign holds the first root. Written without arrays or
+// data-dependent loops over the pieces (a software rasteriser runs fragments
+// in SIMD groups, where indexing a local array with a varying index becomes
+// per-lane memory traffic).
 bool firstRoot(vec4 k, float t0, float t1, float tolerance, out float hit)
 {
   float r0, r1;
@@ -349,53 +333,72 @@ void main()
   fragOutput0 = vec4(shade(p, gLook.rgb), 1.0);
   gl_FragDepth = depthOf(p);
 #else
-  // Translucent: every hit of every crossing isovalue, sorted, composited.
-  float hitTs[8];
-  int hitIso[8];
-  int hits = 0;
+  // Translucent: every hit of every crossing isovalue, composited front to
+  // back as a merge of the isovalues' hit sequences. Each crossing isovalue
+  // keeps its next hit (the first root at or after its own start); the
+  // nearest of them is composited and only that isovalue looks for its next
+  // one, from just past the hit (2 tolerances: the refined root is within
+  // one of the true one, so a pair of roots closer than that, a ray grazing
+  // the surface, counts once). No arrays (see firstRoot()): the per-isovalue
+  // state lives in two vec4s, and MEDISO_ISOVALUES is a constant.
+  const float none = 3.0e38;
+  vec4 nextLo = vec4(none);
+  vec4 nextHi = vec4(none);
   for (int t = 0; t < MEDISO_ISOVALUES; ++t)
   {
-    if (((gMask >> t) & 1) == 0)
+    float root;
+    if (((gMask >> t) & 1) == 1 && firstRoot(cubic(o, d, isovalues[t]), t0, t1, tolerance, root))
     {
-      continue;
-    }
-    vec4 k = cubic(o, d, isovalues[t]);
-    float s[4];
-    int n = pieces(k, t0, t1, s);
-    float fa = evalCubic(k, s[0]);
-    for (int i = 0; i + 1 < n && hits < 8; ++i)
-    {
-      float fb = evalCubic(k, s[i + 1]);
-      if (fa == 0.0 || (fa * fb < 0.0))
+      if (t < 4)
       {
-        float root = fa == 0.0 ? s[i] : refine(k, s[i], s[i + 1], fa, fb, tolerance);
-        // Insertion into the sorted list.
-        int j = hits;
-        while (j > 0 && hitTs[j - 1] > root)
-        {
-          hitTs[j] = hitTs[j - 1];
-          hitIso[j] = hitIso[j - 1];
-          --j;
-        }
-        hitTs[j] = root;
-        hitIso[j] = t;
-        ++hits;
+        nextLo[t] = root;
       }
-      fa = fb;
+      else
+      {
+        nextHi[t - 4] = root;
+      }
     }
   }
-  if (hits == 0)
+  vec4 sum = vec4(0.0);
+  float firstHit = none;
+  // A cubic has at most 3 roots per isovalue.
+  for (int h = 0; h < 3 * MEDISO_ISOVALUES && sum.a < 0.998; ++h)
+  {
+    // The nearest next hit; on a tie, the lower isovalue first.
+    float best = none;
+    int iso = -1;
+    for (int t = 0; t < MEDISO_ISOVALUES; ++t)
+    {
+      float next = t < 4 ? nextLo[t] : nextHi[t - 4];
+      if (next < best)
+      {
+        best = next;
+        iso = t;
+      }
+    }
+    if (iso < 0)
+    {
+      break;
+    }
+    firstHit = min(firstHit, best);
+    vec3 p = clamp(o + best * d, 0.0, 1.0);
+    vec4 c = isoColors[iso];
+    sum += (1.0 - sum.a) * c.a * vec4(shade(p, c.rgb), 1.0);
+    float from = best + 2.0 * tolerance;
+    float root;
+    float next = none;
+    if (from <= t1 && firstRoot(cubic(o, d, isovalues[iso]), from, t1, tolerance, root))
+    {
+      next = root;
+    }
+    nextLo = mix(nextLo, vec4(next), equal(ivec4(0, 1, 2, 3), ivec4(iso)));
+    nextHi = mix(nextHi, vec4(next), equal(ivec4(4, 5, 6, 7), ivec4(iso)));
+  }
+  if (firstHit == none)
   {
     discard;
   }
-  vec4 sum = vec4(0.0);
-  for (int h = 0; h < hits; ++h)
-  {
-    vec3 p = clamp(o + hitTs[h] * d, 0.0, 1.0);
-    vec4 c = isoColors[hitIso[h]];
-    sum += (1.0 - sum.a) * c.a * vec4(shade(p, c.rgb), 1.0);
-  }
   fragOutput0 = sum;
-  gl_FragDepth = depthOf(clamp(o + hitTs[0] * d, 0.0, 1.0));
+  gl_FragDepth = depthOf(clamp(o + firstHit * d, 0.0, 1.0));
 #endif
 }
