@@ -18,7 +18,11 @@
 //   BenchmarkHistoPyramidIsoMapper --input ct|ct512|phantom256|phantomN
 //     [--ct FILE.mha] [--windows 1920x1080,1024x768] [--frames 360] [--sweep 95]
 //     [--isovalues -500,400] [--methods hp,rc,fe[,hpbox]] [--rc-factors 0.5,1.0]
-//     [--opacity 1]
+//     [--opacity 1] [--together 0|1]
+//
+// --together 1: one rotation scene per window and method with all the
+// isovalues at once (the demo's skin over bone): the first at --opacity, the
+// others opaque; FlyingEdges extracts them all. The sweep is unchanged.
 //     [--images DIR]
 #include "MedicalTestUtilities.h"
 #include "vtkHistoPyramidIsoMapper.h"
@@ -75,6 +79,7 @@ struct Options
   std::vector<std::string> Methods = { "hp", "rc", "fe" };
   std::vector<double> RayCastFactors = { 0.5 };
   double Opacity = 1.0; // of every isovalue (< 1: the mapper's translucent mode)
+  bool Together = false; // rotation with all isovalues in one scene
   std::string ImageDir;
 };
 
@@ -143,6 +148,8 @@ bool Parse(int argc, char* argv[], Options& opt)
       opt.RayCastFactors = Numbers(value);
     else if (name == "--opacity")
       opt.Opacity = std::min(1.0, std::max(0.01, std::stod(value)));
+    else if (name == "--together")
+      opt.Together = std::stoi(value) != 0;
     else if (name == "--images")
       opt.ImageDir = value;
     else if (name == "--windows")
@@ -385,12 +392,18 @@ struct Scene
 
 double SurfaceOpacity = 1.0; // --opacity
 
-void SetLook(vtkVolumeProperty* property)
+// One isovalue: SurfaceOpacity. Several: the first at SurfaceOpacity, the
+// others opaque (skin over bone).
+void SetLook(vtkVolumeProperty* property, const std::vector<double>& isovalues)
 {
   vtkNew<vtkColorTransferFunction> color;
   color->AddRGBPoint(0.0, 0.93, 0.85, 0.75);
   vtkNew<vtkPiecewiseFunction> opacity;
-  opacity->AddPoint(0.0, SurfaceOpacity); // the same at every isovalue
+  opacity->AddPoint(isovalues.front(), SurfaceOpacity);
+  for (size_t i = 1; i < isovalues.size(); ++i)
+  {
+    opacity->AddPoint(isovalues[i], 1.0);
+  }
   property->SetColor(color);
   property->SetScalarOpacity(opacity);
   property->SetInterpolationTypeToLinear();
@@ -402,7 +415,7 @@ void SetLook(vtkVolumeProperty* property)
 }
 
 Scene MakeScene(const std::string& method, double factor, vtkImageData* image, int width,
-  int height, double isovalue)
+  int height, const std::vector<double>& isovalues)
 {
   Scene scene;
   scene.Method = method;
@@ -424,7 +437,10 @@ Scene MakeScene(const std::string& method, double factor, vtkImageData* image, i
     scene.FlyingEdges->ComputeNormalsOn();
     scene.FlyingEdges->ComputeScalarsOff();
     scene.FlyingEdges->ComputeGradientsOff();
-    scene.FlyingEdges->SetValue(0, isovalue);
+    for (size_t i = 0; i < isovalues.size(); ++i)
+    {
+      scene.FlyingEdges->SetValue(static_cast<int>(i), isovalues[i]);
+    }
     scene.PolyMapper = vtkSmartPointer<vtkPolyDataMapper>::New();
     scene.PolyMapper->SetInputConnection(scene.FlyingEdges->GetOutputPort());
     scene.PolyMapper->ScalarVisibilityOff();
@@ -441,8 +457,11 @@ Scene MakeScene(const std::string& method, double factor, vtkImageData* image, i
   else
   {
     scene.VolumeProperty = vtkSmartPointer<vtkVolumeProperty>::New();
-    SetLook(scene.VolumeProperty);
-    scene.VolumeProperty->GetIsoSurfaceValues()->SetValue(0, isovalue);
+    SetLook(scene.VolumeProperty, isovalues);
+    for (size_t i = 0; i < isovalues.size(); ++i)
+    {
+      scene.VolumeProperty->GetIsoSurfaceValues()->SetValue(static_cast<int>(i), isovalues[i]);
+    }
     vtkNew<vtkVolume> volume;
     volume->SetProperty(scene.VolumeProperty);
     if (method == "hp" || method == "hpbox")
@@ -607,9 +626,19 @@ int main(int argc, char* argv[])
       for (double factor : factors)
       {
         // --- rotation, per isovalue: a fresh scene each, so every one starts cold.
+        std::vector<std::vector<double>> rotations;
         for (double iso : opt.Isovalues)
         {
-          Scene scene = MakeScene(method, factor, image, window.first, window.second, iso);
+          rotations.push_back({ iso });
+        }
+        if (opt.Together)
+        {
+          rotations = { opt.Isovalues };
+        }
+        for (const std::vector<double>& isos : rotations)
+        {
+          const double iso = isos.front();
+          Scene scene = MakeScene(method, factor, image, window.first, window.second, isos);
           double extract = scene.Extract();
           const double first = scene.Frame();
           if (!reportedGL)
@@ -669,6 +698,7 @@ int main(int argc, char* argv[])
             .Add("label", scene.Label)
             .Add("factor", factor)
             .Add("iso", iso)
+            .Add("isovalues", static_cast<double>(isos.size()))
             .Add("frames", opt.Frames)
             .Add("min_s", s.Min)
             .Add("median_s", s.Median)
@@ -706,7 +736,7 @@ int main(int argc, char* argv[])
           continue;
         }
         Scene scene =
-          MakeScene(method, factor, image, window.first, window.second, opt.Isovalues.front());
+          MakeScene(method, factor, image, window.first, window.second, { opt.Isovalues.front() });
         scene.Extract();
         scene.Frame();
         scene.Frame();
