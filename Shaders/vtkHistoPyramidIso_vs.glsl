@@ -88,30 +88,60 @@ int orderMask(ivec3 node, ivec3 factor, vec3 childSpan)
   return mask;
 }
 
+// The child (0..7, dx + 2 dy + 4 dz) whose running sum, in visiting order,
+// covers index, given the children's counts (low: dz = 0, high: dz = 1) and
+// the order mask (child o ^ mask is the o-th visited); index becomes the
+// rank inside that child. Loop-free (see descend()).
+int pickChild(uvec4 low, uvec4 high, int mask, inout uint index)
+{
+  // Visiting order: position o holds child o ^ mask.
+  bool flipZ = (mask & 4) != 0, flipY = (mask & 2) != 0, flipX = (mask & 1) != 0;
+  uvec4 a = flipZ ? high : low;
+  uvec4 b = flipZ ? low : high;
+  a = flipY ? a.zwxy : a;
+  b = flipY ? b.zwxy : b;
+  a = flipX ? a.yxwz : a;
+  b = flipX ? b.yxwz : b;
+  // Inclusive running sums; those not above index are the children passed.
+  uvec4 sumA = uvec4(a.x, a.x + a.y, a.x + a.y + a.z, a.x + a.y + a.z + a.w);
+  uvec4 sumB = sumA.w + uvec4(b.x, b.x + b.y, b.x + b.y + b.z, b.x + b.y + b.z + b.w);
+  uvec4 passedA = uvec4(lessThanEqual(sumA, uvec4(index)));
+  uvec4 passedB = uvec4(lessThanEqual(sumB, uvec4(index)));
+  uvec4 before = max(sumA * passedA, sumB * passedB);
+  int order = int(passedA.x + passedA.y + passedA.z + passedA.w + passedB.x + passedB.y +
+    passedB.z + passedB.w);
+  index -= max(max(before.x, before.y), max(before.z, before.w));
+  return order ^ mask;
+}
+
 // One step down: from node (of the level above `lower`) to the child whose
-// running sum covers index.
+// running sum, in visiting order, covers index. Straight-line code, no loop:
+// the 8 children's counts are fetched with constant offsets (factor is a
+// literal at every call, so the fetches of absent children fold away), put
+// in visiting order (child o ^ mask is the o-th visited) by three
+// conditional swaps, and the child is the number of running sums not above
+// index. (A loop with an early exit per level costs about as much to run,
+// but chained loops make llvmpipe's LLVM compile time double with every
+// level: 13 s for the CT's 7 levels against 2 s without loops.)
 void descend(usampler3D lower, ivec3 factor, vec3 childSpan, inout ivec3 node, inout uint index)
 {
   int mask = orderMask(node, factor, childSpan);
-  ivec3 chosen = node * factor;
-  for (int order = 0; order < 8; ++order)
+  ivec3 base = node * factor;
+  bool hasX = factor.x == 2, hasY = factor.y == 2, hasZ = factor.z == 2;
+  uvec4 low = uvec4(texelFetch(lower, base, 0).r,
+    hasX ? texelFetch(lower, base + ivec3(1, 0, 0), 0).r : 0u,
+    hasY ? texelFetch(lower, base + ivec3(0, 1, 0), 0).r : 0u,
+    hasX && hasY ? texelFetch(lower, base + ivec3(1, 1, 0), 0).r : 0u);
+  uvec4 high = uvec4(0u);
+  if (hasZ)
   {
-    int c = order ^ mask;
-    ivec3 d = ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-    if (any(greaterThanEqual(d, factor)))
-    {
-      continue;
-    }
-    ivec3 child = node * factor + d;
-    uint count = texelFetch(lower, child, 0).r;
-    if (index < count)
-    {
-      chosen = child;
-      break;
-    }
-    index -= count;
+    high = uvec4(texelFetch(lower, base + ivec3(0, 0, 1), 0).r,
+      hasX ? texelFetch(lower, base + ivec3(1, 0, 1), 0).r : 0u,
+      hasY ? texelFetch(lower, base + ivec3(0, 1, 1), 0).r : 0u,
+      hasX && hasY ? texelFetch(lower, base + ivec3(1, 1, 1), 0).r : 0u);
   }
-  node = chosen;
+  int child = pickChild(low, high, mask, index);
+  node = base + ivec3(child & 1, (child >> 1) & 1, (child >> 2) & 1);
 }
 
 // Central differences of the volume at the 8 corners of cell c (one-sided
@@ -265,13 +295,17 @@ void main()
     ivec3 d = ivec3(i % 3, (i / 3) % 3, i / 9);
     p[i] = texelFetch(volume, min(first + d, cellDimensions), 0).r;
   }
-  int masks[8];
+  ivec4 masksLow, masksHigh; // child c's crossing mask: c < 4 ? masksLow[c] : masksHigh[c - 4]
 #define MEDISO_CHILD(C, X, Y, Z)                                                             \
   {                                                                                         \
     VALUE_TYPE w[8];                                                                        \
     MEDISO_CHILD_CORNERS(w, p, X, Y, Z)                                                     \
-    masks[C] = any(greaterThanEqual(ivec3(X, Y, Z), firstFactor)) ? 0                      \
-                                                                  : cellMask(first + ivec3(X, Y, Z), w); \
+    int m = any(greaterThanEqual(ivec3(X, Y, Z), firstFactor)) ? 0                          \
+                                                               : cellMask(first + ivec3(X, Y, Z), w); \
+    if (C < 4)                                                                              \
+      masksLow[C & 3] = m;                                                                  \
+    else                                                                                    \
+      masksHigh[C & 3] = m;                                                                 \
   }
   MEDISO_CHILD(0, 0, 0, 0)
   MEDISO_CHILD(1, 1, 0, 0)
@@ -281,40 +315,25 @@ void main()
   MEDISO_CHILD(5, 1, 0, 1)
   MEDISO_CHILD(6, 0, 1, 1)
   MEDISO_CHILD(7, 1, 1, 1)
-  int mask = orderMask(node, firstFactor, vec3(1.0));
-  vCell = first;
-  vMask = 0;
+  uvec4 countsLow = uvec4(bitCount8(masksLow.x), bitCount8(masksLow.y), bitCount8(masksLow.z),
+    bitCount8(masksLow.w));
+  uvec4 countsHigh = uvec4(bitCount8(masksHigh.x), bitCount8(masksHigh.y),
+    bitCount8(masksHigh.z), bitCount8(masksHigh.w));
+  int c = pickChild(countsLow, countsHigh, orderMask(node, firstFactor, vec3(1.0)), index);
+  vCell = first + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+  vMask = c < 4 ? masksLow[c & 3] : masksHigh[c & 3];
+  // The index-th crossing isovalue, in increasing threshold order.
   vIsovalue = -1;
-  for (int order = 0; order < 8; ++order)
+  int rank = int(index);
+  for (int t = 0; t < 8; ++t)
   {
-    int c = order ^ mask;
-    int crossing = masks[c];
-    uint count = bitCount8(crossing);
-    if (index < count)
-    {
-      vCell = first + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-      vMask = crossing;
-      // The index-th crossing isovalue, in increasing threshold order.
-      int rank = int(index);
-      for (int t = 0; t < 8; ++t)
-      {
-        if (((crossing >> t) & 1) == 1)
-        {
-          if (rank == 0)
-          {
-            vIsovalue = t;
-            break;
-          }
-          --rank;
-        }
-      }
-      if (oneRankPerCell == 1 && index != 0u)
-      {
-        vIsovalue = -1;
-      }
-      break;
-    }
-    index -= count;
+    int bit = (vMask >> t) & 1;
+    vIsovalue = bit == 1 && rank == 0 && vIsovalue < 0 ? t : vIsovalue;
+    rank -= bit;
+  }
+  if (oneRankPerCell == 1 && index != 0u)
+  {
+    vIsovalue = -1;
   }
   if (vIsovalue >= 0)
   {
