@@ -24,6 +24,7 @@
 #include "vtkHistoPyramidLayer_vs.h"
 #include "vtkHistoPyramidReduce_fs.h"
 
+#include <algorithm>
 #include <array>
 #include <cfloat>
 #include <cmath>
@@ -333,6 +334,14 @@ void SetNearestClamp(vtkTextureObject* tex)
   tex->SetWrapT(vtkTextureObject::ClampToEdge);
   tex->SetWrapR(vtkTextureObject::ClampToEdge);
 }
+
+// The texel size of a stored level of `size` nodes: levels are packed 2x2
+// nodes (x, y) to an RGBA texel (sizes are powers of two; an axis of 1 node
+// keeps 1 texel, whose odd component is then a node beyond the level).
+std::array<int, 3> Packed(const std::array<int, 3>& size)
+{
+  return { std::max(1, size[0] / 2), std::max(1, size[1] / 2), size[2] };
+}
 } // anonymous namespace
 
 //------------------------------------------------------------------------------
@@ -586,8 +595,8 @@ std::uint64_t vtkOpenGLHistoPyramid::GetGPUMemoryBytes() const
   }
   for (std::size_t l = 1; l < impl.Levels.size(); ++l)
   {
-    const auto& size = impl.Sizes[l];
-    bytes += static_cast<std::uint64_t>(size[0]) * size[1] * size[2] * impl.BytesPerNode[l];
+    const std::array<int, 3> packed = Packed(impl.Sizes[l]);
+    bytes += static_cast<std::uint64_t>(packed[0]) * packed[1] * packed[2] * 4 * impl.BytesPerNode[l];
   }
   return bytes;
 }
@@ -750,18 +759,18 @@ bool vtkOpenGLHistoPyramid::Build(
       // The largest count of a node: every isovalue crossing every cell under it.
       const double maxCount = static_cast<double>(MaximumNumberOfIsovalues) * (base[0] / size[0]) *
         (base[1] / size[1]) * (base[2] / size[2]);
-      GLenum internalFormat = GL_R32UI, dataType = GL_UNSIGNED_INT;
+      GLenum internalFormat = GL_RGBA32UI, dataType = GL_UNSIGNED_INT;
       int bytes = 4, vtkType = VTK_UNSIGNED_INT;
       if (maxCount <= 255.0)
       {
-        internalFormat = GL_R8UI;
+        internalFormat = GL_RGBA8UI;
         dataType = GL_UNSIGNED_BYTE;
         bytes = 1;
         vtkType = VTK_UNSIGNED_CHAR;
       }
       else if (maxCount <= 65535.0)
       {
-        internalFormat = GL_R16UI;
+        internalFormat = GL_RGBA16UI;
         dataType = GL_UNSIGNED_SHORT;
         bytes = 2;
         vtkType = VTK_UNSIGNED_SHORT;
@@ -769,14 +778,15 @@ bool vtkOpenGLHistoPyramid::Build(
       auto level = vtkSmartPointer<vtkTextureObject>::New();
       level->SetContext(renWin);
       level->SetInternalFormat(internalFormat);
-      level->SetFormat(GL_RED_INTEGER);
+      level->SetFormat(GL_RGBA_INTEGER);
       level->SetDataType(dataType);
       SetNearestClamp(level);
-      if (!level->Allocate3D(static_cast<unsigned int>(size[0]), static_cast<unsigned int>(size[1]),
-            static_cast<unsigned int>(size[2]), 1, vtkType))
+      const std::array<int, 3> packed = Packed(size);
+      if (!level->Allocate3D(static_cast<unsigned int>(packed[0]),
+            static_cast<unsigned int>(packed[1]), static_cast<unsigned int>(packed[2]), 4, vtkType))
       {
-        vtkErrorMacro("Cannot allocate a " << size[0] << "x" << size[1] << "x" << size[2]
-                                           << " integer 3D texture: " << TakeGLErrors());
+        vtkErrorMacro("Cannot allocate a " << packed[0] << "x" << packed[1] << "x" << packed[2]
+                                           << " RGBA integer 3D texture: " << TakeGLErrors());
         impl.ReleaseLevels(renWin);
         return false;
       }
@@ -837,9 +847,11 @@ bool vtkOpenGLHistoPyramid::Build(
     const auto& base = impl.Sizes[0];
     const int factor[3] = { base[0] / size[0], base[1] / size[1], base[2] / size[2] };
     SetUniformIVec3(firstProgram, "factor", factor);
-    const int sliceSize[2] = { size[0], size[1] };
+    const std::array<int, 3> packed = Packed(size);
+    const int sliceSize[2] = { packed[0], packed[1] };
     firstProgram->SetUniform2i("sliceSize", sliceSize);
-    ostate->vtkglViewport(0, 0, size[0], size[1]);
+    SetUniformIVec3(firstProgram, "levelSize", size.data());
+    ostate->vtkglViewport(0, 0, packed[0], packed[1]);
     if (!attach(impl.Levels[1]))
     {
       return false;
@@ -855,11 +867,13 @@ bool vtkOpenGLHistoPyramid::Build(
     const auto& size = impl.Sizes[l];
     const auto& lower = impl.Sizes[l - 1];
     const int factor[3] = { lower[0] / size[0], lower[1] / size[1], lower[2] / size[2] };
-    const int sliceSize[2] = { size[0], size[1] };
+    const std::array<int, 3> packed = Packed(size);
+    const int sliceSize[2] = { packed[0], packed[1] };
     reduceProgram->SetUniformi("lowerLevel", impl.Levels[l - 1]->GetTextureUnit());
     SetUniformIVec3(reduceProgram, "factor", factor);
     reduceProgram->SetUniform2i("sliceSize", sliceSize);
-    ostate->vtkglViewport(0, 0, size[0], size[1]);
+    SetUniformIVec3(reduceProgram, "levelSize", size.data());
+    ostate->vtkglViewport(0, 0, packed[0], packed[1]);
     if (!attach(impl.Levels[l]))
     {
       return false;
@@ -867,20 +881,20 @@ bool vtkOpenGLHistoPyramid::Build(
     impl.DrawSlices(size[2]);
   }
 
-  // 6. Read back the top node only.
-  GLuint top = 0;
+  // 6. Read back the top node only (component 0 of the top level's texel).
+  GLuint top[4] = { 0, 0, 0, 0 };
   if (!attach(impl.Levels[numLevels - 1]))
   {
     return false;
   }
-  glReadPixels(0, 0, 1, 1, GL_RED_INTEGER, GL_UNSIGNED_INT, &top);
+  glReadPixels(0, 0, 1, 1, GL_RGBA_INTEGER, GL_UNSIGNED_INT, top);
   const std::string errors = TakeGLErrors();
   if (!errors.empty())
   {
     vtkErrorMacro("Building the HistoPyramid failed: " << errors);
     return false;
   }
-  impl.Total = top;
+  impl.Total = top[0];
   impl.Current = thresholds;
   impl.Built = true;
   return true;
@@ -939,10 +953,29 @@ bool vtkOpenGLHistoPyramid::ReadLevel(int level, std::vector<std::uint32_t>& cou
     impl.DrawSlices(s[2]);
   }
   const std::size_t sliceCount = static_cast<std::size_t>(s[0]) * s[1];
+  const std::array<int, 3> packed = Packed(s);
+  std::vector<GLuint> texels(4 * static_cast<std::size_t>(packed[0]) * packed[1]);
   for (int z = 0; z < s[2]; ++z)
   {
     glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, texture->GetHandle(), 0, z);
-    glReadPixels(0, 0, s[0], s[1], GL_RED_INTEGER, GL_UNSIGNED_INT, counts.data() + z * sliceCount);
+    if (level == 0)
+    {
+      glReadPixels(
+        0, 0, s[0], s[1], GL_RED_INTEGER, GL_UNSIGNED_INT, counts.data() + z * sliceCount);
+      continue;
+    }
+    // Stored levels are packed: node (x, y) is component (x & 1) + 2 (y & 1)
+    // of texel (x / 2, y / 2).
+    glReadPixels(0, 0, packed[0], packed[1], GL_RGBA_INTEGER, GL_UNSIGNED_INT, texels.data());
+    for (int y = 0; y < s[1]; ++y)
+    {
+      for (int x = 0; x < s[0]; ++x)
+      {
+        const std::size_t texel = static_cast<std::size_t>(y / 2) * packed[0] + x / 2;
+        counts[z * sliceCount + static_cast<std::size_t>(y) * s[0] + x] =
+          texels[4 * texel + (x & 1) + 2 * (y & 1)];
+      }
+    }
   }
   glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, 0, 0, 0);
   if (level == 0)

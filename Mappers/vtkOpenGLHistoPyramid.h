@@ -23,11 +23,21 @@
  * and the traversal recounts the cells of the level-1 node it reaches from
  * the same corner values, which it needs anyway to draw the cell. Each stored
  * level takes the narrowest unsigned integer format that holds its largest
- * possible count (8 isovalues times the cells under a node): GL_R8UI for
- * level 1, GL_R16UI up to level 4, GL_R32UI above. The whole pyramid is then
- * about 0.16 bytes per padded cell, against 4.6 for R32UI levels from an
- * R32UI base, so the GPU memory stays close to the volume's own size (a
- * 256x256x108 int16 CT: 14.2 MB volume + 1.4 MB pyramid).
+ * possible count (8 isovalues times the cells under a node): 8 bits for
+ * level 1, 16 up to level 4, 32 above. The whole pyramid is then about 0.16
+ * bytes per padded cell, against 4.6 for R32UI levels from an R32UI base, so
+ * the GPU memory stays close to the volume's own size (a 256x256x108 int16
+ * CT: 14.2 MB volume + 1.4 MB pyramid).
+ *
+ * Packing. Each stored level is an RGBA texture (GL_RGBA8UI, GL_RGBA16UI or
+ * GL_RGBA32UI) of half the level's size in x and y: texel (i, j, k) holds
+ * the counts of the 2x2 nodes (2i + a, 2j + b, k) in component a + 2b (a
+ * node beyond the level, where an axis has one node, counts 0). The same
+ * bytes as one node per texel, but the 8 children of a node of the level
+ * above are then the 4 components of 2 texels, (n.x, n.y, 2 n.z) and
+ * (n.x, n.y, 2 n.z + 1): a step of the mapper's walk down the pyramid is 2
+ * texel fetches instead of 8, and the walk is most of the vertex stage's
+ * work on a software rasteriser. ReadLevel() unpacks.
  *
  * Only OpenGL 3.2 core / GLSL 1.50 is used (no compute shaders, no shader
  * storage buffers, no image load/store). The build is one draw call per
@@ -38,20 +48,21 @@
  * an unsigned integer output (a handful of draw calls per rebuild instead of
  * one per slice and level).
  * -# Level-1 pass (vtkHistoPyramidFirstLevel_fs.glsl): fragment (i, j) of
- *    slice k is node (i, j, k); it sums over its cells the number of
- *    isovalues with min < iso <= max over the cell's eight corners (the
- *    convention of vtkMarchingCubes). Cells with a NaN corner and padding
- *    cells count 0. The test is the one function of
- *    vtkHistoPyramidCommon.glsl that every pass and the drawing program
- *    share. The comparisons are exact: isovalues are turned on the CPU into
+ *    slice k is the packed texel of nodes (2i + a, 2j + b, k); each node
+ *    sums over its cells the number of isovalues with min < iso <= max
+ *    over the cell's eight corners (the convention of vtkMarchingCubes).
+ *    Cells with a NaN corner and padding cells count 0. The test is the one
+ *    function of vtkHistoPyramidCommon.glsl that every pass and the drawing
+ *    program share. The comparisons are exact: isovalues are turned on the CPU into
  *    thresholds of the texture's own value type (ceil(iso) for integer data,
  *    the smallest float >= iso for float data), so that the GPU counts equal
  *    the CPU counts computed in double precision.
- * -# Reduction passes (vtkHistoPyramidReduce_fs.glsl): node (i, j, k) of
- *    level l + 1 is the sum of its 2x2x2 children of level l (2x2x1, 2x1x1,
- *    ... once an axis has reached 1), read with texelFetch.
- * -# Read-back: only the top node (one 32-bit integer) comes back to the
- *    CPU, as GetTotal().
+ * -# Reduction passes (vtkHistoPyramidReduce_fs.glsl): each fragment writes
+ *    a packed texel of level l + 1; each of its nodes is the sum of its
+ *    2x2x2 children of level l (2x2x1, 2x1x1, ... once an axis has reached
+ *    1), the components of 1 or 2 texels read with texelFetch.
+ * -# Read-back: only the top node (component 0 of one texel) comes back to
+ *    the CPU, as GetTotal().
  *
  * The volume is uploaded once by UploadVolume() and kept until it is called
  * again, as a single-channel 3D texture that keeps the data's precision:

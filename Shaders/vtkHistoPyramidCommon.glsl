@@ -22,12 +22,15 @@ uniform int numberOfThresholds;    // 0 .. 8
 uniform ivec3 cellDimensions;      // real cells per axis (points - 1)
 
 // Bit t set when isovalue t crosses a cell whose corner values span [lo, hi].
+// A constant bound, so that the loop unrolls: llvmpipe's LLVM takes time
+// exponential in the number of loops in a chain (a shader inlines this once
+// per cell it classifies), and a uniform bound would keep each one a loop.
 int crossingMask(VALUE_TYPE lo, VALUE_TYPE hi)
 {
   int mask = 0;
-  for (int t = 0; t < numberOfThresholds; ++t)
+  for (int t = 0; t < 8; ++t)
   {
-    if (lo < thresholds[t] && thresholds[t] <= hi)
+    if (t < numberOfThresholds && lo < thresholds[t] && thresholds[t] <= hi)
     {
       mask |= 1 << t;
     }

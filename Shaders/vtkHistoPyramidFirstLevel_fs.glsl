@@ -2,15 +2,19 @@
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // vtkHistoPyramidFirstLevel_fs.glsl: level 1 of the HistoPyramid, the lowest
-// level vtkOpenGLHistoPyramid stores, straight from the volume. Drawn as one
-// full-screen quad per z-slice: fragment (i, j) of slice k is node (i, j, k),
-// whose cells are the box [2i, 2i + fx) x [2j, 2j + fy) x [2k, 2k + fz)
-// (f = 2 along an axis the base level has more than one cell on, else 1). It
-// reads the box's (f + 1)^3 <= 27 corner values once and writes the summed
-// number of crossing isovalues of its cells (0 for padding cells).
+// level vtkOpenGLHistoPyramid stores, straight from the volume. Levels are
+// stored packed (see vtkHistoPyramidReduce_fs.glsl): texel (i, j, k) holds
+// the counts of the 2x2 nodes (2i + a, 2j + b, k) in component a + 2b. Drawn
+// as one full-screen quad per z-slice; each fragment counts its 4 nodes.
+// Node n's cells are the box [2n.x, 2n.x + fx) x [2n.y, 2n.y + fy) x
+// [2n.z, 2n.z + fz) (f = 2 along an axis the base level has more than one
+// cell on, else 1); the node reads the box's (f + 1)^3 <= 27 corner values
+// once and counts the crossing isovalues of its cells (0 for padding cells
+// and for nodes beyond level 1's size).
 //
 // Skipping the stored base level is what keeps the pyramid small: level 1 in
-// GL_R8UI is 1/8 byte per cell, against 4 bytes per cell for an R32UI base.
+// 8 bits per node is 1/8 byte per cell, against 4 bytes per cell for a
+// 32-bit base.
 //
 // GLSL 1.50 only; integer output declared here.
 
@@ -19,14 +23,18 @@
 in vec2 texCoord;
 
 uniform ivec3 factor;    // 1 or 2 per axis (base level to level 1)
-uniform ivec2 sliceSize; // size of level 1 in x and y
+uniform ivec2 sliceSize; // packed size of level 1 in x and y
+uniform ivec3 levelSize; // nodes of level 1
 flat in int slice;       // z of the slice being written (vtkHistoPyramidLayer_gs.glsl)
 
 out uvec4 fragOutput0;
 
-void main()
+uint nodeCount(ivec3 node)
 {
-  ivec3 node = ivec3(ivec2(floor(texCoord * vec2(sliceSize))), slice);
+  if (any(greaterThanEqual(node, levelSize)))
+  {
+    return 0u;
+  }
   ivec3 first = node * factor;
   ivec3 pointMax = cellDimensions; // last point index per axis
   VALUE_TYPE p[27];
@@ -53,5 +61,13 @@ void main()
   MEDISO_CHILD(1, 0, 1)
   MEDISO_CHILD(0, 1, 1)
   MEDISO_CHILD(1, 1, 1)
-  fragOutput0 = uvec4(sum, 0u, 0u, 0u);
+  return sum;
+}
+
+void main()
+{
+  ivec3 texel = ivec3(ivec2(floor(texCoord * vec2(sliceSize))), slice);
+  ivec3 first = ivec3(2 * texel.xy, texel.z);
+  fragOutput0 = uvec4(nodeCount(first), nodeCount(first + ivec3(1, 0, 0)),
+    nodeCount(first + ivec3(0, 1, 0)), nodeCount(first + ivec3(1, 1, 0)));
 }

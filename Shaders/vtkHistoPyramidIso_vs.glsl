@@ -20,7 +20,8 @@
 // w = 1 for a perspective camera (its position), w = 0 for a parallel one
 // (the direction towards the viewer), so both projections share one test.
 //
-// The levels are separate 3D textures (each level has its own size), and
+// The levels are separate 3D textures (each level has its own size; each
+// packed 2x2 nodes to an RGBA texel, see descend()), and
 // GLSL 1.50 cannot index an array of samplers with a variable: the mapper
 // puts one uniform per stored level in place of the HistoPyramidLevels Dec
 // tag and one descend() call per level, with that level's constant factors,
@@ -91,7 +92,9 @@ int orderMask(ivec3 node, ivec3 factor, vec3 childSpan)
 // The child (0..7, dx + 2 dy + 4 dz) whose running sum, in visiting order,
 // covers index, given the children's counts (low: dz = 0, high: dz = 1) and
 // the order mask (child o ^ mask is the o-th visited); index becomes the
-// rank inside that child. Loop-free (see descend()).
+// rank inside that child. Loop-free: the counts are put in visiting order
+// by three conditional swaps, and the child is the number of running sums
+// not above index.
 int pickChild(uvec4 low, uvec4 high, int mask, inout uint index)
 {
   // Visiting order: position o holds child o ^ mask.
@@ -115,33 +118,26 @@ int pickChild(uvec4 low, uvec4 high, int mask, inout uint index)
 }
 
 // One step down: from node (of the level above `lower`) to the child whose
-// running sum, in visiting order, covers index. Straight-line code, no loop:
-// the 8 children's counts are fetched with constant offsets (factor is a
-// literal at every call, so the fetches of absent children fold away), put
-// in visiting order (child o ^ mask is the o-th visited) by three
-// conditional swaps, and the child is the number of running sums not above
-// index. (A loop with an early exit per level costs about as much to run,
-// but chained loops make llvmpipe's LLVM compile time double with every
-// level: 13 s for the CT's 7 levels against 2 s without loops.)
+// running sum, in visiting order, covers index. Levels are stored packed
+// (texel (i, j, k) holds nodes (2i + a, 2j + b, k) in component a + 2b; see
+// vtkOpenGLHistoPyramid), so the children of node n in z-slice z of the
+// level below are the 4 components of texel (n.x, n.y, z), in child order
+// dx + 2 dy (a component beyond an axis of one node holds 0): two fetches
+// give all 8 counts. Straight-line code, no loop (factor is a literal at
+// every call, so the second fetch folds away where z has one node): chained
+// loops made llvmpipe's LLVM compile time double with every level (13 s for
+// the CT's 7 levels against 2 s without loops).
 void descend(usampler3D lower, ivec3 factor, vec3 childSpan, inout ivec3 node, inout uint index)
 {
   int mask = orderMask(node, factor, childSpan);
-  ivec3 base = node * factor;
-  bool hasX = factor.x == 2, hasY = factor.y == 2, hasZ = factor.z == 2;
-  uvec4 low = uvec4(texelFetch(lower, base, 0).r,
-    hasX ? texelFetch(lower, base + ivec3(1, 0, 0), 0).r : 0u,
-    hasY ? texelFetch(lower, base + ivec3(0, 1, 0), 0).r : 0u,
-    hasX && hasY ? texelFetch(lower, base + ivec3(1, 1, 0), 0).r : 0u);
+  uvec4 low = texelFetch(lower, ivec3(node.xy, node.z * factor.z), 0);
   uvec4 high = uvec4(0u);
-  if (hasZ)
+  if (factor.z == 2)
   {
-    high = uvec4(texelFetch(lower, base + ivec3(0, 0, 1), 0).r,
-      hasX ? texelFetch(lower, base + ivec3(1, 0, 1), 0).r : 0u,
-      hasY ? texelFetch(lower, base + ivec3(0, 1, 1), 0).r : 0u,
-      hasX && hasY ? texelFetch(lower, base + ivec3(1, 1, 1), 0).r : 0u);
+    high = texelFetch(lower, ivec3(node.xy, 2 * node.z + 1), 0);
   }
   int child = pickChild(low, high, mask, index);
-  node = base + ivec3(child & 1, (child >> 1) & 1, (child >> 2) & 1);
+  node = node * factor + ivec3(child & 1, (child >> 1) & 1, (child >> 2) & 1);
 }
 
 // Central differences of the volume at the 8 corners of cell c (one-sided

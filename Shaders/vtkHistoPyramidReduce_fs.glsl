@@ -2,38 +2,54 @@
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // vtkHistoPyramidReduce_fs.glsl: one level of the GPU HistoPyramid
-// (vtkOpenGLHistoPyramid) from the level below. Drawn as one full-screen
-// quad per z-slice of the GL_R32UI 3D texture of level l + 1: fragment
-// (i, j) of slice k is node (i, j, k), and writes the sum of its children in
-// level l, the box [2i, 2i + fx) x [2j, 2j + fy) x [2k, 2k + fz) where the
-// factor f is 2 along an axis that level l still has more than one node on,
-// else 1 (the layout of mediso::HistoPyramid).
+// (vtkOpenGLHistoPyramid) from the level below. Every stored level is
+// packed: texel (i, j, k) of its RGBA unsigned integer 3D texture holds the
+// counts of the 2x2 nodes (2i + a, 2j + b, k), component a + 2b (a node
+// beyond the level's size counts 0). Drawn as one full-screen quad per
+// z-slice of the packed level l + 1: fragment (i, j) of slice k writes the
+// counts of its 4 nodes n, each the sum of n's children in level l, the box
+// [2n.x, 2n.x + fx) x [2n.y, 2n.y + fy) x [2n.z, 2n.z + fz) (f is 2 along an
+// axis that level l still has more than one node on, else 1: the layout of
+// mediso::HistoPyramid). Packed, the children of n in the slice z of level l
+// are all 4 components of texel (n.x, n.y, z) of level l (along an axis with
+// f = 1, level l has one node, n is 0 there and the other component is a
+// node beyond the level: 0), so a node reads fz texels.
 //
 // GLSL 1.50 only; integer output declared here, as in the base pass.
 
 in vec2 texCoord;
 
-uniform usampler3D lowerLevel; // GL_R32UI, texelFetch only
+uniform usampler3D lowerLevel; // packed, texelFetch only
 uniform ivec3 factor;          // 1 or 2 per axis
-uniform ivec2 sliceSize;       // size of the level being written, x and y
+uniform ivec2 sliceSize;       // packed size of the level being written, x and y
+uniform ivec3 levelSize;       // nodes of the level being written
 flat in int slice;       // z of the slice being written (vtkHistoPyramidLayer_gs.glsl)
 
 out uvec4 fragOutput0;
 
+uint sum4(uvec4 v)
+{
+  return v.x + v.y + v.z + v.w;
+}
+
+uint nodeCount(ivec3 node)
+{
+  if (any(greaterThanEqual(node, levelSize)))
+  {
+    return 0u;
+  }
+  uint count = sum4(texelFetch(lowerLevel, ivec3(node.xy, node.z * factor.z), 0));
+  if (factor.z == 2)
+  {
+    count += sum4(texelFetch(lowerLevel, ivec3(node.xy, 2 * node.z + 1), 0));
+  }
+  return count;
+}
+
 void main()
 {
-  ivec3 node = ivec3(ivec2(floor(texCoord * vec2(sliceSize))), slice);
-  ivec3 first = node * factor;
-  uint sum = 0u;
-  for (int dz = 0; dz < factor.z; ++dz)
-  {
-    for (int dy = 0; dy < factor.y; ++dy)
-    {
-      for (int dx = 0; dx < factor.x; ++dx)
-      {
-        sum += texelFetch(lowerLevel, first + ivec3(dx, dy, dz), 0).r;
-      }
-    }
-  }
-  fragOutput0 = uvec4(sum, 0u, 0u, 0u);
+  ivec3 texel = ivec3(ivec2(floor(texCoord * vec2(sliceSize))), slice);
+  ivec3 first = ivec3(2 * texel.xy, texel.z);
+  fragOutput0 = uvec4(nodeCount(first), nodeCount(first + ivec3(1, 0, 0)),
+    nodeCount(first + ivec3(0, 1, 0)), nodeCount(first + ivec3(1, 1, 0)));
 }
