@@ -22,6 +22,7 @@
 #include "vtkHistoPyramidFirstLevel_fs.h"
 #include "vtkHistoPyramidLayer_gs.h"
 #include "vtkHistoPyramidLayer_vs.h"
+#include "vtkHistoPyramidPacked.h"
 #include "vtkHistoPyramidReduce_fs.h"
 
 #include <algorithm>
@@ -440,6 +441,14 @@ struct vtkOpenGLHistoPyramid::Internals
     return fs;
   }
 
+  // A pass that writes a stored level: the packed layout's main() put in.
+  static std::string PackedPass(const std::string& source)
+  {
+    std::string fs = source;
+    vtkShaderProgram::Substitute(fs, "//VTK::HistoPyramidPacked::Impl", vtkHistoPyramidPacked);
+    return fs;
+  }
+
   // Ready (compile or rebind) a pass program: the layered full-screen quads
   // with fragment shader `fs`. Returns the bound program, or nullptr when it
   // does not build.
@@ -799,9 +808,10 @@ bool vtkOpenGLHistoPyramid::Build(
 
   // 2. The programs.
   vtkShaderProgram* firstProgram =
-    Internals::ReadyPass(renWin, impl.FirstQuad, impl.PassShader(vtkHistoPyramidFirstLevel_fs));
+    Internals::ReadyPass(renWin, impl.FirstQuad,
+      Internals::PackedPass(impl.PassShader(vtkHistoPyramidFirstLevel_fs)));
   vtkShaderProgram* reduceProgram =
-    Internals::ReadyPass(renWin, impl.ReduceQuad, vtkHistoPyramidReduce_fs);
+    Internals::ReadyPass(renWin, impl.ReduceQuad, Internals::PackedPass(vtkHistoPyramidReduce_fs));
   if (!firstProgram || !reduceProgram)
   {
     vtkErrorMacro("The HistoPyramid shaders do not build.");

@@ -64,10 +64,4 @@ uint nodeCount(ivec3 node)
   return sum;
 }
 
-void main()
-{
-  ivec3 texel = ivec3(ivec2(floor(texCoord * vec2(sliceSize))), slice);
-  ivec3 first = ivec3(2 * texel.xy, texel.z);
-  fragOutput0 = uvec4(nodeCount(first), nodeCount(first + ivec3(1, 0, 0)),
-    nodeCount(first + ivec3(0, 1, 0)), nodeCount(first + ivec3(1, 1, 0)));
-}
+//VTK::HistoPyramidPacked::Impl
