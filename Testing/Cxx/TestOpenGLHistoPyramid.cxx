@@ -4,9 +4,11 @@
 // mediso::HistoPyramid: the total and every level, for the phantom stored as
 // each supported scalar type and for many isovalue sets (single isovalues
 // across the range, isovalues equal to data values and just beside them,
-// sets of 2 to 8, duplicates, NaN). Also checks that the OpenGL state is left
-// as it was, that ReleaseGraphicsResources() then a new upload and build work,
-// and reports the GPU memory of a 256^3 int16 volume.
+// sets of 2 to 8, duplicates, NaN), and for thin int16 volumes (3x40x17,
+// 40x2x9, 2x2x30 points: axes that reach one node early). Also checks that
+// the OpenGL state is left as it was, that ReleaseGraphicsResources() then a
+// new upload and build work, and reports the GPU memory of a 256^3 int16
+// volume.
 //  - exit 0 when everything matches;
 //  - exit 125 (skip), printing "SKIP: <reason>", where the context cannot run
 //    the GPU path;
@@ -26,6 +28,7 @@
 #include "MedicalTestUtilities.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <iostream>
@@ -293,6 +296,19 @@ int TestOpenGLHistoPyramid(int, char*[])
   // Double (converted to float on the GPU; these values are exact in float).
   RunType<double>(win, gpu, "double",
     Convert<double>(hu, [](std::int16_t v) { return static_cast<double>(v) + 0.5; }), dims);
+
+  // Thin volumes, where an axis reaches one node before the others (or has
+  // one cell from the start): the stored levels pack 2x2 nodes in x and y to
+  // a texel, and along such an axis half of each texel is a node beyond the
+  // level, which must count 0. Every isovalue set of RunType, on int16.
+  const std::vector<std::array<int, 3>> thinShapes = { { 3, 40, 17 }, { 40, 2, 9 }, { 2, 2, 30 } };
+  for (const auto& shape : thinShapes)
+  {
+    const std::vector<std::int16_t> thin = MakePhantom(shape.data(), 20.0, 5u);
+    RunType<std::int16_t>(win, gpu, "int16 " + std::to_string(shape[0]) + "x" +
+        std::to_string(shape[1]) + "x" + std::to_string(shape[2]),
+      thin, shape.data());
+  }
 
   // Release everything, then upload and build again.
   gpu->ReleaseGraphicsResources(win);
