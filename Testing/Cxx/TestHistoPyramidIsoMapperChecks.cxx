@@ -13,7 +13,9 @@
 //              vtkPolyDataMapper) of the same isovalues: covered-pixel masks
 //              agree on >= 98.5% of the pixels covered by either, and the
 //              mean colour difference over pixels covered by both is <= 12
-//              (of 255) per channel, shaded and opaque. Translucent: two
+//              (of 255) per channel, shaded and opaque (phantom skin and
+//              bone, a torus, and an ellipsoid in volumes thin in x and in
+//              y, whose pyramid axis reaches one node early). Translucent: two
 //              nested half-transparent spheres 0.35 cell apart, flat colours
 //              (mean difference <= 2, and the centre pixel within 2 of the
 //              exact composite of its four hits), which checks the order of
@@ -396,6 +398,25 @@ void Reference()
   CompareWithCPU("phantom skin", phantom, { skin });
   CompareWithCPU("phantom bone", phantom, { bone });
   CompareWithCPU("torus", iso_test::Torus(40, 11.0), { { 4.2, { 0.5, 0.85, 0.45 }, 1.0 } });
+  // Volumes thin in x, then in y (12 points against 40): padded to 16 against
+  // 64, that axis of the pyramid reaches one node two levels before the
+  // others, so the walk reads packed texels (2x2 nodes in x and y) whose odd
+  // components along it are nodes beyond the level. An ellipsoid flat along
+  // the thin axis.
+  for (int thinAxis = 0; thinAxis < 2; ++thinAxis)
+  {
+    int dims[3] = { 40, 40, 40 };
+    dims[thinAxis] = 12;
+    const double h[3] = { 1.0, 1.0, 1.0 };
+    const double origin[3] = { -0.5 * (dims[0] - 1), -0.5 * (dims[1] - 1), -0.5 * (dims[2] - 1) };
+    double squash[3] = { 1.0, 1.0, 1.0 };
+    squash[thinAxis] = 1.0 / 0.09; // radius 0.3 x 15 = 4.5 along the thin axis
+    auto field = iso_test::SampleField(dims, h, origin,
+      [squash](double x, double y, double z)
+      { return std::sqrt(squash[0] * x * x + squash[1] * y * y + squash[2] * z * z); });
+    CompareWithCPU(std::string("ellipsoid in a volume thin in ") + (thinAxis == 0 ? "x" : "y"),
+      field, { { 15.0, { 0.8, 0.8, 0.55 }, 1.0 } });
+  }
   // Translucent compositing order: two half-transparent spheres 0.35 cell
   // apart, so that most cells the surfaces cross hold both and the order of
   // the hits inside one cell decides the colour. Flat colours, against the
