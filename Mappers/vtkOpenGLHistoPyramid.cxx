@@ -848,25 +848,37 @@ bool vtkOpenGLHistoPyramid::Build(
     ~Detach() { glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, 0, 0); }
   } detachOnExit;
 
-  // 4. Level 1 from the volume: one layered draw.
+  // Level l (packed, every z-slice) from level l - 1 with `program`, whose
+  // other uniforms are set: the uniforms of the layout, the viewport, one
+  // layered draw.
+  auto drawLevel = [&](vtkShaderProgram* program, int l) -> bool
   {
-    renWin->GetShaderCache()->ReadyShaderProgram(firstProgram);
-    ScopedTextureActive volumeActive(impl.Volume);
-    impl.SetCommonUniforms(firstProgram, thresholds);
-    const auto& size = impl.Sizes[1];
-    const auto& base = impl.Sizes[0];
-    const int factor[3] = { base[0] / size[0], base[1] / size[1], base[2] / size[2] };
-    SetUniformIVec3(firstProgram, "factor", factor);
+    const auto& size = impl.Sizes[l];
+    const auto& lower = impl.Sizes[l - 1];
+    const int factor[3] = { lower[0] / size[0], lower[1] / size[1], lower[2] / size[2] };
     const std::array<int, 3> packed = Packed(size);
     const int sliceSize[2] = { packed[0], packed[1] };
-    firstProgram->SetUniform2i("sliceSize", sliceSize);
-    SetUniformIVec3(firstProgram, "levelSize", size.data());
+    SetUniformIVec3(program, "factor", factor);
+    program->SetUniform2i("sliceSize", sliceSize);
+    SetUniformIVec3(program, "levelSize", size.data());
     ostate->vtkglViewport(0, 0, packed[0], packed[1]);
-    if (!attach(impl.Levels[1]))
+    if (!attach(impl.Levels[l]))
     {
       return false;
     }
     impl.DrawSlices(size[2]);
+    return true;
+  };
+
+  // 4. Level 1 from the volume.
+  {
+    renWin->GetShaderCache()->ReadyShaderProgram(firstProgram);
+    ScopedTextureActive volumeActive(impl.Volume);
+    impl.SetCommonUniforms(firstProgram, thresholds);
+    if (!drawLevel(firstProgram, 1))
+    {
+      return false;
+    }
   }
 
   // 5. Reduction passes: level l from level l - 1.
@@ -874,21 +886,11 @@ bool vtkOpenGLHistoPyramid::Build(
   for (int l = 2; l < numLevels; ++l)
   {
     ScopedTextureActive lowerActive(impl.Levels[l - 1]);
-    const auto& size = impl.Sizes[l];
-    const auto& lower = impl.Sizes[l - 1];
-    const int factor[3] = { lower[0] / size[0], lower[1] / size[1], lower[2] / size[2] };
-    const std::array<int, 3> packed = Packed(size);
-    const int sliceSize[2] = { packed[0], packed[1] };
     reduceProgram->SetUniformi("lowerLevel", impl.Levels[l - 1]->GetTextureUnit());
-    SetUniformIVec3(reduceProgram, "factor", factor);
-    reduceProgram->SetUniform2i("sliceSize", sliceSize);
-    SetUniformIVec3(reduceProgram, "levelSize", size.data());
-    ostate->vtkglViewport(0, 0, packed[0], packed[1]);
-    if (!attach(impl.Levels[l]))
+    if (!drawLevel(reduceProgram, l))
     {
       return false;
     }
-    impl.DrawSlices(size[2]);
   }
 
   // 6. Read back the top node only (component 0 of the top level's texel).
