@@ -203,10 +203,11 @@ struct vtkHistoPyramidIsoMapper::Internals
   std::vector<double> BuiltIsovalues;
   bool PyramidValid = false;
 
-  // The drawing programs of the current pyramid layout, one per variant
-  // (footprint, opaque or translucent, number of lights and of translucent
-  // isovalues: see RenderGPU), each with the layout key it was built for.
-  std::map<int, std::pair<std::string, vtkShaderProgram*>> Programs;
+  // The drawing programs of the current pyramid layout, one per variant,
+  // keyed by the variant's #defines (footprint, opaque or translucent,
+  // number of lights and of translucent isovalues: see RenderGPU), each with
+  // the layout key it was built for.
+  std::map<std::string, std::pair<std::string, vtkShaderProgram*>> Programs;
 
   // Fallback path.
   vtkNew<vtkBlockLODContour> Contour;
@@ -753,29 +754,28 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
       << impl.ConservativeDepth;
   // Translucent frames loop over the isovalues: their number is part of the variant too.
   const int numIsovalues = static_cast<int>(std::min<std::size_t>(counted.size(), 8));
-  const int variant =
-    footprint + 2 * (translucent ? 1 : 0) + 4 * numLights + 32 * (translucent ? numIsovalues : 0);
+  std::ostringstream defines;
+  if (footprint == PointFootprint)
+  {
+    defines << "#define MEDISO_POINT_FOOTPRINT\n";
+  }
+  if (translucent)
+  {
+    defines << "#define MEDISO_TRANSLUCENT\n";
+  }
+  defines << "#define MEDISO_LIGHTS " << numLights << "\n";
+  defines << "#define MEDISO_ISOVALUES " << (translucent ? numIsovalues : 8) << "\n";
+  const std::string variant = defines.str();
   auto& cached = impl.Programs[variant];
   if (!cached.second || cached.first != key.str())
   {
-    std::ostringstream defines;
-    if (footprint == PointFootprint)
-    {
-      defines << "#define MEDISO_POINT_FOOTPRINT\n";
-    }
-    if (translucent)
-    {
-      defines << "#define MEDISO_TRANSLUCENT\n";
-    }
-    defines << "#define MEDISO_LIGHTS " << numLights << "\n";
-    defines << "#define MEDISO_ISOVALUES " << (translucent ? numIsovalues : 8) << "\n";
     std::string vs = vtkHistoPyramidIso_vs;
-    vtkShaderProgram::Substitute(vs, "//VTK::Variant::Dec", defines.str());
+    vtkShaderProgram::Substitute(vs, "//VTK::Variant::Dec", variant);
     vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidCommon::Dec", declarations);
     vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Dec", dec.str());
     vtkShaderProgram::Substitute(vs, "//VTK::HistoPyramidLevels::Impl", descend.str());
     std::string fs = vtkHistoPyramidIso_fs;
-    vtkShaderProgram::Substitute(fs, "//VTK::Variant::Dec", defines.str());
+    vtkShaderProgram::Substitute(fs, "//VTK::Variant::Dec", variant);
     vtkShaderProgram::Substitute(fs, "//VTK::ConservativeDepth::Dec",
       impl.ConservativeDepth
         ? "#extension GL_ARB_conservative_depth : require\nlayout(depth_greater) out float gl_FragDepth;\n"
