@@ -282,6 +282,16 @@ vec3 shade(vec3 p, vec3 color)
   return result;
 }
 
+#ifdef MEDISO_TRANSLUCENT
+// Isovalue t's next hit, t in 0..7, kept in two vec4s (lo: 0..3, hi: 4..7)
+// rather than an array (see firstRoot()).
+void setNext(int t, float value, inout vec4 lo, inout vec4 hi)
+{
+  lo = mix(lo, vec4(value), equal(ivec4(0, 1, 2, 3), ivec4(t)));
+  hi = mix(hi, vec4(value), equal(ivec4(4, 5, 6, 7), ivec4(t)));
+}
+#endif
+
 float depthOf(vec3 p)
 {
   vec4 clip = indexToClip * vec4(vec3(gCell) + p, 1.0);
@@ -349,14 +359,7 @@ void main()
     float root;
     if (((gMask >> t) & 1) == 1 && firstRoot(cubic(o, d, isovalues[t]), t0, t1, tolerance, root))
     {
-      if (t < 4)
-      {
-        nextLo[t] = root;
-      }
-      else
-      {
-        nextHi[t - 4] = root;
-      }
+      setNext(t, root, nextLo, nextHi);
     }
   }
   vec4 sum = vec4(0.0);
@@ -391,8 +394,7 @@ void main()
     {
       next = root;
     }
-    nextLo = mix(nextLo, vec4(next), equal(ivec4(0, 1, 2, 3), ivec4(iso)));
-    nextHi = mix(nextHi, vec4(next), equal(ivec4(4, 5, 6, 7), ivec4(iso)));
+    setNext(iso, next, nextLo, nextHi);
   }
   if (firstHit == none)
   {
