@@ -21,6 +21,10 @@
 //              exact composite of its four hits), which checks the order of
 //              the hits inside one cell (GPU) and the back-to-front sort of
 //              the triangles (CPU).
+//  Shading   - the normals the surface is lit with: a linear field's
+//              isosurface (a plane, int16 and float, anisotropic spacing)
+//              has its one analytic Lambert colour at every pixel (within 2
+//              of 255), in both projections and both paths.
 //  Footprint - point sprites and cell boxes give the same image (masks agree
 //              on >= 99.8% of the covered pixels, mean colour difference
 //              <= 1 of 255) for opaque and translucent surfaces in
@@ -44,6 +48,7 @@
 #include "vtkCellData.h"
 #include "vtkDoubleArray.h"
 #include "vtkFloatArray.h"
+#include "vtkMath.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkShortArray.h"
@@ -330,7 +335,8 @@ ImageAgreement Compare(const std::vector<unsigned char>& a, const std::vector<un
 enum class Lighting
 {
   Shaded,
-  Flat
+  Flat,
+  Diffuse // ambient 0, diffuse 1, specular 0: the colour is the Lambert term
 };
 
 // Renders `image` with `looks` through `mapper` in a 300x300 window from the
@@ -342,10 +348,11 @@ std::vector<unsigned char> RenderPixels(vtkHistoPyramidIsoMapper* mapper, vtkIma
   const int size = 300;
   auto volume = iso_test::MakeVolume(image, looks, mapper);
   Scene scene(size, size);
-  if (lighting == Lighting::Flat)
+  if (lighting != Lighting::Shaded)
   {
-    volume->GetProperty()->SetAmbient(1.0);
-    volume->GetProperty()->SetDiffuse(0.0);
+    const bool flat = lighting == Lighting::Flat;
+    volume->GetProperty()->SetAmbient(flat ? 1.0 : 0.0);
+    volume->GetProperty()->SetDiffuse(flat ? 0.0 : 1.0);
     volume->GetProperty()->SetSpecular(0.0);
   }
   scene.Show(volume);
@@ -540,6 +547,86 @@ void Footprint()
   CompareFootprints("bone, eye inside the volume", phantom, { bone }, inside, boxes);
 }
 
+// The shading normal: a linear field f = g . (i, j, k) (index space) has the
+// same gradient everywhere, and central differences (one-sided at the
+// border) of it are exact, so its isosurface is a plane whose every pixel
+// has the one Lambert colour of that gradient: with the renderer's
+// headlight and diffuse light only, 255 c |n . d|, n the world gradient
+// (g divided by the spacing), d the direction of projection, in either
+// projection. A difference that reads a wrong point (every point has its
+// own value), the wrong side or the wrong span changes the normal at some
+// corners, and the colour varies across the plane. int16 and float data,
+// anisotropic spacing, both paths (the fallback's triangles of a plane are
+// flat too).
+void Shading()
+{
+  const int dims[3] = { 20, 24, 28 };
+  const double spacing[3] = { 1.0, 0.8, 1.3 };
+  const double g[3] = { 3.0, 5.0, 8.0 }; // integer: exact in int16
+  const double color[3] = { 0.9, 0.7, 0.5 };
+  double n[3] = { g[0] / spacing[0], g[1] / spacing[1], g[2] / spacing[2] };
+  vtkMath::Normalize(n);
+  for (int type = 0; type < 2; ++type)
+  {
+    auto image = vtkSmartPointer<vtkImageData>::New();
+    image->SetDimensions(dims[0], dims[1], dims[2]);
+    image->SetSpacing(spacing[0], spacing[1], spacing[2]);
+    image->SetOrigin(-4.0, 2.0, 1.0);
+    vtkSmartPointer<vtkDataArray> values = type == 0
+      ? vtkSmartPointer<vtkDataArray>(vtkSmartPointer<vtkShortArray>::New())
+      : vtkSmartPointer<vtkDataArray>(vtkSmartPointer<vtkFloatArray>::New());
+    values->SetNumberOfTuples(image->GetNumberOfPoints());
+    vtkIdType id = 0;
+    for (int k = 0; k < dims[2]; ++k)
+      for (int j = 0; j < dims[1]; ++j)
+        for (int i = 0; i < dims[0]; ++i, ++id)
+          values->SetTuple1(id, g[0] * i + g[1] * j + g[2] * k - 100.0);
+    image->GetPointData()->SetScalars(values);
+    for (int parallel = 0; parallel < 2; ++parallel)
+    {
+      for (int pass = 0; pass < 2; ++pass)
+      {
+        const std::string name = std::string("plane, ") + (type == 0 ? "int16" : "float") +
+          (parallel ? ", parallel" : ", perspective") + (pass == 0 ? ", gpu" : ", fallback");
+        vtkNew<vtkHistoPyramidIsoMapper> mapper;
+        mapper->SetForceCPUFallback(pass == 1);
+        double d[3] = { 0.0, 0.0, 0.0 };
+        const std::vector<unsigned char> pixels = RenderPixels(mapper, image,
+          { { 140.5, { color[0], color[1], color[2] }, 1.0 } },
+          [&](vtkCamera* camera)
+          {
+            camera->SetParallelProjection(parallel);
+            camera->GetDirectionOfProjection(d);
+          },
+          Lighting::Diffuse);
+        Check(mapper->GetLastRenderPath() ==
+            (pass == 0 ? vtkHistoPyramidIsoMapper::GPUPath : vtkHistoPyramidIsoMapper::FallbackPath),
+          name + ": path " + mapper->GetLastRenderPathAsString());
+        const double lambert = std::abs(vtkMath::Dot(n, d));
+        int covered = 0, worst = 0;
+        for (std::size_t p = 0; p + 2 < pixels.size(); p += 3)
+        {
+          if (pixels[p] == 0 && pixels[p + 1] == 0 && pixels[p + 2] == 0)
+          {
+            continue;
+          }
+          ++covered;
+          for (int c = 0; c < 3; ++c)
+          {
+            const double expected = 255.0 * color[c] * lambert;
+            worst = std::max(
+              worst, static_cast<int>(std::lround(std::abs(pixels[p + c] - expected))));
+          }
+        }
+        std::printf("%s: %d pixels, |n . d| = %.4f, at most %d from the Lambert colour\n",
+          name.c_str(), covered, lambert, worst);
+        Check(covered > 5000, name + ": the plane covers a good part of the image");
+        Check(worst <= 2, name + ": every pixel has the plane's Lambert colour");
+      }
+    }
+  }
+}
+
 void Fallback()
 {
   auto phantom = iso_test::Phantom(48);
@@ -698,6 +785,10 @@ int TestHistoPyramidIsoMapperChecks(int argc, char* argv[])
   else if (which == "Reference")
   {
     Reference();
+  }
+  else if (which == "Shading")
+  {
+    Shading();
   }
   else if (which == "Footprint")
   {
