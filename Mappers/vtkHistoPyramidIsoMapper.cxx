@@ -19,7 +19,9 @@
 #include "vtkMedicalGLUtilities.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
+#include "vtkOpenGLFramebufferObject.h"
 #include "vtkOpenGLHistoPyramid.h"
+#include "vtkOpenGLQuadHelper.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
@@ -38,6 +40,7 @@
 #include "vtkWeakPointer.h"
 #include "vtk_glew.h"
 
+#include "vtkHistoPyramidComposite_fs.h"
 #include "vtkHistoPyramidIso_fs.h"
 #include "vtkHistoPyramidIso_gs.h"
 #include "vtkHistoPyramidIso_vs.h"
@@ -47,6 +50,7 @@
 #include <climits>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -209,6 +213,41 @@ struct vtkHistoPyramidIsoMapper::Internals
   // the layout key it was built for.
   std::map<std::string, std::pair<std::string, vtkShaderProgram*>> Programs;
 
+  // First-hit pass (see vtkHistoPyramidIsoMapper::SetFirstHitPass): the
+  // viewport-sized buffers the cells are drawn into, and the program that
+  // composites them into the scene.
+  vtkSmartPointer<vtkOpenGLFramebufferObject> HitFBO;
+  vtkSmartPointer<vtkTextureObject> HitColor; // RGBA8: colour, alpha 1 where hit
+  vtkSmartPointer<vtkTextureObject> HitDepth; // R32F: the hit's window depth
+  vtkSmartPointer<vtkTextureObject> HitFlag;  // 16-bit depth: a hit is there
+  int HitSize[2] = { 0, 0 };
+  std::unique_ptr<vtkOpenGLQuadHelper> Composite;
+
+  void ReleaseFirstHit(vtkWindow* win)
+  {
+    for (vtkTextureObject* texture : { this->HitColor.Get(), this->HitDepth.Get(), this->HitFlag.Get() })
+    {
+      if (texture)
+      {
+        texture->ReleaseGraphicsResources(win);
+      }
+    }
+    if (this->HitFBO)
+    {
+      this->HitFBO->ReleaseGraphicsResources(win);
+    }
+    if (this->Composite)
+    {
+      this->Composite->ReleaseGraphicsResources(win);
+    }
+    this->HitColor = nullptr;
+    this->HitDepth = nullptr;
+    this->HitFlag = nullptr;
+    this->HitFBO = nullptr;
+    this->Composite.reset();
+    this->HitSize[0] = this->HitSize[1] = 0;
+  }
+
   // Fallback path.
   vtkNew<vtkBlockLODContour> Contour;
   vtkNew<vtkImageData> IndexImage;
@@ -248,6 +287,7 @@ struct vtkHistoPyramidIsoMapper::Internals
         entry.second.second->ReleaseGraphicsResources(win);
       }
     }
+    this->ReleaseFirstHit(win);
     this->InvalidateGPU();
     this->Window = nullptr;
     this->Probed = false;
@@ -316,6 +356,13 @@ const char* vtkHistoPyramidIsoMapper::GetLastRenderPathAsString() const
 std::uint64_t vtkHistoPyramidIsoMapper::GetGPUMemoryBytes() const
 {
   return this->Impl->Pyramid->GetGPUMemoryBytes();
+}
+
+//------------------------------------------------------------------------------
+std::uint64_t vtkHistoPyramidIsoMapper::GetFrameBufferBytes() const
+{
+  // RGBA8 colour, R32F depth, 16-bit depth buffer.
+  return static_cast<std::uint64_t>(this->Impl->HitSize[0]) * this->Impl->HitSize[1] * 10u;
 }
 
 //------------------------------------------------------------------------------
@@ -750,6 +797,17 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
         camera->GetClippingRange()[0], parallel, viewport, impl.MaxPointSize)
     ? PointFootprint
     : BoxFootprint;
+  // The first-hit pass (see SetFirstHitPass): opaque frames of one isovalue
+  // (one primitive per cell, so the first hit in drawing order is the
+  // nearest) with point footprints; its buffers are made here, before the
+  // program variant is chosen, so that a context that cannot make them draws
+  // in one pass instead.
+  bool firstHit = this->FirstHitPass && footprint == PointFootprint && !translucent &&
+    counted.size() == 1;
+  if (firstHit && !this->PrepareFirstHit(renWin, viewport[2], viewport[3]))
+  {
+    firstHit = false;
+  }
   key << declarations.size() << declarations.substr(0, 80) << "|" << dec.str() << descend.str()
       << impl.ConservativeDepth;
   // Translucent frames loop over the isovalues: their number is part of the variant too.
@@ -762,6 +820,10 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   if (translucent)
   {
     defines << "#define MEDISO_TRANSLUCENT\n";
+  }
+  if (firstHit)
+  {
+    defines << "#define MEDISO_FIRST_HIT\n";
   }
   defines << "#define MEDISO_LIGHTS " << numLights << "\n";
   defines << "#define MEDISO_ISOVALUES " << (translucent ? numIsovalues : 8) << "\n";
@@ -777,7 +839,7 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     std::string fs = vtkHistoPyramidIso_fs;
     vtkShaderProgram::Substitute(fs, "//VTK::Variant::Dec", variant);
     vtkShaderProgram::Substitute(fs, "//VTK::ConservativeDepth::Dec",
-      impl.ConservativeDepth
+      impl.ConservativeDepth && !firstHit
         ? "#extension GL_ARB_conservative_depth : require\nlayout(depth_greater) out float gl_FragDepth;\n"
         : "");
     cached.second = renWin->GetShaderCache()->ReadyShaderProgram(
@@ -865,8 +927,10 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     const float viewportSize[2] = { static_cast<float>(viewport[2]),
       static_cast<float>(viewport[3]) };
     program->SetUniform2f("viewportSize", viewportSize);
-    const float viewportF[4] = { static_cast<float>(viewport[0]), static_cast<float>(viewport[1]),
-      static_cast<float>(viewport[2]), static_cast<float>(viewport[3]) };
+    // The first-hit pass draws into buffers of the viewport's size.
+    const float viewportF[4] = { firstHit ? 0.0f : static_cast<float>(viewport[0]),
+      firstHit ? 0.0f : static_cast<float>(viewport[1]), static_cast<float>(viewport[2]),
+      static_cast<float>(viewport[3]) };
     program->SetUniform4f("viewport", viewportF);
     program->SetUniformf("maxPointSize", impl.MaxPointSize);
     // Pixels whose centres lie on the square's edges stay covered whatever the
@@ -879,17 +943,54 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   {
     glEnable(GL_PROGRAM_POINT_SIZE);
   }
-  impl.VAO->Bind();
-  glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(total));
-  impl.VAO->Release();
+  auto drawCells = [&]()
+  {
+    impl.VAO->Bind();
+    glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(total));
+    impl.VAO->Release();
+  };
+  if (firstHit)
+  {
+    // Pass 1: into the mapper's buffers, cleared to no hit; every point has
+    // the same depth and the test is GL_LESS, so each pixel keeps its first
+    // hit in drawing order (front to back: the nearest), and the test runs
+    // before the fragment stage.
+    ScopedFramebufferBindings savedBindings(impl.HitFBO);
+    vtkOpenGLState::ScopedglViewport savedViewport(ostate);
+    vtkOpenGLState::ScopedglEnableDisable scissor(ostate, GL_SCISSOR_TEST);
+    vtkOpenGLState::ScopedglColorMask colorMask(ostate);
+    vtkOpenGLState::ScopedglClearColor clearColor(ostate);
+    vtkOpenGLState::ScopedglDepthFunc depthFunc(ostate);
+    impl.HitFBO->Bind();
+    impl.HitFBO->ActivateDrawBuffers(2);
+    ostate->vtkglViewport(0, 0, impl.HitSize[0], impl.HitSize[1]);
+    ostate->vtkglDisable(GL_SCISSOR_TEST);
+    ostate->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    ostate->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+    ostate->vtkglClearDepth(1.0);
+    ostate->vtkglClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    ostate->vtkglDepthFunc(GL_LESS);
+    drawCells();
+  }
+  else
+  {
+    drawCells();
+  }
   if (footprint == PointFootprint && !programPointSize)
   {
     glDisable(GL_PROGRAM_POINT_SIZE);
   }
   this->LastFootprint = footprint;
+  this->LastFirstHitPass = firstHit;
   for (vtkTextureObject* texture : active)
   {
     texture->Deactivate();
+  }
+  if (firstHit && !this->CompositeFirstHit(renWin, reason))
+  {
+    impl.GPUUsable = false;
+    impl.GPUReason = reason;
+    return false;
   }
   const std::string errors = TakeGLErrors();
   if (!errors.empty())
@@ -897,6 +998,115 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     reason = "drawing failed: " + errors;
     impl.GPUUsable = false;
     impl.GPUReason = reason;
+    return false;
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkHistoPyramidIsoMapper::PrepareFirstHit(vtkOpenGLRenderWindow* renWin, int width, int height)
+{
+  Internals& impl = *this->Impl;
+  if (impl.HitFBO && impl.HitSize[0] == width && impl.HitSize[1] == height)
+  {
+    return true;
+  }
+  impl.ReleaseFirstHit(renWin);
+  auto color = vtkSmartPointer<vtkTextureObject>::New();
+  auto depth = vtkSmartPointer<vtkTextureObject>::New();
+  auto flag = vtkSmartPointer<vtkTextureObject>::New();
+  color->SetContext(renWin);
+  depth->SetContext(renWin);
+  flag->SetContext(renWin);
+  depth->SetInternalFormat(GL_R32F);
+  depth->SetFormat(GL_RED);
+  depth->SetDataType(GL_FLOAT);
+  TakeGLErrors();
+  bool made = width > 0 && height > 0 &&
+    color->Allocate2D(static_cast<unsigned int>(width), static_cast<unsigned int>(height), 4,
+      VTK_UNSIGNED_CHAR) &&
+    depth->Allocate2D(
+      static_cast<unsigned int>(width), static_cast<unsigned int>(height), 1, VTK_FLOAT) &&
+    flag->AllocateDepth(static_cast<unsigned int>(width), static_cast<unsigned int>(height),
+      vtkTextureObject::Fixed16);
+  std::string problem = made ? TakeGLErrors() : "the textures could not be allocated";
+  if (problem.empty())
+  {
+    auto fbo = vtkSmartPointer<vtkOpenGLFramebufferObject>::New();
+    fbo->SetContext(renWin);
+    ScopedFramebufferBindings savedBindings(fbo);
+    fbo->Bind();
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, color->GetHandle(), 0);
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, depth->GetHandle(), 0);
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, flag->GetHandle(), 0);
+    const char* status = nullptr;
+    if (!vtkOpenGLFramebufferObject::GetFrameBufferStatus(GL_FRAMEBUFFER, status))
+    {
+      problem = std::string("framebuffer incomplete (") + (status ? status : "?") + ")";
+    }
+    problem += TakeGLErrors();
+    impl.HitFBO = fbo;
+  }
+  if (!problem.empty())
+  {
+    for (vtkTextureObject* texture : { color.Get(), depth.Get(), flag.Get() })
+    {
+      texture->ReleaseGraphicsResources(renWin);
+    }
+    if (impl.HitFBO)
+    {
+      impl.HitFBO->ReleaseGraphicsResources(renWin);
+      impl.HitFBO = nullptr;
+    }
+    const std::string message = "first-hit pass unavailable (" + problem +
+      "); drawing opaque surfaces in one pass";
+    if (impl.Said.insert(message).second)
+    {
+      vtkWarningMacro(<< message);
+    }
+    return false;
+  }
+  impl.HitColor = color;
+  impl.HitDepth = depth;
+  impl.HitFlag = flag;
+  impl.HitSize[0] = width;
+  impl.HitSize[1] = height;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkHistoPyramidIsoMapper::CompositeFirstHit(vtkOpenGLRenderWindow* renWin, std::string& reason)
+{
+  // Pass 2: the first pass's colour and exact depth into the scene's
+  // framebuffer over the viewport, with the scene's depth test (enabled by
+  // the caller, with depth writes, no blending).
+  Internals& impl = *this->Impl;
+  if (!impl.Composite)
+  {
+    impl.Composite.reset(new vtkOpenGLQuadHelper(renWin, nullptr, vtkHistoPyramidComposite_fs, ""));
+  }
+  else if (impl.Composite->Program)
+  {
+    renWin->GetShaderCache()->ReadyShaderProgram(impl.Composite->Program);
+  }
+  vtkShaderProgram* program = impl.Composite->Program;
+  if (!program)
+  {
+    impl.Composite.reset();
+    reason = "the first-hit composite shader does not build";
+    return false;
+  }
+  impl.HitColor->Activate();
+  impl.HitDepth->Activate();
+  program->SetUniformi("hitColor", impl.HitColor->GetTextureUnit());
+  program->SetUniformi("hitDepth", impl.HitDepth->GetTextureUnit());
+  impl.Composite->Render();
+  impl.HitColor->Deactivate();
+  impl.HitDepth->Deactivate();
+  const std::string errors = TakeGLErrors();
+  if (!errors.empty())
+  {
+    reason = "compositing the first-hit pass failed: " + errors;
     return false;
   }
   return true;

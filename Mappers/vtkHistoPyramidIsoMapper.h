@@ -36,7 +36,9 @@
  *    (vtkHistoPyramidIso_fs.glsl) finds the first root of the cubic the
  *    trilinear interpolant makes along the ray, shades it with Phong (the
  *    volume property's ambient, diffuse, specular and specular power, the
- *    renderer's lights) and writes gl_FragDepth.
+ *    renderer's lights) and writes gl_FragDepth (or, in the first-hit
+ *    pass of opaque single-isovalue frames, see FirstHitPass, its colour and
+ *    depth go to the mapper's own buffers and are composited after).
  * -# Colour and opacity of each isovalue come from the property's colour and
  *    scalar opacity transfer functions at that value. When all are opaque,
  *    each primitive draws one isovalue, front to back, with depth writes.
@@ -86,6 +88,7 @@
 
 class vtkDataArray;
 class vtkImageData;
+class vtkOpenGLRenderWindow;
 
 class MEDICALISOSURFACESMAPPERS_EXPORT vtkHistoPyramidIsoMapper : public vtkVolumeMapper
 {
@@ -152,6 +155,28 @@ public:
   const char* GetLastFootprintAsString() const;
   ///@}
 
+  ///@{
+  /**
+   * Draw opaque single-isovalue frames with point footprints in two passes
+   * (default on): the cells into the mapper's own buffers, where the depth
+   * test keeps only the first hit of each pixel in drawing order, then that
+   * colour and exact depth into the scene with the scene's depth test. The
+   * cells come out front to back, so the first hit in drawing order is the
+   * nearest, and the depth test runs before the fragment stage: a fragment
+   * behind a surface already found costs no ray cast. In one pass the
+   * fragment stage writes gl_FragDepth, which makes many rasterisers
+   * (llvmpipe always; GPUs without GL_ARB_conservative_depth) test depth
+   * only after it. The image is the same; the buffers cost 10 bytes per
+   * pixel of the viewport (GetFrameBufferBytes()). Off: always one pass.
+   */
+  vtkSetMacro(FirstHitPass, bool);
+  vtkGetMacro(FirstHitPass, bool);
+  vtkBooleanMacro(FirstHitPass, bool);
+  ///@}
+
+  /// Whether the last GPU frame drew through the first-hit pass.
+  vtkGetMacro(LastFirstHitPass, bool);
+
   /// Primitives (active cell-isovalue pairs) of the last GPU frame.
   vtkGetMacro(NumberOfPrimitives, std::uint64_t);
 
@@ -159,8 +184,11 @@ public:
   vtkGetMacro(NumberOfPyramidBuilds, std::uint64_t);
   vtkGetMacro(NumberOfVolumeUploads, std::uint64_t);
 
-  /// Bytes of GPU memory the mapper holds now (volume and pyramid).
+  /// Bytes of GPU memory the mapper holds now for the volume (volume and pyramid).
   std::uint64_t GetGPUMemoryBytes() const;
+
+  /// Bytes of the first-hit pass's viewport-sized buffers (0 until one is drawn).
+  std::uint64_t GetFrameBufferBytes() const;
 
   /// Triangles of the last fallback frame (0 on the GPU path).
   vtkGetMacro(NumberOfFallbackTriangles, std::uint64_t);
@@ -183,6 +211,8 @@ private:
   bool ForceCPUFallback = false;
   bool AllowPointFootprint = true;
   int LastFootprint = BoxFootprint;
+  bool FirstHitPass = true;
+  bool LastFirstHitPass = false;
   std::uint64_t NumberOfPrimitives = 0;
   std::uint64_t NumberOfPyramidBuilds = 0;
   std::uint64_t NumberOfVolumeUploads = 0;
@@ -191,6 +221,8 @@ private:
   struct Surface; // one isovalue and its colour and opacity
   bool RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image, vtkDataArray* scalars,
     const std::vector<Surface>& surfaces, std::string& reason);
+  bool PrepareFirstHit(vtkOpenGLRenderWindow* renWin, int width, int height);
+  bool CompositeFirstHit(vtkOpenGLRenderWindow* renWin, std::string& reason);
   void RenderFallback(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image,
     vtkDataArray* scalars, const std::vector<Surface>& surfaces);
 

@@ -129,6 +129,8 @@ def method_name(r):
         return "HistoPyramid (ours)"
     if r["method"] == "hpbox":
         return "HistoPyramid, boxes only"
+    if r["method"] == "hp1":
+        return "HistoPyramid, one pass"
     if r["method"] == "rc":
         return "GPU ray caster, sample %gx" % r["factor"]
     return "FlyingEdges + PolyDataMapper"
@@ -180,12 +182,13 @@ def report(args, command, records, failed, started, wall, load_before, load_afte
     for r in rot:
         peer = [p for p in rot if p["method"] == "rc" and p["input"] == r["input"]
                 and p["window"] == r["window"] and p["iso"] == r["iso"]]
+        ours = r["method"] in ("hp", "hp1", "hpbox")
         ratios = " / ".join(fmt_ratio(r["median_s"] / p["median_s"]) for p in peer) \
-            if r["method"] == "hp" else ""
+            if ours else ""
         el = "%d %s" % (r["elements"], "triangles" if r["method"] == "fe" else "cells") \
             if r["elements"] >= 0 else "-"
         rows.append(["%s %s" % (r["input"], dims.get(r["input"], "")), r["window"], "%g" % r["iso"],
-                     method_name(r) + (" [%s path]" % r["path"] if r["method"] == "hp" else ""),
+                     method_name(r) + (" [%s path]" % r["path"] if ours else ""),
                      r["frames"], fmt_s(r["min_s"]), fmt_s(r["median_s"]),
                      "%.2f" % (1.0 / r["median_s"]), "%.1f" % r["total_s"], el, ratios])
         if r["method"] == "hp":
@@ -235,15 +238,26 @@ def report(args, command, records, failed, started, wall, load_before, load_afte
         seen.add((r["input"], r["iso"]))
         ratio = r["gpu_bytes"] / r["volume_bytes"]
         s = next((x for x in sw if x["method"] == "hp" and x["input"] == r["input"]), None)
+        # The first-hit pass's viewport-sized buffers (10 bytes per pixel), per window.
+        buffers = {x["window"]: x.get("framebuffer_bytes", 0) for x in rot
+                   if x["method"] == "hp" and x["input"] == r["input"] and x["iso"] == r["iso"]}
+        largest = max(buffers.values()) if buffers else 0
+        with_buffers = (r["gpu_bytes"] + largest) / r["volume_bytes"]
         rows.append(["%s %s" % (r["input"], dims.get(r["input"], "")), "%g" % r["iso"],
                      "%.1f" % (r["volume_bytes"] / 2**20), "%.1f" % (r["gpu_bytes"] / 2**20),
                      fmt_ratio(ratio), int(r["builds_during_rotation"]),
                      ("%.1f / %.1f" % (s["gpu_bytes_before"] / 2**20, s["gpu_bytes_after"] / 2**20))
-                     if s else "-"])
+                     if s else "-",
+                     ", ".join("%s %.1f" % (w, b / 2**20) for w, b in sorted(buffers.items())),
+                     fmt_ratio(with_buffers)])
         targets.append(target_row("GPU memory <= 1.5x volume bytes",
                                   "%s, iso %g" % (r["input"], r["iso"]), ratio, TARGET_MEMORY))
+        targets.append(target_row("the same with the first-hit buffers of the largest window",
+                                  "%s, iso %g" % (r["input"], r["iso"]), with_buffers,
+                                  TARGET_MEMORY))
     lines.extend(table(["input", "iso", "volume MB", "GPU MB", "GPU / volume",
-                        "pyramid builds during rotation", "GPU MB before / after sweep"], rows))
+                        "pyramid builds during rotation", "GPU MB before / after sweep",
+                        "first-hit buffers MB per window", "with the largest / volume"], rows))
     ends = [r for r in records if r["kind"] == "end"]
     if ends:
         out("")

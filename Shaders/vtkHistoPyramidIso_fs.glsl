@@ -51,7 +51,11 @@
 // and ordered hits inside each cell give the exact compositing order: an
 // opaque bone behind translucent skin, in one pass.
 
-out vec4 fragOutput0; // colour (premultiplied in translucent mode)
+// Outputs: gl_FragData[0], the colour (premultiplied in translucent mode);
+// in the first-hit pass (MEDISO_FIRST_HIT) also gl_FragData[1], the hit's
+// window depth, in place of gl_FragDepth. (VTK declares them as fragOutput0
+// and fragOutput1 and binds those to draw buffers 0 and 1.)
+//VTK::Output::Dec
 
 #ifdef MEDISO_POINT_FOOTPRINT
 // Point footprint: the vertex stage's outputs come straight here, and the
@@ -340,8 +344,15 @@ void main()
     discard;
   }
   vec3 p = clamp(o + hitT * d, 0.0, 1.0);
-  fragOutput0 = vec4(shade(p, gLook.rgb), 1.0);
+  gl_FragData[0] = vec4(shade(p, gLook.rgb), 1.0);
+#ifdef MEDISO_FIRST_HIT
+  // First-hit pass: the depth test ran before this stage, on the point's
+  // constant depth (see the vertex stage): this pixel had no hit yet. The
+  // exact depth goes to the mapper's buffer; the composite pass writes it.
+  gl_FragData[1] = vec4(depthOf(p), 0.0, 0.0, 1.0);
+#else
   gl_FragDepth = depthOf(p);
+#endif
 #else
   // Translucent: every hit of every crossing isovalue, composited front to
   // back as a merge of the isovalues' hit sequences. Each crossing isovalue
@@ -400,7 +411,7 @@ void main()
   {
     discard;
   }
-  fragOutput0 = sum;
+  gl_FragData[0] = sum;
   gl_FragDepth = depthOf(clamp(o + firstHit * d, 0.0, 1.0));
 #endif
 }

@@ -335,7 +335,16 @@ void pointFootprint(ivec3 c, vec3 boxLo, vec3 boxHi)
   // 3-pixel point 78% more fragments.)
   gl_PointSize = min(max(pixels.x, pixels.y) + pointMargin, maxPointSize);
   vNearDepth = max(nearest, -1.0);
+#ifdef MEDISO_FIRST_HIT
+  // First-hit pass (opaque, one isovalue, the mapper's own depth buffer):
+  // every point at one depth, with the depth test GL_LESS, so a fragment
+  // passes only where no earlier primitive has hit; the primitives come
+  // front to back, so the first hit is the nearest. The depth test runs
+  // before the fragment stage, which then writes no gl_FragDepth.
+  gl_Position = vec4(0.5 * (lo + hi), 0.0, 1.0);
+#else
   gl_Position = vec4(0.5 * (lo + hi), vNearDepth, 1.0);
+#endif
 }
 #endif
 

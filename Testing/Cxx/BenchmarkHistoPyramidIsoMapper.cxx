@@ -17,7 +17,7 @@
 //
 //   BenchmarkHistoPyramidIsoMapper --input ct|ct512|phantom256|phantomN
 //     [--ct FILE.mha] [--windows 1920x1080,1024x768] [--frames 360] [--sweep 95]
-//     [--isovalues -500,400] [--methods hp,rc,fe[,hpbox]] [--rc-factors 0.5,1.0]
+//     [--isovalues -500,400] [--methods hp,rc,fe[,hpbox][,hp1]] [--rc-factors 0.5,1.0]
 //     [--opacity 1] [--together 0|1]
 //
 // --together 1: one rotation scene per window and method with all the
@@ -464,14 +464,17 @@ Scene MakeScene(const std::string& method, double factor, vtkImageData* image, i
     }
     vtkNew<vtkVolume> volume;
     volume->SetProperty(scene.VolumeProperty);
-    if (method == "hp" || method == "hpbox")
+    if (method == "hp" || method == "hpbox" || method == "hp1")
     {
       // hpbox: the cell boxes of the geometry stage on every frame (no point
-      // sprites), to compare the two footprints in one run.
+      // sprites), to compare the two footprints in one run; hp1: one pass
+      // always (no first-hit pass), to compare the two drawings.
       scene.Label = method == "hp" ? "vtkHistoPyramidIsoMapper"
-                                   : "vtkHistoPyramidIsoMapper, boxes only";
+        : method == "hpbox"        ? "vtkHistoPyramidIsoMapper, boxes only"
+                                   : "vtkHistoPyramidIsoMapper, one pass";
       scene.HistoPyramid = vtkSmartPointer<vtkHistoPyramidIsoMapper>::New();
-      scene.HistoPyramid->SetAllowPointFootprint(method == "hp");
+      scene.HistoPyramid->SetAllowPointFootprint(method != "hpbox");
+      scene.HistoPyramid->SetFirstHitPass(method != "hp1");
       scene.HistoPyramid->SetInputData(image);
       volume->SetMapper(scene.HistoPyramid);
     }
@@ -663,6 +666,10 @@ int main(int argc, char* argv[])
             if (scene.HistoPyramid->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath)
             {
               path = path + "/" + scene.HistoPyramid->GetLastFootprintAsString();
+              if (scene.HistoPyramid->GetLastFirstHitPass())
+              {
+                path += "/first-hit";
+              }
             }
             reason = scene.HistoPyramid->GetFallbackReason();
             buildsBefore = static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds());
@@ -711,6 +718,8 @@ int main(int argc, char* argv[])
           {
             r.Add("reason", reason)
               .Add("gpu_bytes", static_cast<double>(scene.HistoPyramid->GetGPUMemoryBytes()))
+              .Add("framebuffer_bytes",
+                static_cast<double>(scene.HistoPyramid->GetFrameBufferBytes()))
               .Add("volume_bytes", volumeBytes)
               .Add("builds_during_rotation",
                 static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds()) - buildsBefore)
