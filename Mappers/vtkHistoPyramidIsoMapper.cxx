@@ -34,6 +34,7 @@
 #include "vtkRenderer.h"
 #include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
+#include "vtkTimerLog.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
@@ -633,12 +634,16 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   }
   if (!impl.PyramidValid || isovalues != impl.BuiltIsovalues)
   {
+    vtkNew<vtkTimerLog> timer;
+    timer->StartTimer();
     if (!impl.Pyramid->Build(renWin, isovalues))
     {
       impl.InvalidateGPU();
       reason = "the HistoPyramid could not be built";
       return false;
     }
+    timer->StopTimer(); // Build() ends by reading the total back: the passes are done
+    this->LastBuildSeconds = timer->GetElapsedTime();
     ++this->NumberOfPyramidBuilds;
     impl.BuiltIsovalues = isovalues;
     impl.PyramidValid = true;

@@ -180,6 +180,9 @@ public:
   /// Primitives (active cell-isovalue pairs) of the last GPU frame.
   vtkGetMacro(NumberOfPrimitives, std::uint64_t);
 
+  /// Seconds the last pyramid build took (its passes and the read-back of the total).
+  vtkGetMacro(LastBuildSeconds, double);
+
   /// Pyramid builds and volume uploads so far (camera moves do neither).
   vtkGetMacro(NumberOfPyramidBuilds, std::uint64_t);
   vtkGetMacro(NumberOfVolumeUploads, std::uint64_t);
@@ -215,6 +218,7 @@ private:
   bool LastFirstHitPass = false;
   std::uint64_t NumberOfPrimitives = 0;
   std::uint64_t NumberOfPyramidBuilds = 0;
+  double LastBuildSeconds = 0.0;
   std::uint64_t NumberOfVolumeUploads = 0;
   std::uint64_t NumberOfFallbackTriangles = 0;
 

@@ -754,7 +754,7 @@ int main(int argc, char* argv[])
                              : 0.0;
         const double bytesBefore =
           scene.HistoPyramid ? static_cast<double>(scene.HistoPyramid->GetGPUMemoryBytes()) : 0.0;
-        std::vector<double> changes, extracts, elements;
+        std::vector<double> changes, extracts, elements, builds;
         int notGPU = 0;
         for (double v : sweep)
         {
@@ -765,6 +765,10 @@ int main(int argc, char* argv[])
           changes.push_back(Now() - t0);
           extracts.push_back(e);
           elements.push_back(scene.Elements());
+          if (scene.HistoPyramid)
+          {
+            builds.push_back(scene.HistoPyramid->GetLastBuildSeconds());
+          }
           if (scene.HistoPyramid &&
             scene.HistoPyramid->GetLastRenderPath() != vtkHistoPyramidIsoMapper::GPUPath)
           {
@@ -794,6 +798,7 @@ int main(int argc, char* argv[])
         {
           r.Add("builds", static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds()) -
                   buildsBefore)
+            .Add("build_median_s", Summarise(builds).Median)
             .Add("gpu_bytes_before", bytesBefore)
             .Add("gpu_bytes_after", static_cast<double>(scene.HistoPyramid->GetGPUMemoryBytes()))
             .Add("volume_bytes", volumeBytes)
