@@ -49,6 +49,18 @@ bool vtkHistoPyramidIsoRepresentation::GetAllowPointFootprint()
 }
 
 //------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetFirstHitPass(bool use)
+{
+  this->IsoMapper->SetFirstHitPass(use);
+}
+
+//------------------------------------------------------------------------------
+bool vtkHistoPyramidIsoRepresentation::GetFirstHitPass()
+{
+  return this->IsoMapper->GetFirstHitPass();
+}
+
+//------------------------------------------------------------------------------
 const char* vtkHistoPyramidIsoRepresentation::GetFootprint()
 {
   return this->IsoMapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath
@@ -90,6 +102,12 @@ double vtkHistoPyramidIsoRepresentation::GetNumberOfPyramidBuilds()
 double vtkHistoPyramidIsoRepresentation::GetGPUMemoryBytes()
 {
   return static_cast<double>(this->IsoMapper->GetGPUMemoryBytes());
+}
+
+//------------------------------------------------------------------------------
+double vtkHistoPyramidIsoRepresentation::GetFrameBufferBytes()
+{
+  return static_cast<double>(this->IsoMapper->GetFrameBufferBytes());
 }
 
 //------------------------------------------------------------------------------

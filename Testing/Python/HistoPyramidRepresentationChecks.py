@@ -79,6 +79,7 @@ def render_info(display, location=vtkPVSession.RENDER_SERVER):
         "triangles": int(value("HistoPyramidFallbackTriangles")),
         "builds": int(value("HistoPyramidBuilds")),
         "gpu_bytes": int(value("HistoPyramidGPUMemoryBytes")),
+        "framebuffer_bytes": int(value("HistoPyramidFrameBufferBytes")),
     }
 
 

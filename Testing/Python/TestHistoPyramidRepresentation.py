@@ -12,7 +12,10 @@ GPU run (default):
 - HistoPyramidForceCPUFallback switches to the fallback (one warning, checked)
   and back;
 - the whole-head view draws point footprints (HistoPyramidFootprint "points"),
-  HistoPyramidAllowPointFootprint off draws boxes and gives the same image.
+  HistoPyramidAllowPointFootprint off draws boxes and gives the same image;
+- bone alone (opaque, one isovalue) reports the first-hit pass's buffers
+  (HistoPyramidFrameBufferBytes, 10 bytes per pixel), and
+  HistoPyramidFirstHitPass off gives the same image.
 A machine whose GL lacks what the GPU path needs skips (exit 125) with the reason.
 
 Fallback run (--expect-fallback, under MEDISO_DISABLE_GPU_PATH=1): the first
@@ -139,10 +142,26 @@ else:
     check(differing < 0.002, "points and boxes give the same image (%.3f%% of pixels differ)"
           % (100 * differing))
     display.HistoPyramidAllowPointFootprint = 1
+
+    # Bone alone is opaque with one isovalue: drawn through the first-hit
+    # pass, whose buffers are reported; one pass on request gives the same image.
+    Render(view)
+    hit = hp.render_info(display)
+    size = view.ViewSize
+    check(hit["path"] == "gpu" and hit["framebuffer_bytes"] == 10 * size[0] * size[1],
+          "first-hit buffers of 10 bytes per pixel (%d for %dx%d)"
+          % (hit["framebuffer_bytes"], size[0], size[1]))
+    display.HistoPyramidFirstHitPass = 0
+    Render(view)
+    single = hp.screenshot(view, os.path.join(args.out, "TestHistoPyramidRepresentationOnePass.png"))
+    onepass = hp.changed_fraction(points, single)
+    check(onepass == 0.0, "the first-hit pass and one pass give the same image (%.3f%% of pixels "
+          "differ)" % (100 * onepass))
+    display.HistoPyramidFirstHitPass = 1
     print("gpu: %d primitives (skin+bone), %d (bone); fallback %d triangles; %.1f%% covered; "
-          "points vs boxes: %.3f%% of pixels differ"
+          "points vs boxes: %.3f%% of pixels differ; first-hit buffers %d bytes"
           % (info["primitives"], bone["primitives"], forced["triangles"], 100 * fraction,
-             100 * differing))
+             100 * differing, hit["framebuffer_bytes"]))
 
 if check.failures:
     print("%d check(s) failed" % len(check.failures))
