@@ -1017,63 +1017,50 @@ bool vtkHistoPyramidIsoMapper::PrepareFirstHit(vtkOpenGLRenderWindow* renWin, in
     return true;
   }
   impl.ReleaseFirstHit(renWin);
-  auto color = vtkSmartPointer<vtkTextureObject>::New();
-  auto depth = vtkSmartPointer<vtkTextureObject>::New();
-  auto flag = vtkSmartPointer<vtkTextureObject>::New();
-  color->SetContext(renWin);
-  depth->SetContext(renWin);
-  flag->SetContext(renWin);
-  depth->SetInternalFormat(GL_R32F);
-  depth->SetFormat(GL_RED);
-  depth->SetDataType(GL_FLOAT);
+  impl.HitColor = vtkSmartPointer<vtkTextureObject>::New();
+  impl.HitDepth = vtkSmartPointer<vtkTextureObject>::New();
+  impl.HitFlag = vtkSmartPointer<vtkTextureObject>::New();
+  impl.HitFBO = vtkSmartPointer<vtkOpenGLFramebufferObject>::New();
+  impl.HitColor->SetContext(renWin);
+  impl.HitDepth->SetContext(renWin);
+  impl.HitFlag->SetContext(renWin);
+  impl.HitFBO->SetContext(renWin);
+  impl.HitDepth->SetInternalFormat(GL_R32F);
+  impl.HitDepth->SetFormat(GL_RED);
+  impl.HitDepth->SetDataType(GL_FLOAT);
+  const auto w = static_cast<unsigned int>(width);
+  const auto h = static_cast<unsigned int>(height);
   TakeGLErrors();
-  bool made = width > 0 && height > 0 &&
-    color->Allocate2D(static_cast<unsigned int>(width), static_cast<unsigned int>(height), 4,
-      VTK_UNSIGNED_CHAR) &&
-    depth->Allocate2D(
-      static_cast<unsigned int>(width), static_cast<unsigned int>(height), 1, VTK_FLOAT) &&
-    flag->AllocateDepth(static_cast<unsigned int>(width), static_cast<unsigned int>(height),
-      vtkTextureObject::Fixed16);
+  const bool made = width > 0 && height > 0 &&
+    impl.HitColor->Allocate2D(w, h, 4, VTK_UNSIGNED_CHAR) &&
+    impl.HitDepth->Allocate2D(w, h, 1, VTK_FLOAT) &&
+    impl.HitFlag->AllocateDepth(w, h, vtkTextureObject::Fixed16);
   std::string problem = made ? TakeGLErrors() : "the textures could not be allocated";
   if (problem.empty())
   {
-    auto fbo = vtkSmartPointer<vtkOpenGLFramebufferObject>::New();
-    fbo->SetContext(renWin);
-    ScopedFramebufferBindings savedBindings(fbo);
-    fbo->Bind();
-    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, color->GetHandle(), 0);
-    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, depth->GetHandle(), 0);
-    glFramebufferTexture(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, flag->GetHandle(), 0);
+    ScopedFramebufferBindings savedBindings(impl.HitFBO);
+    impl.HitFBO->Bind();
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, impl.HitColor->GetHandle(), 0);
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, impl.HitDepth->GetHandle(), 0);
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, impl.HitFlag->GetHandle(), 0);
     const char* status = nullptr;
     if (!vtkOpenGLFramebufferObject::GetFrameBufferStatus(GL_FRAMEBUFFER, status))
     {
       problem = std::string("framebuffer incomplete (") + (status ? status : "?") + ")";
     }
     problem += TakeGLErrors();
-    impl.HitFBO = fbo;
   }
   if (!problem.empty())
   {
-    for (vtkTextureObject* texture : { color.Get(), depth.Get(), flag.Get() })
-    {
-      texture->ReleaseGraphicsResources(renWin);
-    }
-    if (impl.HitFBO)
-    {
-      impl.HitFBO->ReleaseGraphicsResources(renWin);
-      impl.HitFBO = nullptr;
-    }
-    const std::string message = "first-hit pass unavailable (" + problem +
-      "); drawing opaque surfaces in one pass";
+    impl.ReleaseFirstHit(renWin);
+    const std::string message =
+      "first-hit pass unavailable (" + problem + "); drawing opaque surfaces in one pass";
     if (impl.Said.insert(message).second)
     {
       vtkWarningMacro(<< message);
     }
     return false;
   }
-  impl.HitColor = color;
-  impl.HitDepth = depth;
-  impl.HitFlag = flag;
   impl.HitSize[0] = width;
   impl.HitSize[1] = height;
   return true;
