@@ -51,6 +51,17 @@
  *    slice k is the packed texel of nodes (2i + a, 2j + b, k); each node
  *    sums over its cells the number of isovalues with min < iso <= max
  *    over the cell's eight corners (the convention of vtkMarchingCubes).
+ *    Only the tiles of the level (TileNodes x TileNodes x 1 nodes) that can
+ *    hold an active cell are drawn: UploadVolume() computes, once, the range
+ *    of the point values each tile's cells read (a small RG32 texture, 8
+ *    bytes per tile); the level is cleared to 0, and one point per tile
+ *    (vtkHistoPyramidFirstLevel_vs.glsl) becomes a quad on its slice
+ *    (vtkHistoPyramidFirstLevel_gs.glsl) only where an isovalue lies in that
+ *    range. A tile's points are connected by cell edges, so that happens
+ *    exactly when one of its cells crosses the isovalue: the pass costs what
+ *    the surface touches (on the 256x256x108 CT a skin or bone isovalue
+ *    crosses 30% of the tiles), not the whole volume. This is the build's
+ *    main cost: the reductions above it read 1/8 of the level below each.
  *    Cells with a NaN corner and padding cells count 0. The test is the one
  *    function of vtkHistoPyramidCommon.glsl that every pass and the drawing
  *    program share. The comparisons are exact: isovalues are turned on the CPU into
@@ -111,6 +122,13 @@ public:
 
   /// Most isovalues one Build() can count (a uniform array of the base pass).
   static constexpr int MaximumNumberOfIsovalues = 8;
+
+  /**
+   * Level-1 nodes per side of a tile of the level-1 pass: a tile is
+   * TileNodes x TileNodes x 1 nodes of level 1 (16 x 16 x 2 cells where the
+   * level-1 factor is 2), cut at the level's edges.
+   */
+  static constexpr int TileNodes = 8;
 
   /**
    * Upload the single-component @a scalars of a volume of @a pointDims points
@@ -175,7 +193,17 @@ public:
    */
   std::vector<int> GetCountedIsovalues() const;
 
-  /// Bytes of the GPU textures this object owns now (volume and levels).
+  ///@{
+  /**
+   * The level-1 pass's tiles: how many there are for the uploaded volume
+   * (0 before), and how many the last successful Build() drew (those whose
+   * value range holds an isovalue; 0 before). See the class description.
+   */
+  std::uint64_t GetNumberOfTiles() const;
+  std::uint64_t GetLastTilesDrawn() const;
+  ///@}
+
+  /// Bytes of the GPU textures this object owns now (volume, tile ranges, levels).
   std::uint64_t GetGPUMemoryBytes() const;
 
   /**

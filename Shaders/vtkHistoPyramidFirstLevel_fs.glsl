@@ -5,7 +5,9 @@
 // level vtkOpenGLHistoPyramid stores, straight from the volume. Levels are
 // stored packed (see vtkHistoPyramidReduce_fs.glsl): texel (i, j, k) holds
 // the counts of the 2x2 nodes (2i + a, 2j + b, k) in component a + 2b. Drawn
-// as one full-screen quad per z-slice; each fragment counts its 4 nodes.
+// as a quad per tile of a z-slice, for the tiles an isovalue can cross
+// (vtkHistoPyramidFirstLevel_vs.glsl; the others keep the 0 the level is
+// cleared to); each fragment counts its 4 nodes.
 // Node n's cells are the box [2n.x, 2n.x + fx) x [2n.y, 2n.y + fy) x
 // [2n.z, 2n.z + fz) (f = 2 along an axis the base level has more than one
 // cell on, else 1); the node reads the box's (f + 1)^3 <= 27 corner values

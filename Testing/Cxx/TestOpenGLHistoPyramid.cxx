@@ -159,12 +159,47 @@ void CompareBuild(vtkOpenGLHistoPyramid* gpu, const std::string& name, const T* 
           }
         }
   }
+  // The level-1 pass draws only the tiles (TileNodes^2 x 1 nodes of level 1)
+  // whose value range holds an isovalue. The points of a tile are connected
+  // by cell edges, so its range holds an isovalue exactly when one of its
+  // cells crosses it: without NaN values, the tiles drawn are exactly those
+  // with a non-zero level-1 node (with NaN values, at least those).
+  const int* one = cpu.GetLevelSize(1);
+  const int tiles[3] = { (one[0] + vtkOpenGLHistoPyramid::TileNodes - 1) /
+      vtkOpenGLHistoPyramid::TileNodes,
+    (one[1] + vtkOpenGLHistoPyramid::TileNodes - 1) / vtkOpenGLHistoPyramid::TileNodes, one[2] };
+  std::vector<char> activeTile(static_cast<std::size_t>(tiles[0]) * tiles[1] * tiles[2], 0);
+  for (int k = 0; k < one[2]; ++k)
+    for (int j = 0; j < one[1]; ++j)
+      for (int i = 0; i < one[0]; ++i)
+      {
+        if (cpu.GetCount(1, i, j, k) != 0)
+        {
+          activeTile[(static_cast<std::size_t>(k) * tiles[1] + j / vtkOpenGLHistoPyramid::TileNodes) *
+              tiles[0] +
+            i / vtkOpenGLHistoPyramid::TileNodes] = 1;
+        }
+      }
+  const std::uint64_t expectedTiles =
+    static_cast<std::uint64_t>(std::count(activeTile.begin(), activeTile.end(), 1));
+  bool hasNaN = false;
+  const std::size_t numPoints = static_cast<std::size_t>(dims[0]) * dims[1] * dims[2];
+  for (std::size_t i = 0; i < numPoints && !hasNaN; ++i)
+  {
+    hasNaN = std::isnan(static_cast<double>(data[i]));
+  }
+  const std::uint64_t drawn = gpu->GetLastTilesDrawn();
   std::cout << what << ": total GPU " << total << " CPU " << cpu.GetTotal() << ", "
             << cpu.GetNumberOfLevels() << " levels, "
             << (mismatches ? std::to_string(mismatches) + " node mismatches" : "all nodes equal")
-            << "\n";
+            << ", level-1 tiles drawn " << drawn << " of " << gpu->GetNumberOfTiles()
+            << " (with an active cell: " << expectedTiles << ")\n";
   Check(total == cpu.GetTotal(), what + ": totals differ");
   Check(mismatches == 0, what + ": " + firstMismatch);
+  Check(gpu->GetNumberOfTiles() == activeTile.size(), what + ": unexpected number of tiles");
+  Check(hasNaN ? drawn >= expectedTiles : drawn == expectedTiles,
+    what + ": the level-1 pass drew " + std::to_string(drawn) + " tiles, not " +
+      std::to_string(expectedTiles));
 }
 
 // One scalar type: upload, then every isovalue set.
