@@ -644,6 +644,8 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     }
     timer->StopTimer(); // Build() ends by reading the total back: the passes are done
     this->LastBuildSeconds = timer->GetElapsedTime();
+    this->LastBuildTilesDrawn = impl.Pyramid->GetLastTilesDrawn();
+    this->LastBuildTiles = impl.Pyramid->GetNumberOfTiles();
     ++this->NumberOfPyramidBuilds;
     impl.BuiltIsovalues = isovalues;
     impl.PyramidValid = true;

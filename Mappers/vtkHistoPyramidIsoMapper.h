@@ -183,6 +183,16 @@ public:
   /// Seconds the last pyramid build took (its passes and the read-back of the total).
   vtkGetMacro(LastBuildSeconds, double);
 
+  ///@{
+  /**
+   * The last pyramid build's level-1 pass: how many of its tiles it drew
+   * (those whose value range holds an isovalue; see vtkOpenGLHistoPyramid)
+   * and how many there are.
+   */
+  vtkGetMacro(LastBuildTilesDrawn, std::uint64_t);
+  vtkGetMacro(LastBuildTiles, std::uint64_t);
+  ///@}
+
   /// Pyramid builds and volume uploads so far (camera moves do neither).
   vtkGetMacro(NumberOfPyramidBuilds, std::uint64_t);
   vtkGetMacro(NumberOfVolumeUploads, std::uint64_t);
@@ -219,6 +229,8 @@ private:
   std::uint64_t NumberOfPrimitives = 0;
   std::uint64_t NumberOfPyramidBuilds = 0;
   double LastBuildSeconds = 0.0;
+  std::uint64_t LastBuildTilesDrawn = 0;
+  std::uint64_t LastBuildTiles = 0;
   std::uint64_t NumberOfVolumeUploads = 0;
   std::uint64_t NumberOfFallbackTriangles = 0;
 

@@ -215,7 +215,10 @@ def report(args, command, records, failed, started, wall, load_before, load_afte
                      "%d (%g..%g)" % (r["n"], r["first_iso"], r["last_iso"]), fmt_s(r["min_s"]),
                      fmt_s(r["median_s"]), fmt_s(r["max_s"]), "%.1f" % r["total_s"],
                      fmt_s(r["extract_median_s"]) if r["method"] == "fe"
-                     else ("build " + fmt_s(r["build_median_s"])) if "build_median_s" in r else "-",
+                     else ("build " + fmt_s(r["build_median_s"]) +
+                           (" (%.0f%% of tiles)" % (100.0 * r["build_tiles_median"])
+                            if "build_tiles_median" in r else ""))
+                     if "build_median_s" in r else "-",
                      ("%d..%d" % (r["min_elements"], r["max_elements"]))
                      if r["min_elements"] >= 0 else "-",
                      fmt_ratio(ratio) if ratio is not None else ""])
@@ -224,7 +227,8 @@ def report(args, command, records, failed, started, wall, load_before, load_afte
                 "change+frame <= 0.5x FlyingEdges + PolyDataMapper (median)",
                 "%s, %s, sweep of %d" % (r["input"], r["window"], r["n"]), ratio, TARGET_SWEEP))
     lines.extend(table(["input", "window", "method", "isovalues", "min s", "median s", "max s",
-                        "total s", "FE extract / our build, median s", "primitives", "ours / FE+PDM (median)"],
+                        "total s", "FE extract / our build, median s (level-1 tiles drawn)",
+                        "primitives", "ours / FE+PDM (median)"],
                        rows))
 
     # 3. memory

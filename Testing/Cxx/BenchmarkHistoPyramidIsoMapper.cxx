@@ -754,7 +754,7 @@ int main(int argc, char* argv[])
                              : 0.0;
         const double bytesBefore =
           scene.HistoPyramid ? static_cast<double>(scene.HistoPyramid->GetGPUMemoryBytes()) : 0.0;
-        std::vector<double> changes, extracts, elements, builds;
+        std::vector<double> changes, extracts, elements, builds, tiles;
         int notGPU = 0;
         for (double v : sweep)
         {
@@ -768,6 +768,8 @@ int main(int argc, char* argv[])
           if (scene.HistoPyramid)
           {
             builds.push_back(scene.HistoPyramid->GetLastBuildSeconds());
+            tiles.push_back(static_cast<double>(scene.HistoPyramid->GetLastBuildTilesDrawn()) /
+              static_cast<double>(std::max<std::uint64_t>(1, scene.HistoPyramid->GetLastBuildTiles())));
           }
           if (scene.HistoPyramid &&
             scene.HistoPyramid->GetLastRenderPath() != vtkHistoPyramidIsoMapper::GPUPath)
@@ -799,6 +801,7 @@ int main(int argc, char* argv[])
           r.Add("builds", static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds()) -
                   buildsBefore)
             .Add("build_median_s", Summarise(builds).Median)
+            .Add("build_tiles_median", Summarise(tiles).Median)
             .Add("gpu_bytes_before", bytesBefore)
             .Add("gpu_bytes_after", static_cast<double>(scene.HistoPyramid->GetGPUMemoryBytes()))
             .Add("volume_bytes", volumeBytes)
