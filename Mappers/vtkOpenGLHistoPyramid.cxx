@@ -1118,10 +1118,11 @@ bool vtkOpenGLHistoPyramid::Build(
     ~Detach() { glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, 0, 0); }
   } detachOnExit;
 
-  // Level l (packed, every z-slice) from level l - 1 with `program`, whose
-  // other uniforms are set: the uniforms of the layout, the viewport, one
-  // layered draw.
-  auto drawLevel = [&](vtkShaderProgram* program, int l) -> bool
+  // Make level l the target of `program`: the uniforms of the layout (level
+  // l's size and its factor over level l - 1), the viewport, the attachment.
+  // drawLevel() then draws every z-slice in one layered draw; the level-1
+  // pass draws its tiles instead.
+  auto targetLevel = [&](vtkShaderProgram* program, int l) -> bool
   {
     const auto& size = impl.Sizes[l];
     const auto& lower = impl.Sizes[l - 1];
@@ -1132,11 +1133,15 @@ bool vtkOpenGLHistoPyramid::Build(
     program->SetUniform2i("sliceSize", sliceSize);
     SetUniformIVec3(program, "levelSize", size.data());
     ostate->vtkglViewport(0, 0, packed[0], packed[1]);
-    if (!attach(impl.Levels[l]))
+    return attach(impl.Levels[l]);
+  };
+  auto drawLevel = [&](vtkShaderProgram* program, int l) -> bool
+  {
+    if (!targetLevel(program, l))
     {
       return false;
     }
-    impl.DrawSlices(size[2]);
+    impl.DrawSlices(impl.Sizes[l][2]);
     return true;
   };
 
@@ -1152,16 +1157,7 @@ bool vtkOpenGLHistoPyramid::Build(
     const int tiles[2] = { impl.Tiles[0], impl.Tiles[1] };
     firstProgram->SetUniform2i("tiles", tiles);
     firstProgram->SetUniformi("tileSize", TileTexels);
-    const auto& size = impl.Sizes[1];
-    const auto& lower = impl.Sizes[0];
-    const int factor[3] = { lower[0] / size[0], lower[1] / size[1], lower[2] / size[2] };
-    const std::array<int, 3> packed = Packed(size);
-    const int sliceSize[2] = { packed[0], packed[1] };
-    SetUniformIVec3(firstProgram, "factor", factor);
-    firstProgram->SetUniform2i("sliceSize", sliceSize);
-    SetUniformIVec3(firstProgram, "levelSize", size.data());
-    ostate->vtkglViewport(0, 0, packed[0], packed[1]);
-    if (!attach(impl.Levels[1]))
+    if (!targetLevel(firstProgram, 1))
     {
       return false;
     }
