@@ -156,6 +156,39 @@ bool PointsCoverCells(vtkMatrix4x4* indexToView, vtkMatrix4x4* projection,
   return pixels + 3.0 <= maxPointSize;
 }
 
+// The window pixels the volume can cover: the bounding rectangle of the
+// index box [0, cells]'s 8 projected corners (x, y, width, height), widened by
+// a pixel on every side and cut to the viewport (at least 1x1). Only for a box
+// wholly in front of the eye (as point footprints require; see
+// PointsCoverCells), where the projected corners bound the box's projection.
+void ProjectedRectangle(
+  vtkMatrix4x4* indexToClip, const int cells[3], const int viewport[4], int rect[4])
+{
+  double lo[2] = { VTK_DOUBLE_MAX, VTK_DOUBLE_MAX };
+  double hi[2] = { -VTK_DOUBLE_MAX, -VTK_DOUBLE_MAX };
+  for (int i = 0; i < 8; ++i)
+  {
+    const double p[4] = { (i & 1) ? double(cells[0]) : 0.0, (i & 2) ? double(cells[1]) : 0.0,
+      (i & 4) ? double(cells[2]) : 0.0, 1.0 };
+    double clip[4];
+    indexToClip->MultiplyPoint(p, clip);
+    for (int a = 0; a < 2; ++a)
+    {
+      const double window = viewport[a] + 0.5 * (clip[a] / clip[3] + 1.0) * viewport[2 + a];
+      lo[a] = std::min(lo[a], window);
+      hi[a] = std::max(hi[a], window);
+    }
+  }
+  for (int a = 0; a < 2; ++a)
+  {
+    const double first = std::max(std::floor(lo[a]) - 1.0, double(viewport[a]));
+    const double last = std::min(std::ceil(hi[a]) + 1.0, double(viewport[a] + viewport[2 + a]));
+    const int begin = std::min(static_cast<int>(first), viewport[a] + viewport[2 + a] - 1);
+    rect[a] = begin;
+    rect[2 + a] = std::max(static_cast<int>(last) - begin, 1);
+  }
+}
+
 bool SupportedType(int type)
 {
   switch (type)
@@ -221,10 +254,11 @@ struct vtkHistoPyramidIsoMapper::Internals
   vtkSmartPointer<vtkTextureObject> HitColor; // RGBA8: colour, alpha 1 where hit
   vtkSmartPointer<vtkTextureObject> HitDepth; // R32F: the hit's window depth
   vtkSmartPointer<vtkTextureObject> HitFlag;  // 16-bit depth: a hit is there
-  int HitSize[2] = { 0, 0 };
+  int HitSize[2] = { 0, 0 }; // the buffers' size
+  int HitRect[4] = { 0, 0, 0, 0 }; // the window pixels they hold this frame (x, y, w, h)
   std::unique_ptr<vtkOpenGLQuadHelper> Composite;
 
-  void ReleaseFirstHit(vtkWindow* win)
+  void ReleaseHitBuffers(vtkWindow* win)
   {
     for (vtkTextureObject* texture : { this->HitColor.Get(), this->HitDepth.Get(), this->HitFlag.Get() })
     {
@@ -237,16 +271,21 @@ struct vtkHistoPyramidIsoMapper::Internals
     {
       this->HitFBO->ReleaseGraphicsResources(win);
     }
-    if (this->Composite)
-    {
-      this->Composite->ReleaseGraphicsResources(win);
-    }
     this->HitColor = nullptr;
     this->HitDepth = nullptr;
     this->HitFlag = nullptr;
     this->HitFBO = nullptr;
-    this->Composite.reset();
     this->HitSize[0] = this->HitSize[1] = 0;
+  }
+
+  void ReleaseFirstHit(vtkWindow* win)
+  {
+    this->ReleaseHitBuffers(win);
+    if (this->Composite)
+    {
+      this->Composite->ReleaseGraphicsResources(win);
+    }
+    this->Composite.reset();
   }
 
   // Fallback path.
@@ -811,7 +850,11 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   // in one pass instead.
   bool firstHit = this->FirstHitPass && footprint == PointFootprint && !translucent &&
     counted.size() == 1;
-  if (firstHit && !this->PrepareFirstHit(renWin, viewport[2], viewport[3]))
+  if (firstHit)
+  {
+    ProjectedRectangle(indexToClip, cells, viewport, impl.HitRect);
+  }
+  if (firstHit && !this->PrepareFirstHit(renWin, impl.HitRect[2], impl.HitRect[3], viewport))
   {
     firstHit = false;
   }
@@ -934,10 +977,12 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     const float viewportSize[2] = { static_cast<float>(viewport[2]),
       static_cast<float>(viewport[3]) };
     program->SetUniform2f("viewportSize", viewportSize);
-    // The first-hit pass draws into buffers of the viewport's size.
-    const float viewportF[4] = { firstHit ? 0.0f : static_cast<float>(viewport[0]),
-      firstHit ? 0.0f : static_cast<float>(viewport[1]), static_cast<float>(viewport[2]),
-      static_cast<float>(viewport[3]) };
+    // The first-hit pass draws into buffers whose pixel (0, 0) is the
+    // window's pixel (HitRect[0], HitRect[1]).
+    const float viewportF[4] = {
+      static_cast<float>(firstHit ? viewport[0] - impl.HitRect[0] : viewport[0]),
+      static_cast<float>(firstHit ? viewport[1] - impl.HitRect[1] : viewport[1]),
+      static_cast<float>(viewport[2]), static_cast<float>(viewport[3]) };
     program->SetUniform4f("viewport", viewportF);
     program->SetUniformf("maxPointSize", impl.MaxPointSize);
     // Pixels whose centres lie on the square's edges stay covered whatever the
@@ -970,7 +1015,8 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     vtkOpenGLState::ScopedglDepthFunc depthFunc(ostate);
     impl.HitFBO->Bind();
     impl.HitFBO->ActivateDrawBuffers(2);
-    ostate->vtkglViewport(0, 0, impl.HitSize[0], impl.HitSize[1]);
+    ostate->vtkglViewport(viewport[0] - impl.HitRect[0], viewport[1] - impl.HitRect[1],
+      viewport[2], viewport[3]);
     ostate->vtkglDisable(GL_SCISSOR_TEST);
     ostate->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     ostate->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);
@@ -1011,14 +1057,25 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
 }
 
 //------------------------------------------------------------------------------
-bool vtkHistoPyramidIsoMapper::PrepareFirstHit(vtkOpenGLRenderWindow* renWin, int width, int height)
+bool vtkHistoPyramidIsoMapper::PrepareFirstHit(
+  vtkOpenGLRenderWindow* renWin, int rectWidth, int rectHeight, const int viewport[4])
 {
+  // Buffers for the volume's projection (HitRect), not the whole viewport:
+  // rounded up to 64 pixels (at most the viewport's size), kept while the
+  // projection fits in them, made again when it outgrows them or shrinks
+  // to less than a quarter of their area (a zoom out).
   Internals& impl = *this->Impl;
-  if (impl.HitFBO && impl.HitSize[0] == width && impl.HitSize[1] == height)
+  const int rounded[2] = { std::max(std::min((rectWidth + 63) / 64 * 64, viewport[2]), rectWidth),
+    std::max(std::min((rectHeight + 63) / 64 * 64, viewport[3]), rectHeight) };
+  if (impl.HitFBO && impl.HitSize[0] >= rectWidth && impl.HitSize[1] >= rectHeight &&
+    static_cast<double>(impl.HitSize[0]) * impl.HitSize[1] <=
+      4.0 * static_cast<double>(rounded[0]) * rounded[1])
   {
     return true;
   }
-  impl.ReleaseFirstHit(renWin);
+  const int width = rounded[0];
+  const int height = rounded[1];
+  impl.ReleaseHitBuffers(renWin);
   impl.HitColor = vtkSmartPointer<vtkTextureObject>::New();
   impl.HitDepth = vtkSmartPointer<vtkTextureObject>::New();
   impl.HitFlag = vtkSmartPointer<vtkTextureObject>::New();
@@ -1054,7 +1111,7 @@ bool vtkHistoPyramidIsoMapper::PrepareFirstHit(vtkOpenGLRenderWindow* renWin, in
   }
   if (!problem.empty())
   {
-    impl.ReleaseFirstHit(renWin);
+    impl.ReleaseHitBuffers(renWin);
     const std::string message =
       "first-hit pass unavailable (" + problem + "); drawing opaque surfaces in one pass";
     if (impl.Said.insert(message).second)
@@ -1072,8 +1129,9 @@ bool vtkHistoPyramidIsoMapper::PrepareFirstHit(vtkOpenGLRenderWindow* renWin, in
 bool vtkHistoPyramidIsoMapper::CompositeFirstHit(vtkOpenGLRenderWindow* renWin, std::string& reason)
 {
   // Pass 2: the first pass's colour and exact depth into the scene's
-  // framebuffer over the viewport, with the scene's depth test (enabled by
-  // the caller, with depth writes, no blending).
+  // framebuffer over the pixels the buffers hold (HitRect, inside the
+  // viewport), with the scene's depth test (enabled by the caller, with
+  // depth writes, no blending).
   Internals& impl = *this->Impl;
   if (!impl.Composite)
   {
@@ -1094,7 +1152,14 @@ bool vtkHistoPyramidIsoMapper::CompositeFirstHit(vtkOpenGLRenderWindow* renWin, 
   impl.HitDepth->Activate();
   program->SetUniformi("hitColor", impl.HitColor->GetTextureUnit());
   program->SetUniformi("hitDepth", impl.HitDepth->GetTextureUnit());
-  impl.Composite->Render();
+  const float extent[2] = { static_cast<float>(impl.HitRect[2]), static_cast<float>(impl.HitRect[3]) };
+  program->SetUniform2f("hitExtent", extent);
+  {
+    vtkOpenGLState* ostate = renWin->GetState();
+    vtkOpenGLState::ScopedglViewport savedViewport(ostate);
+    ostate->vtkglViewport(impl.HitRect[0], impl.HitRect[1], impl.HitRect[2], impl.HitRect[3]);
+    impl.Composite->Render();
+  }
   impl.HitColor->Deactivate();
   impl.HitDepth->Deactivate();
   const std::string errors = TakeGLErrors();

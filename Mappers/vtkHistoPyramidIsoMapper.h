@@ -167,7 +167,10 @@ public:
    * fragment stage writes gl_FragDepth, which makes many rasterisers
    * (llvmpipe always; GPUs without GL_ARB_conservative_depth) test depth
    * only after it. The image is the same; the buffers cost 10 bytes per
-   * pixel of the viewport (GetFrameBufferBytes()). Off: always one pass.
+   * pixel of the rectangle the volume's box projects to (cut to the
+   * viewport, rounded up to 64 pixels; kept while the projection fits,
+   * remade when it outgrows them or shrinks below a quarter of them;
+   * GetFrameBufferBytes()). Off: always one pass.
    */
   vtkSetMacro(FirstHitPass, bool);
   vtkGetMacro(FirstHitPass, bool);
@@ -237,7 +240,8 @@ private:
   struct Surface; // one isovalue and its colour and opacity
   bool RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image, vtkDataArray* scalars,
     const std::vector<Surface>& surfaces, std::string& reason);
-  bool PrepareFirstHit(vtkOpenGLRenderWindow* renWin, int width, int height);
+  bool PrepareFirstHit(
+    vtkOpenGLRenderWindow* renWin, int rectWidth, int rectHeight, const int viewport[4]);
   bool CompositeFirstHit(vtkOpenGLRenderWindow* renWin, std::string& reason);
   void RenderFallback(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image,
     vtkDataArray* scalars, const std::vector<Surface>& surfaces);

@@ -243,7 +243,7 @@ def report(args, command, records, failed, started, wall, load_before, load_afte
         seen.add((r["input"], r["iso"]))
         ratio = r["gpu_bytes"] / r["volume_bytes"]
         s = next((x for x in sw if x["method"] == "hp" and x["input"] == r["input"]), None)
-        # The first-hit pass's viewport-sized buffers (10 bytes per pixel), per window.
+        # The first-hit pass's buffers (10 bytes per pixel of the volume's projection), per window.
         buffers = {x["window"]: x.get("framebuffer_bytes", 0) for x in rot
                    if x["method"] == "hp" and x["input"] == r["input"] and x["iso"] == r["iso"]}
         largest = max(buffers.values()) if buffers else 0

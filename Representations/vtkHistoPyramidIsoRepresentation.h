@@ -76,7 +76,8 @@ public:
   /**
    * Draw opaque single-isovalue frames through the first-hit pass
    * (vtkHistoPyramidIsoMapper::SetFirstHitPass: hidden fragments cost no ray
-   * cast; 10 bytes per viewport pixel). Same image either way. Default on.
+   * cast; 10 bytes per pixel of the volume's projection on the view). Same
+   * image either way. Default on.
    */
   void SetFirstHitPass(bool use);
   bool GetFirstHitPass();

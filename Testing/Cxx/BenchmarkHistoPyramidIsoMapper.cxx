@@ -690,11 +690,20 @@ int main(int argc, char* argv[])
           }
           std::vector<double> times;
           times.reserve(opt.Frames);
+          // The first-hit buffers follow the volume's projection, which
+          // changes as it turns: the largest they were.
+          double peakBuffers =
+            scene.HistoPyramid ? static_cast<double>(scene.HistoPyramid->GetFrameBufferBytes()) : 0.0;
           const double rotationStart = Now();
           for (int f = 0; f < opt.Frames; ++f)
           {
             scene.Rotate(1.0);
             times.push_back(scene.Frame());
+            if (scene.HistoPyramid)
+            {
+              peakBuffers = std::max(
+                peakBuffers, static_cast<double>(scene.HistoPyramid->GetFrameBufferBytes()));
+            }
           }
           const double wall = Now() - rotationStart;
           const Stats s = Summarise(times);
@@ -718,8 +727,7 @@ int main(int argc, char* argv[])
           {
             r.Add("reason", reason)
               .Add("gpu_bytes", static_cast<double>(scene.HistoPyramid->GetGPUMemoryBytes()))
-              .Add("framebuffer_bytes",
-                static_cast<double>(scene.HistoPyramid->GetFrameBufferBytes()))
+              .Add("framebuffer_bytes", peakBuffers)
               .Add("volume_bytes", volumeBytes)
               .Add("builds_during_rotation",
                 static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds()) - buildsBefore)
