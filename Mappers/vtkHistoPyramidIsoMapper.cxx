@@ -843,13 +843,12 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
         camera->GetClippingRange()[0], parallel, viewport, impl.MaxPointSize)
     ? PointFootprint
     : BoxFootprint;
-  // The first-hit pass (see SetFirstHitPass): opaque frames of one isovalue
-  // (one primitive per cell, so the first hit in drawing order is the
-  // nearest) with point footprints; its buffers are made here, before the
+  // The first-hit pass (see SetFirstHitPass): opaque frames (one primitive
+  // per cell, so the first hit in drawing order is the nearest) with point
+  // footprints; its buffers are made here, before the
   // program variant is chosen, so that a context that cannot make them draws
   // in one pass instead.
-  bool firstHit = this->FirstHitPass && footprint == PointFootprint && !translucent &&
-    counted.size() == 1;
+  bool firstHit = this->FirstHitPass && footprint == PointFootprint && !translucent;
   if (firstHit)
   {
     ProjectedRectangle(indexToClip, cells, viewport, impl.HitRect);
@@ -860,7 +859,12 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   }
   key << declarations.size() << declarations.substr(0, 80) << "|" << dec.str() << descend.str()
       << impl.ConservativeDepth;
-  // Translucent frames loop over the isovalues: their number is part of the variant too.
+  // Several opaque isovalues in the first-hit pass: one primitive per cell,
+  // whose fragments take the nearest hit of the cell's isovalues (so that
+  // the first hit in drawing order is the nearest; see the fragment stage).
+  const bool nearest = firstHit && counted.size() > 1;
+  // Translucent and `nearest` frames loop over the isovalues: their number
+  // is part of the variant too.
   const int numIsovalues = static_cast<int>(std::min<std::size_t>(counted.size(), 8));
   std::ostringstream defines;
   if (footprint == PointFootprint)
@@ -875,8 +879,12 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   {
     defines << "#define MEDISO_FIRST_HIT\n";
   }
+  if (nearest)
+  {
+    defines << "#define MEDISO_NEAREST\n";
+  }
   defines << "#define MEDISO_LIGHTS " << numLights << "\n";
-  defines << "#define MEDISO_ISOVALUES " << (translucent ? numIsovalues : 8) << "\n";
+  defines << "#define MEDISO_ISOVALUES " << (translucent || nearest ? numIsovalues : 8) << "\n";
   const std::string variant = defines.str();
   auto& cached = impl.Programs[variant];
   if (!cached.second || cached.first != key.str())
@@ -953,7 +961,7 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     static_cast<float>(eye[2]), static_cast<float>(eye[3]) };
   program->SetUniform4f("eyeIndex", eyeIndex);
   program->SetUniformi("backToFront", translucent ? 1 : 0);
-  program->SetUniformi("oneRankPerCell", translucent ? 1 : 0);
+  program->SetUniformi("oneRankPerCell", translucent || nearest ? 1 : 0);
   program->SetUniformi("parallelProjection", parallel ? 1 : 0);
   SetMatrix4(program, "indexToClip", indexToClip);
   SetMatrix4(program, "indexToView", indexToView);

@@ -37,11 +37,13 @@
  *    trilinear interpolant makes along the ray, shades it with Phong (the
  *    volume property's ambient, diffuse, specular and specular power, the
  *    renderer's lights) and writes gl_FragDepth (or, in the first-hit
- *    pass of opaque single-isovalue frames, see FirstHitPass, its colour and
- *    depth go to the mapper's own buffers and are composited after).
+ *    pass of opaque frames, see FirstHitPass, its colour and depth go to
+ *    the mapper's own buffers and are composited after).
  * -# Colour and opacity of each isovalue come from the property's colour and
  *    scalar opacity transfer functions at that value. When all are opaque,
- *    each primitive draws one isovalue, front to back, with depth writes.
+ *    each primitive draws one isovalue, front to back, with depth writes
+ *    (in the first-hit pass each cell is one primitive that takes the
+ *    nearest hit of its isovalues).
  *    Otherwise every cell is drawn once, back to front, and composites all of
  *    its isovalues' hits in depth order: translucent skin over opaque bone
  *    in one pass, blended over whatever the scene holds.
@@ -157,13 +159,15 @@ public:
 
   ///@{
   /**
-   * Draw opaque single-isovalue frames with point footprints in two passes
-   * (default on): the cells into the mapper's own buffers, where the depth
-   * test keeps only the first hit of each pixel in drawing order, then that
-   * colour and exact depth into the scene with the scene's depth test. The
-   * cells come out front to back, so the first hit in drawing order is the
-   * nearest, and the depth test runs before the fragment stage: a fragment
-   * behind a surface already found costs no ray cast. In one pass the
+   * Draw opaque frames with point footprints in two passes (default on):
+   * the cells into the mapper's own buffers, where the depth test keeps
+   * only the first hit of each pixel in drawing order, then that colour and
+   * exact depth into the scene with the scene's depth test. The cells come
+   * out front to back, so the first hit in drawing order is the nearest, and
+   * the depth test runs before the fragment stage: a fragment behind a
+   * surface already found costs no ray cast. With several (opaque)
+   * isovalues each cell is one primitive that takes the nearest hit of its
+   * isovalues. In one pass the
    * fragment stage writes gl_FragDepth, which makes many rasterisers
    * (llvmpipe always; GPUs without GL_ARB_conservative_depth) test depth
    * only after it. The image is the same; the buffers cost 10 bytes per

@@ -74,7 +74,7 @@ public:
 
   ///@{
   /**
-   * Draw opaque single-isovalue frames through the first-hit pass
+   * Draw opaque frames through the first-hit pass
    * (vtkHistoPyramidIsoMapper::SetFirstHitPass: hidden fragments cost no ray
    * cast; 10 bytes per pixel of the volume's projection on the view). Same
    * image either way. Default on.

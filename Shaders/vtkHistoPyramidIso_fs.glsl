@@ -42,6 +42,13 @@
 // rasteriser runs every branch under SIMD masks, so code for another mode or
 // a loop with a uniform bound costs every fragment.
 //
+// Several opaque isovalues in the first-hit pass (MEDISO_NEAREST): one
+// primitive per cell, as in translucent mode, and this stage takes the
+// nearest of the first roots of the cell's crossing isovalues. With the
+// cells in front-to-back order, the first hit in drawing order is then the
+// nearest hit of any isovalue (with one primitive per cell-isovalue pair, a
+// cell's primitives come in isovalue order, not depth order).
+//
 // Translucent mode (MEDISO_TRANSLUCENT): the mapper draws the
 // cells back to front and only one primitive per cell; this fragment takes
 // the hits of every crossing isovalue along its piece of ray in order of t
@@ -334,7 +341,29 @@ void main()
   }
   float tolerance = 1e-4 / max(length(d), 1e-30);
 
-#ifndef MEDISO_TRANSLUCENT
+#if defined(MEDISO_NEAREST)
+  // 2. Several opaque isovalues, one primitive per cell (the first-hit
+  //    pass): the nearest of the first roots of the cell's crossing
+  //    isovalues, in that isovalue's colour.
+  float hitT = 3.0e38;
+  int nearest = -1;
+  for (int t = 0; t < MEDISO_ISOVALUES; ++t)
+  {
+    float root;
+    if (((gMask >> t) & 1) == 1 && firstRoot(cubic(o, d, isovalues[t]), t0, t1, tolerance, root) &&
+      root < hitT)
+    {
+      hitT = root;
+      nearest = t;
+    }
+  }
+  if (nearest < 0)
+  {
+    discard;
+  }
+  vec3 p = clamp(o + hitT * d, 0.0, 1.0);
+  gl_FragData[0] = vec4(shade(p, isoColors[nearest].rgb), 1.0);
+#elif !defined(MEDISO_TRANSLUCENT)
   // 2. First root of the one isovalue of this primitive (gLook: its colour
   //    and value, looked up once per cell by the vertex stage).
   vec4 k = cubic(o, d, gLook.w);
@@ -345,6 +374,8 @@ void main()
   }
   vec3 p = clamp(o + hitT * d, 0.0, 1.0);
   gl_FragData[0] = vec4(shade(p, gLook.rgb), 1.0);
+#endif
+#ifndef MEDISO_TRANSLUCENT
 #ifdef MEDISO_FIRST_HIT
   // First-hit pass: the depth test ran before this stage, on the point's
   // constant depth (see the vertex stage): this pixel had no hit yet. The

@@ -415,7 +415,7 @@ void main()
   {
     vec3 boxLo = vec3(1.0);
     vec3 boxHi = vec3(0.0);
-#ifdef MEDISO_TRANSLUCENT
+#if defined(MEDISO_TRANSLUCENT) || defined(MEDISO_NEAREST)
     for (int t = 0; t < MEDISO_ISOVALUES; ++t) // the cell's one primitive draws them all
     {
       if (((vMask >> t) & 1) == 1)
