@@ -843,11 +843,10 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
         camera->GetClippingRange()[0], parallel, viewport, impl.MaxPointSize)
     ? PointFootprint
     : BoxFootprint;
-  // The first-hit pass (see SetFirstHitPass): opaque frames (one primitive
-  // per cell, so the first hit in drawing order is the nearest) with point
-  // footprints; its buffers are made here, before the
-  // program variant is chosen, so that a context that cannot make them draws
-  // in one pass instead.
+  // The first-hit pass (see SetFirstHitPass): opaque frames with point
+  // footprints; its buffers are made here, before the program variant is
+  // chosen, so that a context that cannot make them draws in one pass
+  // instead.
   bool firstHit = this->FirstHitPass && footprint == PointFootprint && !translucent;
   if (firstHit)
   {

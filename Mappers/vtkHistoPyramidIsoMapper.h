@@ -167,10 +167,10 @@ public:
    * the depth test runs before the fragment stage: a fragment behind a
    * surface already found costs no ray cast. With several (opaque)
    * isovalues each cell is one primitive that takes the nearest hit of its
-   * isovalues. In one pass the
-   * fragment stage writes gl_FragDepth, which makes many rasterisers
-   * (llvmpipe always; GPUs without GL_ARB_conservative_depth) test depth
-   * only after it. The image is the same; the buffers cost 10 bytes per
+   * isovalues. In one pass the fragment stage writes gl_FragDepth, which
+   * makes many rasterisers (llvmpipe always; GPUs without
+   * GL_ARB_conservative_depth) test depth only after it. The image is the
+   * same; the buffers cost 10 bytes per
    * pixel of the rectangle the volume's box projects to (cut to the
    * viewport, rounded up to 64 pixels; kept while the projection fits,
    * remade when it outgrows them or shrinks below a quarter of them;
