@@ -248,8 +248,8 @@ struct vtkHistoPyramidIsoMapper::Internals
   std::map<std::string, std::pair<std::string, vtkShaderProgram*>> Programs;
 
   // First-hit pass (see vtkHistoPyramidIsoMapper::SetFirstHitPass): the
-  // viewport-sized buffers the cells are drawn into, and the program that
-  // composites them into the scene.
+  // buffers the cells are drawn into (over the volume's projected rectangle,
+  // HitRect), and the program that composites them into the scene.
   vtkSmartPointer<vtkOpenGLFramebufferObject> HitFBO;
   vtkSmartPointer<vtkTextureObject> HitColor; // RGBA8: colour, alpha 1 where hit
   vtkSmartPointer<vtkTextureObject> HitDepth; // R32F: the hit's window depth

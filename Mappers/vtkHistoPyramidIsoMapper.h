@@ -207,7 +207,7 @@ public:
   /// Bytes of GPU memory the mapper holds now for the volume (volume and pyramid).
   std::uint64_t GetGPUMemoryBytes() const;
 
-  /// Bytes of the first-hit pass's viewport-sized buffers (0 until one is drawn).
+  /// Bytes of the first-hit pass's buffers (0 until one is drawn; see SetFirstHitPass).
   std::uint64_t GetFrameBufferBytes() const;
 
   /// Triangles of the last fallback frame (0 on the GPU path).
