@@ -856,6 +856,11 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   {
     firstHit = false;
   }
+  // Where the cells are drawn: the viewport's origin, or in the first-hit
+  // pass that origin in buffers whose pixel (0, 0) is the window's pixel
+  // (HitRect[0], HitRect[1]).
+  const int drawViewport[2] = { firstHit ? viewport[0] - impl.HitRect[0] : viewport[0],
+    firstHit ? viewport[1] - impl.HitRect[1] : viewport[1] };
   key << declarations.size() << declarations.substr(0, 80) << "|" << dec.str() << descend.str()
       << impl.ConservativeDepth;
   // Several opaque isovalues in the first-hit pass: one primitive per cell,
@@ -984,12 +989,9 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     const float viewportSize[2] = { static_cast<float>(viewport[2]),
       static_cast<float>(viewport[3]) };
     program->SetUniform2f("viewportSize", viewportSize);
-    // The first-hit pass draws into buffers whose pixel (0, 0) is the
-    // window's pixel (HitRect[0], HitRect[1]).
-    const float viewportF[4] = {
-      static_cast<float>(firstHit ? viewport[0] - impl.HitRect[0] : viewport[0]),
-      static_cast<float>(firstHit ? viewport[1] - impl.HitRect[1] : viewport[1]),
-      static_cast<float>(viewport[2]), static_cast<float>(viewport[3]) };
+    const float viewportF[4] = { static_cast<float>(drawViewport[0]),
+      static_cast<float>(drawViewport[1]), static_cast<float>(viewport[2]),
+      static_cast<float>(viewport[3]) };
     program->SetUniform4f("viewport", viewportF);
     program->SetUniformf("maxPointSize", impl.MaxPointSize);
     // Pixels whose centres lie on the square's edges stay covered whatever the
@@ -1022,8 +1024,7 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     vtkOpenGLState::ScopedglDepthFunc depthFunc(ostate);
     impl.HitFBO->Bind();
     impl.HitFBO->ActivateDrawBuffers(2);
-    ostate->vtkglViewport(viewport[0] - impl.HitRect[0], viewport[1] - impl.HitRect[1],
-      viewport[2], viewport[3]);
+    ostate->vtkglViewport(drawViewport[0], drawViewport[1], viewport[2], viewport[3]);
     ostate->vtkglDisable(GL_SCISSOR_TEST);
     ostate->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     ostate->vtkglClearColor(0.0f, 0.0f, 0.0f, 0.0f);

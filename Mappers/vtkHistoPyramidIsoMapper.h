@@ -170,11 +170,10 @@ public:
    * isovalues. In one pass the fragment stage writes gl_FragDepth, which
    * makes many rasterisers (llvmpipe always; GPUs without
    * GL_ARB_conservative_depth) test depth only after it. The image is the
-   * same; the buffers cost 10 bytes per
-   * pixel of the rectangle the volume's box projects to (cut to the
-   * viewport, rounded up to 64 pixels; kept while the projection fits,
-   * remade when it outgrows them or shrinks below a quarter of them;
-   * GetFrameBufferBytes()). Off: always one pass.
+   * same; the buffers cost 10 bytes per pixel of the rectangle the volume's
+   * box projects to (cut to the viewport, rounded up to 64 pixels; kept
+   * while the projection fits, remade when it outgrows them or shrinks
+   * below a quarter of them; GetFrameBufferBytes()). Off: always one pass.
    */
   vtkSetMacro(FirstHitPass, bool);
   vtkGetMacro(FirstHitPass, bool);

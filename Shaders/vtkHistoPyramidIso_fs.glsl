@@ -361,8 +361,7 @@ void main()
   {
     discard;
   }
-  vec3 p = clamp(o + hitT * d, 0.0, 1.0);
-  gl_FragData[0] = vec4(shade(p, isoColors[nearest].rgb), 1.0);
+  vec3 color = isoColors[nearest].rgb;
 #elif !defined(MEDISO_TRANSLUCENT)
   // 2. First root of the one isovalue of this primitive (gLook: its colour
   //    and value, looked up once per cell by the vertex stage).
@@ -372,10 +371,11 @@ void main()
   {
     discard;
   }
-  vec3 p = clamp(o + hitT * d, 0.0, 1.0);
-  gl_FragData[0] = vec4(shade(p, gLook.rgb), 1.0);
+  vec3 color = gLook.rgb;
 #endif
 #ifndef MEDISO_TRANSLUCENT
+  vec3 p = clamp(o + hitT * d, 0.0, 1.0);
+  gl_FragData[0] = vec4(shade(p, color), 1.0);
 #ifdef MEDISO_FIRST_HIT
   // First-hit pass: the depth test ran before this stage, on the point's
   // constant depth (see the vertex stage): this pixel had no hit yet. The

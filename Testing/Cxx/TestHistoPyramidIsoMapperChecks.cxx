@@ -31,13 +31,13 @@
 //              differ), also with an opaque plane through the surface, in a
 //              renderer that does not start at the window's origin, and
 //              with two or three opaque isovalues that share cells (the
-//              nearest hit of a cell's isovalues). Its buffers (10 bytes per pixel) cover the
-//              volume's projection, not the viewport: at least the box's
-//              projected rectangle, at most that rounded up to 64 pixels
-//              (and the viewport); they grow after a frame of a smaller
-//              projection and shrink after one of a much larger one (same
-//              images); they exist only where used and are freed with the
-//              rest.
+//              nearest hit of a cell's isovalues). Its buffers (10 bytes per
+//              pixel) cover the volume's projection, not the viewport: at
+//              least the box's projected rectangle, at most that rounded up
+//              to 64 pixels (and the viewport); they grow after a frame of a
+//              smaller projection and shrink after one of a much larger one
+//              (same images); they exist only where used and are freed with
+//              the rest.
 //  Footprint - point sprites and cell boxes give the same image (masks agree
 //              on >= 99.8% of the covered pixels, mean colour difference
 //              <= 1 of 255) for opaque and translucent surfaces in
