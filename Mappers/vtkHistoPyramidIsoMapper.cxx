@@ -93,15 +93,6 @@ void SetMatrix3(vtkShaderProgram* program, const char* name, const double m[9])
   }
 }
 
-void SetIVec3(vtkShaderProgram* program, const char* name, const int v[3])
-{
-  const GLint location = program->FindUniform(name);
-  if (location >= 0)
-  {
-    glUniform3i(location, v[0], v[1], v[2]);
-  }
-}
-
 // Whether point sprites cover every cell this frame (see the vertex shader):
 // the index box [0, cells] lies wholly beyond the near plane, and no cell can
 // project to more than maxPointSize - 3 pixels. The bound on a cell's
@@ -960,7 +951,7 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   }
   const int firstFactor[3] = { sizes[0][0] / sizes[1][0], sizes[0][1] / sizes[1][1],
     sizes[0][2] / sizes[1][2] };
-  SetIVec3(program, "firstFactor", firstFactor);
+  SetUniformIVec3(program, "firstFactor", firstFactor);
   const float eyeIndex[4] = { static_cast<float>(eye[0]), static_cast<float>(eye[1]),
     static_cast<float>(eye[2]), static_cast<float>(eye[3]) };
   program->SetUniform4f("eyeIndex", eyeIndex);

@@ -40,6 +40,7 @@ constexpr int ProbeNX = 9;
 constexpr int ProbeNY = 7;
 constexpr int ProbeNZ = 5;
 constexpr int ProbeCellsX = ProbeNX - 1;
+constexpr int ProbeTexelsX = (ProbeNX + 3) / 4; // stored 4 points to a texel along x
 constexpr int ProbeCellsY = ProbeNY - 1;
 
 // Deterministic int16 pattern: an off-centre ellipsoidal distance field
@@ -56,16 +57,21 @@ std::int16_t ProbeValue(int i, int j, int k)
   return static_cast<std::int16_t>((d2 - 180) * 50 + (i * 3 + j * 5 + k * 7) % 5 - 2);
 }
 
+// The probe volume as the mapper stores a volume (vtkOpenGLHistoPyramid):
+// 4 points to a texel along x, the last texel of a row repeating the row's
+// last point where the points run out.
 std::vector<std::int16_t> MakeProbeVolume()
 {
-  std::vector<std::int16_t> values(static_cast<size_t>(ProbeNX) * ProbeNY * ProbeNZ);
+  const int rowLength = 4 * ProbeTexelsX;
+  std::vector<std::int16_t> values(static_cast<size_t>(rowLength) * ProbeNY * ProbeNZ);
   for (int k = 0; k < ProbeNZ; ++k)
   {
     for (int j = 0; j < ProbeNY; ++j)
     {
-      for (int i = 0; i < ProbeNX; ++i)
+      for (int i = 0; i < rowLength; ++i)
       {
-        values[(static_cast<size_t>(k) * ProbeNY + j) * ProbeNX + i] = ProbeValue(i, j, k);
+        values[(static_cast<size_t>(k) * ProbeNY + j) * rowLength + i] =
+          ProbeValue(std::min(i, ProbeNX - 1), j, k);
       }
     }
   }
@@ -73,8 +79,9 @@ std::vector<std::int16_t> MakeProbeVolume()
 }
 
 // CPU reference of vtkMedicalProbe_fs.glsl: active cells per (i, j) column,
-// row-major with i fastest, like glReadPixels returns them.
-std::vector<unsigned int> CPUColumnCounts(const std::vector<std::int16_t>& values, float iso)
+// row-major with i fastest, like glReadPixels returns them (from the values
+// themselves, not from the texture's layout).
+std::vector<unsigned int> CPUColumnCounts(float iso)
 {
   std::vector<unsigned int> counts(static_cast<size_t>(ProbeCellsX) * ProbeCellsY, 0u);
   for (int j = 0; j < ProbeCellsY; ++j)
@@ -91,8 +98,7 @@ std::vector<unsigned int> CPUColumnCounts(const std::vector<std::int16_t>& value
           const int ii = i + (c & 1);
           const int jj = j + ((c >> 1) & 1);
           const int kk = k + ((c >> 2) & 1);
-          const float v =
-            static_cast<float>(values[(static_cast<size_t>(kk) * ProbeNY + jj) * ProbeNX + ii]);
+          const float v = static_cast<float>(ProbeValue(ii, jj, kk));
           vmin = std::min(vmin, v);
           vmax = std::max(vmax, v);
         }
@@ -416,13 +422,14 @@ bool vtkMedicalGLCapabilities::RunFunctionalProbe(vtkOpenGLRenderWindow* win)
 
   ProbeResources res(win);
 
-  // 1. The volume: int16 values as a GL_R16I 3D texture, nearest filtering
-  //    (integer textures are incomplete with linear filtering).
+  // 1. The volume: int16 values as a GL_RGBA16I 3D texture, 4 points to a
+  //    texel along x as the mapper stores them, nearest filtering (integer
+  //    textures are incomplete with linear filtering).
   std::vector<std::int16_t> values = MakeProbeVolume();
   vtkTextureObject* volume = res.Volume;
   volume->SetContext(win);
-  volume->SetInternalFormat(GL_R16I);
-  volume->SetFormat(GL_RED_INTEGER);
+  volume->SetInternalFormat(GL_RGBA16I);
+  volume->SetFormat(GL_RGBA_INTEGER);
   volume->SetDataType(GL_SHORT);
   volume->SetMinificationFilter(vtkTextureObject::Nearest);
   volume->SetMagnificationFilter(vtkTextureObject::Nearest);
@@ -430,20 +437,20 @@ bool vtkMedicalGLCapabilities::RunFunctionalProbe(vtkOpenGLRenderWindow* win)
   volume->SetWrapT(vtkTextureObject::ClampToEdge);
   volume->SetWrapR(vtkTextureObject::ClampToEdge);
   const bool volumeCreated =
-    volume->Create3DFromRaw(ProbeNX, ProbeNY, ProbeNZ, 1, VTK_SHORT, values.data());
+    volume->Create3DFromRaw(ProbeTexelsX, ProbeNY, ProbeNZ, 4, VTK_SHORT, values.data());
   std::string errors = TakeGLErrors();
   if (!volumeCreated || !errors.empty())
   {
     this->SetFailure(StatusMissingFeature,
-      "cannot create a GL_R16I 3D texture" + (errors.empty() ? "" : ": " + errors));
+      "cannot create a GL_RGBA16I 3D texture" + (errors.empty() ? "" : ": " + errors));
     return false;
   }
-  if (volume->GetInternalFormat(VTK_SHORT, 1, false) != GL_R16I ||
-    volume->GetFormat(VTK_SHORT, 1, false) != GL_RED_INTEGER ||
+  if (volume->GetInternalFormat(VTK_SHORT, 4, false) != GL_RGBA16I ||
+    volume->GetFormat(VTK_SHORT, 4, false) != GL_RGBA_INTEGER ||
     static_cast<unsigned int>(volume->GetDataType(VTK_SHORT)) != GL_SHORT)
   {
     this->SetFailure(StatusProbeFailed,
-      "vtkTextureObject did not keep the GL_R16I / GL_RED_INTEGER / GL_SHORT formats");
+      "vtkTextureObject did not keep the GL_RGBA16I / GL_RGBA_INTEGER / GL_SHORT formats");
     return false;
   }
 
@@ -536,17 +543,23 @@ bool vtkMedicalGLCapabilities::RunFunctionalProbe(vtkOpenGLRenderWindow* win)
   res.VolumeActive = true;
   GLint allocatedFormat = 0;
   glGetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_INTERNAL_FORMAT, &allocatedFormat);
-  if (allocatedFormat != GL_R16I)
+  if (allocatedFormat != GL_RGBA16I)
   {
     std::ostringstream reason;
     reason << "the 3D texture was allocated as internal format 0x" << std::hex << allocatedFormat
-           << ", not GL_R16I";
+           << ", not GL_RGBA16I";
     this->SetFailure(StatusMissingFeature, reason.str());
     return false;
   }
   if (!program->SetUniformi("probeVolume", volume->GetTextureUnit()))
   {
     this->SetFailure(StatusProbeFailed, "probe shader has no uniform probeVolume");
+    return false;
+  }
+  const int probePoints[3] = { ProbeNX, ProbeNY, ProbeNZ };
+  if (!SetUniformIVec3(program, "probePoints", probePoints))
+  {
+    this->SetFailure(StatusProbeFailed, "probe shader has no uniform probePoints");
     return false;
   }
 
@@ -574,7 +587,7 @@ bool vtkMedicalGLCapabilities::RunFunctionalProbe(vtkOpenGLRenderWindow* win)
         "rendering or reading back the integer probe pass failed: " + errors);
       return false;
     }
-    const std::vector<unsigned int> cpu = CPUColumnCounts(values, iso);
+    const std::vector<unsigned int> cpu = CPUColumnCounts(iso);
     for (int j = 0; j < ProbeCellsY; ++j)
     {
       for (int i = 0; i < ProbeCellsX; ++i)
@@ -642,7 +655,7 @@ std::string vtkMedicalGLCapabilities::GetReport() const
   os << "GL_MAX_DRAW_BUFFERS: " << this->MaxDrawBuffers << "\n";
   os << "GL_POINT_SIZE_RANGE: " << this->PointSizeRange[0] << " " << this->PointSizeRange[1]
      << "\n";
-  os << "functional probe (GL_R16I 3D texture -> GL_R32UI target, " << ProbeNX << "x" << ProbeNY
+  os << "functional probe (GL_RGBA16I 3D texture -> GL_R32UI target, " << ProbeNX << "x" << ProbeNY
      << "x" << ProbeNZ << " volume, 3 isovalues): " << (this->ProbePassed ? "passed" : "not passed")
      << "\n";
   return os.str();

@@ -23,7 +23,8 @@
  *    GL_POINT_SIZE_RANGE.
  * -# It runs a functional probe of exactly what the HistoPyramid base level
  *    does: a small deterministic int16 volume (with negative values) is
- *    uploaded as a GL_R16I 3D texture, one full-screen pass of the fragment
+ *    uploaded as a GL_RGBA16I 3D texture (4 points to a texel along x, as the
+ *    mapper stores a volume), one full-screen pass of the fragment
  *    shader vtkMedicalProbe_fs.glsl writes, into a GL_R32UI texture attached
  *    to a framebuffer object, the number of active cells of every cell column
  *    (texelFetch from an isampler3D), and the counts read back with

@@ -4,13 +4,15 @@
  * @brief Private OpenGL helpers shared by the Mappers classes (not installed,
  * not wrapped): error flags read directly (VTK's error-check macros are
  * compiled out in release builds) and RAII guards for the current context,
- * pixel-buffer bindings and framebuffer bindings.
+ * pixel-buffer bindings and framebuffer bindings, and an ivec3 uniform
+ * setter.
  */
 #ifndef vtkMedicalGLUtilities_h
 #define vtkMedicalGLUtilities_h
 
 #include "vtkOpenGLFramebufferObject.h"
 #include "vtkOpenGLRenderWindow.h"
+#include "vtkShaderProgram.h"
 #include "vtk_glew.h"
 
 #include <string>
@@ -112,6 +114,19 @@ public:
 private:
   vtkOpenGLFramebufferObject* FBO;
 };
+
+// vtkShaderProgram has no ivec3 setter: sets one on the bound program.
+// False when the program has no such (active) uniform.
+inline bool SetUniformIVec3(vtkShaderProgram* program, const char* name, const int v[3])
+{
+  const GLint location = program->FindUniform(name);
+  if (location < 0)
+  {
+    return false;
+  }
+  glUniform3i(location, v[0], v[1], v[2]);
+  return true;
+}
 
 } // namespace medical_gl
 

@@ -49,14 +49,16 @@ enum class ValueKind
   Float     // sampler3D, float
 };
 
-// The texture format of a VTK scalar type, and the range of its values.
+// The texture format of a VTK scalar type, and the range of its values. The
+// volume is stored 4 points to a texel along x (see PackVolumeRows()), so
+// the formats are the RGBA ones of the value type.
 struct VolumeFormat
 {
   GLenum InternalFormat = 0;
   GLenum Format = 0;
   GLenum DataType = 0;
   int UploadVTKType = 0; // type of the array handed to vtkTextureObject
-  int BytesPerTexel = 0;
+  int BytesPerValue = 0;
   ValueKind Kind = ValueKind::Float;
   double Min = 0.0; // value range of integer types
   double Max = 0.0;
@@ -67,10 +69,10 @@ VolumeFormat IntegerFormat(GLenum internalFormat, GLenum dataType, int uploadTyp
 {
   VolumeFormat f;
   f.InternalFormat = internalFormat;
-  f.Format = GL_RED_INTEGER;
+  f.Format = GL_RGBA_INTEGER;
   f.DataType = dataType;
   f.UploadVTKType = uploadType;
-  f.BytesPerTexel = static_cast<int>(sizeof(T));
+  f.BytesPerValue = static_cast<int>(sizeof(T));
   f.Kind = std::numeric_limits<T>::is_signed ? ValueKind::Signed : ValueKind::Unsigned;
   f.Min = static_cast<double>(std::numeric_limits<T>::lowest());
   f.Max = static_cast<double>(std::numeric_limits<T>::max());
@@ -84,39 +86,76 @@ bool ChooseFormat(int vtkType, VolumeFormat& f)
     case VTK_CHAR:
       // Plain char is signed or unsigned depending on the platform.
       f = std::numeric_limits<char>::is_signed
-        ? IntegerFormat<signed char>(GL_R8I, GL_BYTE, VTK_SIGNED_CHAR)
-        : IntegerFormat<unsigned char>(GL_R8UI, GL_UNSIGNED_BYTE, VTK_UNSIGNED_CHAR);
+        ? IntegerFormat<signed char>(GL_RGBA8I, GL_BYTE, VTK_SIGNED_CHAR)
+        : IntegerFormat<unsigned char>(GL_RGBA8UI, GL_UNSIGNED_BYTE, VTK_UNSIGNED_CHAR);
       return true;
     case VTK_SIGNED_CHAR:
-      f = IntegerFormat<signed char>(GL_R8I, GL_BYTE, VTK_SIGNED_CHAR);
+      f = IntegerFormat<signed char>(GL_RGBA8I, GL_BYTE, VTK_SIGNED_CHAR);
       return true;
     case VTK_UNSIGNED_CHAR:
-      f = IntegerFormat<unsigned char>(GL_R8UI, GL_UNSIGNED_BYTE, VTK_UNSIGNED_CHAR);
+      f = IntegerFormat<unsigned char>(GL_RGBA8UI, GL_UNSIGNED_BYTE, VTK_UNSIGNED_CHAR);
       return true;
     case VTK_SHORT:
-      f = IntegerFormat<short>(GL_R16I, GL_SHORT, VTK_SHORT);
+      f = IntegerFormat<short>(GL_RGBA16I, GL_SHORT, VTK_SHORT);
       return true;
     case VTK_UNSIGNED_SHORT:
-      f = IntegerFormat<unsigned short>(GL_R16UI, GL_UNSIGNED_SHORT, VTK_UNSIGNED_SHORT);
+      f = IntegerFormat<unsigned short>(GL_RGBA16UI, GL_UNSIGNED_SHORT, VTK_UNSIGNED_SHORT);
       return true;
     case VTK_INT:
-      f = IntegerFormat<int>(GL_R32I, GL_INT, VTK_INT);
+      f = IntegerFormat<int>(GL_RGBA32I, GL_INT, VTK_INT);
       return true;
     case VTK_UNSIGNED_INT:
-      f = IntegerFormat<unsigned int>(GL_R32UI, GL_UNSIGNED_INT, VTK_UNSIGNED_INT);
+      f = IntegerFormat<unsigned int>(GL_RGBA32UI, GL_UNSIGNED_INT, VTK_UNSIGNED_INT);
       return true;
     case VTK_FLOAT:
     case VTK_DOUBLE: // converted to float on upload
-      f.InternalFormat = GL_R32F;
-      f.Format = GL_RED;
+      f.InternalFormat = GL_RGBA32F;
+      f.Format = GL_RGBA;
       f.DataType = GL_FLOAT;
       f.UploadVTKType = VTK_FLOAT;
-      f.BytesPerTexel = 4;
+      f.BytesPerValue = 4;
       f.Kind = ValueKind::Float;
       return true;
     default:
       return false;
   }
+}
+
+// Texels per row of the stored volume: 4 points to a texel along x.
+int PackedVolumeWidth(int pointsX)
+{
+  return (pointsX + 3) / 4;
+}
+
+// The volume as its texture stores it: texel (i, j, k) holds points
+// (4 i + c, j, k) in component c, and where a row's points run out, its last
+// texel repeats the row's last point (so a read past the end of a row gives
+// the value a clamp to the volume would). Rows are copied as bytes, so the
+// values keep their type. Readers: pointQuad() and pointValue() in
+// vtkHistoPyramidCommon.glsl. With a multiple of 4 points per row the data
+// is already laid out so, and is uploaded as it is (this is not called).
+std::vector<unsigned char> PackVolumeRows(const void* data, const int points[3], int bytesPerValue)
+{
+  const std::size_t inRow = static_cast<std::size_t>(points[0]) * bytesPerValue;
+  const std::size_t outRow = static_cast<std::size_t>(4 * PackedVolumeWidth(points[0])) * bytesPerValue;
+  const vtkIdType rows = static_cast<vtkIdType>(points[1]) * points[2];
+  std::vector<unsigned char> packed(outRow * static_cast<std::size_t>(rows));
+  const unsigned char* in = static_cast<const unsigned char*>(data);
+  vtkSMPTools::For(0, rows,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType r = begin; r < end; ++r)
+      {
+        const unsigned char* from = in + inRow * r;
+        unsigned char* to = packed.data() + outRow * r;
+        std::copy(from, from + inRow, to);
+        for (std::size_t pad = inRow; pad < outRow; pad += bytesPerValue)
+        {
+          std::copy(from + inRow - bytesPerValue, from + inRow, to + pad);
+        }
+      }
+    });
+  return packed;
 }
 
 // The #defines that select the value type in vtkHistoPyramidCommon.glsl.
@@ -125,13 +164,13 @@ const char* ValueTypeDefines(ValueKind kind)
   switch (kind)
   {
     case ValueKind::Signed:
-      return "#define VALUE_SAMPLER isampler3D\n#define VALUE_TYPE int\n";
+      return "#define VALUE_SAMPLER isampler3D\n#define VALUE_TYPE int\n#define VALUE_VEC4 ivec4\n";
     case ValueKind::Unsigned:
-      return "#define VALUE_SAMPLER usampler3D\n#define VALUE_TYPE uint\n";
+      return "#define VALUE_SAMPLER usampler3D\n#define VALUE_TYPE uint\n#define VALUE_VEC4 uvec4\n";
     case ValueKind::Float:
     default:
-      return "#define VALUE_SAMPLER sampler3D\n#define VALUE_TYPE float\n#define VALUE_IS_FLOAT "
-             "1\n";
+      return "#define VALUE_SAMPLER sampler3D\n#define VALUE_TYPE float\n#define VALUE_VEC4 "
+             "vec4\n#define VALUE_IS_FLOAT 1\n";
   }
 }
 
@@ -318,16 +357,6 @@ int NextPowerOfTwo(int n)
     p *= 2;
   }
   return p;
-}
-
-// vtkShaderProgram has no ivec3 setter: set one on the bound program.
-void SetUniformIVec3(vtkShaderProgram* program, const char* name, const int v[3])
-{
-  const GLint location = program->FindUniform(name);
-  if (location >= 0)
-  {
-    glUniform3i(location, v[0], v[1], v[2]);
-  }
 }
 
 void SetNearestClamp(vtkTextureObject* tex)
@@ -650,7 +679,7 @@ struct vtkOpenGLHistoPyramid::Internals
   // made quads on their slices by vtkHistoPyramidFirstLevel_gs.glsl.
   vtkShaderProgram* ReadyFirstLevelPass(vtkOpenGLRenderWindow* win)
   {
-    const std::string fs = PackedPass(this->PassShader(vtkHistoPyramidFirstLevel_fs));
+    const std::string fs = this->PassShader(vtkHistoPyramidFirstLevel_fs);
     const std::string vs = this->PassShader(vtkHistoPyramidFirstLevel_vs);
     this->FirstQuad = win->GetShaderCache()->ReadyShaderProgram(
       vs.c_str(), fs.c_str(), vtkHistoPyramidFirstLevel_gs);
@@ -809,8 +838,8 @@ std::uint64_t vtkOpenGLHistoPyramid::GetGPUMemoryBytes() const
   std::uint64_t bytes = 0;
   if (impl.Volume)
   {
-    bytes += static_cast<std::uint64_t>(impl.PointDims[0]) * impl.PointDims[1] * impl.PointDims[2] *
-      impl.Format.BytesPerTexel;
+    bytes += static_cast<std::uint64_t>(4 * PackedVolumeWidth(impl.PointDims[0])) *
+      impl.PointDims[1] * impl.PointDims[2] * impl.Format.BytesPerValue;
   }
   if (impl.TileRanges)
   {
@@ -912,9 +941,16 @@ bool vtkOpenGLHistoPyramid::UploadVolume(
   impl.Volume->SetFormat(format.Format);
   impl.Volume->SetDataType(format.DataType);
   SetNearestClamp(impl.Volume);
-  const bool created = impl.Volume->Create3DFromRaw(static_cast<unsigned int>(pointDims[0]),
-    static_cast<unsigned int>(pointDims[1]), static_cast<unsigned int>(pointDims[2]), 1,
-    format.UploadVTKType, data);
+  std::vector<unsigned char> packed;
+  if (pointDims[0] % 4 != 0)
+  {
+    packed = PackVolumeRows(data, pointDims, format.BytesPerValue);
+  }
+  const bool created =
+    impl.Volume->Create3DFromRaw(static_cast<unsigned int>(PackedVolumeWidth(pointDims[0])),
+      static_cast<unsigned int>(pointDims[1]), static_cast<unsigned int>(pointDims[2]), 4,
+      format.UploadVTKType, packed.empty() ? data : packed.data());
+  packed = std::vector<unsigned char>();
   const std::string errors = TakeGLErrors();
   if (!created || !errors.empty())
   {

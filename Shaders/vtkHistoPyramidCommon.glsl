@@ -8,6 +8,7 @@
 // the volume's value type:
 //   VALUE_SAMPLER  isampler3D, usampler3D or sampler3D
 //   VALUE_TYPE     int, uint or float
+//   VALUE_VEC4     ivec4, uvec4 or vec4
 //   VALUE_IS_FLOAT defined for float data (NaN corners make a cell inactive)
 //
 // The isovalues arrive as thresholds of the volume's own value type, computed
@@ -16,10 +17,34 @@
 // below iso for float data), in increasing order; isovalues that can cross no
 // cell are dropped before they get here.
 
-uniform VALUE_SAMPLER volume;      // point values, read with texelFetch only
+uniform VALUE_SAMPLER volume;      // point values, 4 to a texel; read with texelFetch only
 uniform VALUE_TYPE thresholds[8];  // see above
 uniform int numberOfThresholds;    // 0 .. 8
 uniform ivec3 cellDimensions;      // real cells per axis (points - 1)
+
+// The volume is stored 4 points to a texel along x: texel (i, j, k) holds
+// points (4 i + c, j, k) in component c, and the last texel of a row repeats
+// the row's last point where the points run out (vtkOpenGLHistoPyramid's
+// PackVolumeRows(); same bytes as one point per texel). The passes that read
+// whole rows of points (a level-1 node's, a packed texel of level 1's) then
+// need a fetch per 4 points instead of one per point.
+
+// Points 4 texelX .. 4 texelX + 3 of row (y, z) (y, z inside the volume);
+// past the row's end every one is the row's last point, as a clamp gives.
+VALUE_VEC4 pointQuad(int texelX, int y, int z)
+{
+  int last = cellDimensions.x >> 2; // the row's last texel
+  VALUE_VEC4 quad = texelFetch(volume, ivec3(min(texelX, last), y, z), 0);
+  return texelX <= last ? quad : quad.wwww;
+}
+
+// The value of point p (inside the volume).
+VALUE_TYPE pointValue(ivec3 p)
+{
+  VALUE_VEC4 quad = texelFetch(volume, ivec3(p.x >> 2, p.yz), 0);
+  int c = p.x & 3;
+  return c < 2 ? (c == 0 ? quad.x : quad.y) : (c == 2 ? quad.z : quad.w);
+}
 
 // Bit t set when isovalue t crosses a cell whose corner values span [lo, hi].
 // A constant bound, so that the loop unrolls: llvmpipe's LLVM takes time
@@ -85,7 +110,7 @@ void fetchCorners(ivec3 c, out VALUE_TYPE v[8])
 {
   for (int i = 0; i < 8; ++i)
   {
-    v[i] = texelFetch(volume, c + ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1), 0).r;
+    v[i] = pointValue(c + ivec3(i & 1, (i >> 1) & 1, (i >> 2) & 1));
   }
 }
 

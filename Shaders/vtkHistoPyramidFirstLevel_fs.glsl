@@ -7,7 +7,7 @@
 // the counts of the 2x2 nodes (2i + a, 2j + b, k) in component a + 2b. Drawn
 // as a quad per tile of a z-slice, for the tiles an isovalue can cross
 // (vtkHistoPyramidFirstLevel_vs.glsl; the others keep the 0 the level is
-// cleared to); each fragment counts its 4 nodes.
+// cleared to); each fragment counts its 4 nodes (main(), below).
 // Node n's cells are the box [2n.x, 2n.x + fx) x [2n.y, 2n.y + fy) x
 // [2n.z, 2n.z + fz) (f = 2 along an axis the base level has more than one
 // cell on, else 1); the node reads the box's (f + 1)^3 <= 27 corner values
@@ -31,20 +31,16 @@ flat in int slice;       // z of the slice being written (vtkHistoPyramidLayer_g
 
 out uvec4 fragOutput0;
 
-uint nodeCount(ivec3 node)
+// The crossings of node `node`, whose <= 27 corner values are p[i + 3 j +
+// 9 k] (points node * factor + (i, j, k), clamped to the volume): 0 beyond
+// level 1's size.
+uint nodeCount(ivec3 node, VALUE_TYPE p[27])
 {
   if (any(greaterThanEqual(node, levelSize)))
   {
     return 0u;
   }
   ivec3 first = node * factor;
-  ivec3 pointMax = cellDimensions; // last point index per axis
-  VALUE_TYPE p[27];
-  for (int i = 0; i < 27; ++i)
-  {
-    ivec3 d = ivec3(i % 3, (i / 3) % 3, i / 9);
-    p[i] = texelFetch(volume, min(first + d, pointMax), 0).r;
-  }
   // Each child cell's corners by constant indices (arrays indexed by
   // variables are spilled to memory by software rasterisers such as llvmpipe).
   uint sum = 0u;
@@ -66,4 +62,39 @@ uint nodeCount(ivec3 node)
   return sum;
 }
 
-//VTK::HistoPyramidPacked::Impl
+// Texel (i, j, k) holds nodes (2i + a, 2j + b, k) in component a + 2b (the
+// layout of vtkHistoPyramidPacked.glsl). The 4 nodes read the points
+// (4i .. 4i + 4, 4j .. 4j + 4, k fz .. k fz + 2), clamped to the volume, once:
+// 2 stored texels per row of 5 points along x (the volume holds 4 points to
+// a texel, see vtkHistoPyramidCommon.glsl), 30 fetches against 4 x 27. Node
+// (a, b)'s points are then those from (2a, 2b, 0) on, by constant indices.
+// (Along an axis with one cell, factor 1, only node 0 exists and it starts
+// at point 0 as well.)
+void main()
+{
+  ivec3 texel = ivec3(ivec2(floor(texCoord * vec2(sliceSize))), slice);
+  ivec3 base = ivec3(4 * texel.xy, texel.z * factor.z);
+  VALUE_TYPE points[75]; // point base + (x, y, z) at x + 5 y + 25 z
+  for (int r = 0; r < 15; ++r) // row r: points base + (0..4, r % 5, r / 5)
+  {
+    int y = min(base.y + r % 5, cellDimensions.y);
+    int z = min(base.z + r / 5, cellDimensions.z);
+    VALUE_VEC4 quad = pointQuad(texel.x, y, z);
+    points[5 * r] = quad.x;
+    points[5 * r + 1] = quad.y;
+    points[5 * r + 2] = quad.z;
+    points[5 * r + 3] = quad.w;
+    points[5 * r + 4] = pointQuad(texel.x + 1, y, z).x;
+  }
+  uint counts[4];
+  for (int n = 0; n < 4; ++n) // node (a, b) = (n & 1, n >> 1)
+  {
+    VALUE_TYPE p[27];
+    for (int i = 0; i < 27; ++i)
+    {
+      p[i] = points[2 * (n & 1) + i % 3 + 5 * (2 * (n >> 1) + (i / 3) % 3) + 25 * (i / 9)];
+    }
+    counts[n] = nodeCount(ivec3(2 * texel.xy + ivec2(n & 1, n >> 1), texel.z), p);
+  }
+  fragOutput0 = uvec4(counts[0], counts[1], counts[2], counts[3]);
+}

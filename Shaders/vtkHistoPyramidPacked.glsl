@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // vtkHistoPyramidPacked.glsl: the packed layout of the stored HistoPyramid
-// levels, in one place for the two passes that write them (level 1 from the
-// volume and each reduction). vtkOpenGLHistoPyramid puts this text in place
-// of the //VTK::HistoPyramidPacked::Impl line of those fragment shaders,
-// which define uint nodeCount(ivec3 node) (0 for a node beyond the level).
+// levels, for the reductions that write levels 2 and up.
+// vtkOpenGLHistoPyramid puts this text in place of the
+// //VTK::HistoPyramidPacked::Impl line of their fragment shader, which
+// defines uint nodeCount(ivec3 node) (0 for a node beyond the level). Level 1
+// (vtkHistoPyramidFirstLevel_fs.glsl) writes the same layout with a main() of
+// its own, which reads its 4 nodes' points once.
 //
 // Texel (i, j, k) of a stored level holds the counts of the 2x2 nodes
 // (2i + a, 2j + b, k) in component a + 2b; the mapper's walk

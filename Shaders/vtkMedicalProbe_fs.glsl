@@ -4,8 +4,9 @@
 // vtkMedicalProbe_fs.glsl: fragment shader of the functional probe of
 // vtkMedicalGLCapabilities. It does, on a tiny volume, exactly what the base
 // level of the HistoPyramid mapper does: read an int16 volume stored as a
-// GL_R16I 3D texture with texelFetch, classify cells against an isovalue and
-// write an unsigned integer count per fragment into a GL_R32UI render target.
+// GL_RGBA16I 3D texture (4 points to a texel along x, as the mapper stores a
+// volume) with texelFetch, classify cells against an isovalue and write an
+// unsigned integer count per fragment into a GL_R32UI render target.
 //
 // vtkOpenGLShaderCache replaces the first line with "#version 150" (OpenGL 3.2
 // core, GLSL 1.50) plus a few portability #defines. Only GLSL 1.50 is used:
@@ -34,14 +35,15 @@
 
 in vec2 texCoord;
 
-uniform isampler3D probeVolume; // GL_R16I, nearest filtering, read with texelFetch only
+uniform isampler3D probeVolume; // GL_RGBA16I, nearest filtering, read with texelFetch only
+uniform ivec3 probePoints;      // points per axis (texel (i, j, k) holds points 4i .. 4i + 3)
 uniform float isovalue;         // int16 values are exact in float
 
 out uvec4 fragOutput0;
 
 void main()
 {
-  ivec3 dims = textureSize(probeVolume, 0);
+  ivec3 dims = probePoints;
   ivec2 ij = ivec2(floor(texCoord * vec2(dims.xy - ivec2(1))));
   uint count = 0u;
   for (int k = 0; k < dims.z - 1; ++k)
@@ -51,7 +53,9 @@ void main()
     for (int c = 0; c < 8; ++c)
     {
       ivec3 p = ivec3(ij.x + (c & 1), ij.y + ((c >> 1) & 1), k + ((c >> 2) & 1));
-      float v = float(texelFetch(probeVolume, p, 0).r);
+      ivec4 quad = texelFetch(probeVolume, ivec3(p.x >> 2, p.yz), 0);
+      int x = p.x & 3;
+      float v = float(x < 2 ? (x == 0 ? quad.x : quad.y) : (x == 2 ? quad.z : quad.w));
       vmin = min(vmin, v);
       vmax = max(vmax, v);
     }

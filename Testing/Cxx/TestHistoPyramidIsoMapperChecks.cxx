@@ -575,10 +575,23 @@ void Footprint()
 // own value), the wrong side or the wrong span changes the normal at some
 // corners, and the colour varies across the plane. int16 and float data,
 // anisotropic spacing, both paths (the fallback's triangles of a plane are
-// flat too).
+// flat too). Two widths: the volume is stored 4 points to a texel along x,
+// and at the +x border the vertex stage reads a point past the row's end,
+// which must read as the last point: from the next texel (past the last
+// one) with 20 points, from the last texel's padding with 22.
+void ShadingPlane(int width);
+
 void Shading()
 {
-  const int dims[3] = { 20, 24, 28 };
+  for (const int width : { 20, 22 })
+  {
+    ShadingPlane(width);
+  }
+}
+
+void ShadingPlane(int width)
+{
+  const int dims[3] = { width, 24, 28 };
   const double spacing[3] = { 1.0, 0.8, 1.3 };
   const double g[3] = { 3.0, 5.0, 8.0 }; // integer: exact in int16
   const double color[3] = { 0.9, 0.7, 0.5 };
@@ -604,7 +617,8 @@ void Shading()
     {
       for (int pass = 0; pass < 2; ++pass)
       {
-        const std::string name = std::string("plane, ") + (type == 0 ? "int16" : "float") +
+        const std::string name = "plane " + std::to_string(width) + " wide, " +
+          (type == 0 ? "int16" : "float") +
           (parallel ? ", parallel" : ", perspective") + (pass == 0 ? ", gpu" : ", fallback");
         vtkNew<vtkHistoPyramidIsoMapper> mapper;
         mapper->SetForceCPUFallback(pass == 1);
