@@ -224,7 +224,6 @@ struct vtkHistoPyramidIsoMapper::Internals
   float PointSizeGranularity = 0.0f;
   bool ConservativeDepth = false;
   int Max3DTextureSize = 0;
-  int MaxTextureBufferSize = 0;
 
   // What the uploaded volume and the built pyramid were made from.
   vtkDataArray* UploadedArray = nullptr;
@@ -595,7 +594,6 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     impl.GPUUsable = caps->Probe(renWin);
     impl.GPUReason = caps->GetReason();
     impl.Max3DTextureSize = caps->GetMax3DTextureSize();
-    impl.MaxTextureBufferSize = caps->GetMaxTextureBufferSize();
     renWin->MakeCurrent();
     GLint units = 0;
     glGetIntegerv(GL_MAX_VERTEX_TEXTURE_IMAGE_UNITS, &units);
@@ -632,17 +630,6 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
     std::ostringstream msg;
     msg << "the " << dims[0] << "x" << dims[1] << "x" << dims[2]
         << " volume exceeds GL_MAX_3D_TEXTURE_SIZE " << impl.Max3DTextureSize;
-    reason = msg.str();
-    return false;
-  }
-  // The volume's buffer texture: 4 points to a texel along x.
-  const double volumeTexels = std::ceil(dims[0] / 4.0) * dims[1] * dims[2];
-  if (volumeTexels > impl.MaxTextureBufferSize)
-  {
-    std::ostringstream msg;
-    msg << "the " << dims[0] << "x" << dims[1] << "x" << dims[2] << " volume needs "
-        << volumeTexels << " texels, more than GL_MAX_TEXTURE_BUFFER_SIZE "
-        << impl.MaxTextureBufferSize;
     reason = msg.str();
     return false;
   }

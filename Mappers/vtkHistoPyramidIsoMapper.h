@@ -60,8 +60,7 @@
  * Capability check and fallback: the first render in a window runs
  * vtkMedicalGLCapabilities::Probe(); if the context lacks OpenGL 3.2 or
  * working integer textures, a shader does not build, the volume exceeds
- * GL_MAX_3D_TEXTURE_SIZE (or, at 4 points to a texel, GL_MAX_TEXTURE_BUFFER_SIZE),
- * or the pyramid needs more vertex texture units than
+ * GL_MAX_3D_TEXTURE_SIZE, or the pyramid needs more vertex texture units than
  * the context has (or MEDISO_DISABLE_GPU_PATH=1, or ForceCPUFallback is on),
  * the mapper says so once (a warning with the reason) and renders the same
  * isovalues with vtkBlockLODContour (level 3) and a vtkPolyDataMapper

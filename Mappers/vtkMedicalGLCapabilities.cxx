@@ -3,7 +3,6 @@
 
 #include "vtkMedicalGLUtilities.h"
 #include "vtkObjectFactory.h"
-#include "vtkOpenGLBufferObject.h"
 #include "vtkOpenGLFramebufferObject.h"
 #include "vtkOpenGLQuadHelper.h"
 #include "vtkOpenGLRenderUtilities.h"
@@ -218,14 +217,12 @@ struct ProbeResources
     this->FBO->ReleaseGraphicsResources(this->Window);
     this->Counts->ReleaseGraphicsResources(this->Window);
     this->Volume->ReleaseGraphicsResources(this->Window);
-    this->VolumeBuffer->ReleaseGraphicsResources();
   }
   ProbeResources(const ProbeResources&) = delete;
   ProbeResources& operator=(const ProbeResources&) = delete;
 
   vtkOpenGLRenderWindow* Window;
   vtkNew<vtkTextureObject> Volume;
-  vtkNew<vtkOpenGLBufferObject> VolumeBuffer;
   vtkNew<vtkTextureObject> Counts;
   vtkNew<vtkOpenGLFramebufferObject> FBO;
   std::unique_ptr<vtkOpenGLQuadHelper> Quad;
@@ -269,7 +266,6 @@ void vtkMedicalGLCapabilities::ResetResults()
   this->MinorVersion = 0;
   this->CoreProfile = false;
   this->Max3DTextureSize = 0;
-  this->MaxTextureBufferSize = 0;
   this->MaxTextureSize = 0;
   this->MaxColorAttachments = 0;
   this->MaxDrawBuffers = 0;
@@ -389,7 +385,6 @@ void vtkMedicalGLCapabilities::QueryLimits()
     return TakeGLErrors().empty() ? static_cast<int>(value) : 0;
   };
   this->Max3DTextureSize = getInt(GL_MAX_3D_TEXTURE_SIZE);
-  this->MaxTextureBufferSize = getInt(GL_MAX_TEXTURE_BUFFER_SIZE);
   this->MaxTextureSize = getInt(GL_MAX_TEXTURE_SIZE);
   this->MaxColorAttachments = getInt(GL_MAX_COLOR_ATTACHMENTS);
   this->MaxDrawBuffers = getInt(GL_MAX_DRAW_BUFFERS);
@@ -427,23 +422,27 @@ bool vtkMedicalGLCapabilities::RunFunctionalProbe(vtkOpenGLRenderWindow* win)
 
   ProbeResources res(win);
 
-  // 1. The volume: int16 values in a GL_RGBA16I buffer texture, 4 points to
-  //    a texel along x, rows one after the other, as the mapper stores them.
+  // 1. The volume: int16 values as a GL_RGBA16I 3D texture, 4 points to a
+  //    texel along x as the mapper stores them, nearest filtering (integer
+  //    textures are incomplete with linear filtering).
   std::vector<std::int16_t> values = MakeProbeVolume();
   vtkTextureObject* volume = res.Volume;
   volume->SetContext(win);
   volume->SetInternalFormat(GL_RGBA16I);
   volume->SetFormat(GL_RGBA_INTEGER);
   volume->SetDataType(GL_SHORT);
+  volume->SetMinificationFilter(vtkTextureObject::Nearest);
+  volume->SetMagnificationFilter(vtkTextureObject::Nearest);
+  volume->SetWrapS(vtkTextureObject::ClampToEdge);
+  volume->SetWrapT(vtkTextureObject::ClampToEdge);
+  volume->SetWrapR(vtkTextureObject::ClampToEdge);
   const bool volumeCreated =
-    res.VolumeBuffer->Upload(values, vtkOpenGLBufferObject::TextureBuffer) &&
-    volume->CreateTextureBuffer(
-      static_cast<unsigned int>(values.size() / 4), 4, VTK_SHORT, res.VolumeBuffer);
+    volume->Create3DFromRaw(ProbeTexelsX, ProbeNY, ProbeNZ, 4, VTK_SHORT, values.data());
   std::string errors = TakeGLErrors();
   if (!volumeCreated || !errors.empty())
   {
     this->SetFailure(StatusMissingFeature,
-      "cannot create a GL_RGBA16I buffer texture" + (errors.empty() ? "" : ": " + errors));
+      "cannot create a GL_RGBA16I 3D texture" + (errors.empty() ? "" : ": " + errors));
     return false;
   }
   if (volume->GetInternalFormat(VTK_SHORT, 4, false) != GL_RGBA16I ||
@@ -542,6 +541,16 @@ bool vtkMedicalGLCapabilities::RunFunctionalProbe(vtkOpenGLRenderWindow* win)
 
   volume->Activate();
   res.VolumeActive = true;
+  GLint allocatedFormat = 0;
+  glGetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_INTERNAL_FORMAT, &allocatedFormat);
+  if (allocatedFormat != GL_RGBA16I)
+  {
+    std::ostringstream reason;
+    reason << "the 3D texture was allocated as internal format 0x" << std::hex << allocatedFormat
+           << ", not GL_RGBA16I";
+    this->SetFailure(StatusMissingFeature, reason.str());
+    return false;
+  }
   if (!program->SetUniformi("probeVolume", volume->GetTextureUnit()))
   {
     this->SetFailure(StatusProbeFailed, "probe shader has no uniform probeVolume");
@@ -641,13 +650,12 @@ std::string vtkMedicalGLCapabilities::GetReport() const
   }
   os << (this->CoreProfile ? " core" : " compatibility") << " profile\n";
   os << "GL_MAX_3D_TEXTURE_SIZE: " << this->Max3DTextureSize << "\n";
-  os << "GL_MAX_TEXTURE_BUFFER_SIZE: " << this->MaxTextureBufferSize << "\n";
   os << "GL_MAX_TEXTURE_SIZE: " << this->MaxTextureSize << "\n";
   os << "GL_MAX_COLOR_ATTACHMENTS: " << this->MaxColorAttachments << "\n";
   os << "GL_MAX_DRAW_BUFFERS: " << this->MaxDrawBuffers << "\n";
   os << "GL_POINT_SIZE_RANGE: " << this->PointSizeRange[0] << " " << this->PointSizeRange[1]
      << "\n";
-  os << "functional probe (GL_RGBA16I buffer texture -> GL_R32UI target, " << ProbeNX << "x" << ProbeNY
+  os << "functional probe (GL_RGBA16I 3D texture -> GL_R32UI target, " << ProbeNX << "x" << ProbeNY
      << "x" << ProbeNZ << " volume, 3 isovalues): " << (this->ProbePassed ? "passed" : "not passed")
      << "\n";
   return os.str();
@@ -668,7 +676,6 @@ void vtkMedicalGLCapabilities::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MinorVersion: " << this->MinorVersion << "\n";
   os << indent << "CoreProfile: " << (this->CoreProfile ? "true" : "false") << "\n";
   os << indent << "Max3DTextureSize: " << this->Max3DTextureSize << "\n";
-  os << indent << "MaxTextureBufferSize: " << this->MaxTextureBufferSize << "\n";
   os << indent << "MaxTextureSize: " << this->MaxTextureSize << "\n";
   os << indent << "MaxColorAttachments: " << this->MaxColorAttachments << "\n";
   os << indent << "MaxDrawBuffers: " << this->MaxDrawBuffers << "\n";

@@ -19,16 +19,15 @@
  * -# It reads the GL_VENDOR, GL_RENDERER, GL_VERSION and
  *    GL_SHADING_LANGUAGE_VERSION strings, the context version and profile
  *    (OpenGL 3.2 or newer is required) and the limits GL_MAX_3D_TEXTURE_SIZE,
- *    GL_MAX_TEXTURE_BUFFER_SIZE,
  *    GL_MAX_TEXTURE_SIZE, GL_MAX_COLOR_ATTACHMENTS, GL_MAX_DRAW_BUFFERS and
  *    GL_POINT_SIZE_RANGE.
  * -# It runs a functional probe of exactly what the HistoPyramid base level
  *    does: a small deterministic int16 volume (with negative values) is
- *    uploaded as a GL_RGBA16I buffer texture (4 points to a texel along x, as
- *    the mapper stores a volume), one full-screen pass of the fragment
+ *    uploaded as a GL_RGBA16I 3D texture (4 points to a texel along x, as the
+ *    mapper stores a volume), one full-screen pass of the fragment
  *    shader vtkMedicalProbe_fs.glsl writes, into a GL_R32UI texture attached
  *    to a framebuffer object, the number of active cells of every cell column
- *    (texelFetch from an isamplerBuffer), and the counts read back with
+ *    (texelFetch from an isampler3D), and the counts read back with
  *    glReadPixels(GL_RED_INTEGER, GL_UNSIGNED_INT) are compared with the same
  *    counts computed on the CPU, for three isovalues. A cell is active when
  *    its eight corner values straddle the isovalue: min < iso <= max (the
@@ -149,7 +148,6 @@ public:
    * Limits of the probed context; 0 when not queried.
    */
   vtkGetMacro(Max3DTextureSize, int);
-  vtkGetMacro(MaxTextureBufferSize, int);
   vtkGetMacro(MaxTextureSize, int);
   vtkGetMacro(MaxColorAttachments, int);
   vtkGetMacro(MaxDrawBuffers, int);
@@ -197,7 +195,6 @@ private:
   int MinorVersion = 0;
   bool CoreProfile = false;
   int Max3DTextureSize = 0;
-  int MaxTextureBufferSize = 0;
   int MaxTextureSize = 0;
   int MaxColorAttachments = 0;
   int MaxDrawBuffers = 0;

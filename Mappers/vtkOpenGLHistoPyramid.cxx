@@ -5,7 +5,6 @@
 #include "vtkDataArray.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
-#include "vtkOpenGLBufferObject.h"
 #include "vtkOpenGLFramebufferObject.h"
 #include "vtkOpenGLVertexArrayObject.h"
 #include "vtkOpenGLRenderWindow.h"
@@ -165,15 +164,13 @@ const char* ValueTypeDefines(ValueKind kind)
   switch (kind)
   {
     case ValueKind::Signed:
-      return "#define VALUE_SAMPLER isamplerBuffer\n#define RANGE_SAMPLER isampler3D\n"
-             "#define VALUE_TYPE int\n#define VALUE_VEC4 ivec4\n";
+      return "#define VALUE_SAMPLER isampler3D\n#define VALUE_TYPE int\n#define VALUE_VEC4 ivec4\n";
     case ValueKind::Unsigned:
-      return "#define VALUE_SAMPLER usamplerBuffer\n#define RANGE_SAMPLER usampler3D\n"
-             "#define VALUE_TYPE uint\n#define VALUE_VEC4 uvec4\n";
+      return "#define VALUE_SAMPLER usampler3D\n#define VALUE_TYPE uint\n#define VALUE_VEC4 uvec4\n";
     case ValueKind::Float:
     default:
-      return "#define VALUE_SAMPLER samplerBuffer\n#define RANGE_SAMPLER sampler3D\n"
-             "#define VALUE_TYPE float\n#define VALUE_VEC4 vec4\n#define VALUE_IS_FLOAT 1\n";
+      return "#define VALUE_SAMPLER sampler3D\n#define VALUE_TYPE float\n#define VALUE_VEC4 "
+             "vec4\n#define VALUE_IS_FLOAT 1\n";
   }
 }
 
@@ -548,8 +545,7 @@ struct vtkOpenGLHistoPyramid::Internals
   vtkWeakPointer<vtkOpenGLRenderWindow> Window;
 
   // The volume.
-  vtkSmartPointer<vtkTextureObject> Volume;             // a buffer texture over VolumeBuffer
-  vtkSmartPointer<vtkOpenGLBufferObject> VolumeBuffer; // 4 points to a texel along x
+  vtkSmartPointer<vtkTextureObject> Volume;
   VolumeFormat Format;
   int PointDims[3] = { 0, 0, 0 };
 
@@ -619,26 +615,15 @@ struct vtkOpenGLHistoPyramid::Internals
     program = nullptr;
   }
 
-  // The volume's texture and buffer; PointDims to 0.
-  void ReleaseVolume(vtkWindow* win)
+  void ReleaseAll(vtkWindow* win)
   {
+    this->ReleaseLevels(win);
     if (this->Volume)
     {
       this->Volume->ReleaseGraphicsResources(win);
       this->Volume = nullptr;
     }
-    if (this->VolumeBuffer)
-    {
-      this->VolumeBuffer->ReleaseGraphicsResources();
-      this->VolumeBuffer = nullptr;
-    }
     this->PointDims[0] = this->PointDims[1] = this->PointDims[2] = 0;
-  }
-
-  void ReleaseAll(vtkWindow* win)
-  {
-    this->ReleaseLevels(win);
-    this->ReleaseVolume(win);
     this->ReleaseTiles(win);
     ReleaseQuad(win, this->FirstQuad);
     ReleaseQuad(win, this->BaseQuad);
@@ -944,47 +929,37 @@ bool vtkOpenGLHistoPyramid::UploadVolume(
   }
   impl.Built = false;
   impl.Total = 0;
-  impl.ReleaseVolume(renWin);
+  if (impl.Volume)
+  {
+    impl.Volume->ReleaseGraphicsResources(renWin);
+  }
   impl.ReleaseTiles(renWin);
   impl.Window = renWin;
-  // The volume: a buffer texture of 4 points to a texel along x (see
-  // PackVolumeRows()).
-  const std::size_t texels = static_cast<std::size_t>(PackedVolumeWidth(pointDims[0])) *
-    pointDims[1] * pointDims[2];
-  GLint maxTexels = 0;
-  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &maxTexels);
-  if (texels > static_cast<std::size_t>(std::max(maxTexels, 0)))
-  {
-    vtkErrorMacro("The " << pointDims[0] << "x" << pointDims[1] << "x" << pointDims[2]
-                         << " volume needs " << texels
-                         << " texels, more than GL_MAX_TEXTURE_BUFFER_SIZE " << maxTexels << ".");
-    return false;
-  }
-  std::vector<unsigned char> packed;
-  if (pointDims[0] % 4 != 0)
-  {
-    packed = PackVolumeRows(data, pointDims, format.BytesPerValue);
-  }
   impl.Volume = vtkSmartPointer<vtkTextureObject>::New();
   impl.Volume->SetContext(renWin);
   impl.Volume->SetInternalFormat(format.InternalFormat);
   impl.Volume->SetFormat(format.Format);
   impl.Volume->SetDataType(format.DataType);
-  impl.VolumeBuffer = vtkSmartPointer<vtkOpenGLBufferObject>::New();
-  const bool uploaded = impl.VolumeBuffer->Upload(
-    static_cast<const unsigned char*>(packed.empty() ? data : packed.data()),
-    texels * 4 * format.BytesPerValue, vtkOpenGLBufferObject::TextureBuffer);
+  SetNearestClamp(impl.Volume);
+  std::vector<unsigned char> packed;
+  if (pointDims[0] % 4 != 0)
+  {
+    packed = PackVolumeRows(data, pointDims, format.BytesPerValue);
+  }
+  const bool created =
+    impl.Volume->Create3DFromRaw(static_cast<unsigned int>(PackedVolumeWidth(pointDims[0])),
+      static_cast<unsigned int>(pointDims[1]), static_cast<unsigned int>(pointDims[2]), 4,
+      format.UploadVTKType, packed.empty() ? data : packed.data());
   packed = std::vector<unsigned char>();
-  const bool created = uploaded &&
-    impl.Volume->CreateTextureBuffer(static_cast<unsigned int>(texels), 4, format.UploadVTKType,
-      impl.VolumeBuffer);
   const std::string errors = TakeGLErrors();
   if (!created || !errors.empty())
   {
     vtkErrorMacro("Cannot upload the " << pointDims[0] << "x" << pointDims[1] << "x" << pointDims[2]
-                                       << " volume as a buffer texture"
+                                       << " volume as a 3D texture"
                                        << (errors.empty() ? "" : ": " + errors));
-    impl.ReleaseVolume(renWin);
+    impl.Volume->ReleaseGraphicsResources(renWin);
+    impl.Volume = nullptr;
+    impl.PointDims[0] = impl.PointDims[1] = impl.PointDims[2] = 0;
     return false;
   }
 
@@ -1038,7 +1013,9 @@ bool vtkOpenGLHistoPyramid::UploadVolume(
                                        << " tile ranges of the volume"
                                        << (tileErrors.empty() ? "" : ": " + tileErrors));
     impl.ReleaseTiles(renWin);
-    impl.ReleaseVolume(renWin);
+    impl.Volume->ReleaseGraphicsResources(renWin);
+    impl.Volume = nullptr;
+    impl.PointDims[0] = impl.PointDims[1] = impl.PointDims[2] = 0;
     return false;
   }
   impl.Tiles = tiles;

@@ -76,26 +76,20 @@
  *    the CPU, as GetTotal().
  *
  * The volume is uploaded once by UploadVolume() and kept until it is called
- * again, as a buffer texture (OpenGL 3.1) that keeps the data's precision
- * and holds 4 points to a texel along x: texel i + w (y + ny z), with w =
- * ceil(nx / 4), holds points (4i + c, y, z) in component c, and where a
- * row's points run out its last texel repeats the row's last point.
- * Signed/unsigned char go to GL_RGBA8I/GL_RGBA8UI, short/unsigned short to
- * GL_RGBA16I/GL_RGBA16UI, int/unsigned int to GL_RGBA32I/GL_RGBA32UI (read
- * with texelFetch from an isamplerBuffer or usamplerBuffer), float to
- * GL_RGBA32F (samplerBuffer). These are the data's own bytes (with a
- * multiple of 4 points per row, the array is uploaded as it is), but the
- * passes that read rows of points need a fetch per 4 of them: a texel of
- * level 1 (the 5x5x3 points of its 4 nodes) takes 30 fetches instead of
- * 108, and the traversal's level-1 node 18 instead of 27; and a buffer
- * texture's fetch is a linear address, which llvmpipe serves faster than a
- * 3D texture's (see the README for the builds measured). The volume may
- * take at most GL_MAX_TEXTURE_BUFFER_SIZE texels (2^27 on llvmpipe: 512 M
- * points; beyond it UploadVolume() fails with an error, and
- * vtkHistoPyramidIsoMapper falls back to the CPU path, saying why). Double data is
- * converted to float (GL_RGBA32F): counts then match a CPU reference
- * computed on the double values only where those values are representable
- * as floats.
+ * again, as a 3D texture that keeps the data's precision and holds 4 points
+ * to a texel along x: texel (i, j, k) holds points (4i + c, j, k) in
+ * component c, and where a row's points run out its last texel repeats the
+ * row's last point. Signed/unsigned char go to GL_RGBA8I/GL_RGBA8UI,
+ * short/unsigned short to GL_RGBA16I/GL_RGBA16UI, int/unsigned int to
+ * GL_RGBA32I/GL_RGBA32UI (all read with texelFetch from an isampler3D or
+ * usampler3D), float to GL_RGBA32F (sampler3D). These are the data's own
+ * bytes (with a multiple of 4 points per row, the array is uploaded as it
+ * is), but the passes that read rows of points need a fetch per 4 of them:
+ * a texel of level 1 (the 5x5x3 points of its 4 nodes) takes 30 fetches
+ * instead of 108, which halved the build on the test volumes, and the
+ * traversal's level-1 node 18 instead of 27. Double data is converted to
+ * float (GL_RGBA32F): counts then match a CPU reference computed on the
+ * double values only where those values are representable as floats.
  *
  * Every call saves and restores the OpenGL state it changes (current context,
  * framebuffer bindings, draw/read buffers, viewport, blend/depth/scissor/

@@ -6,8 +6,7 @@
 // can never disagree. vtkOpenGLHistoPyramid puts this text in place of the
 // //VTK::HistoPyramidCommon::Dec line of each shader, after the #defines of
 // the volume's value type:
-//   VALUE_SAMPLER  isamplerBuffer, usamplerBuffer or samplerBuffer (the volume)
-//   RANGE_SAMPLER  isampler3D, usampler3D or sampler3D (the tile ranges)
+//   VALUE_SAMPLER  isampler3D, usampler3D or sampler3D
 //   VALUE_TYPE     int, uint or float
 //   VALUE_VEC4     ivec4, uvec4 or vec4
 //   VALUE_IS_FLOAT defined for float data (NaN corners make a cell inactive)
@@ -23,35 +22,26 @@ uniform VALUE_TYPE thresholds[8];  // see above
 uniform int numberOfThresholds;    // 0 .. 8
 uniform ivec3 cellDimensions;      // real cells per axis (points - 1)
 
-// The volume is a buffer texture of 4 points to a texel along x: texel
-// i + w (y + ny z), w = ceil(nx / 4), holds points (4 i + c, y, z) in
-// component c, and the last texel of a row repeats the row's last point
-// where the points run out (vtkOpenGLHistoPyramid's PackVolumeRows(); the
-// same bytes as one point per texel). The passes that read whole rows of
-// points (a level-1 node's, a packed texel of level 1's) need a fetch per 4
-// points instead of one per point, and a buffer texture's fetch is a linear
-// address (a software rasteriser fetches from it for less than from a 3D
-// texture).
-
-// The texel of points 4 texelX .. 4 texelX + 3 of row (y, z).
-int volumeTexel(int texelX, int y, int z)
-{
-  return texelX + ((cellDimensions.x >> 2) + 1) * (y + (cellDimensions.y + 1) * z);
-}
+// The volume is stored 4 points to a texel along x: texel (i, j, k) holds
+// points (4 i + c, j, k) in component c, and the last texel of a row repeats
+// the row's last point where the points run out (vtkOpenGLHistoPyramid's
+// PackVolumeRows(); same bytes as one point per texel). The passes that read
+// whole rows of points (a level-1 node's, a packed texel of level 1's) then
+// need a fetch per 4 points instead of one per point.
 
 // Points 4 texelX .. 4 texelX + 3 of row (y, z) (y, z inside the volume);
 // past the row's end every one is the row's last point, as a clamp gives.
 VALUE_VEC4 pointQuad(int texelX, int y, int z)
 {
   int last = cellDimensions.x >> 2; // the row's last texel
-  VALUE_VEC4 quad = texelFetch(volume, volumeTexel(min(texelX, last), y, z));
+  VALUE_VEC4 quad = texelFetch(volume, ivec3(min(texelX, last), y, z), 0);
   return texelX <= last ? quad : quad.wwww;
 }
 
 // The value of point p (inside the volume).
 VALUE_TYPE pointValue(ivec3 p)
 {
-  VALUE_VEC4 quad = texelFetch(volume, volumeTexel(p.x >> 2, p.y, p.z));
+  VALUE_VEC4 quad = texelFetch(volume, ivec3(p.x >> 2, p.yz), 0);
   int c = p.x & 3;
   return c < 2 ? (c == 0 ? quad.x : quad.y) : (c == 2 ? quad.z : quad.w);
 }

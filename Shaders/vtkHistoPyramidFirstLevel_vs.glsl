@@ -22,7 +22,7 @@
 uniform ivec2 tiles;       // tiles per slice, x and y
 uniform int tileSize;      // texels per tile side
 uniform ivec2 sliceSize;   // packed size of level 1 in x and y
-uniform RANGE_SAMPLER tileRanges; // per tile: the least (.r) and greatest (.g) value
+uniform VALUE_SAMPLER tileRanges; // per tile: the least (.r) and greatest (.g) value
 
 flat out int vActive;      // 1: some isovalue may cross a cell of the tile
 flat out int vSlice;

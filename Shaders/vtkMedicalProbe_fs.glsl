@@ -3,9 +3,9 @@
 //
 // vtkMedicalProbe_fs.glsl: fragment shader of the functional probe of
 // vtkMedicalGLCapabilities. It does, on a tiny volume, exactly what the base
-// level of the HistoPyramid mapper does: read an int16 volume stored in a
-// GL_RGBA16I buffer texture (4 points to a texel along x, rows one after the
-// other, as the mapper stores a volume) with texelFetch, classify cells against an isovalue and write an
+// level of the HistoPyramid mapper does: read an int16 volume stored as a
+// GL_RGBA16I 3D texture (4 points to a texel along x, as the mapper stores a
+// volume) with texelFetch, classify cells against an isovalue and write an
 // unsigned integer count per fragment into a GL_R32UI render target.
 //
 // vtkOpenGLShaderCache replaces the first line with "#version 150" (OpenGL 3.2
@@ -35,8 +35,8 @@
 
 in vec2 texCoord;
 
-uniform isamplerBuffer probeVolume; // GL_RGBA16I, 4 points to a texel along x
-uniform ivec3 probePoints;          // points per axis
+uniform isampler3D probeVolume; // GL_RGBA16I, nearest filtering, read with texelFetch only
+uniform ivec3 probePoints;      // points per axis (texel (i, j, k) holds points 4i .. 4i + 3)
 uniform float isovalue;         // int16 values are exact in float
 
 out uvec4 fragOutput0;
@@ -53,8 +53,7 @@ void main()
     for (int c = 0; c < 8; ++c)
     {
       ivec3 p = ivec3(ij.x + (c & 1), ij.y + ((c >> 1) & 1), k + ((c >> 2) & 1));
-      int rowTexels = (dims.x + 3) / 4;
-      ivec4 quad = texelFetch(probeVolume, (p.x >> 2) + rowTexels * (p.y + dims.y * p.z));
+      ivec4 quad = texelFetch(probeVolume, ivec3(p.x >> 2, p.yz), 0);
       int x = p.x & 3;
       float v = float(x < 2 ? (x == 0 ? quad.x : quad.y) : (x == 2 ? quad.z : quad.w));
       vmin = min(vmin, v);
