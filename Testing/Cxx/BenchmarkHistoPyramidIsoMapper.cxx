@@ -558,6 +558,39 @@ std::string WindowText(int w, int h)
 }
 } // namespace
 
+/// One method's part of the interleaved isovalue sweep.
+struct SweepRun
+{
+  Scene View;
+  double BuildsBefore = 0.0;
+  double BytesBefore = 0.0;
+  std::vector<double> Changes, Extracts, Elements, Builds, Tiles;
+  int NotGPU = 0;
+
+  /// Set-isovalue + extract (FlyingEdges) + frame, timed.
+  void Step(double value)
+  {
+    const double t0 = Now();
+    this->View.SetIsovalue(value);
+    const double e = this->View.Extract();
+    this->View.Frame();
+    this->Changes.push_back(Now() - t0);
+    this->Extracts.push_back(e);
+    this->Elements.push_back(this->View.Elements());
+    vtkHistoPyramidIsoMapper* hp = this->View.HistoPyramid;
+    if (hp)
+    {
+      this->Builds.push_back(hp->GetLastBuildSeconds());
+      this->Tiles.push_back(static_cast<double>(hp->GetLastBuildTilesDrawn()) /
+        static_cast<double>(std::max<std::uint64_t>(1, hp->GetLastBuildTiles())));
+      if (hp->GetLastRenderPath() != vtkHistoPyramidIsoMapper::GPUPath)
+      {
+        ++this->NotGPU;
+      }
+    }
+  }
+};
+
 int main(int argc, char* argv[])
 {
   Options opt;
@@ -746,88 +779,120 @@ int main(int argc, char* argv[])
           std::fflush(stdout);
           scene.Window->Finalize();
         }
-
-        // --- isovalue sweep: change + frame (FlyingEdges: extract + frame).
-        if (sweep.empty())
-        {
-          continue;
-        }
-        Scene scene =
-          MakeScene(method, factor, image, window.first, window.second, { opt.Isovalues.front() });
-        scene.Extract();
-        scene.Frame();
-        scene.Frame();
-        const double buildsBefore =
-          scene.HistoPyramid ? static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds())
-                             : 0.0;
-        const double bytesBefore =
-          scene.HistoPyramid ? static_cast<double>(scene.HistoPyramid->GetGPUMemoryBytes()) : 0.0;
-        std::vector<double> changes, extracts, elements, builds, tiles;
-        int notGPU = 0;
-        for (double v : sweep)
-        {
-          const double t0 = Now();
-          scene.SetIsovalue(v);
-          const double e = scene.Extract();
-          scene.Frame();
-          changes.push_back(Now() - t0);
-          extracts.push_back(e);
-          elements.push_back(scene.Elements());
-          if (scene.HistoPyramid)
-          {
-            builds.push_back(scene.HistoPyramid->GetLastBuildSeconds());
-            tiles.push_back(static_cast<double>(scene.HistoPyramid->GetLastBuildTilesDrawn()) /
-              static_cast<double>(std::max<std::uint64_t>(1, scene.HistoPyramid->GetLastBuildTiles())));
-          }
-          if (scene.HistoPyramid &&
-            scene.HistoPyramid->GetLastRenderPath() != vtkHistoPyramidIsoMapper::GPUPath)
-          {
-            ++notGPU;
-          }
-        }
-        const Stats s = Summarise(changes);
-        const Stats se = Summarise(extracts);
-        Record r("sweep");
-        r.Add("input", opt.Input)
-          .Add("window", windowText)
-          .Add("method", method)
-          .Add("label", scene.Label)
-          .Add("factor", factor)
-          .Add("n", static_cast<double>(sweep.size()))
-          .Add("first_iso", sweep.front())
-          .Add("last_iso", sweep.back())
-          .Add("min_s", s.Min)
-          .Add("median_s", s.Median)
-          .Add("mean_s", s.Mean)
-          .Add("total_s", s.Total)
-          .Add("max_s", *std::max_element(changes.begin(), changes.end()))
-          .Add("extract_median_s", se.Median)
-          .Add("min_elements", *std::min_element(elements.begin(), elements.end()))
-          .Add("max_elements", *std::max_element(elements.begin(), elements.end()));
-        if (scene.HistoPyramid)
-        {
-          r.Add("builds", static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds()) -
-                  buildsBefore)
-            .Add("build_median_s", Summarise(builds).Median)
-            .Add("build_tiles_median", Summarise(tiles).Median)
-            .Add("gpu_bytes_before", bytesBefore)
-            .Add("gpu_bytes_after", static_cast<double>(scene.HistoPyramid->GetGPUMemoryBytes()))
-            .Add("volume_bytes", volumeBytes)
-            .Add("frames_not_gpu", notGPU);
-          if (notGPU)
-          {
-            ++failures;
-          }
-        }
-        r.Print();
-        std::printf("%s %s %s sweep of %zu: median %.4f s per change+frame (min %.4f, total "
-                    "%.1f s), elements %.0f..%.0f\n",
-          opt.Input.c_str(), windowText.c_str(), scene.Label.c_str(), sweep.size(), s.Median,
-          s.Min, s.Total, *std::min_element(elements.begin(), elements.end()),
-          *std::max_element(elements.begin(), elements.end()));
-        std::fflush(stdout);
-        scene.Window->Finalize();
       }
+    }
+
+    // --- isovalue sweep: change + frame (FlyingEdges: extract + frame). The
+    // methods' scenes live side by side and take the isovalues in turn, the
+    // order rotating at every step (each method goes first equally often),
+    // so a load that drifts on a shared machine falls on all of them alike,
+    // and each step gives a ratio of two times taken moments apart.
+    if (sweep.empty())
+    {
+      continue;
+    }
+    std::vector<SweepRun> runs;
+    for (const std::string& method : opt.Methods)
+    {
+      const std::vector<double> factors =
+        method == "rc" ? opt.RayCastFactors : std::vector<double>{ 0.0 };
+      for (double factor : factors)
+      {
+        SweepRun run;
+        run.View =
+          MakeScene(method, factor, image, window.first, window.second, { opt.Isovalues.front() });
+        run.View.Extract();
+        run.View.Frame();
+        run.View.Frame();
+        if (run.View.HistoPyramid)
+        {
+          run.BuildsBefore = static_cast<double>(run.View.HistoPyramid->GetNumberOfPyramidBuilds());
+          run.BytesBefore = static_cast<double>(run.View.HistoPyramid->GetGPUMemoryBytes());
+        }
+        runs.push_back(std::move(run));
+      }
+    }
+    for (std::size_t i = 0; i < sweep.size(); ++i)
+    {
+      for (std::size_t k = 0; k < runs.size(); ++k)
+      {
+        runs[(i + k) % runs.size()].Step(sweep[i]);
+      }
+    }
+    const SweepRun* fe = nullptr;
+    for (const SweepRun& run : runs)
+    {
+      if (run.View.Method == "fe")
+      {
+        fe = &run;
+      }
+    }
+    for (SweepRun& run : runs)
+    {
+      Scene& scene = run.View;
+      const Stats s = Summarise(run.Changes);
+      const Stats se = Summarise(run.Extracts);
+      Record r("sweep");
+      r.Add("input", opt.Input)
+        .Add("window", windowText)
+        .Add("method", scene.Method)
+        .Add("label", scene.Label)
+        .Add("factor", scene.SampleFactor)
+        .Add("n", static_cast<double>(sweep.size()))
+        .Add("first_iso", sweep.front())
+        .Add("last_iso", sweep.back())
+        .Add("min_s", s.Min)
+        .Add("median_s", s.Median)
+        .Add("mean_s", s.Mean)
+        .Add("total_s", s.Total)
+        .Add("max_s", *std::max_element(run.Changes.begin(), run.Changes.end()))
+        .Add("extract_median_s", se.Median)
+        .Add("min_elements", *std::min_element(run.Elements.begin(), run.Elements.end()))
+        .Add("max_elements", *std::max_element(run.Elements.begin(), run.Elements.end()))
+        .Add("interleaved_with", static_cast<double>(runs.size() - 1));
+      if (scene.HistoPyramid)
+      {
+        r.Add("builds",
+           static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds()) - run.BuildsBefore)
+          .Add("build_median_s", Summarise(run.Builds).Median)
+          .Add("build_tiles_median", Summarise(run.Tiles).Median)
+          .Add("gpu_bytes_before", run.BytesBefore)
+          .Add("gpu_bytes_after", static_cast<double>(scene.HistoPyramid->GetGPUMemoryBytes()))
+          .Add("volume_bytes", volumeBytes)
+          .Add("frames_not_gpu", run.NotGPU);
+        if (run.NotGPU)
+        {
+          ++failures;
+        }
+      }
+      // Against FlyingEdges + PolyDataMapper step by step: the ratio of each
+      // isovalue's two times, summarised over the sweep.
+      if (fe && &run != fe)
+      {
+        std::vector<double> ratios;
+        for (std::size_t i = 0; i < run.Changes.size(); ++i)
+        {
+          ratios.push_back(run.Changes[i] / fe->Changes[i]);
+        }
+        const Stats sr = Summarise(ratios);
+        r.Add("paired_fe_median", sr.Median)
+          .Add("paired_fe_min", sr.Min)
+          .Add("paired_fe_max", *std::max_element(ratios.begin(), ratios.end()))
+          .Add("paired_fe_at_most_half",
+            static_cast<double>(
+              std::count_if(ratios.begin(), ratios.end(), [](double x) { return x <= 0.5; })));
+      }
+      r.Print();
+      std::printf("%s %s %s sweep of %zu: median %.4f s per change+frame (min %.4f, total "
+                  "%.1f s), elements %.0f..%.0f\n",
+        opt.Input.c_str(), windowText.c_str(), scene.Label.c_str(), sweep.size(), s.Median, s.Min,
+        s.Total, *std::min_element(run.Elements.begin(), run.Elements.end()),
+        *std::max_element(run.Elements.begin(), run.Elements.end()));
+      std::fflush(stdout);
+    }
+    for (SweepRun& run : runs)
+    {
+      run.View.Window->Finalize();
     }
   }
   Record("end").Add("peak_rss_mb", PeakRSSMB()).Add("failures", failures).Print();
