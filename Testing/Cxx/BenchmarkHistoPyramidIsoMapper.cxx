@@ -8,8 +8,9 @@
 // Measures, for every window size: the paper's rotation (1-degree camera
 // azimuth steps after two warm-up renders, per isovalue) and the isovalue
 // sweep (equidistant isovalues strictly inside the data range, time per
-// change + frame), plus the HistoPyramid mapper's GPU memory against the
-// volume's bytes. Every frame is vtkRenderWindow::Render() followed by
+// change + frame; the methods' scenes take each isovalue in turn, and each
+// method's record gives the per-step ratios against FlyingEdges), plus the
+// HistoPyramid mapper's GPU memory against the volume's bytes. Every frame is vtkRenderWindow::Render() followed by
 // WaitForCompletion() (glFinish), so a time includes the drawing itself.
 //
 // Not a ctest test: Python/benchmark_isomapper.py runs it under Xvfb once per
@@ -556,7 +557,6 @@ std::string WindowText(int w, int h)
 {
   return std::to_string(w) + "x" + std::to_string(h);
 }
-} // namespace
 
 /// One method's part of the interleaved isovalue sweep.
 struct SweepRun
@@ -590,6 +590,8 @@ struct SweepRun
     }
   }
 };
+
+} // namespace
 
 int main(int argc, char* argv[])
 {
@@ -853,7 +855,7 @@ int main(int argc, char* argv[])
       if (scene.HistoPyramid)
       {
         r.Add("builds",
-           static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds()) - run.BuildsBefore)
+            static_cast<double>(scene.HistoPyramid->GetNumberOfPyramidBuilds()) - run.BuildsBefore)
           .Add("build_median_s", Summarise(run.Builds).Median)
           .Add("build_tiles_median", Summarise(run.Tiles).Median)
           .Add("gpu_bytes_before", run.BytesBefore)
