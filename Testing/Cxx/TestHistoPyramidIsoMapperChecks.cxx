@@ -579,16 +579,6 @@ void Footprint()
 // and at the +x border the vertex stage reads a point past the row's end,
 // which must read as the last point: from the next texel (past the last
 // one) with 20 points, from the last texel's padding with 22.
-void ShadingPlane(int width);
-
-void Shading()
-{
-  for (const int width : { 20, 22 })
-  {
-    ShadingPlane(width);
-  }
-}
-
 void ShadingPlane(int width)
 {
   const int dims[3] = { width, 24, 28 };
@@ -656,6 +646,14 @@ void ShadingPlane(int width)
         Check(worst <= 2, name + ": every pixel has the plane's Lambert colour");
       }
     }
+  }
+}
+
+void Shading()
+{
+  for (const int width : { 20, 22 })
+  {
+    ShadingPlane(width);
   }
 }
 
