@@ -713,13 +713,18 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   {
     dec << "uniform usampler3D level" << l << ";\n";
   }
+  // With one isovalue level 1 holds child masks: the last step down reads
+  // the level-1 node's mask with the counts (see the vertex stage).
+  const bool childMasks = impl.Pyramid->GetLevelOneHoldsChildMasks();
   for (int l = numLevels - 1; l >= 2; --l)
   {
     const int c = l - 1;
-    descend << "  descend(level" << c << ", ivec3(" << sizes[c][0] / sizes[l][0] << ", "
-            << sizes[c][1] / sizes[l][1] << ", " << sizes[c][2] / sizes[l][2] << "), vec3("
-            << sizes[0][0] / sizes[c][0] << ".0, " << sizes[0][1] / sizes[c][1] << ".0, "
-            << sizes[0][2] / sizes[c][2] << ".0), node, index);\n";
+    descend << (childMasks && c == 1 ? "  descendToMasks(level" : "  descend(level") << c
+            << ", ivec3(" << sizes[c][0] / sizes[l][0] << ", " << sizes[c][1] / sizes[l][1]
+            << ", " << sizes[c][2] / sizes[l][2] << "), vec3(" << sizes[0][0] / sizes[c][0]
+            << ".0, " << sizes[0][1] / sizes[c][1] << ".0, " << sizes[0][2] / sizes[c][2]
+            << ".0), node, index"
+            << (childMasks && c == 1 ? ", nodeBits" : "") << ");\n";
   }
   const std::string declarations = impl.Pyramid->GetShaderDeclarations();
 
@@ -877,6 +882,10 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   if (nearest)
   {
     defines << "#define MEDISO_NEAREST\n";
+  }
+  if (childMasks)
+  {
+    defines << "#define MEDISO_CHILD_MASKS\n";
   }
   defines << "#define MEDISO_LIGHTS " << numLights << "\n";
   defines << "#define MEDISO_ISOVALUES " << (translucent || nearest ? numIsovalues : 8) << "\n";

@@ -30,6 +30,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bitset>
 #include <cfloat>
 #include <cmath>
 #include <limits>
@@ -566,15 +567,18 @@ struct vtkOpenGLHistoPyramid::Internals
   bool Built = false;
   std::uint64_t Total = 0;
   Thresholds Current; // of the last successful Build()
+  bool ChildMasks = false; // level 1 holds child masks (see GetLevelOneHoldsChildMasks())
 
   // The passes.
   vtkSmartPointer<vtkOpenGLFramebufferObject> FBO;
   // The passes' programs (owned by the window's shader cache) and the empty
   // vertex array their attribute-less layered draws need.
   vtkShaderProgram* FirstQuad = nullptr; // the level-1 pass, drawn by tiles
+  vtkShaderProgram* FirstMaskQuad = nullptr; // the same, writing child masks
   vtkShaderProgram* BaseQuad = nullptr;  // ReadLevel(0) only
   ValueKind QuadKind = ValueKind::Float; // value type of FirstQuad and BaseQuad
   vtkShaderProgram* ReduceQuad = nullptr;
+  vtkShaderProgram* ReduceMaskQuad = nullptr; // level 2 from child masks
   vtkNew<vtkOpenGLVertexArrayObject> VAO;
 
   void ReleaseLevels(vtkWindow* win)
@@ -591,6 +595,7 @@ struct vtkOpenGLHistoPyramid::Internals
     this->BytesPerNode.clear();
     this->Built = false;
     this->Total = 0;
+    this->ChildMasks = false;
   }
 
   void ReleaseTiles(vtkWindow* win)
@@ -626,8 +631,10 @@ struct vtkOpenGLHistoPyramid::Internals
     this->PointDims[0] = this->PointDims[1] = this->PointDims[2] = 0;
     this->ReleaseTiles(win);
     ReleaseQuad(win, this->FirstQuad);
+    ReleaseQuad(win, this->FirstMaskQuad);
     ReleaseQuad(win, this->BaseQuad);
     ReleaseQuad(win, this->ReduceQuad);
+    ReleaseQuad(win, this->ReduceMaskQuad);
     if (this->TileQuery && this->Window) // (a query made in a window gone went with it)
     {
       glDeleteQueries(1, &this->TileQuery);
@@ -664,6 +671,16 @@ struct vtkOpenGLHistoPyramid::Internals
     return fs;
   }
 
+  // A shader with `define` (a macro name) defined after its version line.
+  // The pass variants are compiled apart, not chosen by a uniform: a
+  // software rasteriser runs both sides of a branch under SIMD masks.
+  static std::string WithDefine(std::string source, const char* define)
+  {
+    vtkShaderProgram::Substitute(source, "//VTK::System::Dec",
+      std::string("//VTK::System::Dec\n#define ") + define + "\n");
+    return source;
+  }
+
   // Ready (compile or rebind) a pass program: the layered full-screen quads
   // with fragment shader `fs`. Returns the bound program, or nullptr when it
   // does not build.
@@ -677,13 +694,20 @@ struct vtkOpenGLHistoPyramid::Internals
 
   // Ready the level-1 pass: the tiles of vtkHistoPyramidFirstLevel_vs.glsl,
   // made quads on their slices by vtkHistoPyramidFirstLevel_gs.glsl.
-  vtkShaderProgram* ReadyFirstLevelPass(vtkOpenGLRenderWindow* win)
+  // With childMasks, the variant that writes child masks (see
+  // GetLevelOneHoldsChildMasks()).
+  vtkShaderProgram* ReadyFirstLevelPass(vtkOpenGLRenderWindow* win, bool childMasks)
   {
-    const std::string fs = this->PassShader(vtkHistoPyramidFirstLevel_fs);
+    std::string fs = this->PassShader(vtkHistoPyramidFirstLevel_fs);
+    if (childMasks)
+    {
+      fs = WithDefine(fs, "MEDISO_CHILD_MASKS");
+    }
     const std::string vs = this->PassShader(vtkHistoPyramidFirstLevel_vs);
-    this->FirstQuad = win->GetShaderCache()->ReadyShaderProgram(
+    vtkShaderProgram*& program = childMasks ? this->FirstMaskQuad : this->FirstQuad;
+    program = win->GetShaderCache()->ReadyShaderProgram(
       vs.c_str(), fs.c_str(), vtkHistoPyramidFirstLevel_gs);
-    return this->FirstQuad;
+    return program;
   }
 
   // All `slices` z-slices of the layered attachment, in one draw call.
@@ -810,6 +834,12 @@ void vtkOpenGLHistoPyramid::SetShaderUniforms(vtkShaderProgram* program) const
   {
     impl.SetCommonUniforms(program, impl.Current);
   }
+}
+
+//------------------------------------------------------------------------------
+bool vtkOpenGLHistoPyramid::GetLevelOneHoldsChildMasks() const
+{
+  return this->Impl->Built && this->Impl->ChildMasks;
 }
 
 //------------------------------------------------------------------------------
@@ -1113,12 +1143,19 @@ bool vtkOpenGLHistoPyramid::Build(
     } while (size[0] > 1 || size[1] > 1 || size[2] > 1);
   }
   const int numLevels = static_cast<int>(impl.Sizes.size());
-
-  // 2. The programs.
-  vtkShaderProgram* firstProgram = impl.ReadyFirstLevelPass(renWin);
+  // One isovalue: level 1 holds each node's child mask, whose bits the
+  // reduction to level 2 counts (with a level 2 to count them: a volume of at
+  // most 2 cells per axis has level 1 on top, whose node must be the total).
+  const bool childMasks = thresholds.Count == 1 && numLevels >= 3;
+  vtkShaderProgram* firstProgram = impl.ReadyFirstLevelPass(renWin, childMasks);
   vtkShaderProgram* reduceProgram =
     Internals::ReadyPass(renWin, impl.ReduceQuad, Internals::PackedPass(vtkHistoPyramidReduce_fs));
-  if (!firstProgram || !reduceProgram)
+  vtkShaderProgram* reduceMaskProgram = childMasks
+    ? Internals::ReadyPass(renWin, impl.ReduceMaskQuad,
+        Internals::WithDefine(
+          Internals::PackedPass(vtkHistoPyramidReduce_fs), "MEDISO_LOWER_CHILD_MASKS"))
+    : reduceProgram;
+  if (!firstProgram || !reduceProgram || !reduceMaskProgram)
   {
     vtkErrorMacro("The HistoPyramid shaders do not build.");
     return false;
@@ -1210,13 +1247,15 @@ bool vtkOpenGLHistoPyramid::Build(
     glEndQuery(GL_PRIMITIVES_GENERATED);
   }
 
-  // 5. Reduction passes: level l from level l - 1.
-  renWin->GetShaderCache()->ReadyShaderProgram(reduceProgram);
+  // 5. Reduction passes: level l from level l - 1 (level 2 from child masks
+  //    by its own variant).
   for (int l = 2; l < numLevels; ++l)
   {
+    vtkShaderProgram* program = l == 2 ? reduceMaskProgram : reduceProgram;
+    renWin->GetShaderCache()->ReadyShaderProgram(program);
     ScopedTextureActive lowerActive(impl.Levels[l - 1]);
-    reduceProgram->SetUniformi("lowerLevel", impl.Levels[l - 1]->GetTextureUnit());
-    if (!drawLevel(reduceProgram, l))
+    program->SetUniformi("lowerLevel", impl.Levels[l - 1]->GetTextureUnit());
+    if (!drawLevel(program, l))
     {
       return false;
     }
@@ -1242,12 +1281,14 @@ bool vtkOpenGLHistoPyramid::Build(
   impl.TilesDrawn = primitives / 2;
   impl.Total = top[0];
   impl.Current = thresholds;
+  impl.ChildMasks = childMasks;
   impl.Built = true;
   return true;
 }
 
 //------------------------------------------------------------------------------
-bool vtkOpenGLHistoPyramid::ReadLevel(int level, std::vector<std::uint32_t>& counts, int size[3])
+bool vtkOpenGLHistoPyramid::ReadLevel(
+  int level, std::vector<std::uint32_t>& counts, int size[3], bool asStored)
 {
   Internals& impl = *this->Impl;
   if (!impl.Built || level < 0 || level >= static_cast<int>(impl.Sizes.size()) || !impl.Window)
@@ -1318,8 +1359,11 @@ bool vtkOpenGLHistoPyramid::ReadLevel(int level, std::vector<std::uint32_t>& cou
       for (int x = 0; x < s[0]; ++x)
       {
         const std::size_t texel = static_cast<std::size_t>(y / 2) * packed[0] + x / 2;
+        const GLuint node = texels[4 * texel + (x & 1) + 2 * (y & 1)];
+        // Child masks count their bits.
         counts[z * sliceCount + static_cast<std::size_t>(y) * s[0] + x] =
-          texels[4 * texel + (x & 1) + 2 * (y & 1)];
+          level == 1 && impl.ChildMasks && !asStored ? static_cast<std::uint32_t>(std::bitset<8>(node).count())
+                                        : node;
       }
     }
   }

@@ -21,7 +21,10 @@
  * Memory. Level 0 is never stored: level 1 is computed straight from the
  * volume (each node reads the <= 27 corner values of its <= 8 cells once),
  * and the traversal recounts the cells of the level-1 node it reaches from
- * the same corner values, which it needs anyway to draw the cell. Each stored
+ * the same corner values, which it needs anyway to draw the cell. With one
+ * isovalue, level 1 holds each node's child mask instead of its count (see
+ * GetLevelOneHoldsChildMasks()), in the same bytes, and the traversal reads
+ * which cells are active with no recount. Each stored
  * level takes the narrowest unsigned integer format that holds its largest
  * possible count (8 isovalues times the cells under a node): 8 bits for
  * level 1, 16 up to level 4, 32 above. The whole pyramid is then about 0.16
@@ -50,7 +53,9 @@
  * -# Level-1 pass (vtkHistoPyramidFirstLevel_fs.glsl): fragment (i, j) of
  *    slice k is the packed texel of nodes (2i + a, 2j + b, k); each node
  *    sums over its cells the number of isovalues with min < iso <= max
- *    over the cell's eight corners (the convention of vtkMarchingCubes).
+ *    over the cell's eight corners (the convention of vtkMarchingCubes);
+ *    with one isovalue it writes the node's child mask instead, whose set
+ *    bits the reduction to level 2 counts (a compiled variant of each pass).
  *    Only the tiles of the level (TileNodes x TileNodes x 1 nodes) that can
  *    hold an active cell are drawn: UploadVolume() computes, once, the range
  *    of the point values each tile's cells read (a small RG32 texture, 8
@@ -163,9 +168,11 @@ public:
    * window of the last Build() to be alive. Level 0, which is not stored, is
    * drawn into a temporary texture by the same crossing code first
    * (vtkHistoPyramidBase_fs.glsl). Returns false when there is no such level
-   * or reading fails.
+   * or reading fails. Level 1 comes back as counts even where it holds child
+   * masks (GetLevelOneHoldsChildMasks()), unless @a asStored is true: then
+   * each node's value as stored.
    */
-  bool ReadLevel(int level, std::vector<std::uint32_t>& counts, int size[3]);
+  bool ReadLevel(int level, std::vector<std::uint32_t>& counts, int size[3], bool asStored = false);
 
   /// Size of a level of the last successful Build(); false when there is none.
   bool GetLevelSize(int level, int size[3]) const;
@@ -199,6 +206,19 @@ public:
    * no cell of the volume's value type (and NaN ones) are left out.
    */
   std::vector<int> GetCountedIsovalues() const;
+
+  /**
+   * Whether the last successful Build() stored level 1 as child masks rather
+   * than counts: with one counted isovalue (and a level 2 above level 1),
+   * component a + 2b of a level-1 texel holds bit c set when child cell c
+   * (dx + 2 dy + 4 dz) of node (2i + a, 2j + b, k) crosses the isovalue, so
+   * the node's count is its number of bits set. The same bytes as the counts
+   * (a node's count is at most 8 then), and a walk that reaches a level-1
+   * node reads which of its cells are active with no recount
+   * (vtkHistoPyramidIso_vs.glsl, MEDISO_CHILD_MASKS). ReadLevel() returns
+   * counts either way.
+   */
+  bool GetLevelOneHoldsChildMasks() const;
 
   ///@{
   /**

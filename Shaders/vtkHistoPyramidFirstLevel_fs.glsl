@@ -33,7 +33,11 @@ out uvec4 fragOutput0;
 
 // The crossings of node `node`, whose <= 27 corner values are p[i + 3 j +
 // 9 k] (points node * factor + (i, j, k), clamped to the volume): 0 beyond
-// level 1's size.
+// level 1's size. With one isovalue (MEDISO_CHILD_MASKS) the node's child mask
+// instead: bit X + 2 Y + 4 Z set when child cell (X, Y, Z) crosses it, the
+// count being the number of bits set (the reduction to level 2 counts them;
+// the mapper's walk then reads which cells of the node are active with the
+// count it reads anyway, and recounts nothing).
 uint nodeCount(ivec3 node, VALUE_TYPE p[27])
 {
   if (any(greaterThanEqual(node, levelSize)))
@@ -44,12 +48,17 @@ uint nodeCount(ivec3 node, VALUE_TYPE p[27])
   // Each child cell's corners by constant indices (arrays indexed by
   // variables are spilled to memory by software rasterisers such as llvmpipe).
   uint sum = 0u;
+#ifdef MEDISO_CHILD_MASKS
+#define MEDISO_ADD_CHILD(m, c) sum |= uint(m & 1) << uint(c);
+#else
+#define MEDISO_ADD_CHILD(m, c) sum += bitCount8(m);
+#endif
 #define MEDISO_CHILD(X, Y, Z)                                                                \
   if (X < factor.x && Y < factor.y && Z < factor.z)                                         \
   {                                                                                         \
     VALUE_TYPE w[8];                                                                        \
     MEDISO_CHILD_CORNERS(w, p, X, Y, Z)                                                     \
-    sum += bitCount8(cellMask(first + ivec3(X, Y, Z), w));                                  \
+    MEDISO_ADD_CHILD(cellMask(first + ivec3(X, Y, Z), w), X + 2 * Y + 4 * Z)                \
   }
   MEDISO_CHILD(0, 0, 0)
   MEDISO_CHILD(1, 0, 0)

@@ -27,8 +27,16 @@ flat in int slice;       // z of the slice being written (vtkHistoPyramidLayer_g
 
 out uvec4 fragOutput0;
 
+// The sum of 4 counts or, where the level below is level 1 holding child
+// masks (MEDISO_LOWER_CHILD_MASKS: one isovalue, see vtkOpenGLHistoPyramid::
+// GetLevelOneHoldsChildMasks()), of the set bits of 4 masks of 8 bits.
 uint sum4(uvec4 v)
 {
+#ifdef MEDISO_LOWER_CHILD_MASKS
+  v = (v & 0x55u) + ((v >> 1u) & 0x55u);
+  v = (v & 0x33u) + ((v >> 2u) & 0x33u);
+  v = (v & 0x0Fu) + (v >> 4u);
+#endif
   return v.x + v.y + v.z + v.w;
 }
 

@@ -200,6 +200,46 @@ void CompareBuild(vtkOpenGLHistoPyramid* gpu, const std::string& name, const T* 
   Check(hasNaN ? drawn >= expectedTiles : drawn == expectedTiles,
     what + ": the level-1 pass drew " + std::to_string(drawn) + " tiles, not " +
       std::to_string(expectedTiles));
+
+  // With one counted isovalue (and a level 2), level 1 holds child masks:
+  // bit dx + 2 dy + 4 dz of node n set exactly when its child cell
+  // n * factor + (dx, dy, dz) is active in the CPU's base level. The counts
+  // above only check the number of bits; the mapper's walk reads the bits.
+  const bool masksExpected = gpu->GetCountedIsovalues().size() == 1 && cpu.GetNumberOfLevels() >= 3;
+  Check(gpu->GetLevelOneHoldsChildMasks() == masksExpected,
+    what + ": level 1 should hold " + (masksExpected ? "child masks" : "counts"));
+  if (gpu->GetLevelOneHoldsChildMasks())
+  {
+    std::vector<std::uint32_t> stored;
+    int size[3] = { 0, 0, 0 };
+    if (!gpu->ReadLevel(1, stored, size, true))
+    {
+      Check(false, what + ": level 1 cannot be read back as stored");
+      return;
+    }
+    const int* base = cpu.GetLevelSize(0);
+    const int factor[3] = { base[0] / one[0], base[1] / one[1], base[2] / one[2] };
+    int maskMismatches = 0;
+    std::size_t id = 0;
+    for (int k = 0; k < one[2]; ++k)
+      for (int j = 0; j < one[1]; ++j)
+        for (int i = 0; i < one[0]; ++i, ++id)
+        {
+          std::uint32_t want = 0;
+          for (int c = 0; c < 8; ++c)
+          {
+            const int d[3] = { c & 1, (c >> 1) & 1, (c >> 2) & 1 };
+            if (d[0] < factor[0] && d[1] < factor[1] && d[2] < factor[2] &&
+              cpu.GetCount(0, i * factor[0] + d[0], j * factor[1] + d[1], k * factor[2] + d[2]) != 0)
+            {
+              want |= 1u << c;
+            }
+          }
+          maskMismatches += stored[id] != want ? 1 : 0;
+        }
+    Check(maskMismatches == 0,
+      what + ": " + std::to_string(maskMismatches) + " level-1 child masks differ from the CPU's");
+  }
 }
 
 // One scalar type: upload, then every isovalue set.
