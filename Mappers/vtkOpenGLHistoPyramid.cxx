@@ -576,7 +576,7 @@ struct vtkOpenGLHistoPyramid::Internals
   vtkShaderProgram* FirstQuad = nullptr; // the level-1 pass, drawn by tiles
   vtkShaderProgram* FirstMaskQuad = nullptr; // the same, writing child masks
   vtkShaderProgram* BaseQuad = nullptr;  // ReadLevel(0) only
-  ValueKind QuadKind = ValueKind::Float; // value type of FirstQuad and BaseQuad
+  ValueKind QuadKind = ValueKind::Float; // value type of FirstQuad, FirstMaskQuad and BaseQuad
   vtkShaderProgram* ReduceQuad = nullptr;
   vtkShaderProgram* ReduceMaskQuad = nullptr; // level 2 from child masks
   vtkNew<vtkOpenGLVertexArrayObject> VAO;
@@ -752,6 +752,7 @@ struct vtkOpenGLHistoPyramid::Internals
     if (this->QuadKind != this->Format.Kind)
     {
       ReleaseQuad(win, this->FirstQuad);
+      ReleaseQuad(win, this->FirstMaskQuad);
       ReleaseQuad(win, this->BaseQuad);
       this->QuadKind = this->Format.Kind;
     }
@@ -1360,10 +1361,11 @@ bool vtkOpenGLHistoPyramid::ReadLevel(
       {
         const std::size_t texel = static_cast<std::size_t>(y / 2) * packed[0] + x / 2;
         const GLuint node = texels[4 * texel + (x & 1) + 2 * (y & 1)];
-        // Child masks count their bits.
-        counts[z * sliceCount + static_cast<std::size_t>(y) * s[0] + x] =
-          level == 1 && impl.ChildMasks && !asStored ? static_cast<std::uint32_t>(std::bitset<8>(node).count())
-                                        : node;
+        // A child mask counts its set bits.
+        const bool mask = level == 1 && impl.ChildMasks && !asStored;
+        counts[z * sliceCount + static_cast<std::size_t>(y) * s[0] + x] = mask
+          ? static_cast<std::uint32_t>(std::bitset<8>(node).count())
+          : static_cast<std::uint32_t>(node);
       }
     }
   }
