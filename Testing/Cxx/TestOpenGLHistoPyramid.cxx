@@ -5,7 +5,9 @@
 // each supported scalar type and for many isovalue sets (single isovalues
 // across the range, isovalues equal to data values and just beside them,
 // sets of 2 to 8, duplicates, NaN), and for thin int16 volumes (3x40x17,
-// 40x2x9, 2x2x30 points: axes that reach one node early). Also checks that
+// 40x2x9, 2x2x30 points: axes that reach one node early); where one isovalue
+// is counted, level 1's child masks bit for bit against the CPU's base
+// level (vtkOpenGLHistoPyramid::GetLevelOneHoldsChildMasks()). Also checks that
 // the OpenGL state is left as it was, that ReleaseGraphicsResources() then a
 // new upload and build work, and reports the GPU memory of a 256^3 int16
 // volume.
