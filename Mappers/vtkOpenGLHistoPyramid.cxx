@@ -1343,6 +1343,8 @@ bool vtkOpenGLHistoPyramid::ReadLevel(
   const std::size_t sliceCount = static_cast<std::size_t>(s[0]) * s[1];
   const std::array<int, 3> packed = Packed(s);
   std::vector<GLuint> texels(4 * static_cast<std::size_t>(packed[0]) * packed[1]);
+  // Level 1 holding child masks comes back as their counts of set bits.
+  const bool countBits = level == 1 && impl.ChildMasks && !asStored;
   for (int z = 0; z < s[2]; ++z)
   {
     glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, texture->GetHandle(), 0, z);
@@ -1361,9 +1363,7 @@ bool vtkOpenGLHistoPyramid::ReadLevel(
       {
         const std::size_t texel = static_cast<std::size_t>(y / 2) * packed[0] + x / 2;
         const GLuint node = texels[4 * texel + (x & 1) + 2 * (y & 1)];
-        // A child mask counts its set bits.
-        const bool mask = level == 1 && impl.ChildMasks && !asStored;
-        counts[z * sliceCount + static_cast<std::size_t>(y) * s[0] + x] = mask
+        counts[z * sliceCount + static_cast<std::size_t>(y) * s[0] + x] = countBits
           ? static_cast<std::uint32_t>(std::bitset<8>(node).count())
           : static_cast<std::uint32_t>(node);
       }

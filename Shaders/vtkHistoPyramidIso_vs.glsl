@@ -125,6 +125,18 @@ int pickChild(uvec4 low, uvec4 high, int mask, inout uint index)
   return order ^ mask;
 }
 
+// The stored values of node's children in the level below: low for dz = 0,
+// high for dz = 1 (0 where z has one node).
+void childTexels(usampler3D lower, ivec3 factor, ivec3 node, out uvec4 low, out uvec4 high)
+{
+  low = texelFetch(lower, ivec3(node.xy, node.z * factor.z), 0);
+  high = uvec4(0u);
+  if (factor.z == 2)
+  {
+    high = texelFetch(lower, ivec3(node.xy, 2 * node.z + 1), 0);
+  }
+}
+
 // One step down: from node (of the level above `lower`) to the child whose
 // running sum, in visiting order, covers index. Levels are stored packed
 // (texel (i, j, k) holds nodes (2i + a, 2j + b, k) in component a + 2b; see
@@ -137,14 +149,9 @@ int pickChild(uvec4 low, uvec4 high, int mask, inout uint index)
 // the CT's 7 levels against 2 s without loops).
 void descend(usampler3D lower, ivec3 factor, vec3 childSpan, inout ivec3 node, inout uint index)
 {
-  int mask = orderMask(node, factor, childSpan);
-  uvec4 low = texelFetch(lower, ivec3(node.xy, node.z * factor.z), 0);
-  uvec4 high = uvec4(0u);
-  if (factor.z == 2)
-  {
-    high = texelFetch(lower, ivec3(node.xy, 2 * node.z + 1), 0);
-  }
-  int child = pickChild(low, high, mask, index);
+  uvec4 low, high;
+  childTexels(lower, factor, node, low, high);
+  int child = pickChild(low, high, orderMask(node, factor, childSpan), index);
   node = node * factor + ivec3(child & 1, (child >> 1) & 1, (child >> 2) & 1);
 }
 
@@ -165,14 +172,9 @@ uvec4 bitCounts(uvec4 m)
 void descendToMasks(usampler3D lower, ivec3 factor, vec3 childSpan, inout ivec3 node,
   inout uint index, out int bits)
 {
-  int mask = orderMask(node, factor, childSpan);
-  uvec4 low = texelFetch(lower, ivec3(node.xy, node.z * factor.z), 0);
-  uvec4 high = uvec4(0u);
-  if (factor.z == 2)
-  {
-    high = texelFetch(lower, ivec3(node.xy, 2 * node.z + 1), 0);
-  }
-  int child = pickChild(bitCounts(low), bitCounts(high), mask, index);
+  uvec4 low, high;
+  childTexels(lower, factor, node, low, high);
+  int child = pickChild(bitCounts(low), bitCounts(high), orderMask(node, factor, childSpan), index);
   node = node * factor + ivec3(child & 1, (child >> 1) & 1, (child >> 2) & 1);
   uvec4 layer = child < 4 ? low : high;
   int a = child & 3;
