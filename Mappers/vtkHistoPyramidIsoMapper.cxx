@@ -719,12 +719,12 @@ bool vtkHistoPyramidIsoMapper::RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkIm
   for (int l = numLevels - 1; l >= 2; --l)
   {
     const int c = l - 1;
-    descend << (childMasks && c == 1 ? "  descendToMasks(level" : "  descend(level") << c
-            << ", ivec3(" << sizes[c][0] / sizes[l][0] << ", " << sizes[c][1] / sizes[l][1]
-            << ", " << sizes[c][2] / sizes[l][2] << "), vec3(" << sizes[0][0] / sizes[c][0]
-            << ".0, " << sizes[0][1] / sizes[c][1] << ".0, " << sizes[0][2] / sizes[c][2]
-            << ".0), node, index"
-            << (childMasks && c == 1 ? ", nodeBits" : "") << ");\n";
+    const bool toMasks = childMasks && c == 1;
+    descend << (toMasks ? "  descendToMasks(level" : "  descend(level") << c << ", ivec3("
+            << sizes[c][0] / sizes[l][0] << ", " << sizes[c][1] / sizes[l][1] << ", "
+            << sizes[c][2] / sizes[l][2] << "), vec3(" << sizes[0][0] / sizes[c][0] << ".0, "
+            << sizes[0][1] / sizes[c][1] << ".0, " << sizes[0][2] / sizes[c][2]
+            << ".0), node, index" << (toMasks ? ", nodeBits" : "") << ");\n";
   }
   const std::string declarations = impl.Pyramid->GetShaderDeclarations();
 

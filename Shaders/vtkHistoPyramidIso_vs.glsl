@@ -421,9 +421,11 @@ void main()
   ivec4 masksLow, masksHigh; // child c's crossing mask: c < 4 ? masksLow[c] : masksHigh[c - 4]
 #ifdef MEDISO_CHILD_MASKS
   // One isovalue: the masks came with the last step down (a cell's crossing
-  // mask is then its bit).
+  // mask is then its bit, and its count the same bit).
   masksLow = (ivec4(nodeBits) >> ivec4(0, 1, 2, 3)) & 1;
   masksHigh = (ivec4(nodeBits) >> ivec4(4, 5, 6, 7)) & 1;
+  uvec4 countsLow = uvec4(masksLow);
+  uvec4 countsHigh = uvec4(masksHigh);
 #else
 #define MEDISO_CHILD(C, X, Y, Z)                                                             \
   {                                                                                         \
@@ -444,11 +446,6 @@ void main()
   MEDISO_CHILD(5, 1, 0, 1)
   MEDISO_CHILD(6, 0, 1, 1)
   MEDISO_CHILD(7, 1, 1, 1)
-#endif
-#ifdef MEDISO_CHILD_MASKS
-  uvec4 countsLow = uvec4(masksLow);
-  uvec4 countsHigh = uvec4(masksHigh);
-#else
   uvec4 countsLow = uvec4(bitCount8(masksLow.x), bitCount8(masksLow.y), bitCount8(masksLow.z),
     bitCount8(masksLow.w));
   uvec4 countsHigh = uvec4(bitCount8(masksHigh.x), bitCount8(masksHigh.y),
