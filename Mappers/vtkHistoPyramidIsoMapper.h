@@ -6,66 +6,51 @@
  * vtkHistoPyramidIsoMapper renders the isosurfaces of a vtkVolumeProperty
  * (vtkVolumeProperty::GetIsoSurfaceValues(), up to 8) of a single-component
  * vtkImageData as the exact surfaces of the trilinear interpolant, with
- * correct depth, in OpenGL 3.2 core / GLSL 1.50. It implements the GPU path of
- * "Hardware Accelerated Medical Data Visualisation on the Web" (section 4.1),
- * which follows Liu, Clapworthy & Dong, "Fast isosurface rendering on a GPU by
- * cell rasterization" (2009), with the HistoPyramid of Ziegler et al. (2006):
+ * correct depth. It implements the GPU path of "Hardware Accelerated Medical
+ * Data Visualisation on the Web" (section 4.1), which follows Liu, Clapworthy
+ * & Dong, "Fast isosurface rendering on a GPU by cell rasterization" (2009),
+ * with the HistoPyramid of Ziegler et al. (2006), and the paper's CPU path
+ * where a GPU cannot run it. Like vtkSmartVolumeMapper, it checks the input
+ * and chooses; the work is done by:
  *
- * -# The volume is uploaded once as a 3D texture that keeps its precision
- *    (int16 stays 16-bit) and kept until the input or its array changes.
- * -# vtkOpenGLHistoPyramid counts the active cells of the current isovalues
- *    (min < iso <= max over the 8 corners, as vtkMarchingCubes) in a 3D 8:1
- *    pyramid built by render-to-texture passes; only the total comes back to
- *    the CPU. It is rebuilt only when the isovalues or the data change:
- *    camera moves reuse it (GetNumberOfPyramidBuilds()).
- * -# One glDrawArrays(GL_POINTS, 0, total) with no vertex attributes draws
- *    every active (cell, isovalue) pair. The vertex stage
- *    (vtkHistoPyramidIso_vs.glsl) walks down the pyramid with gl_VertexID to
- *    its cell, visiting children nearest-first for the current eye, so the
- *    primitives come out front to back with no sort (back to front for
- *    translucency) and, on frames where that provably covers every cell
- *    (the volume beyond the near plane, no cell wider than the largest
- *    point), makes the cell's footprint a point sprite over the bounding
- *    square of the projected box that holds the surface in that cell (the
- *    crossings on its edges and the faces that straddle the isovalue bound
- *    it; often much less than the cell); on other frames (close zooms, the eye
- *    in the volume) the geometry stage (vtkHistoPyramidIso_gs.glsl) emits
- *    the faces of the cell box that face the eye, a footprint that covers the
- *    cell at any zoom in both projections (see AllowPointFootprint,
- *    GetLastFootprint()); the fragment stage
- *    (vtkHistoPyramidIso_fs.glsl) finds the first root of the cubic the
- *    trilinear interpolant makes along the ray, shades it with Phong (the
- *    volume property's ambient, diffuse, specular and specular power, the
- *    renderer's lights) and writes gl_FragDepth (or, in the first-hit
- *    pass of opaque frames, see FirstHitPass, its colour and depth go to
- *    the mapper's own buffers and are composited after).
- * -# Colour and opacity of each isovalue come from the property's colour and
- *    scalar opacity transfer functions at that value. When all are opaque,
- *    each primitive draws one isovalue, front to back, with depth writes
- *    (in the first-hit pass each cell is one primitive that takes the
- *    nearest hit of its isovalues).
- *    Otherwise every cell is drawn once, back to front, and composites all of
- *    its isovalues' hits in depth order: translucent skin over opaque bone
- *    in one pass, blended over whatever the scene holds.
- * -# The drawing program is compiled per variant (footprint, opaque or
- *    translucent, number of lights): a software rasteriser such as llvmpipe
- *    runs every branch of a fragment shader under SIMD masks, so a mode's
- *    code left in another mode's shader costs every fragment.
+ * - vtkOpenGLHistoPyramidIsosurfaces, the GPU path: a thin VTK shell over
+ *   the portable core (mediso::HistoPyramidGL, mediso::IsosurfaceRendererGL;
+ *   OpenGL 3.2 core / OpenGL ES 3.0, the same code as mediso-render and the
+ *   web page). The volume is uploaded once as a 3D texture of its own type
+ *   (int16 stays 16-bit); the core counts the active cells of the current
+ *   isovalues (min < iso <= max over the 8 corners, as vtkMarchingCubes) in
+ *   a 3D 8:1 pyramid built by render-to-texture passes, rebuilt only when the
+ *   isovalues or the data change (camera moves reuse it:
+ *   GetNumberOfPyramidBuilds()); one draw call with no vertex attributes
+ *   draws every active (cell, isovalue) pair, each walking down the pyramid
+ *   to its cell front to back (back to front for translucency), covering the
+ *   projected box that holds its surface with a point sprite or, where points
+ *   cannot provably cover the cells (close zooms, the eye in the volume), a
+ *   quad (see AllowPointFootprint, GetLastFootprint()); the fragment stage
+ *   finds the first root of the trilinear interpolant's cubic along the ray,
+ *   shades it with Phong (the volume property's ambient, diffuse, specular
+ *   and specular power, the renderer's lights) and writes its depth.
+ *   Opaque frames draw one isovalue per primitive front to back (through the
+ *   first-hit pass, see FirstHitPass); translucent ones draw each cell once,
+ *   back to front, compositing all its isovalues' hits in depth order
+ *   (translucent skin over opaque bone in one pass).
+ * - vtkBlockLODIsosurfaces, the CPU path: vtkBlockLODContour (level 3) and a
+ *   vtkPolyDataMapper (translucent surfaces sorted back to front).
  *
- * The volume's matrix (position, orientation, scale), the image's spacing,
- * origin and direction matrix are honoured. Surfaces are always shaded
- * (an unshaded isosurface shows no shape), regardless of
- * vtkVolumeProperty::GetShade().
+ * Colour and opacity of each isovalue come from the property's colour and
+ * scalar opacity transfer functions at that value. The volume's matrix
+ * (position, orientation, scale), the image's spacing, origin and direction
+ * matrix are honoured. Surfaces are always shaded (an unshaded isosurface
+ * shows no shape), regardless of vtkVolumeProperty::GetShade().
  *
  * Capability check and fallback: the first render in a window runs
  * vtkMedicalGLCapabilities::Probe(); if the context lacks OpenGL 3.2 or
- * working integer textures, a shader does not build, the volume exceeds
- * GL_MAX_3D_TEXTURE_SIZE, or the pyramid needs more vertex texture units than
- * the context has (or MEDISO_DISABLE_GPU_PATH=1, or ForceCPUFallback is on),
- * the mapper says so once (a warning with the reason) and renders the same
- * isovalues with vtkBlockLODContour (level 3) and a vtkPolyDataMapper
- * (translucent surfaces are then blended unsorted). GetLastRenderPath()
- * tells which path drew the last frame, GetFallbackReason() why.
+ * working integer textures, a shader does not build, the volume exceeds the
+ * context's texture limits, or the pyramid needs more vertex texture units
+ * than the context has (or MEDISO_DISABLE_GPU_PATH=1, or ForceCPUFallback is
+ * on), the mapper says so once (a warning with the reason) and renders with
+ * the CPU path. GetLastRenderPath() tells which path drew the last frame,
+ * GetFallbackReason() why.
  *
  * GPU memory: GetGPUMemoryBytes() (the volume texture plus about 0.16 bytes
  * per padded cell for the pyramid) stays the same across isovalue changes;
@@ -75,12 +60,14 @@
  * points along an axis, an unsupported type, no isovalues) gives one error
  * or warning and nothing drawn, never a crash.
  *
- * @sa vtkOpenGLHistoPyramid vtkMedicalGLCapabilities vtkBlockLODContour
+ * @sa vtkOpenGLHistoPyramidIsosurfaces vtkBlockLODIsosurfaces vtkMedicalGLCapabilities
+ * vtkBlockLODContour
  */
 #ifndef vtkHistoPyramidIsoMapper_h
 #define vtkHistoPyramidIsoMapper_h
 
 #include "MedicalIsosurfacesMappersModule.h" // For export macro
+#include "vtkOpenGLHistoPyramidIsosurfaces.h"  // For Surface
 #include "vtkVolumeMapper.h"
 
 #include <cstdint> // For std::uint64_t
@@ -88,9 +75,6 @@
 #include <string>  // For std::string
 #include <vector>  // For std::vector
 
-class vtkDataArray;
-class vtkImageData;
-class vtkOpenGLRenderWindow;
 
 class MEDICALISOSURFACESMAPPERS_EXPORT vtkHistoPyramidIsoMapper : public vtkVolumeMapper
 {
@@ -132,19 +116,20 @@ public:
   /// How the GPU path covers each cell on screen.
   enum FootprintType
   {
-    BoxFootprint = 0,  ///< The cell box's front faces, from a geometry shader.
+    BoxFootprint = 0,  ///< A quad over the projection of the surface's box in the cell, cut by the near plane.
     PointFootprint = 1 ///< One point sprite over the projected bounding square of the surface's box in the cell.
   };
 
   ///@{
   /**
-   * Let the GPU path draw each cell as one point sprite (no geometry shader)
-   * on frames where that provably covers every cell: the whole volume lies
-   * beyond the near plane and no cell can project to more pixels than
-   * GL_POINT_SIZE_RANGE allows. Other frames (close zooms, the eye in or near
-   * the volume) draw the cell box's front faces. Both footprints feed the
-   * same ray casting, so they give the same image; points are much cheaper
-   * where primitives are costly (software rasterisers). Default on.
+   * Let the GPU path draw each cell as one point sprite on frames where that
+   * provably covers every cell: the whole volume lies beyond the near plane
+   * and no cell can project to more pixels than GL_POINT_SIZE_RANGE allows.
+   * Other frames (close zooms, the eye in or near the volume) draw a quad
+   * per cell (an instanced strip of 4 vertices, each walking the pyramid).
+   * Both footprints feed the same ray casting, so they give the same image;
+   * points are much cheaper where vertex work is costly (software
+   * rasterisers). Default on.
    */
   vtkSetMacro(AllowPointFootprint, bool);
   vtkGetMacro(AllowPointFootprint, bool);
@@ -152,7 +137,7 @@ public:
   ///@}
 
   ///@{
-  /// The footprint of the last GPU frame (a FootprintType; "boxes" or "points").
+  /// The footprint of the last GPU frame (a FootprintType; "boxes" for the quads, or "points").
   vtkGetMacro(LastFootprint, int);
   const char* GetLastFootprintAsString() const;
   ///@}
@@ -240,14 +225,7 @@ private:
   std::uint64_t NumberOfVolumeUploads = 0;
   std::uint64_t NumberOfFallbackTriangles = 0;
 
-  struct Surface; // one isovalue and its colour and opacity
-  bool RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image, vtkDataArray* scalars,
-    const std::vector<Surface>& surfaces, std::string& reason);
-  bool PrepareFirstHit(
-    vtkOpenGLRenderWindow* renWin, int rectWidth, int rectHeight, const int viewport[4]);
-  bool CompositeFirstHit(vtkOpenGLRenderWindow* renWin, std::string& reason);
-  void RenderFallback(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image,
-    vtkDataArray* scalars, const std::vector<Surface>& surfaces);
+  using Surface = vtkOpenGLHistoPyramidIsosurfaces::Surface;
 
   struct Internals;
   std::unique_ptr<Internals> Impl;

@@ -16,23 +16,13 @@
  * -# It makes the context of a vtkOpenGLRenderWindow current (initialising
  *    the window first if it has no context yet; on X11 it first checks that
  *    the X display can be opened, because VTK aborts the process otherwise).
- * -# It reads the GL_VENDOR, GL_RENDERER, GL_VERSION and
- *    GL_SHADING_LANGUAGE_VERSION strings, the context version and profile
- *    (OpenGL 3.2 or newer is required) and the limits GL_MAX_3D_TEXTURE_SIZE,
- *    GL_MAX_TEXTURE_SIZE, GL_MAX_COLOR_ATTACHMENTS, GL_MAX_DRAW_BUFFERS and
- *    GL_POINT_SIZE_RANGE.
- * -# It runs a functional probe of exactly what the HistoPyramid base level
- *    does: a small deterministic int16 volume (with negative values) is
- *    uploaded as a GL_RGBA16I 3D texture (4 points to a texel along x, as the
- *    mapper stores a volume), one full-screen pass of the fragment
- *    shader vtkMedicalProbe_fs.glsl writes, into a GL_R32UI texture attached
- *    to a framebuffer object, the number of active cells of every cell column
- *    (texelFetch from an isampler3D), and the counts read back with
- *    glReadPixels(GL_RED_INTEGER, GL_UNSIGNED_INT) are compared with the same
- *    counts computed on the CPU, for three isovalues. A cell is active when
- *    its eight corner values straddle the isovalue: min < iso <= max (the
- *    marching-cubes case index, with "inside" meaning value >= iso, is then
- *    neither 0 nor 255).
+ * -# It loads the GPU core's view of the context (LoadCoreApi(): the
+ *    functions from VTK's GLEW, the version, OpenGL 3.2 or newer being
+ *    required, and the limits) and reports its strings and limits.
+ * -# It runs the core's functional probe (mediso::ProbeGL(): a small int16
+ *    volume as an RGBA16I 3D texture, classified into an R32UI target and
+ *    compared with the CPU for three isovalues), which checks the integer
+ *    textures and targets the HistoPyramid relies on.
  *
  * Probe() saves and restores every piece of OpenGL state it changes (current
  * context, framebuffer bindings and draw/read buffers, viewport, enable
@@ -65,8 +55,13 @@
 #include "MedicalIsosurfacesMappersModule.h" // For export macro
 #include "vtkObject.h"
 
+#include <memory> // For std::shared_ptr
 #include <string> // For std::string
 
+namespace mediso
+{
+class GLApi;
+}
 class vtkOpenGLRenderWindow;
 class vtkRenderWindow;
 
@@ -170,6 +165,16 @@ public:
    */
   static bool IsGPUPathDisabledByEnvironment();
 
+  /**
+   * The GPU core's view (mediso::GLApi) of the context of @a win, which
+   * must be current: its functions from VTK's GLEW, its version and
+   * limits. Null, with the reason in @a error, on a window that is not an
+   * OpenGL one or a context the core cannot use (older than OpenGL 3.2, a
+   * function missing).
+   */
+  static std::shared_ptr<const mediso::GLApi> LoadCoreApi(
+    vtkRenderWindow* win, std::string& error);
+
 protected:
   vtkMedicalGLCapabilities();
   ~vtkMedicalGLCapabilities() override;
@@ -180,9 +185,6 @@ private:
 
   void ResetResults();
   void SetFailure(int status, const std::string& reason);
-  void QueryStrings();
-  void QueryLimits();
-  bool RunFunctionalProbe(vtkOpenGLRenderWindow* win);
 
   bool Supported = false;
   int Status = StatusNotProbed;

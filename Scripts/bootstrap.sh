@@ -27,6 +27,9 @@ packages=(
   cmake ninja-build g++ make python3
   # rendering without a display (Mesa llvmpipe), and tests' network namespaces
   xvfb libgl1-mesa-dri iproute2 util-linux
+  # the GPU core's headless host (mediso-render, EGL tests): EGL, the Khronos
+  # GLES3 headers, Mesa's EGL (surfaceless llvmpipe), zlib for PNG
+  libegl-dev libgles-dev libegl-mesa0 zlib1g-dev
 )
 
 missing=()

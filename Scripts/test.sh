@@ -25,7 +25,7 @@ if [ "${MEDISO_ASAN:-1}" != 0 ]; then
   cmake --build "$asan" --parallel "$(nproc)" --target MedicalIsosurfacesCxxTestTargets
   (cd "$asan" &&
     ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -L '^cxx$' &&
-    ASAN_OPTIONS=detect_leaks=0 ctest --output-on-failure -L '^cxx-render$')
+    ASAN_OPTIONS=detect_leaks=0 ctest --output-on-failure -L '^cxx-(render|egl)$')
 fi
 
 # Tests on the real CT and MRI need the data cache; without network they skip.

@@ -8,6 +8,7 @@
 #define MedicalIsosurfaces_ScalarTypes_h
 
 #include <cstdint>
+#include <type_traits>
 
 /// Applies MACRO(T); to every supported scalar type (for explicit instantiation).
 #define MEDISO_FOR_EACH_SCALAR_TYPE(MACRO)                                                         \
@@ -19,5 +20,82 @@
   MACRO(std::uint32_t);                                                                            \
   MACRO(float);                                                                                    \
   MACRO(double)
+
+namespace mediso
+{
+/// A supported scalar type, for hosts that hold data as bytes (not templates).
+enum class ScalarType
+{
+  Int8,
+  UInt8,
+  Int16,
+  UInt16,
+  Int32,
+  UInt32,
+  Float32,
+  Float64
+};
+
+/// The ScalarType of T (T one of MEDISO_FOR_EACH_SCALAR_TYPE's types).
+template <typename T>
+constexpr ScalarType ScalarTypeOf()
+{
+  static_assert(std::is_arithmetic<T>::value, "not a scalar type");
+  if (std::is_floating_point<T>::value)
+  {
+    return sizeof(T) == 4 ? ScalarType::Float32 : ScalarType::Float64;
+  }
+  switch (sizeof(T))
+  {
+    case 1:
+      return std::is_signed<T>::value ? ScalarType::Int8 : ScalarType::UInt8;
+    case 2:
+      return std::is_signed<T>::value ? ScalarType::Int16 : ScalarType::UInt16;
+    default:
+      return std::is_signed<T>::value ? ScalarType::Int32 : ScalarType::UInt32;
+  }
+}
+
+/// Calls f(T()) with the C++ type of `type`.
+template <typename F>
+void DispatchScalarType(ScalarType type, F&& f)
+{
+  switch (type)
+  {
+    case ScalarType::Int8:
+      f(std::int8_t());
+      break;
+    case ScalarType::UInt8:
+      f(std::uint8_t());
+      break;
+    case ScalarType::Int16:
+      f(std::int16_t());
+      break;
+    case ScalarType::UInt16:
+      f(std::uint16_t());
+      break;
+    case ScalarType::Int32:
+      f(std::int32_t());
+      break;
+    case ScalarType::UInt32:
+      f(std::uint32_t());
+      break;
+    case ScalarType::Float32:
+      f(float());
+      break;
+    case ScalarType::Float64:
+      f(double());
+      break;
+  }
+}
+
+/// Bytes of one value of `type`.
+inline int ScalarTypeSize(ScalarType type)
+{
+  int size = 0;
+  DispatchScalarType(type, [&](auto v) { size = static_cast<int>(sizeof(v)); });
+  return size;
+}
+} // namespace mediso
 
 #endif

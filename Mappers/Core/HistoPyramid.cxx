@@ -8,58 +8,32 @@
 
 namespace mediso
 {
-namespace
-{
-int NextPowerOfTwo(int n)
-{
-  int p = 1;
-  while (p < n)
-  {
-    p *= 2;
-  }
-  return p;
-}
-} // namespace
-
 void HistoPyramid::Build(const int cells[3], const std::vector<std::uint32_t>& baseCounts)
 {
-  this->Levels.clear();
-  Level base;
-  for (int a = 0; a < 3; ++a)
-  {
-    this->Cells[a] = std::max(1, cells[a]);
-    base.Size[a] = NextPowerOfTwo(this->Cells[a]);
-  }
-  base.Counts.assign(static_cast<std::size_t>(base.Size[0]) * base.Size[1] * base.Size[2], 0);
+  this->Layout = PyramidLayout(cells);
+  const PyramidLayout& layout = this->Layout;
+  this->Counts.assign(static_cast<std::size_t>(layout.GetNumberOfLevels()), {});
+  const auto& base = layout.Size(0);
+  std::vector<std::uint32_t>& level0 = this->Counts[0];
+  level0.assign(static_cast<std::size_t>(base[0]) * base[1] * base[2], 0);
   for (int k = 0; k < cells[2]; ++k)
     for (int j = 0; j < cells[1]; ++j)
       for (int i = 0; i < cells[0]; ++i)
-        base.Counts[(static_cast<std::size_t>(k) * base.Size[1] + j) * base.Size[0] + i] =
+        level0[(static_cast<std::size_t>(k) * base[1] + j) * base[0] + i] =
           baseCounts[(static_cast<std::size_t>(k) * cells[1] + j) * cells[0] + i];
-  this->Levels.push_back(std::move(base));
 
-  // Each level halves every axis larger than 1 and sums the children: the
-  // reduction the GPU does in one render-to-texture pass per output slice.
-  while (true)
+  // Each level sums the children of its nodes in the level below.
+  for (int l = 1; l < layout.GetNumberOfLevels(); ++l)
   {
-    const Level& below = this->Levels.back();
-    // A single cell still gets a level 1 (as on the GPU, which never stores
-    // level 0 and so always needs one level above it).
-    if (below.Size[0] == 1 && below.Size[1] == 1 && below.Size[2] == 1 && this->Levels.size() > 1)
-    {
-      break;
-    }
-    Level up;
-    int factor[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      factor[a] = below.Size[a] > 1 ? 2 : 1;
-      up.Size[a] = below.Size[a] / factor[a];
-    }
-    up.Counts.assign(static_cast<std::size_t>(up.Size[0]) * up.Size[1] * up.Size[2], 0);
-    for (int k = 0; k < up.Size[2]; ++k)
-      for (int j = 0; j < up.Size[1]; ++j)
-        for (int i = 0; i < up.Size[0]; ++i)
+    const auto& size = layout.Size(l);
+    const auto& lower = layout.Size(l - 1);
+    const auto factor = layout.Factor(l);
+    const std::vector<std::uint32_t>& below = this->Counts[l - 1];
+    std::vector<std::uint32_t>& up = this->Counts[l];
+    up.assign(static_cast<std::size_t>(size[0]) * size[1] * size[2], 0);
+    for (int k = 0; k < size[2]; ++k)
+      for (int j = 0; j < size[1]; ++j)
+        for (int i = 0; i < size[0]; ++i)
         {
           std::uint32_t sum = 0;
           for (int c = 0; c < 8; ++c)
@@ -70,11 +44,10 @@ void HistoPyramid::Build(const int cells[3], const std::vector<std::uint32_t>& b
               continue;
             }
             const int x = i * factor[0] + d[0], y = j * factor[1] + d[1], z = k * factor[2] + d[2];
-            sum += below.Counts[(static_cast<std::size_t>(z) * below.Size[1] + y) * below.Size[0] + x];
+            sum += below[(static_cast<std::size_t>(z) * lower[1] + y) * lower[0] + x];
           }
-          up.Counts[(static_cast<std::size_t>(k) * up.Size[1] + j) * up.Size[0] + i] = sum;
+          up[(static_cast<std::size_t>(k) * size[1] + j) * size[0] + i] = sum;
         }
-    this->Levels.push_back(std::move(up));
   }
 }
 
@@ -118,31 +91,28 @@ std::vector<std::uint32_t> HistoPyramid::CountCrossings(
 
 std::uint64_t HistoPyramid::GetTotal() const
 {
-  return this->Levels.empty() ? 0 : this->Levels.back().Counts[0];
+  return this->Counts.empty() ? 0 : this->Counts.back()[0];
 }
 
 std::uint32_t HistoPyramid::GetCount(int level, int i, int j, int k) const
 {
-  const Level& l = this->Levels[level];
-  return l.Counts[(static_cast<std::size_t>(k) * l.Size[1] + j) * l.Size[0] + i];
+  const auto& size = this->Layout.Size(level);
+  return this->Counts[level][(static_cast<std::size_t>(k) * size[1] + j) * size[0] + i];
 }
 
 void HistoPyramid::Traverse(std::uint64_t index, const double eye[3], int cell[3], int& rank) const
 {
   int node[3] = { 0, 0, 0 };
-  const int* baseSize = this->Levels[0].Size;
   for (int level = this->GetNumberOfLevels() - 1; level > 0; --level)
   {
-    const int* size = this->Levels[level].Size;
-    const int* childSize = this->Levels[level - 1].Size;
-    int factor[3], nearMask = 0;
+    const auto factor = this->Layout.Factor(level);
+    const auto childSpan = this->Layout.CellsPerNode(level - 1);
+    int nearMask = 0;
     for (int a = 0; a < 3; ++a)
     {
-      factor[a] = childSize[a] / size[a];
       // Split plane of this node along a, in cell units; the near child is
       // the one on the eye's side of it.
-      const double childSpan = static_cast<double>(baseSize[a]) / childSize[a];
-      const double split = (2 * node[a] + 1) * childSpan;
+      const double split = (2.0 * node[a] + 1.0) * childSpan[a];
       if (factor[a] == 2 && eye[a] >= split)
       {
         nearMask |= 1 << a;

@@ -15,12 +15,12 @@
  * implements, so that the GPU pyramid can be checked against it number for
  * number, and so that the design is tested on its own:
  *
- * - 3D, 8:1. Level 0 is the cell grid padded to powers of two per axis
- *   (padding cells count 0); each level above halves every axis that is
- *   larger than 1, down to a single node. A 3D pyramid keeps space in the
- *   hierarchy (a node is a box of cells), which is what makes front-to-back
- *   order cheap; in OpenGL 3.2 each level is an R32UI 3D texture, built one
- *   z-slice at a time by render-to-texture (no compute shaders needed).
+ * - 3D, 8:1, with the sizes of PyramidLayout (level 0 the cell grid padded
+ *   to powers of two, each level above halving every axis longer than 1).
+ *   A 3D pyramid keeps space in the hierarchy (a node is a box of cells),
+ *   which is what makes front-to-back order cheap. The GPU stores the same
+ *   counts packed into 2D atlases (see PyramidLayout and HistoPyramidGL);
+ *   this model stores them plainly, one count per node.
  * - Base counts. With several isovalues in one pass, a cell emits one
  *   primitive per isovalue whose surface crosses it (min < iso <= max over
  *   its 8 corners, the convention of vtkMarchingCubes and vtkBlockLODContour),
@@ -36,6 +36,8 @@
  */
 #ifndef MedicalIsosurfaces_HistoPyramid_h
 #define MedicalIsosurfaces_HistoPyramid_h
+
+#include "PyramidLayout.h"
 
 #include <cstdint>
 #include <vector>
@@ -60,10 +62,13 @@ public:
   std::uint64_t GetTotal() const;
 
   /// Number of levels, base (0) to top.
-  int GetNumberOfLevels() const { return static_cast<int>(this->Levels.size()); }
+  int GetNumberOfLevels() const { return this->Layout.GetNumberOfLevels(); }
 
   /// Size of a level (nodes per axis).
-  const int* GetLevelSize(int level) const { return this->Levels[level].Size; }
+  const int* GetLevelSize(int level) const { return this->Layout.Size(level).data(); }
+
+  /// The layout the levels follow.
+  const PyramidLayout& GetLayout() const { return this->Layout; }
 
   /// Count stored at a node of a level.
   std::uint32_t GetCount(int level, int i, int j, int k) const;
@@ -75,13 +80,8 @@ public:
   void Traverse(std::uint64_t index, const double eye[3], int cell[3], int& rank) const;
 
 private:
-  struct Level
-  {
-    int Size[3];
-    std::vector<std::uint32_t> Counts; // x fastest
-  };
-  std::vector<Level> Levels;
-  int Cells[3] = { 0, 0, 0 };
+  PyramidLayout Layout;
+  std::vector<std::vector<std::uint32_t>> Counts; // per level, x fastest
 };
 
 } // namespace mediso

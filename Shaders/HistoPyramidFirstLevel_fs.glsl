@@ -1,13 +1,10 @@
-//VTK::System::Dec
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// vtkHistoPyramidFirstLevel_fs.glsl: level 1 of the HistoPyramid, the lowest
-// level vtkOpenGLHistoPyramid stores, straight from the volume. Levels are
-// stored packed (see vtkHistoPyramidReduce_fs.glsl): texel (i, j, k) holds
-// the counts of the 2x2 nodes (2i + a, 2j + b, k) in component a + 2b. Drawn
-// as a quad per tile of a z-slice, for the tiles an isovalue can cross
-// (vtkHistoPyramidFirstLevel_vs.glsl; the others keep the 0 the level is
-// cleared to); each fragment counts its 4 nodes (main(), below).
+// HistoPyramidFirstLevel_fs.glsl: level 1 of the HistoPyramid, the lowest
+// level mediso::HistoPyramidGL stores, straight from the volume. Levels are
+// stored packed (texel (i, j, k) holds nodes (2i + a, 2j + b, k) in
+// component a + 2b) in a 2D atlas (see HistoPyramidCommon.glsl); each
+// fragment is one packed texel and counts its 4 nodes (main(), below).
 // Node n's cells are the box [2n.x, 2n.x + fx) x [2n.y, 2n.y + fy) x
 // [2n.z, 2n.z + fz) (f = 2 along an axis the base level has more than one
 // cell on, else 1); the node reads the box's (f + 1)^3 <= 27 corner values
@@ -17,27 +14,22 @@
 // Skipping the stored base level is what keeps the pyramid small: level 1 in
 // 8 bits per node is 1/8 byte per cell, against 4 bytes per cell for a
 // 32-bit base.
-//
-// GLSL 1.50 only; integer output declared here.
 
-//VTK::HistoPyramidCommon::Dec
-
-in vec2 texCoord;
+//MEDISO::HistoPyramidCommon
 
 uniform ivec3 factor;    // 1 or 2 per axis (base level to level 1)
-uniform ivec2 sliceSize; // packed size of level 1 in x and y
 uniform ivec3 levelSize; // nodes of level 1
-flat in int slice;       // z of the slice being written (vtkHistoPyramidLayer_gs.glsl)
+uniform ivec3 shifts;    // level 1's atlas (see atlasTexel())
 
-out uvec4 fragOutput0;
+MEDISO_OUTPUT(0) uvec4 fragOutput0;
 
 // The crossings of node `node`, whose <= 27 corner values are p[i + 3 j +
 // 9 k] (points node * factor + (i, j, k), clamped to the volume): 0 beyond
 // level 1's size. With one isovalue (MEDISO_CHILD_MASKS) the node's child mask
 // instead: bit X + 2 Y + 4 Z set when child cell (X, Y, Z) crosses it, the
 // count being the number of bits set (the reduction to level 2 counts them;
-// the mapper's walk then reads which cells of the node are active with the
-// count it reads anyway, and recounts nothing).
+// the walk of the drawing program then reads which cells of the node are
+// active with the count it reads anyway, and recounts nothing).
 uint nodeCount(ivec3 node, VALUE_TYPE p[27])
 {
   if (any(greaterThanEqual(node, levelSize)))
@@ -71,17 +63,16 @@ uint nodeCount(ivec3 node, VALUE_TYPE p[27])
   return sum;
 }
 
-// Texel (i, j, k) holds nodes (2i + a, 2j + b, k) in component a + 2b (the
-// layout of vtkHistoPyramidPacked.glsl). The 4 nodes read the points
+// The 4 nodes of packed texel (i, j, k) read the points
 // (4i .. 4i + 4, 4j .. 4j + 4, k fz .. k fz + 2), clamped to the volume, once:
 // 2 stored texels per row of 5 points along x (the volume holds 4 points to
-// a texel, see vtkHistoPyramidCommon.glsl), 30 fetches against 4 x 27. Node
+// a texel, see HistoPyramidCommon.glsl), 30 fetches against 4 x 27. Node
 // (a, b)'s points are then those from (2a, 2b, 0) on, by constant indices.
 // (Along an axis with one cell, factor 1, only node 0 exists and it starts
 // at point 0 as well.)
 void main()
 {
-  ivec3 texel = ivec3(ivec2(floor(texCoord * vec2(sliceSize))), slice);
+  ivec3 texel = packedTexel(ivec2(gl_FragCoord.xy), shifts);
   ivec3 base = ivec3(4 * texel.xy, texel.z * factor.z);
   VALUE_TYPE points[75]; // point base + (x, y, z) at x + 5 y + 25 z
   for (int r = 0; r < 15; ++r) // row r: points base + (0..4, r % 5, r / 5)

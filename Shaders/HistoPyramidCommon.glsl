@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// vtkHistoPyramidCommon.glsl: the one definition of an "active cell" shared by
+// HistoPyramidCommon.glsl: the one definition of an "active cell" shared by
 // every HistoPyramid shader (the build passes and the isosurface drawing
 // program), so that the pyramid's counts and the traversal that reads them
-// can never disagree. vtkOpenGLHistoPyramid puts this text in place of the
-// //VTK::HistoPyramidCommon::Dec line of each shader, after the #defines of
+// can never disagree, and the addressing of the stored levels. The GPU core
+// (mediso::HistoPyramidGL) puts this text in place of the
+// //MEDISO::HistoPyramidCommon line of each shader, after the #defines of
 // the volume's value type:
 //   VALUE_SAMPLER  isampler3D, usampler3D or sampler3D
 //   VALUE_TYPE     int, uint or float
@@ -24,7 +25,7 @@ uniform ivec3 cellDimensions;      // real cells per axis (points - 1)
 
 // The volume is stored 4 points to a texel along x: texel (i, j, k) holds
 // points (4 i + c, j, k) in component c, and the last texel of a row repeats
-// the row's last point where the points run out (vtkOpenGLHistoPyramid's
+// the row's last point where the points run out (HistoPyramidGL's
 // PackVolumeRows(); same bytes as one point per texel). The passes that read
 // whole rows of points (a level-1 node's, a packed texel of level 1's) then
 // need a fetch per 4 points instead of one per point.
@@ -126,3 +127,22 @@ void fetchCorners(ivec3 c, out VALUE_TYPE v[8])
   w[5] = p[X + 1 + 3 * Y + 9 * (Z + 1)];                                                    \
   w[6] = p[X + 3 * (Y + 1) + 9 * (Z + 1)];                                                  \
   w[7] = p[X + 1 + 3 * (Y + 1) + 9 * (Z + 1)];
+
+// The stored levels are 2D atlases (mediso::PyramidLayout): packed texel
+// (x, y, z) of a level lies at atlas texel (x + (z % C) px, y + (z / C) py),
+// with px x py packed texels per slice and C slices per atlas row, all
+// powers of two. A level's layout is given as shifts: (log2 px, log2 py,
+// log2 C).
+ivec2 atlasTexel(ivec3 t, ivec3 shifts)
+{
+  int columnMask = (1 << shifts.z) - 1;
+  return ivec2(t.x + ((t.z & columnMask) << shifts.x), t.y + ((t.z >> shifts.z) << shifts.y));
+}
+
+// The packed texel (x, y, z) of a level at atlas texel a (the inverse).
+ivec3 packedTexel(ivec2 a, ivec3 shifts)
+{
+  ivec2 slice = ivec2(a.x >> shifts.x, a.y >> shifts.y);
+  return ivec3(a.x & ((1 << shifts.x) - 1), a.y & ((1 << shifts.y) - 1),
+    (slice.y << shifts.z) | slice.x);
+}

@@ -1,15 +1,15 @@
-//VTK::System::Dec
-//VTK::Variant::Dec
-//VTK::ConservativeDepth::Dec
+//MEDISO::FragmentExtensions
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// vtkHistoPyramidIso_fs.glsl: fragment stage of vtkHistoPyramidIsoMapper.
+// HistoPyramidIso_fs.glsl: fragment stage of the isosurface drawing program
+// (mediso::IsosurfaceRendererGL).
 // Ray-casts the exact trilinear isosurface inside one cell (the cell
 // rasterisation of Liu, Clapworthy & Dong 2009; seed paper, section 4.1).
 //
-// 1. The ray. The eye is homogeneous in cell-index space (w = 1 perspective:
-//    its position; w = 0 parallel: the direction towards the viewer), so the
-//    ray through this fragment's point x of the cell box has direction
+// 1. The ray. The fragment's window position is unprojected at the depth of
+//    the footprint (see the vertex stage) to a point x on its ray. The eye is
+//    homogeneous in cell-index space (w = 1 perspective: its position; w = 0
+//    parallel: the direction towards the viewer), so the ray has direction
 //    x w - eye.xyz in both projections. It is clipped to the cell box (and,
 //    in perspective, to start at the eye, at t = -1).
 // 2. The root. Along the ray, the trilinear interpolant minus the isovalue
@@ -26,17 +26,15 @@
 //    diffuse, specular and specular power, and the renderer's lights.
 // 4. Depth: gl_FragDepth from the hit point, so the surface composites
 //    exactly with polygonal geometry in the same scene. Where the context
-//    has GL_ARB_conservative_depth (or OpenGL 4.2), the mapper declares
-//    gl_FragDepth depth_greater in place of the ConservativeDepth tag above:
-//    the hit lies behind the cell face being rasterised, so the depth test
+//    has GL_ARB_conservative_depth (or OpenGL 4.2), the renderer declares
+//    gl_FragDepth depth_greater in place of the FragmentExtensions hook
+//    above: the hit lies behind the footprint's depth, so the depth test
 //    may run before this shader, and with the cells drawn front to back the
 //    cells hidden behind a surface already drawn cost no ray casting (the
-//    paper's reason for sorting). The one exception, the cell holding a
-//    perspective eye (drawn from inside, by its back faces), only arises
-//    when the surface touches the near plane.
+//    paper's reason for sorting).
 //
-// Variants: the mapper defines MEDISO_POINT_FOOTPRINT (see below),
-// MEDISO_TRANSLUCENT (any isovalue with opacity < 1), MEDISO_LIGHTS (the
+// Variants: the renderer defines MEDISO_POINT_FOOTPRINT (see the vertex
+// stage), MEDISO_TRANSLUCENT (any isovalue with opacity < 1), MEDISO_LIGHTS (the
 // number of lights) and MEDISO_ISOVALUES (the number of isovalues, for the
 // translucent loop) and compiles each combination apart: a software
 // rasteriser runs every branch under SIMD masks, so code for another mode or
@@ -49,7 +47,7 @@
 // nearest hit of any isovalue (with one primitive per cell-isovalue pair, a
 // cell's primitives come in isovalue order, not depth order).
 //
-// Translucent mode (MEDISO_TRANSLUCENT): the mapper draws the
+// Translucent mode (MEDISO_TRANSLUCENT): the renderer draws the
 // cells back to front and only one primitive per cell; this fragment takes
 // the hits of every crossing isovalue along its piece of ray in order of t
 // (a merge of the isovalues' hit sequences) and composites them front to
@@ -58,55 +56,43 @@
 // and ordered hits inside each cell give the exact compositing order: an
 // opaque bone behind translucent skin, in one pass.
 
-// Outputs: gl_FragData[0], the colour (premultiplied in translucent mode);
-// in the first-hit pass (MEDISO_FIRST_HIT) also gl_FragData[1], the hit's
-// window depth, in place of gl_FragDepth. (VTK declares them as fragOutput0
-// and fragOutput1 and binds those to draw buffers 0 and 1.)
-//VTK::Output::Dec
+// Outputs: fragOutput0, the colour (premultiplied in translucent mode); in
+// the first-hit pass (MEDISO_FIRST_HIT) also fragOutput1, the hit's window
+// depth, exactly, in place of gl_FragDepth: the float itself into an R32F
+// target on desktop OpenGL, its bits into an R32UI target on OpenGL ES 3.0
+// (where float targets need an extension).
+MEDISO_OUTPUT(0) vec4 fragOutput0;
+#ifdef MEDISO_FIRST_HIT
+#ifdef MEDISO_GLSL_ES
+MEDISO_OUTPUT(1) uvec4 fragOutput1;
+#else
+MEDISO_OUTPUT(1) vec4 fragOutput1;
+#endif
+#endif
 
-#ifdef MEDISO_POINT_FOOTPRINT
-// Point footprint: the vertex stage's outputs come straight here, and the
-// point on the ray is unprojected from the fragment's window position (at
-// the depth of the cell's nearest corner, to stay close to the cell).
-flat in ivec3 vCell;
-flat in int vMask;
-flat in vec4 vLook;
-flat in vec4 vLow;
-flat in vec4 vHigh;
-in CornerGradients
-{
-  flat vec3 g[8];
-} vGradients;
-flat in float vNearDepth;
+flat in ivec4 vCellMask;    // the cell (xyz) and its crossing isovalues (w)
+flat in vec4 vLook;         // colour (rgb) and value (w) of the isovalue drawn
+flat in vec4 vLow;          // corner values 0..3
+flat in vec4 vHigh;         // corner values 4..7
+flat in vec4 vGradients[6]; // the corners' central-difference gradients, 3 floats each
+flat in float vNearDepth;   // the footprint's NDC depth
 uniform mat4 clipToIndex;
-uniform vec4 viewport; // x, y, width, height in pixels
-#define gCell vCell
-#define gMask vMask
+uniform vec4 viewport;      // x, y, width, height in pixels
+
+#define gCell vCellMask.xyz
+#define gMask vCellMask.w
 #define gLook vLook
 #define gLow vLow
 #define gHigh vHigh
-#define gGradients vGradients.g
+
+// A point on this fragment's ray: its window position unprojected at the
+// footprint's depth (close to the cell).
 vec3 rayPoint()
 {
   vec2 ndc = 2.0 * (gl_FragCoord.xy - viewport.xy) / viewport.zw - 1.0;
   vec4 p = clipToIndex * vec4(ndc, vNearDepth, 1.0);
   return p.xyz / p.w;
 }
-#else
-// Box footprint: a point of a front face of the cell box, from the geometry
-// stage.
-in vec3 gPosition;
-flat in ivec3 gCell;
-flat in int gMask;
-flat in vec4 gLook;
-flat in vec4 gLow;
-flat in vec4 gHigh;
-flat in vec3 gGradients[8]; // central differences at the corners
-vec3 rayPoint()
-{
-  return gPosition;
-}
-#endif
 
 uniform vec4 eyeIndex;
 uniform mat4 indexToClip;
@@ -125,10 +111,18 @@ uniform vec3 lightColors[6];
 // The corners' central-difference gradients, interpolated trilinearly.
 vec3 gradient(vec3 p)
 {
-  vec3 y0z0 = mix(gGradients[0], gGradients[1], p.x);
-  vec3 y1z0 = mix(gGradients[2], gGradients[3], p.x);
-  vec3 y0z1 = mix(gGradients[4], gGradients[5], p.x);
-  vec3 y1z1 = mix(gGradients[6], gGradients[7], p.x);
+  vec3 g0 = vGradients[0].xyz;
+  vec3 g1 = vec3(vGradients[0].w, vGradients[1].xy);
+  vec3 g2 = vec3(vGradients[1].zw, vGradients[2].x);
+  vec3 g3 = vGradients[2].yzw;
+  vec3 g4 = vGradients[3].xyz;
+  vec3 g5 = vec3(vGradients[3].w, vGradients[4].xy);
+  vec3 g6 = vec3(vGradients[4].zw, vGradients[5].x);
+  vec3 g7 = vGradients[5].yzw;
+  vec3 y0z0 = mix(g0, g1, p.x);
+  vec3 y1z0 = mix(g2, g3, p.x);
+  vec3 y0z1 = mix(g4, g5, p.x);
+  vec3 y1z1 = mix(g6, g7, p.x);
   return mix(mix(y0z0, y1z0, p.y), mix(y0z1, y1z1, p.y), p.z);
 }
 
@@ -375,12 +369,16 @@ void main()
 #endif
 #ifndef MEDISO_TRANSLUCENT
   vec3 p = clamp(o + hitT * d, 0.0, 1.0);
-  gl_FragData[0] = vec4(shade(p, color), 1.0);
+  fragOutput0 = vec4(shade(p, color), 1.0);
 #ifdef MEDISO_FIRST_HIT
-  // First-hit pass: the depth test ran before this stage, on the point's
-  // constant depth (see the vertex stage): this pixel had no hit yet. The
-  // exact depth goes to the mapper's buffer; the composite pass writes it.
-  gl_FragData[1] = vec4(depthOf(p), 0.0, 0.0, 1.0);
+  // First-hit pass: the depth test ran before this stage, on the
+  // footprint's constant depth (see the vertex stage): this pixel had no hit
+  // yet. The depth goes to the renderer's buffer; the composite pass writes it.
+#ifdef MEDISO_GLSL_ES
+  fragOutput1 = uvec4(floatBitsToUint(depthOf(p)), 0u, 0u, 0u);
+#else
+  fragOutput1 = vec4(depthOf(p), 0.0, 0.0, 1.0);
+#endif
 #else
   gl_FragDepth = depthOf(p);
 #endif
@@ -442,7 +440,7 @@ void main()
   {
     discard;
   }
-  gl_FragData[0] = sum;
+  fragOutput0 = sum;
   gl_FragDepth = depthOf(clamp(o + firstHit * d, 0.0, 1.0));
 #endif
 }

@@ -1,14 +1,12 @@
-//VTK::System::Dec
-//VTK::Variant::Dec
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// vtkHistoPyramidIso_vs.glsl: vertex stage of vtkHistoPyramidIsoMapper. The
-// mapper draws GetTotal() points with no vertex attributes (one glDrawArrays
-// call, no per-cell CPU work); vertex number gl_VertexID walks down the
-// HistoPyramid of vtkOpenGLHistoPyramid to find its cell and which of the
-// cell's crossing isovalues it draws (Ziegler et al. 2006; the
-// cell-rasterisation scheme of Liu, Clapworthy & Dong 2009, section 4.1 of
-// the seed paper).
+// HistoPyramidIso_vs.glsl: vertex stage of the isosurface drawing program
+// (mediso::IsosurfaceRendererGL). It draws the pyramid's total of primitives
+// with no vertex attributes and one draw call (no per-cell CPU work):
+// primitive number MEDISO_PRIMITIVE walks down the HistoPyramid of
+// mediso::HistoPyramidGL to find its cell and which of the cell's crossing
+// isovalues it draws (Ziegler et al. 2006; the cell-rasterisation scheme of
+// Liu, Clapworthy & Dong 2009, section 4.1 of the seed paper).
 //
 // Front-to-back order without sorting: at every node the children are
 // visited nearest first, the near half along each axis being the one on the
@@ -20,12 +18,13 @@
 // w = 1 for a perspective camera (its position), w = 0 for a parallel one
 // (the direction towards the viewer), so both projections share one test.
 //
-// The levels are separate 3D textures (each level has its own size; each
-// packed 2x2 nodes to an RGBA texel, see descend()), and
-// GLSL 1.50 cannot index an array of samplers with a variable: the mapper
-// puts one uniform per stored level in place of the HistoPyramidLevels Dec
-// tag and one descend() call per level, with that level's constant factors,
-// in place of the HistoPyramidLevels Impl tag. Level 0 is not stored: the
+// The levels are separate 2D atlases (each level has its own size and
+// format; each packed 2x2 nodes to an RGBA texel, slices side by side, see
+// descend()), and GLSL cannot index an array of samplers with a variable:
+// the renderer puts one uniform per stored level in place of the
+// HistoPyramidLevels hook and one descend() call per level, with that
+// level's constant factors and atlas shifts, in place of the
+// HistoPyramidDescent hook. Level 0 is not stored: the
 // last step recounts the up-to-8 cells of the level-1 node from their <= 27
 // corner values, which then give the cell's corners and half of their
 // gradient neighbours as well (cellCorners()): 16 + 18 + 12 texel fetches
@@ -37,25 +36,34 @@
 // of this stage's time on the CT: median of 6 paired runs drawing with the
 // rasteriser discarding), the node's points are still read for the corners.
 //
-// Footprint. With MEDISO_POINT_FOOTPRINT defined (the mapper does so when
-// every cell of the volume projects to fewer pixels than the largest point
-// size and the volume lies wholly beyond the near plane), this stage also
-// makes the cell's footprint itself: a point sprite centred on the bounding
-// rectangle of the 8 projected corners of the surface's box in the cell (see
-// surfaceBox(); cut to the viewport, so the point's centre is always inside
-// the clip volume), as wide as its longer side, at the depth of its nearest
-// corner (so the hit, which lies inside that box, is never in front of it:
-// early depth rejection stays valid). The box is often much smaller than the
-// cell (a surface cutting off a corner), and on a software rasteriser every
-// fragment costs a full ray cast, hit or miss. One
-// vertex and no geometry stage per cell: on software rasterisers the
-// geometry stage's output and the triangle setup of up to six triangles
-// per cell cost far more than the ray casting. Otherwise the geometry stage
-// (vtkHistoPyramidIso_gs.glsl) draws the cell box's front faces.
+// Footprint. This stage makes the cell's footprint itself, over the
+// bounding rectangle, on screen, of the box that holds the surface in the
+// cell (see surfaceBox(); often much smaller than the cell: on a software
+// rasteriser every fragment costs a full ray cast, hit or miss), at the
+// depth of the box's nearest point (the hit lies inside the box, so it is
+// never in front of the footprint: early depth rejection stays valid).
+// - MEDISO_POINT_FOOTPRINT (the renderer chooses it when every cell of the
+//   volume projects to fewer pixels than the largest point size and the
+//   volume lies wholly beyond the near plane): one point sprite per
+//   primitive, as wide as the rectangle's longer side (gl_VertexID is the
+//   primitive).
+// - Otherwise (close zooms, the eye in or near the volume): a quad, drawn as
+//   an instanced triangle strip of 4 vertices (gl_InstanceID is the
+//   primitive), over the rectangle of the box cut by the near plane, so no
+//   size limit applies and a cell that reaches behind the eye is covered
+//   where it is visible. Each of the 4 vertices walks the pyramid, which
+//   costs 4 times the vertex work of a point; no geometry stage exists in
+//   OpenGL ES 3.0.
 
-//VTK::HistoPyramidCommon::Dec
+//MEDISO::HistoPyramidCommon
 
-//VTK::HistoPyramidLevels::Dec
+//MEDISO::HistoPyramidLevels
+
+#ifdef MEDISO_POINT_FOOTPRINT
+#define MEDISO_PRIMITIVE gl_VertexID
+#else
+#define MEDISO_PRIMITIVE gl_InstanceID
+#endif
 
 uniform vec4 eyeIndex;       // eye, homogeneous, in cell-index space
 uniform int backToFront;     // 0: nearest cells first; 1: farthest first
@@ -64,23 +72,23 @@ uniform ivec3 firstFactor;   // level-1 node size in cells (1 or 2 per axis)
 uniform float isovalues[8];  // the fragment stage's isovalues and looks
 uniform vec4 isoColors[8];
 
-flat out ivec3 vCell;        // the cell
-flat out int vMask;          // crossing isovalues of the cell (bit t: threshold t)
-flat out int vIsovalue;      // the isovalue this primitive draws (-1: none)
-flat out vec4 vLook;         // its colour (rgb) and value (w)
-flat out vec4 vLow;          // corner values 0..3 (dx + 2 dy + 4 dz)
-flat out vec4 vHigh;         // corner values 4..7
-#ifdef MEDISO_POINT_FOOTPRINT
 uniform mat4 indexToClip;    // cell-index space to clip coordinates
 uniform vec2 viewportSize;   // pixels
-uniform float maxPointSize;  // GL_POINT_SIZE_RANGE's upper end
-uniform float pointMargin;   // pixels added to each point's size
-flat out float vNearDepth;   // NDC depth of the nearest corner
+uniform float pointMargin;   // pixels added around each footprint
+#ifdef MEDISO_POINT_FOOTPRINT
+uniform float maxPointSize;  // the largest point size
 #endif
-out CornerGradients          // central-difference gradient at each corner
-{
-  flat vec3 g[8];
-} vGradients;
+
+// The fragment stage's inputs: few slots (OpenGL ES 3.0 promises 15 vec4s).
+flat out ivec4 vCellMask;    // the cell (xyz) and its crossing isovalues (w; bit t: threshold t)
+flat out vec4 vLook;         // the colour (rgb) and value (w) of the isovalue drawn
+flat out vec4 vLow;          // corner values 0..3 (dx + 2 dy + 4 dz)
+flat out vec4 vHigh;         // corner values 4..7
+flat out vec4 vGradients[6]; // central-difference gradients at corners 0..7, 3 floats each
+flat out float vNearDepth;   // NDC depth of the footprint
+
+int vIsovalue;               // the isovalue this primitive draws (-1: none)
+vec3 cornerGradients[8];
 
 // Children of a node in visiting order: bit a of the returned mask flips
 // axis a, so that child (order ^ mask) is the order-th one visited.
@@ -127,37 +135,39 @@ int pickChild(uvec4 low, uvec4 high, int mask, inout uint index)
 
 // The stored values of node's children in the level below: low for dz = 0,
 // high for dz = 1 (0 where z has one node).
-void childTexels(usampler3D lower, ivec3 factor, ivec3 node, out uvec4 low, out uvec4 high)
+void childTexels(usampler2D lower, ivec3 factor, ivec3 shifts, ivec3 node, out uvec4 low,
+  out uvec4 high)
 {
-  low = texelFetch(lower, ivec3(node.xy, node.z * factor.z), 0);
+  low = texelFetch(lower, atlasTexel(ivec3(node.xy, node.z * factor.z), shifts), 0);
   high = uvec4(0u);
   if (factor.z == 2)
   {
-    high = texelFetch(lower, ivec3(node.xy, 2 * node.z + 1), 0);
+    high = texelFetch(lower, atlasTexel(ivec3(node.xy, 2 * node.z + 1), shifts), 0);
   }
 }
 
 // One step down: from node (of the level above `lower`) to the child whose
 // running sum, in visiting order, covers index. Levels are stored packed
 // (texel (i, j, k) holds nodes (2i + a, 2j + b, k) in component a + 2b; see
-// vtkOpenGLHistoPyramid), so the children of node n in z-slice z of the
+// mediso::PyramidLayout), so the children of node n in z-slice z of the
 // level below are the 4 components of texel (n.x, n.y, z), in child order
 // dx + 2 dy (a component beyond an axis of one node holds 0): two fetches
 // give all 8 counts. Straight-line code, no loop (factor is a literal at
 // every call, so the second fetch folds away where z has one node): chained
 // loops made llvmpipe's LLVM compile time double with every level (13 s for
 // the CT's 7 levels against 2 s without loops).
-void descend(usampler3D lower, ivec3 factor, vec3 childSpan, inout ivec3 node, inout uint index)
+void descend(usampler2D lower, ivec3 factor, ivec3 shifts, vec3 childSpan, inout ivec3 node,
+  inout uint index)
 {
   uvec4 low, high;
-  childTexels(lower, factor, node, low, high);
+  childTexels(lower, factor, shifts, node, low, high);
   int child = pickChild(low, high, orderMask(node, factor, childSpan), index);
   node = node * factor + ivec3(child & 1, (child >> 1) & 1, (child >> 2) & 1);
 }
 
 #ifdef MEDISO_CHILD_MASKS
 // The last step down, to a node of level 1, where level 1 holds child masks
-// rather than counts (one isovalue: vtkOpenGLHistoPyramid::
+// rather than counts (one isovalue: mediso::HistoPyramidGL::
 // GetLevelOneHoldsChildMasks()): bit c of a node's component is set when its
 // child cell c crosses the isovalue, so the node's count is the number of
 // bits set and `bits` returns the chosen node's mask. The cells of the node
@@ -169,11 +179,11 @@ uvec4 bitCounts(uvec4 m)
   return (m & 0x0Fu) + (m >> 4u);
 }
 
-void descendToMasks(usampler3D lower, ivec3 factor, vec3 childSpan, inout ivec3 node,
-  inout uint index, out int bits)
+void descendToMasks(usampler2D lower, ivec3 factor, ivec3 shifts, vec3 childSpan,
+  inout ivec3 node, inout uint index, out int bits)
 {
   uvec4 low, high;
-  childTexels(lower, factor, node, low, high);
+  childTexels(lower, factor, shifts, node, low, high);
   int child = pickChild(bitCounts(low), bitCounts(high), orderMask(node, factor, childSpan), index);
   node = node * factor + ivec3(child & 1, (child >> 1) & 1, (child >> 2) & 1);
   uvec4 layer = child < 4 ? low : high;
@@ -225,10 +235,10 @@ vec4 shiftLine(bool upper, float n0, float n1, float n2)
     vec3 span = vec3(1.0) + vec3(DX == 0 ? corner.x > 0 : corner.x < cellDimensions.x,     \
                                DY == 0 ? corner.y > 0 : corner.y < cellDimensions.y,       \
                                DZ == 0 ? corner.z > 0 : corner.z < cellDimensions.z);      \
-    vGradients.g[I] = sgn * (inside - outer) / span;                                       \
+    cornerGradients[I] = sgn * (inside - outer) / span;                                       \
   }
 
-// Fills vLow, vHigh and vGradients for cell c, child `child` of the level-1
+// Fills vLow, vHigh and cornerGradients for cell c, child `child` of the level-1
 // node whose points (clamped to the volume) are p[i + 3 j + 9 k].
 void cellCorners(ivec3 c, int child, VALUE_TYPE p[27])
 {
@@ -287,7 +297,6 @@ void cellCorners(ivec3 c, int child, VALUE_TYPE p[27])
   MEDISO_GRADIENT(7, 1, 1, 1)
 }
 
-#ifdef MEDISO_POINT_FOOTPRINT
 // Where, along one axis, the surface f = iso can meet the cell: a (b) holds
 // the values of the 4 cell edges along that axis at its low (high) end. On a
 // plane across the axis the interpolant is bilinear, with corners that vary
@@ -335,10 +344,12 @@ void surfaceBox(vec4 low, vec4 high, float iso, inout vec3 boxLo, inout vec3 box
   boxHi = max(boxHi, vec3(x.y, y.y, z.y));
 }
 
-// The point sprite covering the box [c + boxLo, c + boxHi] (see the
-// header); off the clip volume if the box is not on screen or reaches behind
-// the eye.
-void pointFootprint(ivec3 c, vec3 boxLo, vec3 boxHi)
+// The footprint of the box [c + boxLo, c + boxHi] (see the header): the
+// rectangle, in NDC, of its part in front of the near plane (its corners
+// there and, for a quad, where its edges cross the plane), cut to the
+// viewport, at the NDC depth of that part's nearest point. Off the clip
+// volume when none of it is on screen.
+void footprint(ivec3 c, vec3 boxLo, vec3 boxHi)
 {
   vec3 size = boxHi - boxLo;
   vec4 origin = indexToClip * vec4(vec3(c) + boxLo, 1.0);
@@ -348,55 +359,88 @@ void pointFootprint(ivec3 c, vec3 boxLo, vec3 boxHi)
   vec2 lo = vec2(1e30);
   vec2 hi = vec2(-1e30);
   float nearest = 1e30;
-  bool behind = false;
+  vec4 corner[8];
   for (int i = 0; i < 8; ++i)
   {
-    vec4 corner = origin + float(i & 1) * dx + float((i >> 1) & 1) * dy + float((i >> 2) & 1) * dz;
-    behind = behind || corner.w <= 0.0;
-    vec3 ndc = corner.xyz / corner.w;
-    lo = min(lo, ndc.xy);
-    hi = max(hi, ndc.xy);
-    nearest = min(nearest, ndc.z);
+    corner[i] = origin + float(i & 1) * dx + float((i >> 1) & 1) * dy + float((i >> 2) & 1) * dz;
+    if (corner[i].z + corner[i].w >= 0.0 && corner[i].w > 0.0) // in front of the near plane
+    {
+      vec3 ndc = corner[i].xyz / corner[i].w;
+      lo = min(lo, ndc.xy);
+      hi = max(hi, ndc.xy);
+      nearest = min(nearest, ndc.z);
+    }
   }
+#ifndef MEDISO_POINT_FOOTPRINT
+  // The 12 edges (corner i to i + b, bit b not in i) that cross the near plane.
+  for (int i = 0; i < 8; ++i)
+  {
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      int b = 1 << axis;
+      if ((i & b) == 0)
+      {
+        vec4 p = corner[i];
+        vec4 q = corner[i + b];
+        float dp = p.z + p.w;
+        float dq = q.z + q.w;
+        if ((dp >= 0.0) != (dq >= 0.0))
+        {
+          vec4 x = mix(p, q, dp / (dp - dq));
+          lo = min(lo, x.xy / x.w);
+          hi = max(hi, x.xy / x.w);
+          nearest = -1.0;
+        }
+      }
+    }
+  }
+#endif
   lo = max(lo, vec2(-1.0));
   hi = min(hi, vec2(1.0));
-  if (behind || any(greaterThan(lo, hi)) || nearest > 1.0)
+  if (any(greaterThan(lo, hi)) || nearest > 1.0)
   {
     gl_Position = vec4(0.0, 0.0, 2.0, 1.0); // clipped
+#ifdef MEDISO_POINT_FOOTPRINT
     gl_PointSize = 1.0;
+#endif
     vNearDepth = 1.0;
     return;
   }
-  vec2 pixels = 0.5 * (hi - lo) * viewportSize;
-  // A point covers the pixels whose centres lie in its square; the square
-  // holds the rectangle, and a margin of a tenth of a pixel (plus the point
-  // size granularity) keeps the pixels whose centres lie on its edges,
-  // whatever the rasteriser's tie rule. (A whole pixel of margin costs a
-  // 3-pixel point 78% more fragments.)
-  gl_PointSize = min(max(pixels.x, pixels.y) + pointMargin, maxPointSize);
   vNearDepth = max(nearest, -1.0);
 #ifdef MEDISO_FIRST_HIT
-  // First-hit pass (opaque, one isovalue, the mapper's own depth buffer):
-  // every point at one depth, with the depth test GL_LESS, so a fragment
+  // First-hit pass (opaque, the renderer's own depth buffer): every
+  // primitive at one depth, with the depth test GL_LESS, so a fragment
   // passes only where no earlier primitive has hit; the primitives come
   // front to back, so the first hit is the nearest. The depth test runs
   // before the fragment stage, which then writes no gl_FragDepth.
-  gl_Position = vec4(0.5 * (lo + hi), 0.0, 1.0);
+  float depth = 0.0;
 #else
-  gl_Position = vec4(0.5 * (lo + hi), vNearDepth, 1.0);
+  float depth = vNearDepth;
+#endif
+  // A footprint covers the pixels whose centres lie in it; a margin of a
+  // tenth of a pixel (plus the point size granularity) keeps those whose
+  // centres lie on its edges, whatever the rasteriser's tie rule. (A whole
+  // pixel of margin costs a 3-pixel point 78% more fragments.)
+#ifdef MEDISO_POINT_FOOTPRINT
+  vec2 pixels = 0.5 * (hi - lo) * viewportSize;
+  gl_PointSize = min(max(pixels.x, pixels.y) + pointMargin, maxPointSize);
+  gl_Position = vec4(0.5 * (lo + hi), depth, 1.0);
+#else
+  vec2 margin = pointMargin / viewportSize; // half the margin on each side, in NDC
+  vec2 corner01 = vec2(float(gl_VertexID & 1), float(gl_VertexID >> 1));
+  gl_Position = vec4(mix(lo - margin, hi + margin, corner01), depth, 1.0);
 #endif
 }
-#endif
 
 void main()
 {
-  uint index = uint(gl_VertexID);
+  uint index = uint(MEDISO_PRIMITIVE);
   ivec3 node = ivec3(0);
 #ifdef MEDISO_CHILD_MASKS
   int nodeBits = 0; // the level-1 node's child mask, from its last step down
 #endif
 
-//VTK::HistoPyramidLevels::Impl
+//MEDISO::HistoPyramidDescent
 
   // Last step: the cells of the level-1 node, counted from the volume: the
   // node's <= 27 points are read once and each child cell's crossing mask is
@@ -452,14 +496,15 @@ void main()
     bitCount8(masksHigh.z), bitCount8(masksHigh.w));
 #endif
   int c = pickChild(countsLow, countsHigh, orderMask(node, firstFactor, vec3(1.0)), index);
-  vCell = first + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-  vMask = c < 4 ? masksLow[c & 3] : masksHigh[c & 3];
+  ivec3 cell = first + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+  int mask = c < 4 ? masksLow[c & 3] : masksHigh[c & 3];
+  vCellMask = ivec4(cell, mask);
   // The index-th crossing isovalue, in increasing threshold order.
   vIsovalue = -1;
   int rank = int(index);
   for (int t = 0; t < 8; ++t)
   {
-    int bit = (vMask >> t) & 1;
+    int bit = (mask >> t) & 1;
     vIsovalue = bit == 1 && rank == 0 && vIsovalue < 0 ? t : vIsovalue;
     rank -= bit;
   }
@@ -470,9 +515,14 @@ void main()
   if (vIsovalue >= 0)
   {
     vLook = vec4(isoColors[vIsovalue].rgb, isovalues[vIsovalue]);
-    cellCorners(vCell, c, p);
+    cellCorners(cell, c, p);
+    vGradients[0] = vec4(cornerGradients[0], cornerGradients[1].x);
+    vGradients[1] = vec4(cornerGradients[1].yz, cornerGradients[2].xy);
+    vGradients[2] = vec4(cornerGradients[2].z, cornerGradients[3]);
+    vGradients[3] = vec4(cornerGradients[4], cornerGradients[5].x);
+    vGradients[4] = vec4(cornerGradients[5].yz, cornerGradients[6].xy);
+    vGradients[5] = vec4(cornerGradients[6].z, cornerGradients[7]);
   }
-#ifdef MEDISO_POINT_FOOTPRINT
   if (vIsovalue >= 0)
   {
     vec3 boxLo = vec3(1.0);
@@ -480,7 +530,7 @@ void main()
 #if defined(MEDISO_TRANSLUCENT) || defined(MEDISO_NEAREST)
     for (int t = 0; t < MEDISO_ISOVALUES; ++t) // the cell's one primitive draws them all
     {
-      if (((vMask >> t) & 1) == 1)
+      if (((mask >> t) & 1) == 1)
       {
         surfaceBox(vLow, vHigh, isovalues[t], boxLo, boxHi);
       }
@@ -488,15 +538,14 @@ void main()
 #else
     surfaceBox(vLow, vHigh, vLook.w, boxLo, boxHi);
 #endif
-    pointFootprint(vCell, boxLo, boxHi);
+    footprint(cell, boxLo, boxHi);
   }
   else
   {
     gl_Position = vec4(0.0, 0.0, 2.0, 1.0);
+#ifdef MEDISO_POINT_FOOTPRINT
     gl_PointSize = 1.0;
+#endif
     vNearDepth = 1.0;
   }
-#else
-  gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
-#endif
 }

@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file HistoPyramidGL.h
+ * @brief The HistoPyramid of a scalar volume, built on the GPU (OpenGL 3.2 core or ES 3.0; no VTK).
+ *
+ * HistoPyramidGL is the GPU half of cell rasterisation (Liu, Clapworthy &
+ * Dong, "Fast isosurface rendering on a GPU by cell rasterization", 2009;
+ * section 4.1 of "Hardware Accelerated Medical Data Visualisation on the
+ * Web"): it counts, for every cell of a volume, how many of up to
+ * MaximumIsovalues isovalues cross it (min < iso <= max over its 8
+ * corners, the convention of vtkMarchingCubes), and sums the counts up a 3D
+ * 8:1 HistoPyramid (Ziegler, Tevs, Theobalt & Seidel, VMV 2006) with the
+ * layout of mediso::PyramidLayout, the same as the CPU model
+ * mediso::HistoPyramid, so that both can be compared node for node. A
+ * drawing program (IsosurfaceRendererGL) then draws GetTotal() primitives,
+ * each finding its cell by walking down the levels.
+ *
+ * Passes, all render-to-texture with a vertex and a fragment stage only:
+ * -# Level 1 from the volume (HistoPyramidFirstLevel_fs.glsl): each texel of
+ *    level 1's atlas counts its 4 nodes' cells from their corner values.
+ *    Level 0 is never stored. The level is cleared to 0 and only the tiles
+ *    whose value range holds an isovalue are drawn: the ranges are computed
+ *    once per volume on the CPU, and each build merges the active tiles of a
+ *    row into one rectangle (two triangles in a small vertex buffer). A
+ *    tile's points are linked by cell edges, so an isovalue in its range
+ *    means one of its cells crosses it: the pass costs what the surface
+ *    touches, not the volume. With one isovalue each node stores its child
+ *    mask (which of its 8 cells cross) in place of its count: the same
+ *    bytes, and the walk reads which cells are active with no recount.
+ * -# Reductions (HistoPyramidReduce_fs.glsl): each level from the one below,
+ *    one full-screen triangle over its atlas.
+ * -# Read-back: only the top node comes back to the CPU, as GetTotal().
+ *
+ * The volume is a 3D texture of the data's own type and bytes, 4 points to
+ * a texel along x (RGBA8I/UI, RGBA16I/UI, RGBA32I/UI, RGBA32F; double data
+ * is converted to float), read with texelFetch only. Isovalues become
+ * thresholds of that type on the CPU (ceil(iso) for integers, the smallest
+ * float not below iso for floats), so the GPU's counts equal the CPU's in
+ * double precision.
+ *
+ * Every call saves and restores the GL state it changes (glcore::
+ * ScopedGLState), so a host can call it inside its own frame. The context
+ * the object was used with (or one sharing its objects) must be current in
+ * every call, the destructor and Release() included.
+ *
+ * @warning Counts are 32-bit: the total must stay below 2^32.
+ */
+#ifndef MedicalIsosurfaces_HistoPyramidGL_h
+#define MedicalIsosurfaces_HistoPyramidGL_h
+
+#include "PyramidLayout.h"
+#include "ScalarTypes.h"
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mediso
+{
+class GLApi;
+class IsosurfaceRendererGL;
+
+/// Runs body(begin, end) over sub-ranges that together cover [begin, end), possibly concurrently.
+using GLParallelFor =
+  std::function<void(std::int64_t, std::int64_t, const std::function<void(std::int64_t, std::int64_t)>&)>;
+
+class HistoPyramidGL
+{
+public:
+  explicit HistoPyramidGL(std::shared_ptr<const GLApi> gl);
+  ~HistoPyramidGL();
+  HistoPyramidGL(const HistoPyramidGL&) = delete;
+  HistoPyramidGL& operator=(const HistoPyramidGL&) = delete;
+
+  /**
+   * Upload `values` (x fastest, `points` per axis, each >= 2) as the volume
+   * texture and compute its tile ranges (over `parallel`, serially when it
+   * is empty). Replaces the previous volume and invalidates the pyramid.
+   * False, with the reason in @a error, when the volume exceeds the
+   * context's texture limits or a GL call fails.
+   */
+  bool UploadVolume(ScalarType type, const void* values, const int points[3],
+    const GLParallelFor& parallel, std::string& error);
+
+  /**
+   * Build the pyramid of the uploaded volume for 1 to MaximumIsovalues
+   * isovalues (NaN ones count nothing) and read back the total.
+   */
+  bool Build(const std::vector<double>& isovalues, std::string& error);
+
+  bool HasVolume() const;
+  bool IsBuilt() const;
+  /// Primitives (active cell-isovalue pairs) of the last successful Build() (0 before).
+  std::uint64_t GetTotal() const;
+  /// The layout of the uploaded volume's pyramid.
+  const PyramidLayout& GetLayout() const;
+  ScalarType GetScalarType() const;
+
+  /**
+   * Read a whole level back (x fastest) and its size, for tests. Level 0,
+   * which is not stored, is drawn by the crossing code into a temporary
+   * texture first. Level 1 comes back as counts even where it holds child
+   * masks, unless @a asStored: then as stored.
+   */
+  bool ReadLevel(int level, std::vector<std::uint32_t>& counts, int size[3], bool asStored,
+    std::string& error);
+
+  /**
+   * Which of the last Build()'s isovalues the pyramid counts, by index, in
+   * the order of bit t of the shaders' crossing masks. Isovalues that can
+   * cross no cell of the volume's value type (and NaN ones) are left out.
+   */
+  const std::vector<int>& GetCountedIsovalues() const;
+
+  /// Whether level 1 holds child masks (one counted isovalue and a level 2 above it).
+  bool GetLevelOneHoldsChildMasks() const;
+
+  ///@{
+  /// Level-1 tiles of the uploaded volume, and how many the last Build() drew.
+  std::uint64_t GetNumberOfTiles() const;
+  std::uint64_t GetLastTilesDrawn() const;
+  ///@}
+
+  /// Bytes of GPU memory held now (volume texture and level atlases).
+  std::uint64_t GetGPUMemoryBytes() const;
+
+  /// Frees every GL object (the context must be current). UploadVolume() starts again.
+  void Release();
+
+private:
+  friend class IsosurfaceRendererGL;
+  struct Internals;
+  std::unique_ptr<Internals> Impl;
+};
+
+} // namespace mediso
+
+#endif

@@ -1,0 +1,527 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "IsosurfaceRendererGL.h"
+
+#include "GLObjects.h"
+#include "HistoPyramidGLInternals.h"
+#include "Matrix4.h"
+#include "MedisoShaders.h"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <sstream>
+
+namespace mediso
+{
+namespace
+{
+using namespace glcore;
+using matrix4::Matrix;
+
+// Whether point sprites cover every cell this frame (see the vertex stage):
+// the index box [0, cells] lies wholly beyond the near plane, and no cell can
+// project to more than maxPointSize - 3 pixels. The bound on a cell's
+// projected extent: with d >= dmin the depth of every point of the volume and
+// L the longest cell diagonal in view space, two points of a cell differ in
+// x/d by at most L/dmin (1 + |x/d|), and |x/d| <= (1 + |P02|)/|P00| on screen
+// (NDC x = P00 x/d - P02 in perspective; NDC x = P00 x + P03 in parallel).
+bool PointsCoverCells(const Matrix& indexToView, const Matrix& projection, const int cells[3],
+  double nearPlane, bool parallel, const int viewport[4], float maxPointSize)
+{
+  double dmin = HUGE_VAL;
+  for (int i = 0; i < 8; ++i)
+  {
+    const double p[4] = { (i & 1) ? double(cells[0]) : 0.0, (i & 2) ? double(cells[1]) : 0.0,
+      (i & 4) ? double(cells[2]) : 0.0, 1.0 };
+    dmin = std::min(dmin, -matrix4::Transform(indexToView, p)[2]); // the camera looks down -z
+  }
+  if (!(dmin > nearPlane * 1.0001 && dmin > 0.0))
+  {
+    return false;
+  }
+  double diagonal = 0.0;
+  for (int i = 0; i < 4; ++i)
+  {
+    const double d[3] = { (i & 1) ? -1.0 : 1.0, (i & 2) ? -1.0 : 1.0, 1.0 };
+    double length = 0.0;
+    for (int r = 0; r < 3; ++r)
+    {
+      const double v =
+        indexToView[4 * r] * d[0] + indexToView[4 * r + 1] * d[1] + indexToView[4 * r + 2] * d[2];
+      length += v * v;
+    }
+    diagonal = std::max(diagonal, std::sqrt(length));
+  }
+  const double p00 = std::abs(projection[0]);
+  const double p11 = std::abs(projection[5]);
+  double ndcX, ndcY; // largest NDC extent of a cell
+  if (parallel)
+  {
+    ndcX = diagonal * p00;
+    ndcY = diagonal * p11;
+  }
+  else
+  {
+    ndcX = diagonal / dmin * (p00 + 1.0 + std::abs(projection[2]));
+    ndcY = diagonal / dmin * (p11 + 1.0 + std::abs(projection[6]));
+  }
+  const double pixels = std::max(0.5 * ndcX * viewport[2], 0.5 * ndcY * viewport[3]);
+  return pixels + 3.0 <= maxPointSize;
+}
+
+// The window pixels the volume can cover: the bounding rectangle of the
+// index box [0, cells]'s 8 projected corners (x, y, width, height), widened by
+// a pixel on every side and cut to the viewport (at least 1x1). Only for a box
+// wholly in front of the eye (as point footprints require).
+void ProjectedRectangle(const Matrix& indexToClip, const int cells[3], const int viewport[4], int rect[4])
+{
+  double lo[2] = { HUGE_VAL, HUGE_VAL };
+  double hi[2] = { -HUGE_VAL, -HUGE_VAL };
+  for (int i = 0; i < 8; ++i)
+  {
+    const double p[4] = { (i & 1) ? double(cells[0]) : 0.0, (i & 2) ? double(cells[1]) : 0.0,
+      (i & 4) ? double(cells[2]) : 0.0, 1.0 };
+    const auto clip = matrix4::Transform(indexToClip, p);
+    for (int a = 0; a < 2; ++a)
+    {
+      const double window = viewport[a] + 0.5 * (clip[a] / clip[3] + 1.0) * viewport[2 + a];
+      lo[a] = std::min(lo[a], window);
+      hi[a] = std::max(hi[a], window);
+    }
+  }
+  for (int a = 0; a < 2; ++a)
+  {
+    const double first = std::max(std::floor(lo[a]) - 1.0, double(viewport[a]));
+    const double last = std::min(std::ceil(hi[a]) + 1.0, double(viewport[a] + viewport[2 + a]));
+    const int begin = std::min(static_cast<int>(first), viewport[a] + viewport[2 + a] - 1);
+    rect[a] = begin;
+    rect[2 + a] = std::max(static_cast<int>(last) - begin, 1);
+  }
+}
+
+// The transpose of the inverse of m's upper 3x3 (normals to view space).
+void NormalMatrix(const Matrix& m, double out[9])
+{
+  const double a = m[0], b = m[1], c = m[2], d = m[4], e = m[5], f = m[6], g = m[8], h = m[9], i = m[10];
+  const double A = e * i - f * h, B = -(d * i - f * g), C = d * h - e * g;
+  const double D = -(b * i - c * h), E = a * i - c * g, F = -(a * h - b * g);
+  const double G = b * f - c * e, H = -(a * f - c * d), I = a * e - b * d;
+  const double det = a * A + b * B + c * C;
+  const double s = det != 0.0 ? 1.0 / det : 0.0;
+  // inverse = adjugate / det, adjugate = cofactor^T; its transpose is cofactor / det.
+  const double cof[9] = { A, B, C, D, E, F, G, H, I };
+  for (int k = 0; k < 9; ++k)
+  {
+    out[k] = cof[k] * s;
+  }
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+struct IsosurfaceRendererGL::Internals
+{
+  std::shared_ptr<const GLApi> GL;
+  ProgramCache Programs;
+  Name VertexArray; // empty: the draws take no attributes
+
+  // First-hit pass: buffers over the volume's projected rectangle (HitRect).
+  Name HitFBO, HitColor, HitDepth, HitFlag;
+  int HitSize[2] = { 0, 0 };
+  int HitRect[4] = { 0, 0, 0, 0 };
+
+  void ReleaseHitBuffers()
+  {
+    this->HitFBO.Reset();
+    this->HitColor.Reset();
+    this->HitDepth.Reset();
+    this->HitFlag.Reset();
+    this->HitSize[0] = this->HitSize[1] = 0;
+  }
+
+  // Buffers for the volume's projection, not the whole viewport: rounded up
+  // to 64 pixels (at most the viewport's size), kept while the projection
+  // fits in them, made again when it outgrows them or shrinks to less than a
+  // quarter of their area. "" when ready, else why not.
+  std::string PrepareFirstHit(int rectWidth, int rectHeight, const int viewport[4])
+  {
+    const GLApi& gl = *this->GL;
+    const GLApi::Functions& f = gl.F();
+    const int rounded[2] = { std::max(std::min((rectWidth + 63) / 64 * 64, viewport[2]), rectWidth),
+      std::max(std::min((rectHeight + 63) / 64 * 64, viewport[3]), rectHeight) };
+    if (this->HitFBO && this->HitSize[0] >= rectWidth && this->HitSize[1] >= rectHeight &&
+      static_cast<double>(this->HitSize[0]) * this->HitSize[1] <=
+        4.0 * static_cast<double>(rounded[0]) * rounded[1])
+    {
+      return "";
+    }
+    this->ReleaseHitBuffers();
+    const int w = rounded[0], h = rounded[1];
+    gl.TakeErrors();
+    this->HitColor = Name(gl, NameKind::Texture);
+    BindTextureUnit(gl, 0, GL_TEXTURE_2D, this->HitColor.Get());
+    SetNearest(gl, GL_TEXTURE_2D);
+    f.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    this->HitDepth = Name(gl, NameKind::Texture);
+    BindTextureUnit(gl, 0, GL_TEXTURE_2D, this->HitDepth.Get());
+    SetNearest(gl, GL_TEXTURE_2D);
+    // The exact depth: a float on desktop OpenGL, its bits on GL ES (see the fragment stage).
+    if (gl.IsES())
+    {
+      f.TexImage2D(GL_TEXTURE_2D, 0, GL_R32UI, w, h, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    }
+    else
+    {
+      f.TexImage2D(GL_TEXTURE_2D, 0, GL_R32F, w, h, 0, GL_RED, GL_FLOAT, nullptr);
+    }
+    this->HitFlag = Name(gl, NameKind::Renderbuffer);
+    f.BindRenderbuffer(GL_RENDERBUFFER, this->HitFlag.Get());
+    f.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT16, w, h);
+    this->HitFBO = Name(gl, NameKind::Framebuffer);
+    f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, this->HitFBO.Get());
+    f.FramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, this->HitColor.Get(), 0);
+    f.FramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, this->HitDepth.Get(), 0);
+    f.FramebufferRenderbuffer(GL_DRAW_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, this->HitFlag.Get());
+    const GLenum buffers[2] = { GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1 };
+    f.DrawBuffers(2, buffers);
+    std::string problem = FramebufferProblem(gl);
+    const std::string errors = gl.TakeErrors();
+    if (problem.empty() && !errors.empty())
+    {
+      problem = errors;
+    }
+    if (!problem.empty())
+    {
+      this->ReleaseHitBuffers();
+      return problem;
+    }
+    this->HitSize[0] = w;
+    this->HitSize[1] = h;
+    return "";
+  }
+
+  void DrawCells(bool points, std::uint64_t total)
+  {
+    const GLApi::Functions& f = this->GL->F();
+    if (points)
+    {
+      f.DrawArrays(GL_POINTS, 0, static_cast<GLsizei>(total));
+    }
+    else
+    {
+      f.DrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, static_cast<GLsizei>(total));
+    }
+  }
+};
+
+IsosurfaceRendererGL::IsosurfaceRendererGL(std::shared_ptr<const GLApi> gl)
+  : Impl(new Internals)
+{
+  this->Impl->GL = std::move(gl);
+}
+
+IsosurfaceRendererGL::~IsosurfaceRendererGL() = default;
+
+void IsosurfaceRendererGL::Release()
+{
+  this->Impl->ReleaseHitBuffers();
+  this->Impl->Programs.Clear();
+  this->Impl->VertexArray.Reset();
+}
+
+std::uint64_t IsosurfaceRendererGL::GetFrameBufferBytes() const
+{
+  // RGBA8 colour, 32-bit depth (R32F or R32UI), 16-bit depth buffer.
+  return static_cast<std::uint64_t>(this->Impl->HitSize[0]) * this->Impl->HitSize[1] * 10u;
+}
+
+//------------------------------------------------------------------------------
+bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
+  IsosurfaceFrameStats& stats, std::string& error)
+{
+  Internals& impl = *this->Impl;
+  const GLApi& gl = *impl.GL;
+  const GLApi::Functions& f = gl.F();
+  const HistoPyramidGL::Internals& pyr = *pyramid.Impl;
+  stats = IsosurfaceFrameStats();
+  if (!pyr.Built)
+  {
+    error = "the pyramid is not built";
+    return false;
+  }
+  if (pyr.GL.get() != impl.GL.get())
+  {
+    error = "the pyramid belongs to another context";
+    return false;
+  }
+  const std::uint64_t total = pyr.Total;
+  stats.Primitives = total;
+  if (total == 0)
+  {
+    return true; // nothing crosses: an empty, correct picture
+  }
+  if (total > static_cast<std::uint64_t>(INT_MAX))
+  {
+    error = "more active cells than one draw call can take";
+    return false;
+  }
+  const PyramidLayout& layout = pyr.Layout;
+  const int numLevels = layout.GetNumberOfLevels();
+  // Stored levels read by the vertex stage (1 .. numLevels - 2) and the volume.
+  if (numLevels - 1 > gl.GetMaxVertexTextureUnits())
+  {
+    error = "the pyramid needs " + std::to_string(numLevels - 1) +
+      " vertex texture units, the context has " + std::to_string(gl.GetMaxVertexTextureUnits());
+    return false;
+  }
+
+  // 1. Isovalues in the pyramid's threshold order, their colours.
+  const std::vector<int>& counted = pyr.Current.Indices;
+  float isoValues[MaximumIsovalues] = { 0 };
+  float isoColors[4 * MaximumIsovalues] = { 0 };
+  bool translucent = false;
+  for (std::size_t t = 0; t < counted.size(); ++t)
+  {
+    if (counted[t] < 0 || counted[t] >= static_cast<int>(frame.Surfaces.size()))
+    {
+      error = "the frame's surfaces are not those the pyramid was built for";
+      return false;
+    }
+    const IsosurfaceLook& s = frame.Surfaces[static_cast<std::size_t>(counted[t])];
+    isoValues[t] = static_cast<float>(s.Value);
+    for (int c = 0; c < 3; ++c)
+    {
+      isoColors[4 * t + c] = s.Color[c];
+    }
+    isoColors[4 * t + 3] = s.Opacity;
+    translucent = translucent || s.Opacity < 1.0f;
+  }
+
+  // 2. Matrices: cell-index space to view and clip, the eye in index space.
+  const Matrix indexToView = matrix4::FromArray(frame.IndexToView);
+  const Matrix projection = matrix4::FromArray(frame.Projection);
+  const Matrix indexToClip = matrix4::Multiply(projection, indexToView);
+  Matrix viewToIndex, clipToIndex;
+  if (!matrix4::Invert(indexToView, viewToIndex) || !matrix4::Invert(indexToClip, clipToIndex))
+  {
+    error = "the volume's transformation to the view is singular";
+    return false;
+  }
+  const double eyeView[4] = { 0.0, 0.0, frame.Parallel ? 1.0 : 0.0, frame.Parallel ? 0.0 : 1.0 };
+  const auto eye = matrix4::Transform(viewToIndex, eyeView);
+  double gradientToView[9];
+  NormalMatrix(indexToView, gradientToView);
+
+  // 3. The footprint (points where they provably cover every cell) and the
+  //    first-hit pass (opaque frames with points); its buffers are made
+  //    before the program is chosen, so that a context that cannot make them
+  //    draws in one pass instead.
+  const int* viewport = frame.Viewport;
+  const int cells[3] = { layout.GetCells()[0], layout.GetCells()[1], layout.GetCells()[2] };
+  const bool points = frame.AllowPointFootprint &&
+    PointsCoverCells(indexToView, projection, cells, frame.NearPlane, frame.Parallel, viewport,
+      gl.GetMaxPointSize());
+  const int units = std::max(numLevels - 1, 2);
+  ScopedGLState saved(gl, units);
+  gl.TakeErrors();
+  GLint hostFramebuffer = 0;
+  f.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &hostFramebuffer);
+  bool firstHit = frame.FirstHitPass && points && !translucent;
+  if (firstHit)
+  {
+    ProjectedRectangle(indexToClip, cells, viewport, impl.HitRect);
+    const std::string problem = impl.PrepareFirstHit(impl.HitRect[2], impl.HitRect[3], viewport);
+    f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(hostFramebuffer));
+    if (!problem.empty())
+    {
+      // Drawn in one pass instead: the same image.
+      firstHit = false;
+    }
+  }
+  // Several opaque isovalues in the first-hit pass: one primitive per cell
+  // whose fragments take the nearest hit of the cell's isovalues.
+  const bool nearest = firstHit && counted.size() > 1;
+  const bool childMasks = pyr.ChildMasks;
+  const int numLights = std::max(0, std::min(frame.NumberOfLights, MaximumLights));
+
+  // 4. The program of this variant and pyramid layout.
+  std::ostringstream defines, levels, descent;
+  if (points)
+  {
+    defines << "#define MEDISO_POINT_FOOTPRINT 1\n";
+  }
+  if (translucent)
+  {
+    defines << "#define MEDISO_TRANSLUCENT 1\n";
+  }
+  if (firstHit)
+  {
+    defines << "#define MEDISO_FIRST_HIT 1\n";
+  }
+  if (nearest)
+  {
+    defines << "#define MEDISO_NEAREST 1\n";
+  }
+  if (childMasks)
+  {
+    defines << "#define MEDISO_CHILD_MASKS 1\n";
+  }
+  defines << "#define MEDISO_LIGHTS " << numLights << "\n";
+  defines << "#define MEDISO_ISOVALUES "
+          << (translucent || nearest ? static_cast<int>(counted.size()) : MaximumIsovalues) << "\n";
+  defines << pyr.Declarations();
+  for (int l = 1; l + 1 < numLevels; ++l)
+  {
+    levels << "uniform usampler2D level" << l << ";\n";
+  }
+  // One step down per level, with the level's constants: with one isovalue
+  // the last step reads level 1's child masks with the counts.
+  for (int l = numLevels - 1; l >= 2; --l)
+  {
+    const int c = l - 1;
+    const auto factor = layout.Factor(l);
+    const auto span = layout.CellsPerNode(c);
+    const auto shifts = pyr.Shifts(c);
+    const bool toMasks = childMasks && c == 1;
+    descent << (toMasks ? "  descendToMasks(level" : "  descend(level") << c << ", ivec3("
+            << factor[0] << ", " << factor[1] << ", " << factor[2] << "), ivec3(" << shifts[0]
+            << ", " << shifts[1] << ", " << shifts[2] << "), vec3(" << span[0] << ".0, " << span[1]
+            << ".0, " << span[2] << ".0), node, index" << (toMasks ? ", nodeBits" : "") << ");\n";
+  }
+  const Hooks common = pyr.CommonHooks();
+  Hooks vertexHooks = common;
+  vertexHooks.emplace_back("HistoPyramidLevels", levels.str());
+  vertexHooks.emplace_back("HistoPyramidDescent", descent.str());
+  const bool conservative = !gl.IsES() && gl.HasConservativeDepth() && !firstHit;
+  Hooks fragmentHooks = { { "FragmentExtensions",
+    conservative
+      ? "#extension GL_ARB_conservative_depth : require\nlayout(depth_greater) out float gl_FragDepth;"
+      : "" } };
+  Program* program = impl.Programs.Get(gl, defines.str(),
+    Compose(shaders::HistoPyramidIso_vs, vertexHooks),
+    Compose(shaders::HistoPyramidIso_fs, fragmentHooks), error);
+  if (!program)
+  {
+    error = "the isosurface shaders do not build: " + error;
+    return false;
+  }
+
+  // 5. State, textures, uniforms.
+  f.Enable(GL_DEPTH_TEST);
+  f.Disable(GL_CULL_FACE);
+  f.Disable(GL_SCISSOR_TEST);
+  f.Disable(GL_STENCIL_TEST);
+  f.Disable(GL_RASTERIZER_DISCARD);
+  f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  if (translucent)
+  {
+    f.Enable(GL_BLEND);
+    f.BlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
+    f.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    f.DepthMask(GL_FALSE);
+  }
+  else
+  {
+    f.Disable(GL_BLEND);
+    f.DepthMask(GL_TRUE);
+  }
+  if (points && !gl.IsES())
+  {
+    f.Enable(GL_PROGRAM_POINT_SIZE); // gl_PointSize (always honoured on GL ES)
+  }
+  program->Use();
+  BindTextureUnit(gl, 0, GL_TEXTURE_3D, pyr.Volume.Get());
+  pyr.SetCommonUniforms(*program, pyr.Current, 0);
+  for (int l = 1; l + 1 < numLevels; ++l)
+  {
+    BindTextureUnit(gl, l, GL_TEXTURE_2D, pyr.Levels[l].Get());
+    program->Set(("level" + std::to_string(l)).c_str(), l);
+  }
+  program->Set3i("firstFactor", layout.Factor(1).data());
+  const float eyeIndex[4] = { static_cast<float>(eye[0]), static_cast<float>(eye[1]),
+    static_cast<float>(eye[2]), static_cast<float>(eye[3]) };
+  program->Set4f("eyeIndex", eyeIndex);
+  program->Set("backToFront", translucent ? 1 : 0);
+  program->Set("oneRankPerCell", translucent || nearest ? 1 : 0);
+  program->Set("parallelProjection", frame.Parallel ? 1 : 0);
+  program->SetMatrix4("indexToClip", indexToClip.data());
+  program->SetMatrix4("indexToView", indexToView.data());
+  program->SetMatrix4("clipToIndex", clipToIndex.data());
+  program->SetMatrix3("gradientToView", gradientToView);
+  program->Set1fv("isovalues", MaximumIsovalues, isoValues);
+  program->Set4fv("isoColors", MaximumIsovalues, isoColors);
+  program->Set("ambient", frame.Ambient);
+  program->Set("diffuse", frame.Diffuse);
+  program->Set("specular", frame.Specular);
+  program->Set("specularPower", frame.SpecularPower);
+  program->Set3fv("lightDirections", MaximumLights, &frame.LightDirections[0][0]);
+  program->Set3fv("lightColors", MaximumLights, &frame.LightColors[0][0]);
+  // Where the cells are drawn: the viewport, or in the first-hit pass the
+  // same viewport in buffers whose pixel (0, 0) is window pixel HitRect.xy.
+  const int drawOrigin[2] = { firstHit ? viewport[0] - impl.HitRect[0] : viewport[0],
+    firstHit ? viewport[1] - impl.HitRect[1] : viewport[1] };
+  program->Set2f("viewportSize", static_cast<float>(viewport[2]), static_cast<float>(viewport[3]));
+  const float viewportF[4] = { static_cast<float>(drawOrigin[0]), static_cast<float>(drawOrigin[1]),
+    static_cast<float>(viewport[2]), static_cast<float>(viewport[3]) };
+  program->Set4f("viewport", viewportF);
+  program->Set("maxPointSize", gl.GetMaxPointSize());
+  // Pixels whose centres lie on a footprint's edges stay covered whatever the
+  // tie rule, and a point size rounded down to the granularity still covers.
+  program->Set("pointMargin", 0.1f + gl.GetPointSizeGranularity());
+  if (!impl.VertexArray)
+  {
+    impl.VertexArray = Name(gl, NameKind::VertexArray);
+  }
+  f.BindVertexArray(impl.VertexArray.Get());
+  f.Viewport(drawOrigin[0], drawOrigin[1], viewport[2], viewport[3]);
+
+  // 6. Draw.
+  if (firstHit)
+  {
+    // Pass 1: into the buffers, cleared to no hit; every primitive has the
+    // same depth and the test is GL_LESS, so each pixel keeps its first hit
+    // in drawing order (front to back: the nearest), and the test runs
+    // before the fragment stage.
+    f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, impl.HitFBO.Get());
+    const GLfloat clearColor[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
+    const GLfloat one = 1.0f;
+    f.ClearBufferfv(GL_COLOR, 0, clearColor);
+    f.ClearBufferfv(GL_DEPTH, 0, &one);
+    // (Attachment 1 needs no clear: its texels are read only where a hit wrote them.)
+    f.DepthFunc(GL_LESS);
+    impl.DrawCells(points, total);
+    // Pass 2: the hits into the host's framebuffer over HitRect, with the
+    // host's depth test.
+    f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(hostFramebuffer));
+    saved.RestoreDepthFunc();
+    Program* composite = impl.Programs.Get(gl, "", shaders::HistoPyramidFullScreen_vs,
+      shaders::HistoPyramidComposite_fs, error);
+    if (!composite)
+    {
+      error = "the first-hit composite shader does not build: " + error;
+      return false;
+    }
+    composite->Use();
+    BindTextureUnit(gl, 0, GL_TEXTURE_2D, impl.HitColor.Get());
+    BindTextureUnit(gl, 1, GL_TEXTURE_2D, impl.HitDepth.Get());
+    composite->Set("hitColor", 0);
+    composite->Set("hitDepth", 1);
+    composite->Set2i("hitOrigin", impl.HitRect[0], impl.HitRect[1]);
+    f.Viewport(impl.HitRect[0], impl.HitRect[1], impl.HitRect[2], impl.HitRect[3]);
+    f.DrawArrays(GL_TRIANGLES, 0, 3);
+  }
+  else
+  {
+    impl.DrawCells(points, total);
+  }
+  const std::string errors = gl.TakeErrors();
+  if (!errors.empty())
+  {
+    error = "drawing the isosurfaces failed: " + errors;
+    return false;
+  }
+  stats.PointFootprint = points;
+  stats.FirstHit = firstHit;
+  return true;
+}
+
+} // namespace mediso

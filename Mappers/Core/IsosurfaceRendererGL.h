@@ -1,0 +1,130 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file IsosurfaceRendererGL.h
+ * @brief Draws the exact isosurfaces of a HistoPyramidGL by cell rasterisation (no VTK).
+ *
+ * The drawing half of the GPU path (Liu, Clapworthy & Dong, "Fast
+ * isosurface rendering on a GPU by cell rasterization", 2009; section 4.1 of
+ * "Hardware Accelerated Medical Data Visualisation on the Web"), on the
+ * common subset of OpenGL 3.2 core and OpenGL ES 3.0 / WebGL2:
+ *
+ * -# One draw call with no vertex attributes draws every active
+ *    (cell, isovalue) pair. The vertex stage (HistoPyramidIso_vs.glsl)
+ *    walks down the pyramid to its cell, visiting children nearest-first
+ *    for the current eye, so the primitives come out front to back with no
+ *    sort (back to front for translucency), and makes the cell's footprint:
+ *    a point sprite over the projected box that holds the surface in the
+ *    cell where points provably cover every cell (the volume beyond the
+ *    near plane, no cell wider than the largest point), otherwise a quad
+ *    (an instanced strip of 4 vertices) over that box cut by the near plane.
+ * -# The fragment stage (HistoPyramidIso_fs.glsl) finds the first root of
+ *    the cubic the trilinear interpolant makes along the ray, shades it with
+ *    Phong (the frame's lights and material) and writes its depth, so the
+ *    surfaces composite exactly with other geometry.
+ * -# Opaque frames draw each primitive's one isovalue, front to back, with
+ *    depth writes. With point footprints they go through the first-hit pass
+ *    (IsosurfaceFrame::FirstHitPass): the cells into the renderer's own
+ *    buffers, where a constant-depth test keeps each pixel's first hit in
+ *    drawing order (the nearest) before any ray is cast, then that colour and
+ *    depth into the host's framebuffer. Translucent frames draw each cell
+ *    once, back to front, compositing all its isovalues' hits in depth order.
+ * -# Programs are compiled per variant (footprint, opaque or translucent,
+ *    first hit, lights, isovalues, the pyramid's layout): a software
+ *    rasteriser runs every branch of a shader under SIMD masks, so one
+ *    mode's code must not sit in another's program.
+ *
+ * The renderer draws into the framebuffer bound when Render() is called,
+ * with the depth function the host has set, and restores every piece of
+ * state it changes.
+ */
+#ifndef MedicalIsosurfaces_IsosurfaceRendererGL_h
+#define MedicalIsosurfaces_IsosurfaceRendererGL_h
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mediso
+{
+class GLApi;
+class HistoPyramidGL;
+
+/// Most lights a frame takes.
+constexpr int MaximumLights = 6;
+
+/// One isosurface: its value, colour and opacity (0 < opacity <= 1).
+struct IsosurfaceLook
+{
+  double Value = 0.0;
+  float Color[3] = { 1.0f, 1.0f, 1.0f };
+  float Opacity = 1.0f;
+};
+
+/// What a frame draws, and from where. Matrices are row-major, column vectors (VTK's convention).
+struct IsosurfaceFrame
+{
+  /// Cell-index space (point (i, j, k) of the volume at (i, j, k)) to the camera's view space.
+  double IndexToView[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
+  /// View space to clip space (OpenGL's convention: the camera looks down -z).
+  double Projection[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
+  bool Parallel = false;
+  /// Distance from the eye to the near clipping plane (view space).
+  double NearPlane = 0.01;
+  /// The viewport in the bound framebuffer's pixels (x, y, width, height).
+  int Viewport[4] = { 0, 0, 1, 1 };
+  /// The isosurfaces, exactly those the pyramid was last built for, in the same order.
+  std::vector<IsosurfaceLook> Surfaces;
+  /// Lights: directions towards the light in view space, and colours (times intensity).
+  int NumberOfLights = 0;
+  float LightDirections[MaximumLights][3] = {};
+  float LightColors[MaximumLights][3] = {};
+  float Ambient = 0.1f;
+  float Diffuse = 0.7f;
+  float Specular = 0.2f;
+  float SpecularPower = 10.0f;
+  /// Let the renderer draw point sprites where they provably cover every cell.
+  bool AllowPointFootprint = true;
+  /// Draw opaque frames with point footprints through the first-hit pass.
+  bool FirstHitPass = true;
+};
+
+/// What a frame did.
+struct IsosurfaceFrameStats
+{
+  std::uint64_t Primitives = 0;
+  bool PointFootprint = false; ///< points (else quads over the box)
+  bool FirstHit = false;       ///< drawn through the first-hit pass
+};
+
+class IsosurfaceRendererGL
+{
+public:
+  explicit IsosurfaceRendererGL(std::shared_ptr<const GLApi> gl);
+  ~IsosurfaceRendererGL();
+  IsosurfaceRendererGL(const IsosurfaceRendererGL&) = delete;
+  IsosurfaceRendererGL& operator=(const IsosurfaceRendererGL&) = delete;
+
+  /**
+   * Draw the isosurfaces of `pyramid` (built, with the same GLApi) for
+   * `frame` into the bound draw framebuffer. False, with the reason in
+   * @a error, when a program does not build, the context lacks what the
+   * frame needs, or a GL call fails.
+   */
+  bool Render(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
+    IsosurfaceFrameStats& stats, std::string& error);
+
+  /// Bytes of the first-hit pass's buffers (0 until one is drawn).
+  std::uint64_t GetFrameBufferBytes() const;
+
+  /// Frees every GL object (the context must be current).
+  void Release();
+
+private:
+  struct Internals;
+  std::unique_ptr<Internals> Impl;
+};
+
+} // namespace mediso
+
+#endif

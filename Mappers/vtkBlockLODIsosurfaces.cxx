@@ -1,0 +1,221 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkBlockLODIsosurfaces.h"
+
+#include "vtkActor.h"
+#include "vtkBlockLODContour.h"
+#include "vtkDataArray.h"
+#include "vtkDepthSortPolyData.h"
+#include "vtkImageData.h"
+#include "vtkMatrix4x4.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLState.h"
+#include "vtkPointData.h"
+#include "vtkPolyData.h"
+#include "vtkPolyDataMapper.h"
+#include "vtkProperty.h"
+#include "vtkRenderer.h"
+#include "vtkUnsignedCharArray.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+#include "vtk_glew.h"
+
+#include <cmath>
+
+vtkStandardNewMacro(vtkBlockLODIsosurfaces);
+
+//------------------------------------------------------------------------------
+struct vtkBlockLODIsosurfaces::Internals
+{
+  vtkNew<vtkBlockLODContour> Contour;
+  vtkNew<vtkImageData> IndexImage;
+  vtkNew<vtkPolyData> Colored;
+  vtkMTimeType ColoredSurfaceTime = 0; // Colored was made from this surface
+  std::vector<double> ColoredLooks;    // and these values, colours, opacities
+  // Translucent surfaces: the triangles sorted back to front for the current
+  // camera (blending in drawing order is only right in that order).
+  vtkNew<vtkDepthSortPolyData> Sort;
+  vtkNew<vtkPolyDataMapper> PolyMapper;
+  vtkNew<vtkActor> Actor;
+  vtkNew<vtkMatrix4x4> ActorMatrix;
+};
+
+//------------------------------------------------------------------------------
+vtkBlockLODIsosurfaces::vtkBlockLODIsosurfaces()
+  : Impl(new Internals)
+{
+  Internals& impl = *this->Impl;
+  impl.Contour->SetLOD(3);
+  impl.Contour->SetComputeNormals(true);
+  impl.Contour->SetComputeScalars(true);
+  impl.Sort->SetInputData(impl.Colored);
+  impl.Sort->SetDirectionToBackToFront();
+  impl.Sort->SetDepthSortModeToParametricCenter();
+  impl.Sort->SortScalarsOff();
+  impl.Sort->SetProp3D(impl.Actor);
+  impl.PolyMapper->SetInputData(impl.Colored);
+  impl.PolyMapper->SetColorModeToDirectScalars();
+  impl.PolyMapper->SetScalarModeToUsePointData();
+  impl.PolyMapper->ScalarVisibilityOn();
+  impl.Actor->SetMapper(impl.PolyMapper);
+  impl.Actor->SetUserMatrix(impl.ActorMatrix);
+}
+
+//------------------------------------------------------------------------------
+vtkBlockLODIsosurfaces::~vtkBlockLODIsosurfaces() = default;
+
+//------------------------------------------------------------------------------
+void vtkBlockLODIsosurfaces::ReleaseGraphicsResources(vtkWindow* win)
+{
+  this->Impl->PolyMapper->ReleaseGraphicsResources(win);
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol,
+  vtkImageData* image, vtkDataArray* scalars, const std::vector<Surface>& surfaces)
+{
+  Internals& impl = *this->Impl;
+
+  // Contour an index-space copy of the image (origin 0, spacing 1, no
+  // direction: vtkBlockLODContour needs an axis-aligned grid) and place it
+  // with the actor's matrix, which also carries the volume's matrix.
+  const int* extent = image->GetExtent();
+  impl.IndexImage->SetExtent(0, extent[1] - extent[0], 0, extent[3] - extent[2], 0,
+    extent[5] - extent[4]);
+  impl.IndexImage->SetOrigin(0.0, 0.0, 0.0);
+  impl.IndexImage->SetSpacing(1.0, 1.0, 1.0);
+  if (impl.IndexImage->GetPointData()->GetScalars() != scalars)
+  {
+    impl.IndexImage->GetPointData()->Initialize();
+    impl.IndexImage->GetPointData()->SetScalars(scalars);
+    impl.IndexImage->Modified();
+  }
+  {
+    vtkNew<vtkMatrix4x4> shift, indexToModel;
+    shift->SetElement(0, 3, extent[0]);
+    shift->SetElement(1, 3, extent[2]);
+    shift->SetElement(2, 3, extent[4]);
+    vtkMatrix4x4::Multiply4x4(image->GetIndexToPhysicalMatrix(), shift, indexToModel);
+    vtkNew<vtkMatrix4x4> matrix;
+    vtkMatrix4x4::Multiply4x4(vol->GetMatrix(), indexToModel, matrix);
+    bool changed = false;
+    for (int i = 0; i < 16; ++i)
+    {
+      changed = changed || impl.ActorMatrix->GetData()[i] != matrix->GetData()[i];
+    }
+    if (changed)
+    {
+      impl.ActorMatrix->DeepCopy(matrix);
+    }
+  }
+
+  impl.Contour->SetInputData(impl.IndexImage);
+  impl.Contour->SetInputArrayToProcess(
+    0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+  bool valuesChanged = impl.Contour->GetNumberOfContours() != static_cast<vtkIdType>(surfaces.size());
+  for (std::size_t i = 0; i < surfaces.size() && !valuesChanged; ++i)
+  {
+    valuesChanged = impl.Contour->GetValue(static_cast<int>(i)) != surfaces[i].Value;
+  }
+  if (valuesChanged)
+  {
+    impl.Contour->SetNumberOfContours(static_cast<int>(surfaces.size()));
+    for (std::size_t i = 0; i < surfaces.size(); ++i)
+    {
+      impl.Contour->SetValue(static_cast<int>(i), surfaces[i].Value);
+    }
+  }
+  impl.Contour->Update();
+  vtkPolyData* surface = impl.Contour->GetOutput();
+
+  // Colour every point by its isovalue (RGBA, opacity in alpha).
+  // Recoloured only when the surface or the looks change (not every frame).
+  bool translucent = false;
+  std::vector<double> looks;
+  for (const Surface& s : surfaces)
+  {
+    translucent = translucent || s.Opacity < 1.0;
+    looks.insert(looks.end(), { s.Value, s.Color[0], s.Color[1], s.Color[2], s.Opacity });
+  }
+  if (surface->GetMTime() != impl.ColoredSurfaceTime || looks != impl.ColoredLooks)
+  {
+    impl.Colored->ShallowCopy(surface);
+    vtkDataArray* which = surface->GetPointData()->GetArray("Isovalue");
+    vtkNew<vtkUnsignedCharArray> colors;
+    colors->SetName("Colors");
+    colors->SetNumberOfComponents(4);
+    const vtkIdType numPoints = surface->GetNumberOfPoints();
+    colors->SetNumberOfTuples(numPoints);
+    for (vtkIdType p = 0; p < numPoints; ++p)
+    {
+      const double v = which ? which->GetTuple1(p) : surfaces[0].Value;
+      const Surface* match = &surfaces[0];
+      for (const Surface& s : surfaces)
+      {
+        if (std::abs(s.Value - v) < std::abs(match->Value - v))
+        {
+          match = &s;
+        }
+      }
+      unsigned char rgba[4];
+      for (int c = 0; c < 3; ++c)
+      {
+        rgba[c] = static_cast<unsigned char>(std::lround(255.0 * match->Color[c]));
+      }
+      rgba[3] = static_cast<unsigned char>(std::lround(255.0 * match->Opacity));
+      colors->SetTypedTuple(p, rgba);
+    }
+    impl.Colored->GetPointData()->SetScalars(colors);
+    impl.ColoredSurfaceTime = surface->GetMTime();
+    impl.ColoredLooks = looks;
+  }
+  this->NumberOfTriangles = static_cast<std::uint64_t>(surface->GetNumberOfPolys());
+
+  vtkVolumeProperty* property = vol->GetProperty();
+  vtkProperty* actorProperty = impl.Actor->GetProperty();
+  actorProperty->SetAmbient(property->GetAmbient());
+  actorProperty->SetDiffuse(property->GetDiffuse());
+  actorProperty->SetSpecular(property->GetSpecular());
+  actorProperty->SetSpecularPower(property->GetSpecularPower());
+  actorProperty->BackfaceCullingOff();
+
+  auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  if (!renWin)
+  {
+    return;
+  }
+  vtkOpenGLState* ostate = renWin->GetState();
+  vtkOpenGLState::ScopedglEnableDisable blend(ostate, GL_BLEND);
+  vtkOpenGLState::ScopedglDepthMask depthMask(ostate);
+  vtkOpenGLState::ScopedglBlendFuncSeparate blendFunc(ostate);
+  if (translucent)
+  {
+    impl.Sort->SetCamera(ren->GetActiveCamera());
+    if (impl.PolyMapper->GetInputAlgorithm() != impl.Sort.GetPointer())
+    {
+      impl.PolyMapper->SetInputConnection(impl.Sort->GetOutputPort());
+    }
+    ostate->vtkglEnable(GL_BLEND);
+    ostate->vtkglBlendFuncSeparate(
+      GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    ostate->vtkglDepthMask(GL_FALSE);
+  }
+  else
+  {
+    if (impl.PolyMapper->GetInputAlgorithm() == impl.Sort.GetPointer())
+    {
+      impl.PolyMapper->SetInputData(impl.Colored);
+    }
+    ostate->vtkglDisable(GL_BLEND);
+    ostate->vtkglDepthMask(GL_TRUE);
+  }
+  impl.PolyMapper->Render(ren, impl.Actor);
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODIsosurfaces::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "NumberOfTriangles: " << this->NumberOfTriangles << "\n";
+}

@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkBlockLODIsosurfaces
+ * @brief   The CPU path of vtkHistoPyramidIsoMapper: vtkBlockLODContour + vtkPolyDataMapper.
+ *
+ * Draws the isosurfaces vtkHistoPyramidIsoMapper asks for where its GPU path
+ * (vtkOpenGLHistoPyramidIsosurfaces) cannot run, or when the fallback is
+ * forced: the surfaces are extracted by vtkBlockLODContour at full
+ * resolution (level 3) from an index-space copy of the image (vtkBlockLODContour
+ * needs an axis-aligned grid) placed by an actor matrix that also carries the
+ * image's direction and the volume's matrix; every point is coloured by its
+ * isovalue (RGBA), recoloured only when the surface or the looks change.
+ * Translucent surfaces are drawn sorted back to front (vtkDepthSortPolyData)
+ * with blending: the renderer's depth peeling does not reach geometry a
+ * volume mapper draws.
+ *
+ * @sa vtkHistoPyramidIsoMapper vtkOpenGLHistoPyramidIsosurfaces vtkBlockLODContour
+ */
+#ifndef vtkBlockLODIsosurfaces_h
+#define vtkBlockLODIsosurfaces_h
+
+#include "MedicalIsosurfacesMappersModule.h" // For export macro
+#include "vtkObject.h"
+#include "vtkOpenGLHistoPyramidIsosurfaces.h" // For Surface
+
+#include <cstdint> // For std::uint64_t
+#include <memory>  // For std::unique_ptr
+#include <vector>  // For std::vector
+
+class vtkDataArray;
+class vtkImageData;
+class vtkRenderer;
+class vtkVolume;
+class vtkWindow;
+
+class MEDICALISOSURFACESMAPPERS_EXPORT vtkBlockLODIsosurfaces : public vtkObject
+{
+public:
+  static vtkBlockLODIsosurfaces* New();
+  vtkTypeMacro(vtkBlockLODIsosurfaces, vtkObject);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  using Surface = vtkOpenGLHistoPyramidIsosurfaces::Surface;
+
+  /// Draw `surfaces` of `scalars` of `image` for `vol` into `ren`.
+  void RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image,
+    vtkDataArray* scalars, const std::vector<Surface>& surfaces);
+
+  /// Triangles of the last frame.
+  vtkGetMacro(NumberOfTriangles, std::uint64_t);
+
+  void ReleaseGraphicsResources(vtkWindow* win);
+
+protected:
+  vtkBlockLODIsosurfaces();
+  ~vtkBlockLODIsosurfaces() override;
+
+private:
+  vtkBlockLODIsosurfaces(const vtkBlockLODIsosurfaces&) = delete;
+  void operator=(const vtkBlockLODIsosurfaces&) = delete;
+
+  std::uint64_t NumberOfTriangles = 0;
+  struct Internals;
+  std::unique_ptr<Internals> Impl;
+};
+
+#endif
