@@ -1,0 +1,743 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file mediso-render.cxx
+ * @brief mediso-render: exact GPU isosurfaces of a MetaImage volume, headless (EGL, no X, no VTK).
+ *
+ * The GPU core (mediso::HistoPyramidGL and IsosurfaceRendererGL, the same
+ * code the ParaView mapper runs) on a context of its own: it renders one
+ * image, or runs the paper's protocol (360 one-degree rotations; the sweep of
+ * 95 equidistant isovalues) and prints a table. The scene follows the
+ * ParaView mapper's conventions (VTK's camera, a headlight, the volume's
+ * spacing, origin and direction), so its images compare with ParaView's.
+ * Run with --help for the options.
+ *
+ * Exit status: 0 done; 2 bad options; 3 the volume cannot be read or is not
+ * usable; 4 no usable OpenGL (no EGL display, too old a context, the volume
+ * over the context's limits); 1 anything else that failed.
+ */
+#include "Camera.h"
+#include "GLApiFunctions.h"
+#include "GLProbe.h"
+#include "HeadlessContext.h"
+#include "HistoPyramidGL.h"
+#include "IsosurfaceRendererGL.h"
+#include "MetaImage.h"
+#include "PngWriter.h"
+#include "ThreadedFor.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <new>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace
+{
+using namespace mediso;
+using Clock = std::chrono::steady_clock;
+
+const char* const Usage = R"(usage: mediso-render VOLUME.mha|VOLUME.mhd [options]
+
+Renders the isosurfaces of an uncompressed MetaImage volume on the GPU (cell
+rasterisation over a HistoPyramid), with no window and no X display (EGL).
+
+Scene:
+  --iso V[:R,G,B[,A]]   an isosurface: value, colour (0..1) and opacity
+                        (default colour 0.93,0.85,0.75, opacity 1); up to 8
+  --size WxH            image size in pixels (default 1024x768)
+  --azimuth DEG         camera rotation about the view up (default 0)
+  --elevation DEG       camera rotation about the view's horizontal axis (default 0)
+  --zoom F              zoom factor (default 1)
+  --parallel            parallel projection (default perspective)
+  --background R,G,B    background colour (default 0.1,0.12,0.16)
+  --material A,D,S,P    ambient, diffuse, specular, specular power
+                        (default 0.15,0.8,0.25,30)
+  --no-points           never draw point footprints (always quads)
+  --no-first-hit        draw opaque frames in one pass
+The camera is VTK's: reset to the volume's bounds (view angle 30 degrees,
+looking down -z), then azimuth, elevation, orthogonalised view up, zoom.
+
+Output:
+  --output FILE.png     write the image
+  --stats               print one JSON line: primitives, build/draw/frame ms,
+                        GPU bytes, the GL renderer
+  --frames N            draw the image N times (timing; default 1)
+
+The paper's protocol (prints a table):
+  --rotate [N]          N one-degree rotations (azimuth), default 360
+  --sweep [N]           N equidistant isovalues strictly inside the data
+                        range (default 95), each built and drawn
+
+Context:
+  --api es|gl           OpenGL ES 3.0 (the WebGL2 subset; default) or OpenGL 3.2 core
+MEDISO_EGL_PLATFORM=surfaceless|device|default picks the EGL display.
+)";
+
+struct Options
+{
+  std::string Input;
+  std::vector<IsosurfaceLook> Surfaces;
+  int Width = 1024, Height = 768;
+  double Azimuth = 0.0, Elevation = 0.0, Zoom = 1.0;
+  bool Parallel = false;
+  double Background[3] = { 0.1, 0.12, 0.16 };
+  double Material[4] = { 0.15, 0.8, 0.25, 30.0 };
+  bool Points = true, FirstHit = true;
+  std::string Output;
+  bool Stats = false;
+  int Frames = 1;
+  int Rotate = 0;
+  int Sweep = 0;
+  bool ES = true;
+};
+
+struct UsageError
+{
+  std::string Text;
+};
+
+std::vector<double> Numbers(const std::string& text, char separator, const std::string& what)
+{
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, separator))
+  {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(v))
+    {
+      throw UsageError{ what + ": \"" + text + "\" is not a list of numbers" };
+    }
+    values.push_back(v);
+  }
+  return values;
+}
+
+double Number(const std::string& text, const std::string& what)
+{
+  const std::vector<double> v = Numbers(text, ',', what);
+  if (v.size() != 1)
+  {
+    throw UsageError{ what + ": \"" + text + "\" is not a number" };
+  }
+  return v[0];
+}
+
+Options Parse(int argc, char* argv[])
+{
+  Options opt;
+  for (int i = 1; i < argc; ++i)
+  {
+    const std::string arg = argv[i];
+    auto value = [&](const char* what) -> std::string
+    {
+      if (i + 1 >= argc)
+      {
+        throw UsageError{ std::string(what) + " needs a value" };
+      }
+      return argv[++i];
+    };
+    // An optional count after a flag (the next argument, when it is a number).
+    auto count = [&](int fallback) -> int
+    {
+      if (i + 1 < argc && argv[i + 1][0] >= '0' && argv[i + 1][0] <= '9')
+      {
+        return static_cast<int>(Number(argv[++i], arg));
+      }
+      return fallback;
+    };
+    if (arg == "--help" || arg == "-h")
+    {
+      std::cout << Usage;
+      std::exit(0);
+    }
+    else if (arg == "--iso")
+    {
+      const std::string text = value("--iso");
+      const std::size_t colon = text.find(':');
+      IsosurfaceLook look;
+      look.Value = Number(text.substr(0, colon), "--iso");
+      look.Color[0] = 0.93f;
+      look.Color[1] = 0.85f;
+      look.Color[2] = 0.75f;
+      if (colon != std::string::npos)
+      {
+        const std::vector<double> c = Numbers(text.substr(colon + 1), ',', "--iso colour");
+        if (c.size() != 3 && c.size() != 4)
+        {
+          throw UsageError{ "--iso " + text + ": give R,G,B or R,G,B,A after the colon" };
+        }
+        for (double x : c)
+        {
+          if (x < 0.0 || x > 1.0)
+          {
+            throw UsageError{ "--iso " + text + ": colour and opacity go from 0 to 1" };
+          }
+        }
+        for (int k = 0; k < 3; ++k)
+        {
+          look.Color[k] = static_cast<float>(c[k]);
+        }
+        look.Opacity = c.size() == 4 ? static_cast<float>(c[3]) : 1.0f;
+        if (look.Opacity <= 0.0f)
+        {
+          throw UsageError{ "--iso " + text + ": an isosurface of opacity 0 draws nothing" };
+        }
+      }
+      opt.Surfaces.push_back(look);
+    }
+    else if (arg == "--size")
+    {
+      const std::string text = value("--size");
+      const std::vector<double> wh = Numbers(text, 'x', "--size");
+      if (wh.size() != 2 || wh[0] < 1 || wh[1] < 1 || wh[0] > 16384 || wh[1] > 16384 ||
+        wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1]))
+      {
+        throw UsageError{ "--size " + text + ": give WIDTHxHEIGHT, 1 to 16384 each" };
+      }
+      opt.Width = static_cast<int>(wh[0]);
+      opt.Height = static_cast<int>(wh[1]);
+    }
+    else if (arg == "--azimuth")
+    {
+      opt.Azimuth = Number(value("--azimuth"), "--azimuth");
+    }
+    else if (arg == "--elevation")
+    {
+      opt.Elevation = Number(value("--elevation"), "--elevation");
+    }
+    else if (arg == "--zoom")
+    {
+      opt.Zoom = Number(value("--zoom"), "--zoom");
+      if (!(opt.Zoom > 0.0))
+      {
+        throw UsageError{ "--zoom must be positive" };
+      }
+    }
+    else if (arg == "--parallel")
+    {
+      opt.Parallel = true;
+    }
+    else if (arg == "--background" || arg == "--material")
+    {
+      const std::vector<double> v = Numbers(value(arg.c_str()), ',', arg);
+      const std::size_t n = arg == "--background" ? 3 : 4;
+      if (v.size() != n)
+      {
+        throw UsageError{ arg + " takes " + std::to_string(n) + " numbers" };
+      }
+      std::copy(v.begin(), v.end(), arg == "--background" ? opt.Background : opt.Material);
+    }
+    else if (arg == "--no-points")
+    {
+      opt.Points = false;
+    }
+    else if (arg == "--no-first-hit")
+    {
+      opt.FirstHit = false;
+    }
+    else if (arg == "--output")
+    {
+      opt.Output = value("--output");
+    }
+    else if (arg == "--stats")
+    {
+      opt.Stats = true;
+    }
+    else if (arg == "--frames")
+    {
+      opt.Frames = static_cast<int>(Number(value("--frames"), "--frames"));
+      if (opt.Frames < 1 || opt.Frames > 100000)
+      {
+        throw UsageError{ "--frames must be 1 to 100000" };
+      }
+    }
+    else if (arg == "--rotate")
+    {
+      opt.Rotate = count(360);
+      if (opt.Rotate < 1 || opt.Rotate > 100000)
+      {
+        throw UsageError{ "--rotate takes 1 to 100000 frames" };
+      }
+    }
+    else if (arg == "--sweep")
+    {
+      opt.Sweep = count(95);
+      if (opt.Sweep < 1 || opt.Sweep > 100000)
+      {
+        throw UsageError{ "--sweep takes 1 to 100000 isovalues" };
+      }
+    }
+    else if (arg == "--api")
+    {
+      const std::string api = value("--api");
+      if (api != "es" && api != "gl")
+      {
+        throw UsageError{ "--api is es or gl, not " + api };
+      }
+      opt.ES = api == "es";
+    }
+    else if (!arg.empty() && arg[0] == '-')
+    {
+      throw UsageError{ "unknown option " + arg };
+    }
+    else if (opt.Input.empty())
+    {
+      opt.Input = arg;
+    }
+    else
+    {
+      throw UsageError{ "one volume only (got " + opt.Input + " and " + arg + ")" };
+    }
+  }
+  if (opt.Input.empty())
+  {
+    throw UsageError{ "no volume given" };
+  }
+  if (opt.Surfaces.empty() && opt.Sweep == 0)
+  {
+    throw UsageError{ "give at least one --iso (or --sweep)" };
+  }
+  if (opt.Surfaces.size() > static_cast<std::size_t>(MaximumIsovalues))
+  {
+    throw UsageError{ "at most " + std::to_string(MaximumIsovalues) + " isosurfaces" };
+  }
+  std::sort(opt.Surfaces.begin(), opt.Surfaces.end(),
+    [](const IsosurfaceLook& a, const IsosurfaceLook& b) { return a.Value < b.Value; });
+  for (std::size_t i = 1; i < opt.Surfaces.size(); ++i)
+  {
+    if (opt.Surfaces[i].Value == opt.Surfaces[i - 1].Value)
+    {
+      throw UsageError{ "isovalue " + std::to_string(opt.Surfaces[i].Value) + " given twice" };
+    }
+  }
+  return opt;
+}
+
+double Milliseconds(Clock::duration d)
+{
+  return std::chrono::duration<double, std::milli>(d).count();
+}
+
+double Median(std::vector<double> v)
+{
+  if (v.empty())
+  {
+    return 0.0;
+  }
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string JsonString(const std::string& s)
+{
+  std::string out = "\"";
+  for (char c : s)
+  {
+    if (c == '"' || c == '\\')
+    {
+      out += '\\';
+      out += c;
+    }
+    else if (static_cast<unsigned char>(c) < 0x20)
+    {
+      out += ' ';
+    }
+    else
+    {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+// The scene: the volume on the GPU, the camera, the target framebuffer.
+class Scene
+{
+public:
+  Scene(const Options& options, const headless::MetaImage& image,
+    std::shared_ptr<const GLApi> gl)
+    : Opt(options)
+    , Image(image)
+    , GL(std::move(gl))
+    , Pyramid(this->GL)
+    , Renderer(this->GL)
+  {
+  }
+
+  ~Scene()
+  {
+    this->Pyramid.Release();
+    this->Renderer.Release();
+    const GLApi::Functions& f = this->GL->F();
+    f.DeleteFramebuffers(1, &this->FBO);
+    f.DeleteRenderbuffers(2, this->Buffers);
+  }
+
+  // Returns "" or why the target or the volume cannot be made.
+  std::string Prepare()
+  {
+    const GLApi::Functions& f = this->GL->F();
+    GLint maxRenderbuffer = 0, maxViewport[2] = { 0, 0 };
+    f.GetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &maxRenderbuffer);
+    f.GetIntegerv(GL_MAX_VIEWPORT_DIMS, maxViewport);
+    const int limit = std::min({ maxRenderbuffer, maxViewport[0], maxViewport[1] });
+    if (this->Opt.Width > limit || this->Opt.Height > limit)
+    {
+      return "a " + std::to_string(this->Opt.Width) + "x" + std::to_string(this->Opt.Height) +
+        " image exceeds this context's limit of " + std::to_string(limit) + " pixels per side";
+    }
+    f.GenFramebuffers(1, &this->FBO);
+    f.GenRenderbuffers(2, this->Buffers);
+    f.BindRenderbuffer(GL_RENDERBUFFER, this->Buffers[0]);
+    f.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, this->Opt.Width, this->Opt.Height);
+    f.BindRenderbuffer(GL_RENDERBUFFER, this->Buffers[1]);
+    f.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, this->Opt.Width, this->Opt.Height);
+    f.BindFramebuffer(GL_FRAMEBUFFER, this->FBO);
+    f.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, this->Buffers[0]);
+    f.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, this->Buffers[1]);
+    if (f.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    {
+      return "the " + std::to_string(this->Opt.Width) + "x" + std::to_string(this->Opt.Height) +
+        " framebuffer cannot be made (" + this->GL->TakeErrors() + ")";
+    }
+    std::string error;
+    const auto start = Clock::now();
+    if (!this->Pyramid.UploadVolume(this->Image.Type, this->Image.Bytes.data(),
+          this->Image.Dimensions, headless::ThreadedFor, error))
+    {
+      return error;
+    }
+    this->UploadMs = Milliseconds(Clock::now() - start);
+    this->SetCamera(0.0);
+    return "";
+  }
+
+  // VTK's camera for the options, turned `extraAzimuth` degrees more.
+  void SetCamera(double extraAzimuth)
+  {
+    const int* d = this->Image.Dimensions;
+    // Index to world: origin + direction * (spacing * index).
+    matrix4::Matrix indexToWorld = matrix4::Identity();
+    for (int r = 0; r < 3; ++r)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        indexToWorld[4 * r + c] = this->Image.Direction[3 * r + c] * this->Image.Spacing[c];
+      }
+      indexToWorld[4 * r + 3] = this->Image.Origin[r];
+    }
+    double bounds[6] = { HUGE_VAL, -HUGE_VAL, HUGE_VAL, -HUGE_VAL, HUGE_VAL, -HUGE_VAL };
+    for (int i = 0; i < 8; ++i)
+    {
+      const double p[4] = { (i & 1) ? d[0] - 1.0 : 0.0, (i & 2) ? d[1] - 1.0 : 0.0,
+        (i & 4) ? d[2] - 1.0 : 0.0, 1.0 };
+      const auto w = matrix4::Transform(indexToWorld, p);
+      for (int a = 0; a < 3; ++a)
+      {
+        bounds[2 * a] = std::min(bounds[2 * a], w[a]);
+        bounds[2 * a + 1] = std::max(bounds[2 * a + 1], w[a]);
+      }
+    }
+    const double aspect = static_cast<double>(this->Opt.Width) / this->Opt.Height;
+    Camera camera;
+    camera.Parallel = this->Opt.Parallel;
+    camera.Reset(bounds, aspect);
+    camera.Azimuth(this->Opt.Azimuth + extraAzimuth);
+    camera.Elevation(this->Opt.Elevation);
+    camera.OrthogonalizeViewUp();
+    camera.Zoom(this->Opt.Zoom);
+    camera.ResetClippingRange(bounds);
+    const matrix4::Matrix indexToView = matrix4::Multiply(camera.ViewMatrix(), indexToWorld);
+    const matrix4::Matrix projection = camera.ProjectionMatrix(aspect);
+    std::copy(indexToView.begin(), indexToView.end(), this->Frame.IndexToView);
+    std::copy(projection.begin(), projection.end(), this->Frame.Projection);
+    this->Frame.Parallel = camera.Parallel;
+    this->Frame.NearPlane = camera.ClippingRange[0];
+    const int viewport[4] = { 0, 0, this->Opt.Width, this->Opt.Height };
+    std::copy(viewport, viewport + 4, this->Frame.Viewport);
+    // VTK's default light: a white headlight of intensity 1.
+    this->Frame.NumberOfLights = 1;
+    this->Frame.LightDirections[0][0] = 0.0f;
+    this->Frame.LightDirections[0][1] = 0.0f;
+    this->Frame.LightDirections[0][2] = 1.0f;
+    this->Frame.LightColors[0][0] = this->Frame.LightColors[0][1] = this->Frame.LightColors[0][2] = 1.0f;
+    this->Frame.Ambient = static_cast<float>(this->Opt.Material[0]);
+    this->Frame.Diffuse = static_cast<float>(this->Opt.Material[1]);
+    this->Frame.Specular = static_cast<float>(this->Opt.Material[2]);
+    this->Frame.SpecularPower = static_cast<float>(this->Opt.Material[3]);
+    this->Frame.AllowPointFootprint = this->Opt.Points;
+    this->Frame.FirstHitPass = this->Opt.FirstHit;
+  }
+
+  // Builds the pyramid for `surfaces`; "" or why not.
+  std::string Build(const std::vector<IsosurfaceLook>& surfaces)
+  {
+    std::vector<double> values;
+    for (const IsosurfaceLook& s : surfaces)
+    {
+      values.push_back(s.Value);
+    }
+    std::string error;
+    const auto start = Clock::now();
+    if (!this->Pyramid.Build(values, error))
+    {
+      return error;
+    }
+    this->BuildMs = Milliseconds(Clock::now() - start);
+    this->Frame.Surfaces = surfaces;
+    return "";
+  }
+
+  // One frame, finished: "" or why not.
+  std::string Draw()
+  {
+    const GLApi::Functions& f = this->GL->F();
+    const auto start = Clock::now();
+    f.BindFramebuffer(GL_FRAMEBUFFER, this->FBO);
+    f.Viewport(0, 0, this->Opt.Width, this->Opt.Height);
+    f.Enable(GL_DEPTH_TEST);
+    f.DepthFunc(GL_LEQUAL);
+    f.DepthMask(GL_TRUE);
+    const GLfloat background[4] = { static_cast<float>(this->Opt.Background[0]),
+      static_cast<float>(this->Opt.Background[1]), static_cast<float>(this->Opt.Background[2]), 1.0f };
+    const GLfloat one = 1.0f;
+    f.ClearBufferfv(GL_COLOR, 0, background);
+    f.ClearBufferfv(GL_DEPTH, 0, &one);
+    std::string error;
+    if (!this->Renderer.Render(this->Pyramid, this->Frame, this->Stats, error))
+    {
+      return error;
+    }
+    f.Finish();
+    this->FrameMs = Milliseconds(Clock::now() - start);
+    const std::string errors = this->GL->TakeErrors();
+    return errors.empty() ? "" : "OpenGL errors: " + errors;
+  }
+
+  std::vector<unsigned char> ReadImage()
+  {
+    const GLApi::Functions& f = this->GL->F();
+    std::vector<unsigned char> rgba(4 * static_cast<std::size_t>(this->Opt.Width) * this->Opt.Height);
+    f.BindFramebuffer(GL_FRAMEBUFFER, this->FBO);
+    f.ReadBuffer(GL_COLOR_ATTACHMENT0);
+    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    f.ReadPixels(0, 0, this->Opt.Width, this->Opt.Height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+    return rgba;
+  }
+
+  const Options& Opt;
+  const headless::MetaImage& Image;
+  std::shared_ptr<const GLApi> GL;
+  HistoPyramidGL Pyramid;
+  IsosurfaceRendererGL Renderer;
+  IsosurfaceFrame Frame;
+  IsosurfaceFrameStats Stats;
+  GLuint FBO = 0;
+  GLuint Buffers[2] = { 0, 0 };
+  double UploadMs = 0.0, BuildMs = 0.0, FrameMs = 0.0;
+};
+
+int Fail(int code, const std::string& text)
+{
+  std::cerr << "mediso-render: " << text << "\n";
+  return code;
+}
+
+int Run(int argc, char* argv[])
+{
+  Options opt;
+  try
+  {
+    opt = Parse(argc, argv);
+  }
+  catch (const UsageError& e)
+  {
+    std::cerr << "mediso-render: " << e.Text << "\n(mediso-render --help lists the options)\n";
+    return 2;
+  }
+  headless::MetaImage image;
+  std::string error;
+  if (!headless::ReadMetaImage(opt.Input, image, error))
+  {
+    return Fail(3, error);
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    if (image.Dimensions[a] < 2)
+    {
+      return Fail(3, opt.Input + ": a " + std::to_string(image.Dimensions[0]) + "x" +
+          std::to_string(image.Dimensions[1]) + "x" + std::to_string(image.Dimensions[2]) +
+          " volume has no cells; isosurfaces need at least 2 points per axis");
+    }
+  }
+  double range[2];
+  image.GetRange(range);
+  if (!(range[0] <= range[1]))
+  {
+    return Fail(3, opt.Input + ": every value is NaN");
+  }
+  auto context = headless::HeadlessContext::Create(
+    opt.ES ? headless::ContextApi::ES3 : headless::ContextApi::GL32, error);
+  if (!context)
+  {
+    return Fail(4, error);
+  }
+  const GLApi& gl = *context->GetGLApi();
+  if (ProbeGL(gl, error) != ProbeResult::Passed)
+  {
+    return Fail(4, gl.Describe() + " cannot run the GPU path: " + error);
+  }
+  Scene scene(opt, image, context->GetGLApi());
+  error = scene.Prepare();
+  if (!error.empty())
+  {
+    return Fail(4, opt.Input + ": " + error);
+  }
+  const int* d = image.Dimensions;
+  std::printf("mediso-render: %s, %dx%dx%d %s (%g..%g), %s, EGL %s, %dx%d\n", opt.Input.c_str(),
+    d[0], d[1], d[2], headless::MetaElementType(image.Type), range[0], range[1],
+    gl.Describe().c_str(), context->GetPlatform().c_str(), opt.Width, opt.Height);
+
+  if (!opt.Surfaces.empty())
+  {
+    error = scene.Build(opt.Surfaces);
+    if (!error.empty())
+    {
+      return Fail(1, error);
+    }
+    std::vector<double> frames;
+    for (int i = 0; i < opt.Frames; ++i)
+    {
+      error = scene.Draw();
+      if (!error.empty())
+      {
+        return Fail(1, error);
+      }
+      frames.push_back(scene.FrameMs);
+    }
+    if (!opt.Output.empty() && !headless::WritePng(opt.Output, opt.Width, opt.Height, scene.ReadImage(), error))
+    {
+      return Fail(1, error);
+    }
+    if (opt.Stats)
+    {
+      std::ostringstream json;
+      json.precision(6);
+      json << "{\"renderer\": " << JsonString(gl.GetRenderer())
+           << ", \"gl\": " << JsonString(gl.GetVersion())
+           << ", \"egl_platform\": " << JsonString(context->GetPlatform())
+           << ", \"volume\": [" << d[0] << ", " << d[1] << ", " << d[2]
+           << "], \"type\": " << JsonString(headless::MetaElementType(image.Type))
+           << ", \"image\": [" << opt.Width << ", " << opt.Height << "], \"isovalues\": [";
+      for (std::size_t i = 0; i < opt.Surfaces.size(); ++i)
+      {
+        json << (i ? ", " : "") << opt.Surfaces[i].Value;
+      }
+      json << "], \"primitives\": " << scene.Stats.Primitives << ", \"upload_ms\": " << scene.UploadMs
+           << ", \"build_ms\": " << scene.BuildMs << ", \"draw_ms\": " << Median(frames)
+           << ", \"frame_ms\": " << scene.BuildMs + Median(frames) << ", \"frames\": " << frames.size()
+           << ", \"gpu_bytes\": " << scene.Pyramid.GetGPUMemoryBytes()
+           << ", \"framebuffer_bytes\": " << scene.Renderer.GetFrameBufferBytes()
+           << ", \"volume_bytes\": " << image.Bytes.size()
+           << ", \"footprint\": " << JsonString(scene.Stats.PointFootprint ? "points" : "boxes")
+           << ", \"first_hit\": " << (scene.Stats.FirstHit ? "true" : "false") << "}";
+      std::printf("%s\n", json.str().c_str());
+    }
+  }
+
+  if (opt.Rotate > 0 || opt.Sweep > 0)
+  {
+    std::printf("%-9s %7s %10s %9s %10s %10s %10s %12s\n", "protocol", "frames", "total s", "fps",
+      "median ms", "min ms", "build ms", "primitives");
+  }
+  if (opt.Rotate > 0 && !opt.Surfaces.empty())
+  {
+    std::vector<double> frames;
+    double total = 0.0;
+    for (int i = 1; i <= opt.Rotate; ++i)
+    {
+      scene.SetCamera(static_cast<double>(i));
+      error = scene.Draw();
+      if (!error.empty())
+      {
+        return Fail(1, error);
+      }
+      frames.push_back(scene.FrameMs);
+      total += scene.FrameMs;
+    }
+    std::printf("%-9s %7d %10.3f %9.2f %10.3f %10.3f %10s %12llu\n", "rotation", opt.Rotate,
+      total / 1000.0, 1000.0 * opt.Rotate / total, Median(frames),
+      *std::min_element(frames.begin(), frames.end()), "-",
+      static_cast<unsigned long long>(scene.Stats.Primitives));
+    scene.SetCamera(0.0);
+  }
+  if (opt.Sweep > 0)
+  {
+    IsosurfaceLook look;
+    if (!opt.Surfaces.empty())
+    {
+      look = opt.Surfaces.front();
+      look.Opacity = 1.0f;
+    }
+    else
+    {
+      look.Color[0] = 0.93f;
+      look.Color[1] = 0.85f;
+      look.Color[2] = 0.75f;
+    }
+    std::vector<double> steps, builds;
+    double total = 0.0;
+    std::uint64_t primitives = 0;
+    for (int i = 0; i < opt.Sweep; ++i)
+    {
+      look.Value = range[0] + (range[1] - range[0]) * (i + 1) / (opt.Sweep + 1);
+      const auto start = Clock::now();
+      error = scene.Build({ look });
+      if (error.empty())
+      {
+        error = scene.Draw();
+      }
+      if (!error.empty())
+      {
+        return Fail(1, error);
+      }
+      const double ms = Milliseconds(Clock::now() - start);
+      steps.push_back(ms);
+      builds.push_back(scene.BuildMs);
+      total += ms;
+      primitives = std::max(primitives, scene.Stats.Primitives);
+    }
+    std::printf("%-9s %7d %10.3f %9.2f %10.3f %10.3f %10.3f %12llu\n", "sweep", opt.Sweep,
+      total / 1000.0, 1000.0 * opt.Sweep / total, Median(steps),
+      *std::min_element(steps.begin(), steps.end()), Median(builds),
+      static_cast<unsigned long long>(primitives));
+    std::printf("(sweep: median ms is one isovalue change + frame; primitives the largest)\n");
+  }
+  return 0;
+}
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  try
+  {
+    return Run(argc, argv);
+  }
+  catch (const std::bad_alloc&)
+  {
+    return Fail(1, "out of memory");
+  }
+  catch (const std::exception& e)
+  {
+    return Fail(1, e.what());
+  }
+}
