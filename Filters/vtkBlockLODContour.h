@@ -8,9 +8,13 @@
  * Medical Data Visualisation on the Web" (section 4.2): marching cubes over
  * 8x8x8-cell blocks at four levels of detail, for clients that cannot use the
  * GPU path, that need geometry to process further, or that must fit a memory
- * budget. The algorithm itself (blocks, levels, point merging, normals) is
- * the VTK-free core in Filters/Core/BlockLOD.h, which documents it; this class
- * adds what a pipeline filter needs:
+ * budget. The method is the VTK-free core in Filters/Core, which documents
+ * it: BlockLOD.h (blocks, levels, point merging, normals), BlockLODVolume.h
+ * (one input with its block ranges and coarse copies), BlockLODEstimator.h
+ * (the memory and time estimates, the level choice) and BlockLODCache.h (the
+ * (isovalue, level) surface cache). This class converts the input and output
+ * and runs, per update: check the input, refresh the block ranges, choose the
+ * level, plan it, generate the surfaces, assemble the output. In short:
  *
  * -# Block ranges. The minimum and maximum of every block are computed once
  *    per input array (in parallel) and kept until the input data, the array or
@@ -92,6 +96,10 @@
 #include "vtkPolyDataAlgorithm.h"
 
 #include <memory> // For std::unique_ptr
+#include <vector> // For the steps' isovalues
+
+class vtkDataArray;
+class vtkImageData;
 
 class MEDICALISOSURFACESFILTERS_EXPORT vtkBlockLODContour : public vtkPolyDataAlgorithm
 {
@@ -268,6 +276,15 @@ protected:
 private:
   vtkBlockLODContour(const vtkBlockLODContour&) = delete;
   void operator=(const vtkBlockLODContour&) = delete;
+
+  // The steps of RequestData, in order.
+  vtkDataArray* CheckInput(vtkImageData* input, vtkInformationVector** inputVector);
+  std::vector<double> IsovaluesWithSurface();
+  int ChooseLevel(const std::vector<double>& values);
+  bool PlanLevel(const std::vector<double>& values, int& level);
+  void ReportEstimates(double isovalue);
+  bool GenerateLevel(const std::vector<double>& values, int level);
+  void AssembleOutput(vtkPolyData* output);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

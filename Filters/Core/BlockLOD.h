@@ -70,6 +70,21 @@ constexpr int LevelStride(int level)
   return BlockCells >> level;
 }
 
+/// An (isovalue, level) pair: what the estimator and the surface cache key on.
+struct SurfaceKey
+{
+  double Isovalue = 0;
+  int Level = 0;
+  bool operator==(const SurfaceKey& o) const
+  {
+    return this->Isovalue == o.Isovalue && this->Level == o.Level;
+  }
+  bool operator<(const SurfaceKey& o) const
+  {
+    return this->Isovalue < o.Isovalue || (this->Isovalue == o.Isovalue && this->Level < o.Level);
+  }
+};
+
 /// Runs body(begin, end) over sub-ranges that together cover [begin, end),
 /// possibly concurrently.
 using RangeBody = std::function<void(std::int64_t, std::int64_t)>;
@@ -174,7 +189,8 @@ void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const Para
 struct ExtractionPlan
 {
   double Isovalue = 0;
-  int Level = 3;
+  int Level = 3;       ///< Stride level of the pass on the volume it read.
+  int VolumeLevel = 3; ///< Level whose volume it read (BlockLODVolume: the coarse copy below 3).
   std::vector<std::int32_t> ActiveBlocks;   ///< Linear indices of visited blocks.
   std::vector<std::int32_t> ActiveIndex;    ///< Per block: position in ActiveBlocks or -1.
   std::vector<std::int64_t> PointOffset;    ///< Per active block (+1): first point.

@@ -20,4 +20,55 @@
   MACRO(float);                                                                                    \
   MACRO(double)
 
+namespace mediso
+{
+/// The scalar types as a value, for hosts that describe their data at run time.
+enum class ScalarType
+{
+  Int8,
+  UInt8,
+  Int16,
+  UInt16,
+  Int32,
+  UInt32,
+  Float32,
+  Float64
+};
+
+/// Calls f(T{}) with the C++ type of `type`; false (f not called) for an
+/// unknown value.
+template <typename F>
+bool VisitScalarType(ScalarType type, F&& f)
+{
+  switch (type)
+  {
+    case ScalarType::Int8:
+      f(std::int8_t{});
+      return true;
+    case ScalarType::UInt8:
+      f(std::uint8_t{});
+      return true;
+    case ScalarType::Int16:
+      f(std::int16_t{});
+      return true;
+    case ScalarType::UInt16:
+      f(std::uint16_t{});
+      return true;
+    case ScalarType::Int32:
+      f(std::int32_t{});
+      return true;
+    case ScalarType::UInt32:
+      f(std::uint32_t{});
+      return true;
+    case ScalarType::Float32:
+      f(float{});
+      return true;
+    case ScalarType::Float64:
+      f(double{});
+      return true;
+  }
+  return false;
+}
+} // namespace mediso
+
 #endif
