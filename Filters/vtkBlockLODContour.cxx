@@ -33,8 +33,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <map>
+#include <sstream>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -180,6 +183,31 @@ SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const
   return out;
 }
 
+// "its point arrays: 'a' (1 component), 'b' (3 components)", or "it has no
+// point arrays", for messages about the array to contour.
+std::string DescribeArrays(vtkFieldData* data, const char* kind)
+{
+  std::ostringstream text;
+  int listed = 0;
+  for (int i = 0; i < data->GetNumberOfArrays(); ++i)
+  {
+    vtkAbstractArray* a = data->GetAbstractArray(i);
+    if (!a)
+    {
+      continue;
+    }
+    text << (listed++ ? ", '" : "'") << (a->GetName() ? a->GetName() : "(unnamed)") << "' ("
+         << a->GetNumberOfComponents()
+         << (a->GetNumberOfComponents() == 1 ? " component" : " components")
+         << (vtkArrayDownCast<vtkDataArray>(a) ? "" : ", not numeric") << ")";
+  }
+  if (listed == 0)
+  {
+    return std::string("it has no ") + kind + " arrays";
+  }
+  return std::string("its ") + kind + (listed == 1 ? " array: " : " arrays: ") + text.str();
+}
+
 // Bytes of the output the filter's options make (what estimates in MB count).
 mediso::SurfaceLayout OutputLayout(vtkBlockLODContour* self)
 {
@@ -203,7 +231,7 @@ struct vtkBlockLODContour::vtkInternals
   mediso::BlockLODEstimator Estimator{ Volume };
   mediso::SurfaceCache<vtkSmartPointer<vtkPolyData>> Cache;
   mediso::SurfaceLayout CacheLayout;
-  bool WarnedNaN = false;
+  bool WarnedMissing = false; // NaN or infinite values, once per input
 
   // What the last RequestData planned and generated.
   std::map<double, mediso::ExtractionPlan> Plans;
@@ -332,7 +360,7 @@ struct vtkBlockLODContour::vtkInternals
     }
     this->Estimator.Reset();
     this->Cache.Clear();
-    this->WarnedNaN = false;
+    this->WarnedMissing = false;
     return true;
   }
 };
@@ -498,19 +526,114 @@ int vtkBlockLODContour::RequestData(
 }
 
 //------------------------------------------------------------------------------
-vtkDataArray* vtkBlockLODContour::CheckInput(vtkImageData* input, vtkInformationVector** inputVector)
+vtkDataArray* vtkBlockLODContour::ChooseArray(vtkImageData* input, vtkInformationVector** inputVector)
 {
-  vtkDataArray* array = this->GetInputArrayToProcess(0, inputVector);
-  if (!array)
+  vtkInformation* chosen = this->GetInputArrayInformation(0);
+  const char* name =
+    chosen->Has(vtkDataObject::FIELD_NAME()) ? chosen->Get(vtkDataObject::FIELD_NAME()) : nullptr;
+  vtkPointData* pd = input->GetPointData();
+  if (name && *name)
   {
-    vtkErrorMacro("No point scalars to contour: the input has no point data array "
-                  "(choose one with SetInputArrayToProcess). The output is empty.");
+    // An array chosen by name (ContourBy): it must be one of the point arrays.
+    vtkDataArray* array = this->GetInputArrayToProcess(0, inputVector);
+    if (array && pd->GetArray(name) == array)
+    {
+      return array;
+    }
+    if (input->GetCellData()->GetAbstractArray(name))
+    {
+      vtkErrorMacro("'" << name << "' is a cell array; contouring needs a point array (apply "
+                    "Cell Data to Point Data first). The output is empty.");
+    }
+    else if (pd->GetAbstractArray(name))
+    {
+      vtkErrorMacro("Point array '" << name << "' is not numeric. The output is empty.");
+    }
+    else
+    {
+      vtkErrorMacro("ContourBy names the point array '"
+        << name << "', which the input does not have (" << DescribeArrays(pd, "point")
+        << "). The output is empty.");
+    }
     return nullptr;
   }
+
+  // None chosen (ParaView leaves ContourBy empty until the input has run):
+  // the active point scalars when they have one component, else the only
+  // one-component point array.
+  vtkDataArray* active = pd->GetScalars();
+  if (active && active->GetNumberOfComponents() == 1)
+  {
+    return active;
+  }
+  std::vector<vtkDataArray*> single;
+  int numeric = 0;
+  vtkDataArray* only = nullptr; // the numeric array, when there is one
+  for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
+  {
+    if (vtkDataArray* a = pd->GetArray(i))
+    {
+      ++numeric;
+      only = a;
+      if (a->GetNumberOfComponents() == 1)
+      {
+        single.push_back(a);
+      }
+    }
+  }
+  if (single.size() == 1)
+  {
+    return single[0];
+  }
+  if (numeric == 0)
+  {
+    vtkErrorMacro("No point scalars to contour: the input has no point data arrays"
+      << (input->GetCellData()->GetNumberOfArrays() > 0
+             ? " (" + DescribeArrays(input->GetCellData(), "cell") +
+               "; apply Cell Data to Point Data first)"
+             : std::string())
+      << ". The output is empty.");
+  }
+  else if (single.empty())
+  {
+    std::ostringstream what;
+    if (numeric == 1)
+    {
+      what << "the input's only point array, '" << (only->GetName() ? only->GetName() : "(unnamed)")
+           << "', has " << only->GetNumberOfComponents() << " components";
+    }
+    else
+    {
+      what << "none of the input's point arrays has one component (" << DescribeArrays(pd, "point")
+           << ")";
+    }
+    vtkErrorMacro("No array chosen to contour, and "
+      << what.str()
+      << ": contouring needs a one-component array (extract a component first, e.g. with a "
+         "Calculator). The output is empty.");
+  }
+  else
+  {
+    vtkErrorMacro("No array chosen to contour, and the input has several one-component point "
+                  "arrays and no active scalars ("
+      << DescribeArrays(pd, "point")
+      << "): choose one with ContourBy (SetInputArrayToProcess). The output is empty.");
+  }
+  return nullptr;
+}
+
+//------------------------------------------------------------------------------
+vtkDataArray* vtkBlockLODContour::CheckInput(vtkImageData* input, vtkInformationVector** inputVector)
+{
+  vtkDataArray* array = this->ChooseArray(input, inputVector);
+  if (!array)
+  {
+    return nullptr;
+  }
+  const std::string name = array->GetName() ? array->GetName() : "(unnamed)";
   if (array->GetNumberOfComponents() != 1)
   {
-    vtkErrorMacro("Array '" << (array->GetName() ? array->GetName() : "")
-                            << "' has " << array->GetNumberOfComponents()
+    vtkErrorMacro("Array '" << name << "' has " << array->GetNumberOfComponents()
                             << " components; contouring needs one. The output is empty.");
     return nullptr;
   }
@@ -523,6 +646,19 @@ vtkDataArray* vtkBlockLODContour::CheckInput(vtkImageData* input, vtkInformation
                                  "points along each axis. The output is empty.");
     return nullptr;
   }
+  const double* spacing = input->GetSpacing();
+  const double* origin = input->GetOrigin();
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!(spacing[a] != 0 && std::isfinite(spacing[a]) && std::isfinite(origin[a])))
+    {
+      vtkErrorMacro("The input's spacing (" << spacing[0] << ", " << spacing[1] << ", "
+        << spacing[2] << ") or origin (" << origin[0] << ", " << origin[1] << ", " << origin[2]
+        << ") has a zero or non-finite component: the surface would have no extent or "
+           "non-finite points. The output is empty.");
+      return nullptr;
+    }
+  }
   if (input->GetDirectionMatrix() && !input->GetDirectionMatrix()->IsIdentity())
   {
     vtkErrorMacro("The input has a non-identity direction matrix, which this filter does not "
@@ -533,8 +669,7 @@ vtkDataArray* vtkBlockLODContour::CheckInput(vtkImageData* input, vtkInformation
   if (!CoreScalarType(array->GetDataType(), type) || !array->HasStandardMemoryLayout() ||
     array->GetNumberOfTuples() != static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2])
   {
-    vtkErrorMacro("Array '" << (array->GetName() ? array->GetName() : "") << "' of type "
-                            << array->GetDataTypeAsString()
+    vtkErrorMacro("Array '" << name << "' of type " << array->GetDataTypeAsString()
                             << " is not supported (use a contiguous point array of 8/16/32-bit "
                                "integers, float or double). The output is empty.");
     return nullptr;
@@ -551,16 +686,32 @@ std::vector<double> vtkBlockLODContour::IsovaluesWithSurface()
 {
   vtkInternals& in = *this->Internals;
   const mediso::BlockRanges& ranges = in.Volume.GetRanges();
-  if (ranges.NaNCount > 0 && !in.WarnedNaN)
-  {
-    vtkWarningMacro("The input has NaN values: cubes touching them produce no surface.");
-    in.WarnedNaN = true;
-  }
   std::vector<double> values;
-  const double* range = ranges.ValueRange;
   // A parallel piece may well lie outside an isovalue (all air, say): only a
   // whole volume warns about its range.
   const bool piece = in.Volume.GetDescription().IsPiece();
+  if (!ranges.HasFiniteValues())
+  {
+    if (piece)
+    {
+      vtkDebugMacro("This piece has no finite values: no surface here.");
+    }
+    else
+    {
+      vtkWarningMacro("The input has no finite values (every point is NaN or infinite): there "
+                      "is no isosurface.");
+    }
+    return values;
+  }
+  if ((ranges.NaNCount > 0 || ranges.InfiniteCount > 0) && !in.WarnedMissing)
+  {
+    vtkWarningMacro("The input has "
+      << (ranges.NaNCount > 0 ? (ranges.InfiniteCount > 0 ? "NaN and infinite" : "NaN")
+                              : "infinite")
+      << " values: cubes touching them produce no surface.");
+    in.WarnedMissing = true;
+  }
+  const double* range = ranges.ValueRange;
   if (!(range[0] < range[1]))
   {
     if (piece)

@@ -78,12 +78,18 @@
  *
  * Inputs: vtkImageData with a one-component point array of type char, signed
  * char, unsigned char, short, unsigned short, int, unsigned int, float or
- * double; spacing, origin and extent are honoured; a non-identity direction
- * matrix is rejected. Bad input (no scalars, 2D data, several components, an
- * unsupported type, a constant volume, an isovalue outside the data range,
- * NaN values, a budget too small) gives a clear error or warning and an empty
- * or partial output, never a crash. Passes run with vtkSMPTools; progress is
- * reported and abort honoured between passes and blocks.
+ * double: the one named by SetInputArrayToProcess (ParaView's ContourBy), or,
+ * when none is named, the active point scalars if they have one component,
+ * else the only one-component point array. Spacing, origin and extent are
+ * honoured; a non-identity direction matrix is rejected. NaN and infinite
+ * values are missing data: cubes touching them make no triangle (one warning
+ * per input), so the output holds only finite points. Bad input (no point
+ * array, a named array the input lacks or a cell array, several components,
+ * 2D data, zero or non-finite spacing, an unsupported type, a constant or
+ * all-NaN volume, an isovalue outside the data range, a budget too small)
+ * gives one error or warning saying what is wrong, and an empty or partial
+ * output, never a crash. Passes run with vtkSMPTools; progress is reported and
+ * abort honoured between passes and blocks.
  *
  * @sa vtkFlyingEdges3D vtkMarchingCubes vtkContourValues
  */
@@ -277,7 +283,8 @@ private:
   vtkBlockLODContour(const vtkBlockLODContour&) = delete;
   void operator=(const vtkBlockLODContour&) = delete;
 
-  // The steps of RequestData, in order.
+  // The steps of RequestData, in order (ChooseArray is part of CheckInput).
+  vtkDataArray* ChooseArray(vtkImageData* input, vtkInformationVector** inputVector);
   vtkDataArray* CheckInput(vtkImageData* input, vtkInformationVector** inputVector);
   std::vector<double> IsovaluesWithSurface();
   int ChooseLevel(const std::vector<double>& values);
