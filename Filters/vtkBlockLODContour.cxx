@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkBlockLODContour.h"
 
-#include "BlockLOD.h"
+#include "BlockLODCache.h"
+#include "BlockLODEstimator.h"
+#include "BlockLODVolume.h"
 
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
+#include "vtkDataSetAttributes.h"
 #include "vtkDoubleArray.h"
 #include "vtkExtentTranslator.h"
 #include "vtkFieldData.h"
@@ -23,23 +26,19 @@
 #include "vtkPolyData.h"
 #include "vtkSMPTools.h"
 #include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkTypeInt32Array.h"
 #include "vtkTypeInt64Array.h"
 #include "vtkUnsignedCharArray.h"
-#include "vtkStreamingDemandDrivenPipeline.h"
-#include "vtkDataSetAttributes.h"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <map>
-#include <memory>
-#include <type_traits>
 #include <sstream>
-#include <utility>
+#include <string>
+#include <type_traits>
 #include <vector>
 
 vtkStandardNewMacro(vtkBlockLODContour);
@@ -47,14 +46,6 @@ vtkStandardNewMacro(vtkBlockLODContour);
 namespace
 {
 constexpr double BytesPerMB = 1.0e6;
-// Sampled estimates count about this many active blocks.
-constexpr std::int64_t EstimateSampleBlocks = 256;
-
-// Every `step`-th active block is counted; step 1 counts them all (exact).
-int SampleStep(std::int64_t activeBlocks)
-{
-  return static_cast<int>(std::max<std::int64_t>(1, activeBlocks / EstimateSampleBlocks));
-}
 
 mediso::TriangleCaseTable VTKCaseTable()
 {
@@ -74,25 +65,39 @@ void SMPFor(std::int64_t begin, std::int64_t end, const mediso::RangeBody& body)
   vtkSMPTools::For(begin, end, grain, [&](vtkIdType b, vtkIdType e) { body(b, e); });
 }
 
-// Output layout flags that change the bytes and content of a surface.
-struct OutputFlags
+// The core's scalar type of a VTK array type; false when the core has none.
+bool CoreScalarType(int vtkType, mediso::ScalarType& type)
 {
-  bool Normals;
-  bool Scalars;
-  bool BlockIds;
-  bool operator==(const OutputFlags& o) const
+  switch (vtkType)
   {
-    return this->Normals == o.Normals && this->Scalars == o.Scalars && this->BlockIds == o.BlockIds;
+    case VTK_CHAR:
+    case VTK_SIGNED_CHAR:
+      type = mediso::ScalarType::Int8;
+      return true;
+    case VTK_UNSIGNED_CHAR:
+      type = mediso::ScalarType::UInt8;
+      return true;
+    case VTK_SHORT:
+      type = mediso::ScalarType::Int16;
+      return true;
+    case VTK_UNSIGNED_SHORT:
+      type = mediso::ScalarType::UInt16;
+      return true;
+    case VTK_INT:
+      type = mediso::ScalarType::Int32;
+      return true;
+    case VTK_UNSIGNED_INT:
+      type = mediso::ScalarType::UInt32;
+      return true;
+    case VTK_FLOAT:
+      type = mediso::ScalarType::Float32;
+      return true;
+    case VTK_DOUBLE:
+      type = mediso::ScalarType::Float64;
+      return true;
+    default:
+      return false;
   }
-};
-
-// Bytes the output vtkPolyData holds for a surface of this size.
-double SurfaceBytes(double points, double triangles, const OutputFlags& flags)
-{
-  const double id = (points < 2147483647.0 && 3 * triangles < 2147483647.0) ? 4.0 : 8.0;
-  double perPoint = 12.0 + (flags.Normals ? 12.0 : 0.0) + (flags.Scalars ? 4.0 : 0.0);
-  double perTriangle = 4.0 * id + (flags.BlockIds ? 4.0 : 0.0); // 3 ids + 1 offset
-  return points * perPoint + triangles * perTriangle + id;
 }
 
 // An output vtkPolyData sized for `points` and `triangles`, with raw pointers
@@ -108,7 +113,7 @@ struct SurfaceArrays
   std::int64_t* Connectivity64 = nullptr;
 };
 
-SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const OutputFlags& flags)
+SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const mediso::SurfaceLayout& layout)
 {
   SurfaceArrays out;
   out.Surface = vtkSmartPointer<vtkPolyData>::New();
@@ -119,7 +124,7 @@ SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const
   vtkNew<vtkPoints> pts;
   pts->SetData(coords);
   out.Surface->SetPoints(pts);
-  if (flags.Normals)
+  if (layout.Normals)
   {
     vtkNew<vtkFloatArray> normals;
     normals->SetName("Normals");
@@ -128,7 +133,7 @@ SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const
     out.Normals = normals->GetPointer(0);
     out.Surface->GetPointData()->SetNormals(normals);
   }
-  if (flags.Scalars)
+  if (layout.Scalars)
   {
     vtkNew<vtkFloatArray> scalars;
     scalars->SetName("Isovalue");
@@ -136,7 +141,7 @@ SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const
     out.Scalars = scalars->GetPointer(0);
     out.Surface->GetPointData()->SetScalars(scalars);
   }
-  if (flags.BlockIds)
+  if (layout.BlockIds)
   {
     vtkNew<vtkIntArray> ids;
     ids->SetName("BlockId");
@@ -145,8 +150,8 @@ SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const
     out.Surface->GetCellData()->AddArray(ids);
   }
   vtkNew<vtkCellArray> polys;
-  const bool small = points < std::numeric_limits<std::int32_t>::max() &&
-    3 * triangles < std::numeric_limits<std::int32_t>::max();
+  const bool small = !mediso::SurfaceLayout::NeedsWideIds(
+    static_cast<double>(points), static_cast<double>(triangles));
   auto fillOffsets = [triangles](auto* offsets) {
     vtkSMPTools::For(0, triangles + 1, [offsets](vtkIdType b, vtkIdType e) {
       for (vtkIdType i = b; i < e; ++i)
@@ -178,70 +183,41 @@ SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const
   return out;
 }
 
-template <typename F>
-bool DispatchScalarType(int type, F&& f)
+// "its point arrays: 'a' (1 component), 'b' (3 components)", or "it has no
+// point arrays", for messages about the array to contour.
+std::string DescribeArrays(vtkFieldData* data, const char* kind)
 {
-  switch (type)
+  std::ostringstream text;
+  int listed = 0;
+  for (int i = 0; i < data->GetNumberOfArrays(); ++i)
   {
-    case VTK_CHAR:
-    case VTK_SIGNED_CHAR:
-      f(std::int8_t{});
-      return true;
-    case VTK_UNSIGNED_CHAR:
-      f(std::uint8_t{});
-      return true;
-    case VTK_SHORT:
-      f(std::int16_t{});
-      return true;
-    case VTK_UNSIGNED_SHORT:
-      f(std::uint16_t{});
-      return true;
-    case VTK_INT:
-      f(std::int32_t{});
-      return true;
-    case VTK_UNSIGNED_INT:
-      f(std::uint32_t{});
-      return true;
-    case VTK_FLOAT:
-      f(float{});
-      return true;
-    case VTK_DOUBLE:
-      f(double{});
-      return true;
-    default:
-      return false;
+    vtkAbstractArray* a = data->GetAbstractArray(i);
+    if (!a)
+    {
+      continue;
+    }
+    text << (listed++ ? ", '" : "'") << (a->GetName() ? a->GetName() : "(unnamed)") << "' ("
+         << a->GetNumberOfComponents()
+         << (a->GetNumberOfComponents() == 1 ? " component" : " components")
+         << (vtkArrayDownCast<vtkDataArray>(a) ? "" : ", not numeric") << ")";
   }
+  if (listed == 0)
+  {
+    return std::string("it has no ") + kind + " arrays";
+  }
+  return std::string("its ") + kind + (listed == 1 ? " array: " : " arrays: ") + text.str();
 }
 
-using Key = std::pair<double, int>; // (isovalue, level)
-
-struct Counts
+// Bytes of the output the filter's options make (what estimates in MB count).
+mediso::SurfaceLayout OutputLayout(vtkBlockLODContour* self)
 {
-  double Points = 0;
-  double Triangles = 0;
-  double Cubes = 0; ///< Cubes visited to extract the pair (cost model).
-};
-
-// A level's samples as a small contiguous volume of their own, with its block
-// ranges (built once per input, the first time the level is extracted).
-struct CoarseLevelBase
-{
-  virtual ~CoarseLevelBase() = default;
-  mediso::BlockRanges Ranges;
-};
-template <typename T>
-struct CoarseLevel : CoarseLevelBase
-{
-  std::vector<T> Values;
-  mediso::Volume<T> Volume;
-};
-
-struct CacheEntry
-{
-  vtkSmartPointer<vtkPolyData> Surface;
-  double Bytes = 0;
-  std::uint64_t LastUse = 0;
-};
+  mediso::SurfaceLayout layout;
+  layout.Normals = self->GetComputeNormals();
+  layout.Scalars = self->GetComputeScalars();
+  layout.BlockIds = self->GetGenerateBlockIds();
+  layout.Offsets = true; // vtkCellArray: offsets and connectivity
+  return layout;
+}
 
 double Now()
 {
@@ -251,93 +227,16 @@ double Now()
 
 struct vtkBlockLODContour::vtkInternals
 {
-  // What the block ranges and the cache were computed from.
-  vtkImageData* Input = nullptr;
-  vtkDataArray* Array = nullptr;
-  vtkMTimeType ArrayMTime = 0;
-  int Extent[6] = { 0, -1, 0, -1, 0, -1 };
-  int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
-  double Origin[3] = { 0, 0, 0 };
-  double Spacing[3] = { 1, 1, 1 };
-  int ScalarType = -1;
-  const void* Data = nullptr;
-  int OwnedCells[6] = { 0, -1, 0, -1, 0, -1 };
-  bool RangesValid = false;
-  mediso::BlockRanges Ranges;
-  std::unique_ptr<CoarseLevelBase> Coarse[mediso::NumberOfLevels - 1];
-  bool WarnedNaN = false;
+  mediso::BlockLODVolume Volume{ VTKCaseTable(), SMPFor };
+  mediso::BlockLODEstimator Estimator{ Volume };
+  mediso::SurfaceCache<vtkSmartPointer<vtkPolyData>> Cache;
+  mediso::SurfaceLayout CacheLayout;
+  bool WarnedMissing = false; // NaN or infinite values, once per input
 
-  OutputFlags CacheFlags{ true, false, false };
-  std::map<Key, CacheEntry> Cache;
-  std::map<Key, Counts> Exact;   // exact counts of every planned pair
-  std::map<Key, Counts> Sampled; // sampled estimates, kept until the input changes
-  std::vector<std::pair<double, std::vector<std::int32_t>>> ActiveLists;
-  std::uint64_t Clock = 0;
-
-  // Cost model: seconds = A * cubes visited + B * triangles, least squares over
-  // this filter's extractions (sums of the normal equations).
-  double Sxx = 0, Sxy = 0, Syy = 0, Sxt = 0, Syt = 0;
-  int CostSamples = 0;
-
-  template <typename T>
-  mediso::Volume<T> MakeVolume() const
-  {
-    mediso::Volume<T> v;
-    v.Data = static_cast<const T*>(this->Data);
-    for (int a = 0; a < 3; ++a)
-    {
-      v.Dims[a] = this->Extent[2 * a + 1] - this->Extent[2 * a] + 1;
-      v.Origin[a] = this->Origin[a] + this->Spacing[a] * this->Extent[2 * a];
-      v.Spacing[a] = this->Spacing[a];
-      v.OwnedCells[2 * a] = this->OwnedCells[2 * a];
-      v.OwnedCells[2 * a + 1] = this->OwnedCells[2 * a + 1];
-    }
-    if (this->IsPiece())
-    {
-      for (int a = 0; a < 3; ++a)
-      {
-        v.GlobalOffset[a] = this->Extent[2 * a] - this->WholeExtent[2 * a];
-        v.GlobalDims[a] = this->WholeExtent[2 * a + 1] - this->WholeExtent[2 * a] + 1;
-      }
-    }
-    return v;
-  }
-
-  // True when the input is a part of a larger whole extent (a parallel piece).
-  bool IsPiece() const
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      if (this->WholeExtent[2 * a] > this->WholeExtent[2 * a + 1])
-      {
-        return false; // no whole extent known
-      }
-    }
-    return !std::equal(this->Extent, this->Extent + 6, this->WholeExtent);
-  }
-
-  template <typename F>
-  bool WithVolume(F&& f) const
-  {
-    return DispatchScalarType(this->ScalarType, [&](auto tag) {
-      using T = decltype(tag);
-      f(this->MakeVolume<T>());
-    });
-  }
-
-  void ForgetInput()
-  {
-    this->RangesValid = false;
-    for (auto& c : this->Coarse)
-    {
-      c.reset();
-    }
-    this->Cache.clear();
-    this->Exact.clear();
-    this->Sampled.clear();
-    this->ActiveLists.clear();
-    this->WarnedNaN = false;
-  }
+  // What the last RequestData planned and generated.
+  std::map<double, mediso::ExtractionPlan> Plans;
+  std::map<double, double> PlanSeconds;
+  std::vector<vtkSmartPointer<vtkPolyData>> Surfaces;
 
   // Cells that are not ghosts, as an inclusive cell index range per axis:
   // ghost layers of a structured piece are whole slabs at its faces. Without
@@ -396,255 +295,73 @@ struct vtkBlockLODContour::vtkInternals
     }
   }
 
-  // Brings block ranges up to date with the input; returns true when they were recomputed.
-  bool Refresh(
-    vtkImageData* input, vtkDataArray* array, const int wholeExtent[6], const int* zeroExtent)
+  // The core's description of the input: its values, place, own cells and,
+  // for a parallel piece, its place in the whole extent.
+  static mediso::VolumeDescription Describe(
+    vtkImageData* input, vtkDataArray* array, vtkInformation* inInfo)
   {
+    mediso::VolumeDescription d;
+    CoreScalarType(array->GetDataType(), d.Type);
+    d.Data = array->GetVoidPointer(0);
+    d.Stamp = array->GetMTime();
     int extent[6];
     input->GetExtent(extent);
-    int dims[3] = { extent[1] - extent[0] + 1, extent[3] - extent[2] + 1, extent[5] - extent[4] + 1 };
-    int owned[6];
-    FindOwnedCells(input, dims, zeroExtent, owned);
     double origin[3], spacing[3];
     input->GetOrigin(origin);
     input->GetSpacing(spacing);
-    const bool same = this->RangesValid && input == this->Input && array == this->Array &&
-      array->GetMTime() == this->ArrayMTime && std::equal(extent, extent + 6, this->Extent) &&
-      std::equal(origin, origin + 3, this->Origin) && std::equal(spacing, spacing + 3, this->Spacing) &&
-      std::equal(owned, owned + 6, this->OwnedCells) && array->GetVoidPointer(0) == this->Data &&
-      std::equal(wholeExtent, wholeExtent + 6, this->WholeExtent);
-    if (same)
+    for (int a = 0; a < 3; ++a)
+    {
+      d.Dims[a] = extent[2 * a + 1] - extent[2 * a] + 1;
+      d.Spacing[a] = spacing[a];
+      d.Origin[a] = origin[a] + spacing[a] * extent[2 * a];
+    }
+    int whole[6] = { 0, -1, 0, -1, 0, -1 };
+    if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+    {
+      inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
+    }
+    const bool wholeKnown = whole[0] <= whole[1] && whole[2] <= whole[3] && whole[4] <= whole[5];
+    // The piece without ghost layers, for an input that lost its ghost array.
+    int zeroExtent[6];
+    const int* zero = nullptr;
+    const int pieces = inInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
+      ? inInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
+      : 1;
+    if (pieces > 1 && !input->GetCellGhostArray() && wholeKnown)
+    {
+      vtkNew<vtkExtentTranslator> translator;
+      translator->SetWholeExtent(whole);
+      translator->SetPiece(inInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()));
+      translator->SetNumberOfPieces(pieces);
+      translator->SetGhostLevel(0);
+      translator->PieceToExtent();
+      translator->GetExtent(zeroExtent);
+      zero = zeroExtent;
+    }
+    FindOwnedCells(input, d.Dims, zero, d.OwnedCells);
+    if (wholeKnown && !std::equal(extent, extent + 6, whole))
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        d.GlobalOffset[a] = extent[2 * a] - whole[2 * a];
+        d.GlobalDims[a] = whole[2 * a + 1] - whole[2 * a] + 1;
+      }
+    }
+    return d;
+  }
+
+  // Adopts the input; true when its block ranges were computed (a new input:
+  // counts and surfaces of the old one are forgotten).
+  bool Refresh(const mediso::VolumeDescription& description)
+  {
+    if (!this->Volume.SetVolume(description))
     {
       return false;
     }
-    this->ForgetInput();
-    this->Input = input;
-    this->Array = array;
-    this->ArrayMTime = array->GetMTime();
-    std::copy(extent, extent + 6, this->Extent);
-    std::copy(wholeExtent, wholeExtent + 6, this->WholeExtent);
-    std::copy(origin, origin + 3, this->Origin);
-    std::copy(spacing, spacing + 3, this->Spacing);
-    std::copy(owned, owned + 6, this->OwnedCells);
-    this->ScalarType = array->GetDataType();
-    this->Data = array->GetVoidPointer(0);
-    this->WithVolume([&](const auto& volume) {
-      mediso::ComputeBlockRanges(volume, this->Ranges, SMPFor);
-    });
-    this->RangesValid = true;
+    this->Estimator.Reset();
+    this->Cache.Clear();
+    this->WarnedMissing = false;
     return true;
-  }
-
-  // Runs f(volume, ranges) on the volume a level is extracted from: the full
-  // volume at level 3, the level's coarse copy below (built on first use).
-  template <typename F>
-  void WithLevelVolume(int level, F&& f)
-  {
-    this->WithVolume([&](const auto& full) {
-      using T = std::remove_const_t<std::remove_pointer_t<decltype(full.Data)>>;
-      if (level == mediso::NumberOfLevels - 1)
-      {
-        f(full, this->Ranges);
-        return;
-      }
-      auto& slot = this->Coarse[level];
-      if (!slot)
-      {
-        auto coarse = std::make_unique<CoarseLevel<T>>();
-        coarse->Volume = mediso::MakeCoarseCopy(full, level, coarse->Values, SMPFor);
-        mediso::ComputeBlockRanges(coarse->Volume, coarse->Ranges, SMPFor);
-        slot = std::move(coarse);
-      }
-      auto* coarse = static_cast<CoarseLevel<T>*>(slot.get());
-      f(coarse->Volume, coarse->Ranges);
-    });
-  }
-
-  // Active blocks of an isovalue (full-volume blocks), listed once and kept
-  // for the last few isovalues: every estimate of every level uses them.
-  const std::vector<std::int32_t>& ActiveBlocks(double iso)
-  {
-    for (auto& entry : this->ActiveLists)
-    {
-      if (entry.first == iso)
-      {
-        return entry.second;
-      }
-    }
-    if (this->ActiveLists.size() >= 4)
-    {
-      this->ActiveLists.erase(this->ActiveLists.begin());
-    }
-    this->ActiveLists.emplace_back(iso, mediso::ListActiveBlocks(this->Ranges, iso));
-    return this->ActiveLists.back().second;
-  }
-
-  std::int64_t CountActive(double iso)
-  {
-    return static_cast<std::int64_t>(this->ActiveBlocks(iso).size());
-  }
-
-  void RecordExact(const Key& key, const Counts& counts) { this->Exact[key] = counts; }
-
-  void RecordCost(double cubes, double triangles, double seconds)
-  {
-    this->Sxx += cubes * cubes;
-    this->Sxy += cubes * triangles;
-    this->Syy += triangles * triangles;
-    this->Sxt += cubes * seconds;
-    this->Syt += triangles * seconds;
-    ++this->CostSamples;
-  }
-
-  double PredictSeconds(double cubes, double triangles) const
-  {
-    // Defaults for a 2-core machine of this project's kind until measured.
-    double a = 4.0e-9, b = 6.0e-8;
-    const double det = this->Sxx * this->Syy - this->Sxy * this->Sxy;
-    if (this->CostSamples >= 2 && det > 1e-12 * this->Sxx * this->Syy)
-    {
-      a = (this->Sxt * this->Syy - this->Syt * this->Sxy) / det;
-      b = (this->Syt * this->Sxx - this->Sxt * this->Sxy) / det;
-      if (a < 0 || b < 0)
-      {
-        // Degenerate fit (collinear samples): one rate per triangle-equivalent.
-        const double scale = (this->Sxt + this->Syt) / (this->Sxx + this->Syy);
-        a = std::max(0.0, scale);
-        b = std::max(0.0, scale);
-      }
-    }
-    else if (this->CostSamples == 1 && this->Sxx + this->Syy > 0)
-    {
-      const double predicted = std::sqrt(this->Sxx) * a + std::sqrt(this->Syy) * b;
-      const double measured = this->Sxt / std::max(1e-30, std::sqrt(this->Sxx));
-      if (predicted > 0)
-      {
-        const double f = measured / predicted;
-        a *= f;
-        b *= f;
-      }
-    }
-    return a * cubes + b * triangles;
-  }
-
-  // Estimated counts, and how they were obtained (0 exact, 1 scaled, 2 sampled):
-  // exact for a planned pair; the memoized sampled count; scaled from two
-  // exact levels of the same isovalue, by that isovalue's own growth per
-  // level (growth is about 4x for smooth surfaces but nearer 2x for thin
-  // structures, so no global factor is trusted); otherwise a new count on
-  // sampled blocks.
-  Counts Estimate(double iso, int level, int& method)
-  {
-    const Key key(iso, level);
-    auto exact = this->Exact.find(key);
-    if (exact != this->Exact.end())
-    {
-      method = 0;
-      return exact->second;
-    }
-    std::vector<int> known;
-    for (int l = 0; l < mediso::NumberOfLevels; ++l)
-    {
-      auto it = this->Exact.find(Key(iso, l));
-      if (it != this->Exact.end() && it->second.Triangles > 0)
-      {
-        known.push_back(l);
-      }
-    }
-    // Scale only where counting would be approximate: with few active blocks
-    // every block is counted, which is exact and cheap.
-    if (known.size() >= 2 && !this->Sampled.count(key) && SampleStep(this->CountActive(iso)) > 1)
-    {
-      // The two known levels nearest to the requested one.
-      std::sort(known.begin(), known.end(),
-        [level](int a, int b) { return std::abs(a - level) < std::abs(b - level); });
-      const Counts& a = this->Exact[Key(iso, known[0])];
-      const Counts& b = this->Exact[Key(iso, known[1])];
-      const double growth = std::pow(a.Triangles / b.Triangles, 1.0 / (known[0] - known[1]));
-      const double f = std::pow(growth, level - known[0]);
-      Counts c;
-      c.Triangles = a.Triangles * f;
-      c.Points = a.Points * f;
-      c.Cubes = a.Cubes * std::pow(8.0, level - known[0]);
-      method = 1;
-      return c;
-    }
-    auto sampled = this->Sampled.find(key);
-    if (sampled != this->Sampled.end())
-    {
-      method = 2;
-      return sampled->second;
-    }
-    Counts c;
-    int step = 1;
-    if (level < mediso::NumberOfLevels - 1 && this->Coarse[level])
-    {
-      // The level's coarse copy exists: sample it (contiguous, cheap).
-      this->WithLevelVolume(level, [&](const auto& volume, const mediso::BlockRanges& ranges) {
-        const std::vector<std::int32_t> active = mediso::ListActiveBlocks(ranges, iso);
-        step = SampleStep(static_cast<std::int64_t>(active.size()));
-        const mediso::SampledCounts s =
-          mediso::CountSampled(volume, ranges, VTKCaseTable(), active, iso, 3, step, SMPFor);
-        c.Points = s.Points;
-        c.Triangles = s.Triangles;
-        c.Cubes = static_cast<double>(s.ActiveBlocks) * std::pow(mediso::BlockCells, 3);
-      });
-    }
-    else
-    {
-      const std::vector<std::int32_t>& active = this->ActiveBlocks(iso);
-      step = SampleStep(static_cast<std::int64_t>(active.size()));
-      this->WithVolume([&](const auto& volume) {
-        const mediso::SampledCounts s = mediso::CountSampled(
-          volume, this->Ranges, VTKCaseTable(), active, iso, level, step, SMPFor);
-        c.Points = s.Points;
-        c.Triangles = s.Triangles;
-        c.Cubes = static_cast<double>(s.ActiveBlocks) *
-          std::pow(mediso::BlockCells / mediso::LevelStride(level), 3);
-      });
-    }
-    method = 2;
-    if (step == 1)
-    {
-      this->RecordExact(key, c); // every active block counted: the count is exact
-    }
-    else
-    {
-      this->Sampled[key] = c;
-    }
-    return c;
-  }
-
-  void Touch(CacheEntry& entry) { entry.LastUse = ++this->Clock; }
-
-  void Evict(double limitBytes, const std::vector<Key>& keep)
-  {
-    double total = 0;
-    for (const auto& e : this->Cache)
-    {
-      total += e.second.Bytes;
-    }
-    while (total > limitBytes && !this->Cache.empty())
-    {
-      auto victim = this->Cache.end();
-      for (auto it = this->Cache.begin(); it != this->Cache.end(); ++it)
-      {
-        if (std::find(keep.begin(), keep.end(), it->first) != keep.end())
-        {
-          continue;
-        }
-        if (victim == this->Cache.end() || it->second.LastUse < victim->second.LastUse)
-        {
-          victim = it;
-        }
-      }
-      if (victim == this->Cache.end())
-      {
-        break;
-      }
-      total -= victim->second.Bytes;
-      this->Cache.erase(victim);
-    }
   }
 };
 
@@ -712,57 +429,43 @@ int vtkBlockLODContour::FillInputPortInformation(int, vtkInformation* info)
 
 void vtkBlockLODContour::ClearCache()
 {
-  this->Internals->Cache.clear();
+  this->Internals->Cache.Clear();
 }
 
 double vtkBlockLODContour::GetCacheMegabytes()
 {
-  double total = 0;
-  for (const auto& e : this->Internals->Cache)
-  {
-    total += e.second.Bytes;
-  }
-  return total / BytesPerMB;
+  return this->Internals->Cache.GetBytes() / BytesPerMB;
 }
 
 //------------------------------------------------------------------------------
 double vtkBlockLODContour::EstimateTriangles(double isovalue, int level)
 {
-  if (!this->Internals->RangesValid || level < 0 || level >= mediso::NumberOfLevels)
-  {
-    this->LastEstimateMethod = -1;
-    return -1;
-  }
-  return this->Internals->Estimate(isovalue, level, this->LastEstimateMethod).Triangles;
+  const mediso::SurfaceEstimate e = this->Internals->Estimator.Estimate(isovalue, level);
+  this->LastEstimateMethod = static_cast<int>(e.Method);
+  return e.Method == mediso::EstimateMethod::None ? -1.0 : e.Counts.Triangles;
 }
 
 double vtkBlockLODContour::EstimateMegabytes(double isovalue, int level)
 {
-  if (!this->Internals->RangesValid || level < 0 || level >= mediso::NumberOfLevels)
-  {
-    this->LastEstimateMethod = -1;
-    return -1;
-  }
-  const Counts c = this->Internals->Estimate(isovalue, level, this->LastEstimateMethod);
-  const OutputFlags flags{ this->ComputeNormals, this->ComputeScalars, this->GenerateBlockIds };
-  return SurfaceBytes(c.Points, c.Triangles, flags) / BytesPerMB;
+  const mediso::SurfaceEstimate e = this->Internals->Estimator.Estimate(isovalue, level);
+  this->LastEstimateMethod = static_cast<int>(e.Method);
+  return e.Method == mediso::EstimateMethod::None
+    ? -1.0
+    : OutputLayout(this).Bytes(e.Counts) / BytesPerMB;
 }
 
 double vtkBlockLODContour::EstimateSeconds(double isovalue, int level)
 {
-  if (!this->Internals->RangesValid || level < 0 || level >= mediso::NumberOfLevels)
+  vtkInternals& in = *this->Internals;
+  if (in.Volume.IsValid() && in.Cache.Contains(mediso::SurfaceKey{ isovalue, level }))
   {
-    this->LastEstimateMethod = -1;
-    return -1;
-  }
-  const Key key(isovalue, level);
-  if (this->Internals->Cache.count(key))
-  {
-    this->LastEstimateMethod = 0;
+    this->LastEstimateMethod = static_cast<int>(mediso::EstimateMethod::Exact);
     return 0.0; // served from the cache
   }
-  const Counts c = this->Internals->Estimate(isovalue, level, this->LastEstimateMethod);
-  return this->Internals->PredictSeconds(c.Cubes, c.Triangles);
+  const mediso::SurfaceEstimate e = in.Estimator.Estimate(isovalue, level);
+  this->LastEstimateMethod = static_cast<int>(e.Method);
+  return e.Method == mediso::EstimateMethod::None ? -1.0
+                                                  : in.Estimator.GetCostModel().Predict(e.Counts);
 }
 
 //------------------------------------------------------------------------------
@@ -775,26 +478,164 @@ int vtkBlockLODContour::RequestData(
   std::fill(this->EstimatedTriangles, this->EstimatedTriangles + 4, 0.0);
   std::fill(this->EstimatedMegabytes, this->EstimatedMegabytes + 4, 0.0);
   std::fill(this->EstimatedSeconds, this->EstimatedSeconds + 4, 0.0);
-  vtkInternals& in = *this->Internals;
   if (!input || !output)
   {
     return 0;
   }
+  vtkInternals& in = *this->Internals;
+  in.Plans.clear();
+  in.PlanSeconds.clear();
+  in.Surfaces.clear();
 
-  // --- Input checks -----------------------------------------------------------
-  vtkDataArray* array = this->GetInputArrayToProcess(0, inputVector);
-  if (!array)
+  // Check: an array the core can read, on a grid it can contour.
+  vtkDataArray* array = this->CheckInput(input, inputVector);
+  if (!array || this->ContourValues->GetNumberOfContours() < 1)
   {
-    vtkErrorMacro("No point scalars to contour: the input has no point data array "
-                  "(choose one with SetInputArrayToProcess). The output is empty.");
     return 1;
   }
+  // Refresh block ranges (kept while the input stays the same).
+  if (in.Refresh(vtkInternals::Describe(input, array, inputVector[0]->GetInformationObject(0))))
+  {
+    ++this->NumberOfBlockRangeComputations;
+  }
+  this->UpdateProgress(0.1);
+  const std::vector<double> values = this->IsovaluesWithSurface();
+  if (values.empty())
+  {
+    return 1;
+  }
+  // Choose the level, plan it (exact sizes before any allocation), generate, output.
+  int level = this->ChooseLevel(values);
+  if (level < 0 || !this->PlanLevel(values, level))
+  {
+    output->Initialize();
+    return 1;
+  }
+  this->ChosenLevel = level;
+  this->ReportEstimates(values[0]);
+  this->UpdateProgress(0.5);
+  if (!this->GenerateLevel(values, level))
+  {
+    output->Initialize();
+    return 1;
+  }
+  this->UpdateProgress(0.9);
+  this->AssembleOutput(output);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+vtkDataArray* vtkBlockLODContour::ChooseArray(vtkImageData* input, vtkInformationVector** inputVector)
+{
+  vtkInformation* chosen = this->GetInputArrayInformation(0);
+  const char* name =
+    chosen->Has(vtkDataObject::FIELD_NAME()) ? chosen->Get(vtkDataObject::FIELD_NAME()) : nullptr;
+  vtkPointData* pd = input->GetPointData();
+  if (name && *name)
+  {
+    // An array chosen by name (ContourBy): it must be one of the point arrays.
+    vtkDataArray* array = this->GetInputArrayToProcess(0, inputVector);
+    if (array && pd->GetArray(name) == array)
+    {
+      return array;
+    }
+    if (input->GetCellData()->GetAbstractArray(name))
+    {
+      vtkErrorMacro("'" << name << "' is a cell array; contouring needs a point array (apply "
+                    "Cell Data to Point Data first). The output is empty.");
+    }
+    else if (pd->GetAbstractArray(name))
+    {
+      vtkErrorMacro("Point array '" << name << "' is not numeric. The output is empty.");
+    }
+    else
+    {
+      vtkErrorMacro("ContourBy names the point array '"
+        << name << "', which the input does not have (" << DescribeArrays(pd, "point")
+        << "). The output is empty.");
+    }
+    return nullptr;
+  }
+
+  // None chosen (ParaView leaves ContourBy empty until the input has run):
+  // the active point scalars when they have one component, else the only
+  // one-component point array.
+  vtkDataArray* active = pd->GetScalars();
+  if (active && active->GetNumberOfComponents() == 1)
+  {
+    return active;
+  }
+  std::vector<vtkDataArray*> single;
+  int numeric = 0;
+  vtkDataArray* only = nullptr; // the numeric array, when there is one
+  for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
+  {
+    if (vtkDataArray* a = pd->GetArray(i))
+    {
+      ++numeric;
+      only = a;
+      if (a->GetNumberOfComponents() == 1)
+      {
+        single.push_back(a);
+      }
+    }
+  }
+  if (single.size() == 1)
+  {
+    return single[0];
+  }
+  if (numeric == 0)
+  {
+    vtkErrorMacro("No point scalars to contour: the input has no point data arrays"
+      << (input->GetCellData()->GetNumberOfArrays() > 0
+             ? " (" + DescribeArrays(input->GetCellData(), "cell") +
+               "; apply Cell Data to Point Data first)"
+             : std::string())
+      << ". The output is empty.");
+  }
+  else if (single.empty())
+  {
+    std::ostringstream what;
+    if (numeric == 1)
+    {
+      what << "the input's only point array, '" << (only->GetName() ? only->GetName() : "(unnamed)")
+           << "', has " << only->GetNumberOfComponents() << " components";
+    }
+    else
+    {
+      what << "none of the input's point arrays has one component (" << DescribeArrays(pd, "point")
+           << ")";
+    }
+    vtkErrorMacro("No array chosen to contour, and "
+      << what.str()
+      << ": contouring needs a one-component array (extract a component first, e.g. with a "
+         "Calculator). The output is empty.");
+  }
+  else
+  {
+    vtkErrorMacro("No array chosen to contour, and the input has several one-component point "
+                  "arrays and no active scalars ("
+      << DescribeArrays(pd, "point")
+      << "): choose one with ContourBy (SetInputArrayToProcess). The output is empty.");
+  }
+  return nullptr;
+}
+
+//------------------------------------------------------------------------------
+vtkDataArray* vtkBlockLODContour::CheckInput(vtkImageData* input, vtkInformationVector** inputVector)
+{
+  vtkDataArray* array = this->ChooseArray(input, inputVector);
+  if (!array)
+  {
+    return nullptr;
+  }
+  const std::string name = array->GetName() ? array->GetName() : "(unnamed)";
   if (array->GetNumberOfComponents() != 1)
   {
-    vtkErrorMacro("Array '" << (array->GetName() ? array->GetName() : "")
-                            << "' has " << array->GetNumberOfComponents()
+    vtkErrorMacro("Array '" << name << "' has " << array->GetNumberOfComponents()
                             << " components; contouring needs one. The output is empty.");
-    return 1;
+    return nullptr;
   }
   int dims[3];
   input->GetDimensions(dims);
@@ -803,69 +644,74 @@ int vtkBlockLODContour::RequestData(
     vtkErrorMacro("Input is " << dims[0] << " x " << dims[1] << " x " << dims[2]
                               << " points: isosurfaces need 3D image data with at least 2 "
                                  "points along each axis. The output is empty.");
-    return 1;
+    return nullptr;
+  }
+  const double* spacing = input->GetSpacing();
+  const double* origin = input->GetOrigin();
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!(spacing[a] != 0 && std::isfinite(spacing[a]) && std::isfinite(origin[a])))
+    {
+      vtkErrorMacro("The input's spacing (" << spacing[0] << ", " << spacing[1] << ", "
+        << spacing[2] << ") or origin (" << origin[0] << ", " << origin[1] << ", " << origin[2]
+        << ") has a zero or non-finite component: the surface would have no extent or "
+           "non-finite points. The output is empty.");
+      return nullptr;
+    }
   }
   if (input->GetDirectionMatrix() && !input->GetDirectionMatrix()->IsIdentity())
   {
     vtkErrorMacro("The input has a non-identity direction matrix, which this filter does not "
                   "support; resample it to an axis-aligned grid first. The output is empty.");
-    return 1;
+    return nullptr;
   }
-  bool supported = DispatchScalarType(array->GetDataType(), [](auto) {});
-  if (!supported || !array->HasStandardMemoryLayout() ||
+  mediso::ScalarType type;
+  if (!CoreScalarType(array->GetDataType(), type) || !array->HasStandardMemoryLayout() ||
     array->GetNumberOfTuples() != static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2])
   {
-    vtkErrorMacro("Array '" << (array->GetName() ? array->GetName() : "") << "' of type "
-                            << array->GetDataTypeAsString()
+    vtkErrorMacro("Array '" << name << "' of type " << array->GetDataTypeAsString()
                             << " is not supported (use a contiguous point array of 8/16/32-bit "
                                "integers, float or double). The output is empty.");
-    return 1;
+    return nullptr;
   }
-  const vtkIdType numValues = this->ContourValues->GetNumberOfContours();
-  if (numValues < 1)
+  if (this->ContourValues->GetNumberOfContours() < 1)
   {
     vtkDebugMacro("No isovalues: empty output.");
-    return 1;
   }
+  return array;
+}
 
-  // --- Block ranges (once per input) --------------------------------------------
-  int wholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
-  vtkInformation* inInfo = inputVector[0]->GetInformationObject(0);
-  if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
-  {
-    inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), wholeExtent);
-  }
-  // The piece without ghost layers, for an input that lost its ghost array.
-  int zeroExtent[6];
-  const int* zero = nullptr;
-  const int numPieces = inInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
-    ? inInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES())
-    : 1;
-  if (numPieces > 1 && !input->GetCellGhostArray() && wholeExtent[0] <= wholeExtent[1])
-  {
-    vtkNew<vtkExtentTranslator> translator;
-    translator->SetWholeExtent(wholeExtent);
-    translator->SetPiece(inInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()));
-    translator->SetNumberOfPieces(numPieces);
-    translator->SetGhostLevel(0);
-    translator->PieceToExtent();
-    translator->GetExtent(zeroExtent);
-    zero = zeroExtent;
-  }
-  if (in.Refresh(input, array, wholeExtent, zero))
-  {
-    ++this->NumberOfBlockRangeComputations;
-  }
-  this->UpdateProgress(0.1);
-  if (in.Ranges.NaNCount > 0 && !in.WarnedNaN)
-  {
-    vtkWarningMacro("The input has NaN values: cubes touching them produce no surface.");
-    in.WarnedNaN = true;
-  }
-  const double* range = in.Ranges.ValueRange;
+//------------------------------------------------------------------------------
+std::vector<double> vtkBlockLODContour::IsovaluesWithSurface()
+{
+  vtkInternals& in = *this->Internals;
+  const mediso::BlockRanges& ranges = in.Volume.GetRanges();
+  std::vector<double> values;
   // A parallel piece may well lie outside an isovalue (all air, say): only a
   // whole volume warns about its range.
-  const bool piece = in.IsPiece();
+  const bool piece = in.Volume.GetDescription().IsPiece();
+  if (!ranges.HasFiniteValues())
+  {
+    if (piece)
+    {
+      vtkDebugMacro("This piece has no finite values: no surface here.");
+    }
+    else
+    {
+      vtkWarningMacro("The input has no finite values (every point is NaN or infinite): there "
+                      "is no isosurface.");
+    }
+    return values;
+  }
+  if ((ranges.NaNCount > 0 || ranges.InfiniteCount > 0) && !in.WarnedMissing)
+  {
+    vtkWarningMacro("The input has "
+      << (ranges.NaNCount > 0 ? (ranges.InfiniteCount > 0 ? "NaN and infinite" : "NaN")
+                              : "infinite")
+      << " values: cubes touching them produce no surface.");
+    in.WarnedMissing = true;
+  }
+  const double* range = ranges.ValueRange;
   if (!(range[0] < range[1]))
   {
     if (piece)
@@ -876,16 +722,9 @@ int vtkBlockLODContour::RequestData(
     {
       vtkWarningMacro("The input is constant (" << range[0] << "): there is no isosurface.");
     }
-    return 1;
+    return values;
   }
-  const OutputFlags flags{ this->ComputeNormals, this->ComputeScalars, this->GenerateBlockIds };
-  if (!(flags == in.CacheFlags))
-  {
-    in.Cache.clear();
-    in.CacheFlags = flags;
-  }
-
-  std::vector<double> values;
+  const vtkIdType numValues = this->ContourValues->GetNumberOfContours();
   for (vtkIdType i = 0; i < numValues; ++i)
   {
     const double v = this->ContourValues->GetValue(static_cast<int>(i));
@@ -905,169 +744,151 @@ int vtkBlockLODContour::RequestData(
       values.push_back(v);
     }
   }
-  if (values.empty())
-  {
-    return 1;
-  }
+  return values;
+}
 
-  // --- Estimates and the level ----------------------------------------------------
+//------------------------------------------------------------------------------
+int vtkBlockLODContour::ChooseLevel(const std::vector<double>& values)
+{
+  if (!this->AutoLOD)
+  {
+    return this->LOD;
+  }
+  double level0Bytes = 0;
+  const int level = this->Internals->Estimator.ChooseLevel(
+    values, this->MemoryBudget * BytesPerMB, OutputLayout(this), level0Bytes);
+  if (level < 0)
+  {
+    vtkErrorMacro("MemoryBudget " << this->MemoryBudget << " MB is too small: even level 0 needs "
+                                  << level0Bytes / BytesPerMB << " MB. The output is empty.");
+  }
+  return level;
+}
+
+//------------------------------------------------------------------------------
+bool vtkBlockLODContour::PlanLevel(const std::vector<double>& values, int& level)
+{
+  vtkInternals& in = *this->Internals;
+  const mediso::SurfaceLayout layout = OutputLayout(this);
+  if (layout != in.CacheLayout)
+  {
+    in.Cache.Clear();
+    in.CacheLayout = layout;
+  }
   const double budgetBytes = this->MemoryBudget * BytesPerMB;
-  int level = this->LOD;
-  if (this->AutoLOD)
-  {
-    level = -1;
-    double needLevel0 = 0;
-    for (int l = mediso::NumberOfLevels - 1; l >= 0 && level < 0; --l)
-    {
-      double bytes = 0;
-      for (double v : values)
-      {
-        int method;
-        const Counts c = in.Estimate(v, l, method);
-        bytes += SurfaceBytes(c.Points, c.Triangles, flags);
-      }
-      if (bytes <= budgetBytes)
-      {
-        level = l;
-      }
-      needLevel0 = bytes;
-    }
-    if (level < 0)
-    {
-      vtkErrorMacro("MemoryBudget " << this->MemoryBudget << " MB is too small: even level 0 needs "
-                                    << needLevel0 / BytesPerMB << " MB. The output is empty.");
-      return 1;
-    }
-  }
-
-  // --- Pass 1 for every pair not cached: exact sizes before any allocation -------------
-  const mediso::TriangleCaseTable cases = VTKCaseTable();
   auto abort = [this]() { return this->GetAbortExecute() != 0; };
-  std::map<double, mediso::ExtractionPlan> plans;
-  std::map<double, double> planSeconds;
   for (;;)
   {
-    plans.clear();
+    in.Plans.clear();
     double bytes = 0;
     for (double v : values)
     {
-      const Key key(v, level);
-      auto cached = in.Cache.find(key);
-      if (cached != in.Cache.end())
+      const mediso::SurfaceKey key{ v, level };
+      if (in.Cache.Contains(key))
       {
-        bytes += cached->second.Bytes;
+        bytes += in.Cache.EntryBytes(key);
         continue;
       }
-      mediso::ExtractionPlan& plan = plans[v];
+      mediso::ExtractionPlan& plan = in.Plans[v];
       const double start = Now();
-      bool complete = true;
-      // Marching cubes at stride 1 on the level's samples: the level's surface.
-      in.WithLevelVolume(level, [&](const auto& volume, const mediso::BlockRanges& ranges) {
-        complete = mediso::PlanExtraction(volume, ranges, cases, v, 3, plan, SMPFor, abort);
-      });
-      if (!complete || this->CheckAbort())
+      if (!in.Volume.Plan(v, level, plan, abort) || this->CheckAbort())
       {
-        output->Initialize();
-        return 1;
+        return false;
       }
-      planSeconds[v] = Now() - start;
-      Counts exact;
-      exact.Points = static_cast<double>(plan.GetNumberOfPoints());
-      exact.Triangles = static_cast<double>(plan.GetNumberOfTriangles());
-      exact.Cubes = static_cast<double>(plan.ActiveBlocks.size()) * plan.CubesPerBlock;
-      in.RecordExact(key, exact);
-      bytes += SurfaceBytes(exact.Points, exact.Triangles, flags);
+      in.PlanSeconds[v] = Now() - start;
+      const mediso::SurfaceCounts exact = mediso::BlockLODVolume::CountsOf(plan);
+      in.Estimator.RecordExact(v, level, exact);
+      bytes += layout.Bytes(exact);
     }
     if (!this->AutoLOD || bytes <= budgetBytes)
     {
-      break;
+      return true;
     }
     if (level == 0)
     {
       vtkErrorMacro("MemoryBudget " << this->MemoryBudget << " MB is too small: level 0 needs "
                                     << bytes / BytesPerMB << " MB. The output is empty.");
-      return 1;
+      return false;
     }
     vtkWarningMacro("Level " << level << " needs " << bytes / BytesPerMB
                              << " MB, over the MemoryBudget of " << this->MemoryBudget
                              << " MB (the estimate was low): using level " << level - 1 << ".");
     --level;
   }
-  this->ChosenLevel = level;
-  // Estimates of every level for the first isovalue, reported after planning:
-  // the planned level's is exact, and AutoLOD's were made while choosing.
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODContour::ReportEstimates(double isovalue)
+{
+  // After planning: the planned level's estimate is exact, AutoLOD's were
+  // made while choosing.
   for (int l = 0; l < mediso::NumberOfLevels; ++l)
   {
-    this->EstimatedTriangles[l] = this->EstimateTriangles(values[0], l);
-    this->EstimatedMegabytes[l] = this->EstimateMegabytes(values[0], l);
-    this->EstimatedSeconds[l] = this->EstimateSeconds(values[0], l);
+    this->EstimatedTriangles[l] = this->EstimateTriangles(isovalue, l);
+    this->EstimatedMegabytes[l] = this->EstimateMegabytes(isovalue, l);
+    this->EstimatedSeconds[l] = this->EstimateSeconds(isovalue, l);
   }
-  this->UpdateProgress(0.5);
+}
 
-  // --- Pass 2: generate, cache -------------------------------------------------
-  std::vector<vtkSmartPointer<vtkPolyData>> pieces;
-  std::vector<Key> used;
+//------------------------------------------------------------------------------
+bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int level)
+{
+  vtkInternals& in = *this->Internals;
+  const mediso::SurfaceLayout layout = OutputLayout(this);
+  std::vector<mediso::SurfaceKey> used;
   for (double v : values)
   {
-    const Key key(v, level);
+    const mediso::SurfaceKey key{ v, level };
     used.push_back(key);
-    auto cached = in.Cache.find(key);
-    if (cached != in.Cache.end())
+    if (vtkSmartPointer<vtkPolyData>* cached = in.Cache.Find(key))
     {
       ++this->NumberOfCacheHits;
-      in.Touch(cached->second);
-      pieces.push_back(cached->second.Surface);
+      in.Surfaces.push_back(*cached);
       continue;
     }
-    const mediso::ExtractionPlan& plan = plans[v];
+    const mediso::ExtractionPlan& plan = in.Plans[v];
     const double start = Now();
     SurfaceArrays arrays =
-      AllocateSurface(plan.GetNumberOfPoints(), plan.GetNumberOfTriangles(), flags);
-    in.WithLevelVolume(level, [&](const auto& volume, const mediso::BlockRanges& ranges) {
-      if (arrays.Connectivity32)
-      {
-        mediso::SurfaceBuffers<std::int32_t> buffers;
-        buffers.Points = arrays.Points;
-        buffers.Normals = arrays.Normals;
-        buffers.Scalars = arrays.Scalars;
-        buffers.BlockIds = arrays.BlockIds;
-        buffers.Connectivity = arrays.Connectivity32;
-        mediso::GenerateSurface(volume, ranges, cases, plan, buffers, SMPFor);
-      }
-      else
-      {
-        mediso::SurfaceBuffers<std::int64_t> buffers;
-        buffers.Points = arrays.Points;
-        buffers.Normals = arrays.Normals;
-        buffers.Scalars = arrays.Scalars;
-        buffers.BlockIds = arrays.BlockIds;
-        buffers.Connectivity = arrays.Connectivity64;
-        mediso::GenerateSurface(volume, ranges, cases, plan, buffers, SMPFor);
-      }
-    });
+      AllocateSurface(plan.GetNumberOfPoints(), plan.GetNumberOfTriangles(), layout);
+    auto generate = [&](auto* connectivity) {
+      mediso::SurfaceBuffers<std::remove_pointer_t<decltype(connectivity)>> buffers;
+      buffers.Points = arrays.Points;
+      buffers.Normals = arrays.Normals;
+      buffers.Scalars = arrays.Scalars;
+      buffers.BlockIds = arrays.BlockIds;
+      buffers.Connectivity = connectivity;
+      in.Volume.Generate(plan, buffers);
+    };
+    if (arrays.Connectivity32)
+    {
+      generate(arrays.Connectivity32);
+    }
+    else
+    {
+      generate(arrays.Connectivity64);
+    }
     ++this->NumberOfExtractions;
-    const double seconds = planSeconds[v] + (Now() - start);
-    in.RecordCost(static_cast<double>(plan.ActiveBlocks.size()) * plan.CubesPerBlock,
-      static_cast<double>(plan.GetNumberOfTriangles()), seconds);
-    pieces.push_back(arrays.Surface);
+    const mediso::SurfaceCounts counts = mediso::BlockLODVolume::CountsOf(plan);
+    in.Estimator.GetCostModel().Record(
+      counts.Cubes, counts.Triangles, in.PlanSeconds[v] + (Now() - start));
+    in.Surfaces.push_back(arrays.Surface);
     if (this->CacheMemoryLimit > 0)
     {
-      CacheEntry& entry = in.Cache[key];
-      entry.Surface = arrays.Surface;
-      entry.Bytes = SurfaceBytes(static_cast<double>(plan.GetNumberOfPoints()),
-        static_cast<double>(plan.GetNumberOfTriangles()), flags);
-      in.Touch(entry);
+      in.Cache.Insert(key, arrays.Surface, layout.Bytes(counts));
     }
     if (this->CheckAbort())
     {
-      output->Initialize();
-      return 1;
+      return false;
     }
   }
-  in.Evict(this->CacheMemoryLimit * BytesPerMB, used);
-  this->UpdateProgress(0.9);
+  in.Cache.Evict(this->CacheMemoryLimit * BytesPerMB, used);
+  return true;
+}
 
-  // --- Output ----------------------------------------------------------------------
+//------------------------------------------------------------------------------
+void vtkBlockLODContour::AssembleOutput(vtkPolyData* output)
+{
+  const std::vector<vtkSmartPointer<vtkPolyData>>& pieces = this->Internals->Surfaces;
   if (pieces.size() == 1)
   {
     output->ShallowCopy(pieces[0]);
@@ -1080,7 +901,7 @@ int vtkBlockLODContour::RequestData(
       points += p->GetNumberOfPoints();
       triangles += p->GetNumberOfPolys();
     }
-    SurfaceArrays all = AllocateSurface(points, triangles, flags);
+    SurfaceArrays all = AllocateSurface(points, triangles, OutputLayout(this));
     std::int64_t p0 = 0, t0 = 0;
     for (const auto& p : pieces)
     {
@@ -1126,13 +947,11 @@ int vtkBlockLODContour::RequestData(
     std::copy(v, v + n, a->GetPointer(0));
     output->GetFieldData()->AddArray(a);
   };
-  const double chosen = level;
+  const double chosen = this->ChosenLevel;
   addField("BlockLODLevel", &chosen, 1);
   addField("BlockLODEstimatedTriangles", this->EstimatedTriangles, 4);
   addField("BlockLODEstimatedMB", this->EstimatedMegabytes, 4);
   addField("BlockLODEstimatedSeconds", this->EstimatedSeconds, 4);
-  this->UpdateProgress(1.0);
-  return 1;
 }
 
 //------------------------------------------------------------------------------

@@ -8,9 +8,13 @@
  * Medical Data Visualisation on the Web" (section 4.2): marching cubes over
  * 8x8x8-cell blocks at four levels of detail, for clients that cannot use the
  * GPU path, that need geometry to process further, or that must fit a memory
- * budget. The algorithm itself (blocks, levels, point merging, normals) is
- * the VTK-free core in Filters/Core/BlockLOD.h, which documents it; this class
- * adds what a pipeline filter needs:
+ * budget. The method is the VTK-free core in Filters/Core, which documents
+ * it: BlockLOD.h (blocks, levels, point merging, normals), BlockLODVolume.h
+ * (one input with its block ranges and coarse copies), BlockLODEstimator.h
+ * (the memory and time estimates, the level choice) and BlockLODCache.h (the
+ * (isovalue, level) surface cache). This class converts the input and output
+ * and runs, per update: check the input, refresh the block ranges, choose the
+ * level, plan it, generate the surfaces, assemble the output. In short:
  *
  * -# Block ranges. The minimum and maximum of every block are computed once
  *    per input array (in parallel) and kept until the input data, the array or
@@ -74,12 +78,18 @@
  *
  * Inputs: vtkImageData with a one-component point array of type char, signed
  * char, unsigned char, short, unsigned short, int, unsigned int, float or
- * double; spacing, origin and extent are honoured; a non-identity direction
- * matrix is rejected. Bad input (no scalars, 2D data, several components, an
- * unsupported type, a constant volume, an isovalue outside the data range,
- * NaN values, a budget too small) gives a clear error or warning and an empty
- * or partial output, never a crash. Passes run with vtkSMPTools; progress is
- * reported and abort honoured between passes and blocks.
+ * double: the one named by SetInputArrayToProcess (ParaView's ContourBy), or,
+ * when none is named, the active point scalars if they have one component,
+ * else the only one-component point array. Spacing, origin and extent are
+ * honoured; a non-identity direction matrix is rejected. NaN and infinite
+ * values are missing data: cubes touching them make no triangle (one warning
+ * per input), so the output holds only finite points. Bad input (no point
+ * array, a named array the input lacks or a cell array, several components,
+ * 2D data, zero or non-finite spacing, an unsupported type, a constant or
+ * all-NaN volume, an isovalue outside the data range, a budget too small)
+ * gives one error or warning saying what is wrong, and an empty or partial
+ * output, never a crash. Passes run with vtkSMPTools; progress is reported and
+ * abort honoured between passes and blocks.
  *
  * @sa vtkFlyingEdges3D vtkMarchingCubes vtkContourValues
  */
@@ -92,6 +102,10 @@
 #include "vtkPolyDataAlgorithm.h"
 
 #include <memory> // For std::unique_ptr
+#include <vector> // For the steps' isovalues
+
+class vtkDataArray;
+class vtkImageData;
 
 class MEDICALISOSURFACESFILTERS_EXPORT vtkBlockLODContour : public vtkPolyDataAlgorithm
 {
@@ -268,6 +282,16 @@ protected:
 private:
   vtkBlockLODContour(const vtkBlockLODContour&) = delete;
   void operator=(const vtkBlockLODContour&) = delete;
+
+  // The steps of RequestData, in order (ChooseArray is part of CheckInput).
+  vtkDataArray* ChooseArray(vtkImageData* input, vtkInformationVector** inputVector);
+  vtkDataArray* CheckInput(vtkImageData* input, vtkInformationVector** inputVector);
+  std::vector<double> IsovaluesWithSurface();
+  int ChooseLevel(const std::vector<double>& values);
+  bool PlanLevel(const std::vector<double>& values, int& level);
+  void ReportEstimates(double isovalue);
+  bool GenerateLevel(const std::vector<double>& values, int level);
+  void AssembleOutput(vtkPolyData* output);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

@@ -126,7 +126,7 @@ void MetaImage::GetRange(double range[2]) const
 {
   range[0] = HUGE_VAL;
   range[1] = -HUGE_VAL;
-  DispatchScalarType(this->Type,
+  VisitScalarType(this->Type,
     [&](auto tag)
     {
       using T = decltype(tag);

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 namespace mediso
 {
@@ -44,10 +45,19 @@ struct TriangleCounts
   }
 };
 
+// A sample that is no number to contour: NaN or infinite. Never for integer
+// types (the test is compiled away).
 template <typename T>
-inline bool IsNaN(T v)
+inline bool IsMissing(T v)
 {
-  return v != v; // false, and compiled away, for integer types
+  if constexpr (std::is_floating_point<T>::value)
+  {
+    return !std::isfinite(v);
+  }
+  else
+  {
+    return false;
+  }
 }
 
 // The samples of one block at one level (see BlockLOD.h).
@@ -102,7 +112,7 @@ int WordsPerBlock(int level)
 }
 
 // Per-sample classification of a gathered block: 1 when value >= iso, 0 when
-// below, NaNFlag when NaN.
+// below, NaNFlag when missing (NaN or infinite).
 constexpr std::uint8_t NaNFlag = 2;
 
 // Classifies a block's samples straight from the data (no copy of the values).
@@ -129,16 +139,16 @@ void Classify(const Volume<T>& v, const BlockSamples& s, double iso, std::vector
         const T* r = row + xs[0];
         for (int i = 0; i < s.Count[0]; ++i)
         {
-          const double value = static_cast<double>(r[i]);
-          *out++ = IsNaN(value) ? NaNFlag : static_cast<std::uint8_t>(value >= iso);
+          const T value = r[i];
+          *out++ = IsMissing(value) ? NaNFlag : static_cast<std::uint8_t>(static_cast<double>(value) >= iso);
         }
       }
       else
       {
         for (int i = 0; i < s.Count[0]; ++i)
         {
-          const double value = static_cast<double>(row[xs[i]]);
-          *out++ = IsNaN(value) ? NaNFlag : static_cast<std::uint8_t>(value >= iso);
+          const T value = row[xs[i]];
+          *out++ = IsMissing(value) ? NaNFlag : static_cast<std::uint8_t>(static_cast<double>(value) >= iso);
         }
       }
     }
@@ -420,13 +430,13 @@ void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const Para
     // A piece too thin to hold one cube of a coarse level.
     ranges.Min.clear();
     ranges.Max.clear();
-    ranges.NaNCount = 0;
+    ranges.NaNCount = ranges.InfiniteCount = 0;
     ranges.ValueRange[0] = ranges.ValueRange[1] = 0;
     return;
   }
   ranges.Min.assign(numBlocks, std::numeric_limits<double>::infinity());
   ranges.Max.assign(numBlocks, -std::numeric_limits<double>::infinity());
-  std::vector<std::int64_t> nanPerSlab(ranges.Blocks[2], 0);
+  std::vector<std::int64_t> nanPerSlab(ranges.Blocks[2], 0), infPerSlab(ranges.Blocks[2], 0);
 
   // One z-slab of blocks per task: each block row reads its points once
   // (the shared face plane is read by both slabs).
@@ -437,7 +447,7 @@ void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const Para
     {
       const int z0 = static_cast<int>(bz) * BlockCells;
       const int z1 = std::min(z0 + BlockCells, volume.Dims[2] - 1);
-      std::int64_t nans = 0;
+      std::int64_t nans = 0, infinities = 0;
       for (int by = 0; by < ranges.Blocks[1]; ++by)
       {
         const int y0 = by * BlockCells;
@@ -456,9 +466,9 @@ void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const Para
               for (int x = x0; x <= x1; ++x)
               {
                 const T v = row[x];
-                if (IsNaN(v))
+                if (IsMissing(v))
                 {
-                  ++nans;
+                  ++(std::isnan(static_cast<double>(v)) ? nans : infinities);
                   continue;
                 }
                 lo = v < lo ? v : lo;
@@ -475,13 +485,15 @@ void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const Para
         }
       }
       nanPerSlab[bz] = nans;
+      infPerSlab[bz] = infinities;
     }
   });
-  // Shared faces count NaNs twice; report the exact count only when there are none.
-  ranges.NaNCount = 0;
-  for (std::int64_t n : nanPerSlab)
+  // Shared faces count missing samples twice; the counts are exact only when 0.
+  ranges.NaNCount = ranges.InfiniteCount = 0;
+  for (std::size_t bz = 0; bz < nanPerSlab.size(); ++bz)
   {
-    ranges.NaNCount += n;
+    ranges.NaNCount += nanPerSlab[bz];
+    ranges.InfiniteCount += infPerSlab[bz];
   }
   ranges.ValueRange[0] = *std::min_element(ranges.Min.begin(), ranges.Min.end());
   ranges.ValueRange[1] = *std::max_element(ranges.Max.begin(), ranges.Max.end());
@@ -625,9 +637,10 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
               g[c] = g0[c] + t * (g1[c] - g0[c]);
               len2 += g[c] * g[c];
             }
-            if (!(len2 > 0))
+            if (!(len2 > 0 && len2 < std::numeric_limits<double>::infinity()))
             {
-              // Flat or NaN gradient: use the edge itself, pointing to lower values.
+              // Flat gradient, or one read from a missing sample: use the edge
+              // itself, pointing to lower values.
               g[0] = g[1] = g[2] = 0;
               g[axis] = v1 > v0 ? -1.0 : 1.0;
               len2 = 1;

@@ -42,8 +42,10 @@
  * - Degenerate triangles: like vtkFlyingEdges3D, a point is created per cut
  *   edge and every triangle of the case table is kept; a triangle can only
  *   have coincident vertices when a sample value equals the isovalue exactly.
- * - NaN samples: an edge with a NaN end is never cut and a cube with a NaN
- *   corner makes no triangle, so NaN regions leave holes but never NaN points.
+ * - Missing samples (NaN or infinite): an edge with a missing end is never cut
+ *   and a cube with a missing corner makes no triangle, so such regions leave
+ *   holes but never non-finite points; a normal whose gradient reads a missing
+ *   sample falls back to the edge direction.
  *
  * Every pass runs over ranges of blocks through a caller-supplied ParallelFor
  * (vtkBlockLODContour passes vtkSMPTools), so the core is testable alone.
@@ -69,6 +71,21 @@ constexpr int LevelStride(int level)
 {
   return BlockCells >> level;
 }
+
+/// An (isovalue, level) pair: what the estimator and the surface cache key on.
+struct SurfaceKey
+{
+  double Isovalue = 0;
+  int Level = 0;
+  bool operator==(const SurfaceKey& o) const
+  {
+    return this->Isovalue == o.Isovalue && this->Level == o.Level;
+  }
+  bool operator<(const SurfaceKey& o) const
+  {
+    return this->Isovalue < o.Isovalue || (this->Isovalue == o.Isovalue && this->Level < o.Level);
+  }
+};
 
 /// Runs body(begin, end) over sub-ranges that together cover [begin, end),
 /// possibly concurrently.
@@ -135,10 +152,15 @@ struct BlockRanges
 {
   int Dims[3] = { 0, 0, 0 };
   int Blocks[3] = { 0, 0, 0 };
-  std::vector<double> Min; ///< NaN-free minimum of each block (x fastest).
+  std::vector<double> Min; ///< Minimum of each block's finite samples (x fastest).
   std::vector<double> Max;
-  std::int64_t NaNCount = 0; ///< NaN samples in the whole volume.
-  double ValueRange[2] = { 0, 0 };
+  /// NaN and infinite samples (those on block faces counted once per block:
+  /// exact when 0).
+  std::int64_t NaNCount = 0;
+  std::int64_t InfiniteCount = 0;
+  double ValueRange[2] = { 0, 0 }; ///< Of the finite samples; empty (min > max) when none.
+
+  bool HasFiniteValues() const { return this->ValueRange[0] <= this->ValueRange[1]; }
 
   std::int64_t GetNumberOfBlocks() const
   {
@@ -174,7 +196,8 @@ void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const Para
 struct ExtractionPlan
 {
   double Isovalue = 0;
-  int Level = 3;
+  int Level = 3;       ///< Stride level of the pass on the volume it read.
+  int VolumeLevel = 3; ///< Level whose volume it read (BlockLODVolume: the coarse copy below 3).
   std::vector<std::int32_t> ActiveBlocks;   ///< Linear indices of visited blocks.
   std::vector<std::int32_t> ActiveIndex;    ///< Per block: position in ActiveBlocks or -1.
   std::vector<std::int64_t> PointOffset;    ///< Per active block (+1): first point.

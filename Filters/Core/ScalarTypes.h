@@ -23,7 +23,7 @@
 
 namespace mediso
 {
-/// A supported scalar type, for hosts that hold data as bytes (not templates).
+/// The scalar types as a value, for hosts that describe their data at run time.
 enum class ScalarType
 {
   Int8,
@@ -56,44 +56,46 @@ constexpr ScalarType ScalarTypeOf()
   }
 }
 
-/// Calls f(T()) with the C++ type of `type`.
+/// Calls f(T{}) with the C++ type of `type`; false (f not called) for an
+/// unknown value.
 template <typename F>
-void DispatchScalarType(ScalarType type, F&& f)
+bool VisitScalarType(ScalarType type, F&& f)
 {
   switch (type)
   {
     case ScalarType::Int8:
-      f(std::int8_t());
-      break;
+      f(std::int8_t{});
+      return true;
     case ScalarType::UInt8:
-      f(std::uint8_t());
-      break;
+      f(std::uint8_t{});
+      return true;
     case ScalarType::Int16:
-      f(std::int16_t());
-      break;
+      f(std::int16_t{});
+      return true;
     case ScalarType::UInt16:
-      f(std::uint16_t());
-      break;
+      f(std::uint16_t{});
+      return true;
     case ScalarType::Int32:
-      f(std::int32_t());
-      break;
+      f(std::int32_t{});
+      return true;
     case ScalarType::UInt32:
-      f(std::uint32_t());
-      break;
+      f(std::uint32_t{});
+      return true;
     case ScalarType::Float32:
-      f(float());
-      break;
+      f(float{});
+      return true;
     case ScalarType::Float64:
-      f(double());
-      break;
+      f(double{});
+      return true;
   }
+  return false;
 }
 
-/// Bytes of one value of `type`.
+/// Bytes of one value of `type` (0 for an unknown value).
 inline int ScalarTypeSize(ScalarType type)
 {
   int size = 0;
-  DispatchScalarType(type, [&](auto v) { size = static_cast<int>(sizeof(v)); });
+  VisitScalarType(type, [&](auto v) { size = static_cast<int>(sizeof(v)); });
   return size;
 }
 } // namespace mediso

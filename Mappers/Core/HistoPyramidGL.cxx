@@ -431,7 +431,7 @@ bool HistoPyramidGL::UploadVolume(ScalarType type, const void* values, const int
   impl.UIntRanges.clear();
   impl.FloatRanges.clear();
   const ScalarType rangeType = type == ScalarType::Float64 ? ScalarType::Float32 : type;
-  DispatchScalarType(rangeType,
+  VisitScalarType(rangeType,
     [&](auto tag)
     {
       using T = decltype(tag);

@@ -70,7 +70,7 @@ IsoThresholds MakeIsoThresholds(ScalarType type, const std::vector<double>& isov
   IsoThresholds t;
   t.Kind = ValueKindOf(type);
   double typeMin = 0.0, typeMax = 0.0;
-  DispatchScalarType(type,
+  VisitScalarType(type,
     [&](auto v)
     {
       using T = decltype(v);

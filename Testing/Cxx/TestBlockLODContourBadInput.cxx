@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Bad input to vtkBlockLODContour, one case per ctest test (the case name is
-// the argument): each must give the expected error or warning and an empty
-// (or NaN-free) output, never a crash.
+// the argument): each must give exactly the expected error or warning and an
+// empty (or finite) output, never a crash. The DefaultArray cases check what
+// is contoured when ContourBy is unset (no message then).
 #include "vtkBlockLODContour.h"
 #include "vtkMedicalPhantomSource.h"
 
+#include "vtkCellData.h"
 #include "vtkDoubleArray.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -18,10 +20,34 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <string>
 
 namespace
 {
+int CheckFinite(vtkPolyData* out)
+{
+  vtkDataArray* normals = out->GetPointData()->GetNormals();
+  for (vtkIdType i = 0; i < out->GetNumberOfPoints(); ++i)
+  {
+    double x[3], n[3] = { 0, 0, 0 };
+    out->GetPoint(i, x);
+    if (normals)
+    {
+      normals->GetTuple(i, n);
+    }
+    for (int c = 0; c < 3; ++c)
+    {
+      if (!std::isfinite(x[c]) || !std::isfinite(n[c]))
+      {
+        std::printf("FAILED: non-finite output point or normal %lld\n", static_cast<long long>(i));
+        return 1;
+      }
+    }
+  }
+  return 0;
+}
+
 vtkSmartPointer<vtkImageData> Image(int nx, int ny, int nz, vtkDataArray* scalars)
 {
   auto image = vtkSmartPointer<vtkImageData>::New();
@@ -41,9 +67,35 @@ vtkSmartPointer<vtkImageData> Image(int nx, int ny, int nz, vtkDataArray* scalar
   return image;
 }
 
-// Runs the filter on `image`; checks the message and the output.
+int Count(const std::string& text, const std::string& word)
+{
+  int n = 0;
+  for (std::size_t at = text.find(word); at != std::string::npos; at = text.find(word, at + 1))
+  {
+    ++n;
+  }
+  return n;
+}
+
+// The phantom as float (to hold NaN and infinities), named "HU", active.
+vtkSmartPointer<vtkImageData> FloatPhantom(int n)
+{
+  vtkNew<vtkMedicalPhantomSource> phantom;
+  phantom->SetDimensions(n, n, n);
+  phantom->Update();
+  vtkNew<vtkFloatArray> s;
+  s->DeepCopy(phantom->GetOutput()->GetPointData()->GetScalars());
+  s->SetName("HU");
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->CopyStructure(phantom->GetOutput());
+  image->GetPointData()->SetScalars(s);
+  return image;
+}
+
+// Runs the filter on `image`; checks the message and the output. `arrayName`
+// (when not null) is what ContourBy sets: "" is ParaView's unset property.
 int Expect(vtkImageData* image, double iso, const char* kind, const char* needle,
-  bool allowOutput = false, double budget = -1)
+  bool allowOutput = false, double budget = -1, const char* arrayName = nullptr)
 {
   vtkNew<vtkBlockLODContour> lod;
   vtkNew<vtkTest::ErrorObserver> observer;
@@ -51,6 +103,10 @@ int Expect(vtkImageData* image, double iso, const char* kind, const char* needle
   lod->AddObserver(vtkCommand::WarningEvent, observer);
   lod->SetInputData(image);
   lod->SetValue(0, iso);
+  if (arrayName)
+  {
+    lod->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, arrayName);
+  }
   if (budget >= 0)
   {
     lod->AutoLODOn();
@@ -71,6 +127,13 @@ int Expect(vtkImageData* image, double iso, const char* kind, const char* needle
     std::printf("FAILED: expected a %s mentioning '%s'\n", kind, needle);
     ++failures;
   }
+  // One message, saying the one thing that is wrong.
+  if (Count(message, isError ? "ERROR: In" : "Warning: In") != 1 ||
+    (isError ? observer->GetWarning() : observer->GetError()))
+  {
+    std::printf("FAILED: expected exactly one %s and nothing else\n", kind);
+    ++failures;
+  }
   vtkPolyData* out = lod->GetOutput();
   if (!allowOutput && out->GetNumberOfPoints() != 0)
   {
@@ -78,15 +141,43 @@ int Expect(vtkImageData* image, double iso, const char* kind, const char* needle
       static_cast<long long>(out->GetNumberOfPoints()));
     ++failures;
   }
-  for (vtkIdType i = 0; i < out->GetNumberOfPoints(); ++i)
+  return failures + CheckFinite(out);
+}
+
+// Runs the filter with ContourBy unset as ParaView leaves it (an empty name)
+// and as a C++ caller leaves it (the active scalars attribute); both must
+// contour `expected` without a message, as naming it would.
+int ExpectDefaultArray(vtkImageData* image, double iso, const char* expected)
+{
+  int failures = 0;
+  vtkNew<vtkBlockLODContour> named;
+  named->SetInputData(image);
+  named->SetValue(0, iso);
+  named->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, expected);
+  named->Update();
+  const vtkIdType triangles = named->GetOutput()->GetNumberOfPolys();
+  for (bool paraview : { true, false })
   {
-    double x[3];
-    out->GetPoint(i, x);
-    if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]))
+    vtkNew<vtkBlockLODContour> lod;
+    vtkNew<vtkTest::ErrorObserver> observer;
+    lod->AddObserver(vtkCommand::ErrorEvent, observer);
+    lod->AddObserver(vtkCommand::WarningEvent, observer);
+    lod->SetInputData(image);
+    lod->SetValue(0, iso);
+    if (paraview)
     {
-      std::printf("FAILED: non-finite output point %lld\n", static_cast<long long>(i));
+      lod->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "");
+    }
+    lod->Update();
+    const vtkIdType got = lod->GetOutput()->GetNumberOfPolys();
+    std::printf("ContourBy unset (%s): %lld triangles; naming '%s': %lld\n",
+      paraview ? "ParaView's empty name" : "C++ default", static_cast<long long>(got), expected,
+      static_cast<long long>(triangles));
+    if (observer->GetError() || observer->GetWarning() || got == 0 || got != triangles)
+    {
+      std::printf("FAILED: with ContourBy unset the filter should contour '%s' silently\n",
+        expected);
       ++failures;
-      break;
     }
   }
   return failures;
@@ -125,20 +216,155 @@ int TestBlockLODContourBadInput(int argc, char* argv[])
   }
   if (which == "NaNValues")
   {
-    vtkNew<vtkMedicalPhantomSource> phantom;
-    phantom->SetDimensions(40, 40, 40);
-    phantom->Update();
-    vtkNew<vtkFloatArray> s;
-    s->DeepCopy(phantom->GetOutput()->GetPointData()->GetScalars());
+    auto image = FloatPhantom(40);
+    vtkFloatArray* s = vtkFloatArray::SafeDownCast(image->GetPointData()->GetScalars());
     for (vtkIdType i = 0; i < s->GetNumberOfTuples(); i += 37)
     {
       s->SetValue(i, std::nanf(""));
     }
-    auto image = vtkSmartPointer<vtkImageData>::New();
-    image->CopyStructure(phantom->GetOutput());
-    image->GetPointData()->SetScalars(s);
     // A partial surface is expected: holes around NaNs, no NaN points.
-    return Expect(image, -500, "warning", "NaN", /*allowOutput=*/true);
+    return Expect(image, -500, "warning", "NaN values", /*allowOutput=*/true);
+  }
+  if (which == "InfiniteValues")
+  {
+    // +inf and -inf voxels: treated like NaN, one warning for several
+    // updates, only finite points and normals, and the same surface as NaN there.
+    auto image = FloatPhantom(40);
+    auto nans = FloatPhantom(40);
+    vtkFloatArray* s = vtkFloatArray::SafeDownCast(image->GetPointData()->GetScalars());
+    vtkFloatArray* n = vtkFloatArray::SafeDownCast(nans->GetPointData()->GetScalars());
+    const float inf = std::numeric_limits<float>::infinity();
+    for (vtkIdType i = 0; i < s->GetNumberOfTuples(); i += 37)
+    {
+      s->SetValue(i, (i / 37) % 2 ? inf : -inf);
+      n->SetValue(i, std::nanf(""));
+    }
+    vtkNew<vtkBlockLODContour> lod;
+    vtkNew<vtkTest::ErrorObserver> observer;
+    lod->AddObserver(vtkCommand::ErrorEvent, observer);
+    lod->AddObserver(vtkCommand::WarningEvent, observer);
+    lod->SetInputData(image);
+    vtkNew<vtkBlockLODContour> reference;
+    reference->AddObserver(vtkCommand::WarningEvent, vtkNew<vtkTest::ErrorObserver>());
+    reference->SetInputData(nans);
+    int failures = 0;
+    for (double iso : { -500.0, 400.0 })
+    {
+      for (int level : { 0, 3 })
+      {
+        lod->SetValue(0, iso);
+        lod->SetLOD(level);
+        lod->Update();
+        reference->SetValue(0, iso);
+        reference->SetLOD(level);
+        reference->Update();
+        failures += CheckFinite(lod->GetOutput());
+        const vtkIdType got = lod->GetOutput()->GetNumberOfPolys();
+        std::printf("iso %g level %d: %lld triangles with infinities, %lld with NaN there\n", iso,
+          level, static_cast<long long>(got),
+          static_cast<long long>(reference->GetOutput()->GetNumberOfPolys()));
+        if (got == 0 || got != reference->GetOutput()->GetNumberOfPolys())
+        {
+          std::printf("FAILED: infinite voxels should cut the surface as NaN voxels do\n");
+          ++failures;
+        }
+      }
+    }
+    const std::string message = observer->GetWarningMessage();
+    std::printf("warning reported: %s\n", message.substr(message.find(')') + 1).c_str());
+    if (Count(message, "Warning: In") != 1 || message.find("infinite values") == std::string::npos ||
+      observer->GetError())
+    {
+      std::printf("FAILED: expected one warning about infinite values over four updates\n");
+      ++failures;
+    }
+    return failures;
+  }
+  if (which == "AllNaN")
+  {
+    vtkNew<vtkFloatArray> s;
+    auto image = Image(20, 20, 20, s);
+    s->FillValue(std::nanf(""));
+    return Expect(image, 10, "warning", "no finite values");
+  }
+  if (which == "DefaultArrayActive")
+  {
+    // ParaView leaves ContourBy empty: the active scalars are contoured, not
+    // the other one-component array.
+    auto image = FloatPhantom(40);
+    vtkNew<vtkFloatArray> other;
+    other->SetName("Other");
+    other->SetNumberOfTuples(image->GetNumberOfPoints());
+    other->FillValue(1.0f);
+    image->GetPointData()->AddArray(other);
+    return ExpectDefaultArray(image, 400, "HU");
+  }
+  if (which == "DefaultArrayOnly")
+  {
+    // No active scalars; one one-component array among others: that one.
+    auto phantom = FloatPhantom(40);
+    auto image = vtkSmartPointer<vtkImageData>::New();
+    image->CopyStructure(phantom);
+    vtkNew<vtkFloatArray> velocity;
+    velocity->SetName("Velocity");
+    velocity->SetNumberOfComponents(3);
+    velocity->SetNumberOfTuples(image->GetNumberOfPoints());
+    velocity->FillValue(0.0f);
+    image->GetPointData()->AddArray(velocity);
+    vtkDataArray* hu = phantom->GetPointData()->GetScalars();
+    hu->SetName("Density");
+    image->GetPointData()->AddArray(hu);
+    return ExpectDefaultArray(image, 400, "Density");
+  }
+  if (which == "OnlyArrayThreeComponents")
+  {
+    vtkNew<vtkFloatArray> s;
+    s->SetName("Velocity");
+    s->SetNumberOfComponents(3);
+    auto image = Image(20, 20, 20, nullptr);
+    s->SetNumberOfTuples(image->GetNumberOfPoints());
+    s->FillValue(1.0f);
+    image->GetPointData()->AddArray(s);
+    return Expect(image, 10, "error", "the input's only point array, 'Velocity', has 3 components", false, -1, "");
+  }
+  if (which == "SeveralArraysNoneActive")
+  {
+    auto image = Image(20, 20, 20, nullptr);
+    for (const char* name : { "T1", "T2" })
+    {
+      vtkNew<vtkFloatArray> s;
+      s->SetName(name);
+      s->SetNumberOfTuples(image->GetNumberOfPoints());
+      s->FillValue(1.0f);
+      image->GetPointData()->AddArray(s);
+    }
+    return Expect(image, 10, "error", "several one-component point arrays and no active scalars "
+                                      "(its point arrays: 'T1' (1 component), 'T2' (1 component))",
+      false, -1, "");
+  }
+  if (which == "MissingArray")
+  {
+    auto image = FloatPhantom(20);
+    return Expect(image, 10, "error",
+      "names the point array 'Density', which the input does not have (its point array: 'HU' "
+      "(1 component))",
+      false, -1, "Density");
+  }
+  if (which == "CellArray")
+  {
+    auto image = FloatPhantom(20);
+    vtkNew<vtkFloatArray> cells;
+    cells->SetName("Label");
+    cells->SetNumberOfTuples(image->GetNumberOfCells());
+    cells->FillValue(1.0f);
+    image->GetCellData()->AddArray(cells);
+    return Expect(image, 10, "error", "'Label' is a cell array", false, -1, "Label");
+  }
+  if (which == "ZeroSpacing" || which == "NonFiniteSpacing")
+  {
+    auto image = FloatPhantom(20);
+    image->SetSpacing(1.0, which == "ZeroSpacing" ? 0.0 : std::nan(""), 1.0);
+    return Expect(image, 400, "error", "zero or non-finite component");
   }
   if (which == "IsovalueOutsideRange")
   {

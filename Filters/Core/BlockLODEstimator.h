@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file BlockLODEstimator.h
+ * @brief The memory and time estimator of the block LOD method (no VTK): the
+ * paper's answer to a client's memory limit, and the level choice it drives.
+ *
+ * - SurfaceLayout turns point and triangle counts into the bytes a host's
+ *   output holds (float points, optional float normals and scalars, 32-bit
+ *   connectivity while ids fit, else 64-bit, optional offsets as in a
+ *   vtkCellArray, optional 32-bit block ids per triangle).
+ * - CostModel predicts the seconds of an extraction as A * cubes visited +
+ *   B * triangles, A and B fitted by least squares to the extractions the host
+ *   records (defaults until two are recorded; one record rescales them).
+ * - BlockLODEstimator predicts an (isovalue, level) pair's counts before it is
+ *   extracted, in this order:
+ *   -# exact, for a pair whose plan was recorded (RecordExact);
+ *   -# scaled from two exact levels of the same isovalue by that isovalue's
+ *      own growth per level (smooth surfaces grow about 4x per level, thin
+ *      structures nearer 2x at coarse levels and 8x where they first appear,
+ *      so no global factor is used), when counting would be approximate;
+ *   -# counted on a spread sample of about SampleBlocks active blocks and
+ *      scaled to all of them (exact when there are no more; the paper used a
+ *      fixed 2 triangles per cube instead).
+ *   Sampled counts are kept until Reset() (the input changed).
+ * - ChooseLevel() picks the highest level whose estimated output, all
+ *   isovalues together, fits a byte budget (AutoLOD). A host plans the chosen
+ *   level before allocating and drops a level when the exact bytes do not fit,
+ *   so a low estimate never exceeds the budget.
+ */
+#ifndef MedicalIsosurfaces_BlockLODEstimator_h
+#define MedicalIsosurfaces_BlockLODEstimator_h
+
+#include "BlockLODVolume.h"
+
+#include <cstdint>
+#include <map>
+#include <vector>
+
+namespace mediso
+{
+
+/// Bytes of an output surface in the host's layout.
+struct SurfaceLayout
+{
+  bool Normals = true;   ///< 3 floats per point.
+  bool Scalars = false;  ///< 1 float per point.
+  bool BlockIds = false; ///< 1 int32 per triangle.
+  bool Offsets = true;   ///< 1 id per triangle and 1 more (vtkCellArray); off for an index buffer.
+
+  /// True when point ids or connectivity entries do not fit 32-bit ids.
+  static bool NeedsWideIds(double points, double triangles);
+  double Bytes(double points, double triangles) const;
+  double Bytes(const SurfaceCounts& c) const { return this->Bytes(c.Points, c.Triangles); }
+  bool operator==(const SurfaceLayout& o) const
+  {
+    return this->Normals == o.Normals && this->Scalars == o.Scalars &&
+      this->BlockIds == o.BlockIds && this->Offsets == o.Offsets;
+  }
+  bool operator!=(const SurfaceLayout& o) const { return !(*this == o); }
+};
+
+/// Seconds of an extraction from the cubes it visits and the triangles it makes.
+class CostModel
+{
+public:
+  /// Rates until the host's own extractions are recorded (a 2-core machine).
+  static constexpr double DefaultSecondsPerCube = 4.0e-9;
+  static constexpr double DefaultSecondsPerTriangle = 6.0e-8;
+
+  void Record(double cubes, double triangles, double seconds);
+  double Predict(double cubes, double triangles) const;
+  double Predict(const SurfaceCounts& c) const { return this->Predict(c.Cubes, c.Triangles); }
+  int GetNumberOfSamples() const { return this->Samples; }
+  void Reset() { *this = CostModel(); }
+
+private:
+  // Sums of the normal equations of the least-squares fit.
+  double Sxx = 0, Sxy = 0, Syy = 0, Sxt = 0, Syt = 0;
+  int Samples = 0;
+};
+
+/// How an estimate was made (values as vtkBlockLODContour::GetLastEstimateMethod()).
+enum class EstimateMethod
+{
+  None = -1,
+  Exact = 0,
+  Scaled = 1,
+  Sampled = 2
+};
+
+struct SurfaceEstimate
+{
+  SurfaceCounts Counts;
+  EstimateMethod Method = EstimateMethod::None;
+};
+
+class BlockLODEstimator
+{
+public:
+  /// Active blocks counted for a sampled estimate.
+  static constexpr std::int64_t SampleBlocks = 256;
+
+  explicit BlockLODEstimator(BlockLODVolume& volume);
+
+  /// Forgets every count (the volume changed). The cost model is kept: it
+  /// describes the machine, not the input.
+  void Reset();
+
+  /// Counts of an (isovalue, level) pair (see the file's description).
+  SurfaceEstimate Estimate(double isovalue, int level);
+  /// Records a pair's exact counts (from BlockLODVolume::CountsOf(plan)).
+  void RecordExact(double isovalue, int level, const SurfaceCounts& counts);
+  bool HasExact(double isovalue, int level) const;
+
+  /// Predicted seconds to extract a pair (plan and generate).
+  double EstimateSeconds(double isovalue, int level);
+
+  /// The highest level whose estimated bytes for all `isovalues` together fit
+  /// `budgetBytes`, or -1 when not even level 0 fits; `level0Bytes` receives
+  /// the estimate at level 0 when none fits.
+  int ChooseLevel(const std::vector<double>& isovalues, double budgetBytes,
+    const SurfaceLayout& layout, double& level0Bytes);
+
+  CostModel& GetCostModel() { return this->Cost; }
+  const CostModel& GetCostModel() const { return this->Cost; }
+
+private:
+  BlockLODVolume& Volume;
+  std::map<SurfaceKey, SurfaceCounts> Exact;
+  std::map<SurfaceKey, SurfaceCounts> Sampled;
+  CostModel Cost;
+};
+
+} // namespace mediso
+
+#endif

@@ -1,0 +1,267 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "BlockLODVolume.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mediso
+{
+
+bool VolumeDescription::IsPiece() const
+{
+  return this->GlobalDims[0] > 0;
+}
+
+bool VolumeDescription::operator==(const VolumeDescription& o) const
+{
+  return this->Type == o.Type && this->Data == o.Data && this->Stamp == o.Stamp &&
+    std::equal(this->Dims, this->Dims + 3, o.Dims) &&
+    std::equal(this->Origin, this->Origin + 3, o.Origin) &&
+    std::equal(this->Spacing, this->Spacing + 3, o.Spacing) &&
+    std::equal(this->OwnedCells, this->OwnedCells + 6, o.OwnedCells) &&
+    std::equal(this->GlobalOffset, this->GlobalOffset + 3, o.GlobalOffset) &&
+    std::equal(this->GlobalDims, this->GlobalDims + 3, o.GlobalDims);
+}
+
+// The typed half: the volume as Volume<T>, and the coarse copies of levels 0-2.
+struct BlockLODVolume::Typed
+{
+  virtual ~Typed() = default;
+  virtual void ComputeRanges(BlockRanges& ranges) = 0;
+  virtual bool Plan(double isovalue, int level, ExtractionPlan& plan,
+    const std::function<bool()>& abort) = 0;
+  virtual void Generate(const ExtractionPlan& plan, const SurfaceBuffers<std::int32_t>& out) = 0;
+  virtual void Generate(const ExtractionPlan& plan, const SurfaceBuffers<std::int64_t>& out) = 0;
+  virtual SurfaceCounts CountSampled(double isovalue, int level,
+    const std::vector<std::int32_t>& fullActive, std::int64_t sampleBlocks, bool& exact) = 0;
+};
+
+namespace
+{
+// Every `step`-th active block is counted; step 1 counts them all (exact).
+int SampleStep(std::int64_t activeBlocks, std::int64_t sampleBlocks)
+{
+  return static_cast<int>(std::max<std::int64_t>(1, activeBlocks / std::max<std::int64_t>(1, sampleBlocks)));
+}
+
+double CubesPerBlock(int stride)
+{
+  const double perAxis = BlockCells / stride;
+  return perAxis * perAxis * perAxis;
+}
+} // namespace
+
+template <typename T>
+struct BlockLODVolume::TypedImpl : BlockLODVolume::Typed
+{
+  struct Coarse
+  {
+    bool Built = false;
+    std::vector<T> Values;
+    Volume<T> Samples;
+    BlockRanges Ranges;
+  };
+
+  TriangleCaseTable Cases;
+  const ParallelFor& Parallel;
+  const BlockRanges& FullRanges;
+  Volume<T> Full;
+  Coarse Levels[NumberOfLevels - 1];
+
+  TypedImpl(const VolumeDescription& d, TriangleCaseTable cases, const ParallelFor& parallel,
+    const BlockRanges& fullRanges)
+    : Cases(cases)
+    , Parallel(parallel)
+    , FullRanges(fullRanges)
+  {
+    this->Full.Data = static_cast<const T*>(d.Data);
+    for (int a = 0; a < 3; ++a)
+    {
+      this->Full.Dims[a] = d.Dims[a];
+      this->Full.Origin[a] = d.Origin[a];
+      this->Full.Spacing[a] = d.Spacing[a];
+      this->Full.OwnedCells[2 * a] = d.OwnedCells[2 * a];
+      this->Full.OwnedCells[2 * a + 1] = d.OwnedCells[2 * a + 1];
+      this->Full.GlobalOffset[a] = d.IsPiece() ? d.GlobalOffset[a] : 0;
+      this->Full.GlobalDims[a] = d.IsPiece() ? d.GlobalDims[a] : 0;
+    }
+  }
+
+  void ComputeRanges(BlockRanges& ranges) override
+  {
+    ComputeBlockRanges(this->Full, ranges, this->Parallel);
+  }
+
+  // Runs f(volume, ranges) on the volume a level is extracted from at stride
+  // 1: the full volume at level 3, the level's coarse copy below (built on
+  // first use).
+  template <typename F>
+  void WithLevel(int level, F&& f)
+  {
+    if (level == NumberOfLevels - 1)
+    {
+      f(this->Full, this->FullRanges);
+      return;
+    }
+    Coarse& c = this->Levels[level];
+    if (!c.Built)
+    {
+      c.Samples = MakeCoarseCopy(this->Full, level, c.Values, this->Parallel);
+      ComputeBlockRanges(c.Samples, c.Ranges, this->Parallel);
+      c.Built = true;
+    }
+    f(c.Samples, c.Ranges);
+  }
+
+  bool Plan(double isovalue, int level, ExtractionPlan& plan,
+    const std::function<bool()>& abort) override
+  {
+    bool complete = true;
+    this->WithLevel(level, [&](const Volume<T>& volume, const BlockRanges& ranges) {
+      complete = PlanExtraction(
+        volume, ranges, this->Cases, isovalue, NumberOfLevels - 1, plan, this->Parallel, abort);
+    });
+    plan.VolumeLevel = level;
+    return complete;
+  }
+
+  template <typename IdType>
+  void GenerateAny(const ExtractionPlan& plan, const SurfaceBuffers<IdType>& out)
+  {
+    this->WithLevel(plan.VolumeLevel, [&](const Volume<T>& volume, const BlockRanges& ranges) {
+      GenerateSurface(volume, ranges, this->Cases, plan, out, this->Parallel);
+    });
+  }
+  void Generate(const ExtractionPlan& plan, const SurfaceBuffers<std::int32_t>& out) override
+  {
+    this->GenerateAny(plan, out);
+  }
+  void Generate(const ExtractionPlan& plan, const SurfaceBuffers<std::int64_t>& out) override
+  {
+    this->GenerateAny(plan, out);
+  }
+
+  SurfaceCounts CountSampled(double isovalue, int level,
+    const std::vector<std::int32_t>& fullActive, std::int64_t sampleBlocks, bool& exact) override
+  {
+    SurfaceCounts c;
+    int step = 1;
+    if (level < NumberOfLevels - 1 && this->Levels[level].Built)
+    {
+      // The level's coarse copy exists: count on it (contiguous, cheap).
+      const Coarse& coarse = this->Levels[level];
+      const std::vector<std::int32_t> active = ListActiveBlocks(coarse.Ranges, isovalue);
+      step = SampleStep(static_cast<std::int64_t>(active.size()), sampleBlocks);
+      const SampledCounts s = mediso::CountSampled(coarse.Samples, coarse.Ranges, this->Cases,
+        active, isovalue, NumberOfLevels - 1, step, this->Parallel);
+      c.Points = s.Points;
+      c.Triangles = s.Triangles;
+      c.Cubes = static_cast<double>(s.ActiveBlocks) * CubesPerBlock(1);
+    }
+    else
+    {
+      step = SampleStep(static_cast<std::int64_t>(fullActive.size()), sampleBlocks);
+      const SampledCounts s = mediso::CountSampled(this->Full, this->FullRanges, this->Cases,
+        fullActive, isovalue, level, step, this->Parallel);
+      c.Points = s.Points;
+      c.Triangles = s.Triangles;
+      c.Cubes = static_cast<double>(s.ActiveBlocks) * CubesPerBlock(LevelStride(level));
+    }
+    exact = step == 1;
+    return c;
+  }
+};
+
+BlockLODVolume::BlockLODVolume(TriangleCaseTable cases, ParallelFor parallel)
+  : Cases(cases)
+  , Parallel(parallel ? std::move(parallel) : ParallelFor(SerialFor))
+{
+}
+
+BlockLODVolume::~BlockLODVolume() = default;
+
+void BlockLODVolume::Reset()
+{
+  this->Valid = false;
+  this->Impl.reset();
+  this->ActiveLists.clear();
+  this->Ranges = BlockRanges();
+  this->Description = VolumeDescription();
+}
+
+bool BlockLODVolume::IsValid() const
+{
+  return this->Valid;
+}
+
+bool BlockLODVolume::SetVolume(const VolumeDescription& description)
+{
+  if (this->Valid && description == this->Description)
+  {
+    return false;
+  }
+  this->Reset();
+  this->Description = description;
+  VisitScalarType(description.Type, [this, &description](auto tag) {
+    this->Impl = std::make_unique<TypedImpl<decltype(tag)>>(
+      description, this->Cases, this->Parallel, this->Ranges);
+  });
+  if (!this->Impl)
+  {
+    return false; // not a ScalarType value: nothing to contour
+  }
+  this->Impl->ComputeRanges(this->Ranges);
+  this->Valid = true;
+  return true;
+}
+
+bool BlockLODVolume::Plan(
+  double isovalue, int level, ExtractionPlan& plan, const std::function<bool()>& abort)
+{
+  return this->Impl->Plan(isovalue, level, plan, abort);
+}
+
+void BlockLODVolume::Generate(const ExtractionPlan& plan, const SurfaceBuffers<std::int32_t>& out)
+{
+  this->Impl->Generate(plan, out);
+}
+
+void BlockLODVolume::Generate(const ExtractionPlan& plan, const SurfaceBuffers<std::int64_t>& out)
+{
+  this->Impl->Generate(plan, out);
+}
+
+SurfaceCounts BlockLODVolume::CountsOf(const ExtractionPlan& plan)
+{
+  SurfaceCounts c;
+  c.Points = static_cast<double>(plan.GetNumberOfPoints());
+  c.Triangles = static_cast<double>(plan.GetNumberOfTriangles());
+  c.Cubes = static_cast<double>(plan.ActiveBlocks.size()) * plan.CubesPerBlock;
+  return c;
+}
+
+SurfaceCounts BlockLODVolume::CountSampled(
+  double isovalue, int level, std::int64_t sampleBlocks, bool& exact)
+{
+  const std::vector<std::int32_t>& active = this->ActiveBlocks(isovalue);
+  return this->Impl->CountSampled(isovalue, level, active, sampleBlocks, exact);
+}
+
+const std::vector<std::int32_t>& BlockLODVolume::ActiveBlocks(double isovalue)
+{
+  for (auto& entry : this->ActiveLists)
+  {
+    if (entry.first == isovalue)
+    {
+      return entry.second;
+    }
+  }
+  if (this->ActiveLists.size() >= 4)
+  {
+    this->ActiveLists.erase(this->ActiveLists.begin());
+  }
+  this->ActiveLists.emplace_back(isovalue, ListActiveBlocks(this->Ranges, isovalue));
+  return this->ActiveLists.back().second;
+}
+
+} // namespace mediso

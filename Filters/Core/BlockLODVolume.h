@@ -1,0 +1,133 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file BlockLODVolume.h
+ * @brief One input volume of the block LOD method, whatever its scalar type,
+ * with everything kept between isovalues (no VTK).
+ *
+ * A host (the VTK filter vtkBlockLODContour, or a WebAssembly page) describes
+ * its volume with a VolumeDescription: a pointer to contiguous values of one
+ * of the ScalarType types, x fastest, and the volume's place in space and, for
+ * a parallel piece, in the whole volume. BlockLODVolume then holds, until the
+ * description changes:
+ *
+ * - the block ranges of the full volume (BlockLOD.h), computed by SetVolume();
+ * - per coarse level 0-2, a contiguous copy of the level's samples and its own
+ *   block ranges (MakeCoarseCopy), made the first time the level is planned;
+ * - the active-block lists of the last few isovalues (estimates of every level
+ *   use the same list).
+ *
+ * Plan() and Generate() run the two passes of BlockLOD.h for an (isovalue,
+ * level): at level 3 on the full volume, below it at stride 1 on the level's
+ * coarse copy, which gives exactly the level's surface. CountSampled() counts
+ * a level on a spread sample of active blocks for the estimator
+ * (BlockLODEstimator.h) without building a coarse copy.
+ *
+ * The marching-cubes case table is data the host passes (BlockLOD.h,
+ * TriangleCaseTable), and every pass runs through the host's ParallelFor.
+ */
+#ifndef MedicalIsosurfaces_BlockLODVolume_h
+#define MedicalIsosurfaces_BlockLODVolume_h
+
+#include "BlockLOD.h"
+#include "ScalarTypes.h"
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace mediso
+{
+
+/// What a host tells BlockLODVolume about its volume.
+struct VolumeDescription
+{
+  ScalarType Type = ScalarType::Float32;
+  const void* Data = nullptr; ///< Dims[0] * Dims[1] * Dims[2] values, x fastest.
+  int Dims[3] = { 0, 0, 0 };
+  double Origin[3] = { 0, 0, 0 }; ///< World position of the first point.
+  double Spacing[3] = { 1, 1, 1 };
+  /// Cells that make triangles (see Volume::OwnedCells); every cell by default.
+  int OwnedCells[6] = { 0, 1 << 30, 0, 1 << 30, 0, 1 << 30 };
+  /// For a parallel piece: its first point's index in the whole volume, and
+  /// the whole volume's points (GlobalDims 0: the volume is the whole).
+  int GlobalOffset[3] = { 0, 0, 0 };
+  int GlobalDims[3] = { 0, 0, 0 };
+  /// The host's stamp of the values: a change (with the same pointer) means
+  /// the values changed.
+  std::uint64_t Stamp = 0;
+
+  bool IsPiece() const;
+  bool operator==(const VolumeDescription& other) const;
+  bool operator!=(const VolumeDescription& other) const { return !(*this == other); }
+};
+
+/// Exact or estimated size of one (isovalue, level) surface, and the cubes
+/// visited to extract it (the cost model's first variable).
+struct SurfaceCounts
+{
+  double Points = 0;
+  double Triangles = 0;
+  double Cubes = 0;
+};
+
+class BlockLODVolume
+{
+public:
+  BlockLODVolume(TriangleCaseTable cases, ParallelFor parallel);
+  ~BlockLODVolume();
+  BlockLODVolume(const BlockLODVolume&) = delete;
+  BlockLODVolume& operator=(const BlockLODVolume&) = delete;
+
+  /// Adopts a volume. When it differs from the current one (any field of the
+  /// description), forgets everything and computes the block ranges; returns
+  /// true then, false when the volume is the same (or its Type is no
+  /// ScalarType value: IsValid() is then false).
+  bool SetVolume(const VolumeDescription& description);
+  /// Forgets the volume (IsValid() turns false).
+  void Reset();
+  bool IsValid() const;
+  const VolumeDescription& GetDescription() const { return this->Description; }
+  /// Block ranges of the full volume (value range, NaN count, per-block min/max).
+  const BlockRanges& GetRanges() const { return this->Ranges; }
+
+  /// Pass 1 for an (isovalue, level) on the level's volume (builds the
+  /// level's coarse copy on first use). `abort` is polled between blocks;
+  /// returns false when it stopped the pass.
+  bool Plan(double isovalue, int level, ExtractionPlan& plan,
+    const std::function<bool()>& abort = {});
+  /// Pass 2: writes the surface of a plan made by Plan() on this volume.
+  void Generate(const ExtractionPlan& plan, const SurfaceBuffers<std::int32_t>& out);
+  void Generate(const ExtractionPlan& plan, const SurfaceBuffers<std::int64_t>& out);
+
+  /// Exact counts of a plan made by Plan().
+  static SurfaceCounts CountsOf(const ExtractionPlan& plan);
+
+  /// Counts of an (isovalue, level) on about `sampleBlocks` active blocks
+  /// spread over the volume, scaled to all of them (exact, and `exact` set,
+  /// when there are no more than that). Reads the level's coarse copy when it
+  /// exists, else the level's samples in the full volume (no copy is made).
+  SurfaceCounts CountSampled(double isovalue, int level, std::int64_t sampleBlocks, bool& exact);
+
+  /// Active blocks of the full volume for an isovalue (kept for the last few
+  /// isovalues).
+  const std::vector<std::int32_t>& ActiveBlocks(double isovalue);
+
+private:
+  struct Typed;
+  template <typename T>
+  struct TypedImpl;
+
+  TriangleCaseTable Cases;
+  ParallelFor Parallel;
+  VolumeDescription Description;
+  bool Valid = false;
+  BlockRanges Ranges;
+  std::unique_ptr<Typed> Impl;
+  std::vector<std::pair<double, std::vector<std::int32_t>>> ActiveLists;
+};
+
+} // namespace mediso
+
+#endif

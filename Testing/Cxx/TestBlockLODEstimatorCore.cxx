@@ -1,0 +1,351 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Unit test of the VTK-free block LOD volume and estimator
+// (Filters/Core/BlockLODVolume.h, BlockLODEstimator.h), without VTK. The
+// marching-cubes table is this test's own (the core takes the table as data):
+// each case fans triangles over its cut edges, min(5, cut edges - 2) of them,
+// so that exact counts can be recomputed here by brute force.
+// - Plan's exact points and triangles equal a brute-force count over every
+//   cube of each level's sample grid (with NaN voxels and a size that is no
+//   multiple of 8);
+// - estimates per level: exact (every active block counted) on a small volume;
+//   sampled on a large one, within 10% of the exact count; scaled from two
+//   exact levels by the isovalue's own growth; recorded exact counts returned;
+// - the cost model reproduces a linear law from its samples, rescales its
+//   defaults from one sample and stays non-negative on collinear samples;
+// - the byte layout and the AutoLOD level choice;
+// - SetVolume recomputes only for a changed description.
+#include "MedicalTestUtilities.h"
+#include "BlockLODEstimator.h"
+#include "BlockLODVolume.h"
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace
+{
+using medical_test::Check;
+
+// Corners and edges in vtkMarchingCubes' numbering (the layout the core expects).
+constexpr int Corner[8][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { 0, 0, 1 },
+  { 1, 0, 1 }, { 1, 1, 1 }, { 0, 1, 1 } };
+constexpr int Edge[12][2] = { { 0, 1 }, { 1, 2 }, { 3, 2 }, { 0, 3 }, { 4, 5 }, { 5, 6 }, { 7, 6 },
+  { 4, 7 }, { 0, 4 }, { 1, 5 }, { 3, 7 }, { 2, 6 } };
+
+struct FanTable
+{
+  int Cases[256][16];
+  int Count[256];
+  FanTable()
+  {
+    for (int c = 0; c < 256; ++c)
+    {
+      int cut[12], n = 0;
+      for (int e = 0; e < 12; ++e)
+      {
+        if (((c >> Edge[e][0]) & 1) != ((c >> Edge[e][1]) & 1))
+        {
+          cut[n++] = e;
+        }
+      }
+      this->Count[c] = n >= 3 ? std::min(5, n - 2) : 0;
+      int* out = this->Cases[c];
+      for (int i = 0; i < 16; ++i)
+      {
+        out[i] = -1;
+      }
+      for (int t = 0; t < this->Count[c]; ++t)
+      {
+        out[3 * t] = cut[0];
+        out[3 * t + 1] = cut[t + 1];
+        out[3 * t + 2] = cut[t + 2];
+      }
+    }
+  }
+};
+const FanTable Table;
+
+struct Field
+{
+  int Dims[3];
+  std::vector<float> Values;
+  float At(int i, int j, int k) const
+  {
+    return this->Values[(static_cast<std::size_t>(k) * this->Dims[1] + j) * this->Dims[0] + i];
+  }
+};
+
+// A sphere's distance field with deterministic noise, and a few NaN voxels.
+Field MakeField(int nx, int ny, int nz, double radius, double noise, bool nans)
+{
+  Field f{ { nx, ny, nz }, {} };
+  f.Values.resize(static_cast<std::size_t>(nx) * ny * nz);
+  std::uint32_t state = 2463534242u;
+  std::size_t id = 0;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i, ++id)
+      {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        const double u = (state & 0xFFFFFF) / double(0xFFFFFF) - 0.5;
+        const double x = i - 0.5 * nx + 0.3, y = j - 0.5 * ny + 0.1, z = k - 0.5 * nz + 0.2;
+        f.Values[id] = static_cast<float>(std::sqrt(x * x + y * y + z * z) - radius + noise * u);
+        if (nans && id % 997 == 5)
+        {
+          f.Values[id] = std::nanf("");
+        }
+      }
+  return f;
+}
+
+// Points and triangles of a level by brute force over its sample grid.
+void BruteForce(const Field& f, double iso, int level, double& points, double& triangles)
+{
+  const int stride = mediso::LevelStride(level);
+  std::vector<int> samples[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    for (int p = 0; p < f.Dims[a] - 1; p += stride)
+    {
+      samples[a].push_back(p);
+    }
+    samples[a].push_back(f.Dims[a] - 1);
+  }
+  const int n[3] = { static_cast<int>(samples[0].size()), static_cast<int>(samples[1].size()),
+    static_cast<int>(samples[2].size()) };
+  auto value = [&](int i, int j, int k) { return f.At(samples[0][i], samples[1][j], samples[2][k]); };
+  points = triangles = 0;
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i)
+      {
+        const float v = value(i, j, k);
+        const int l[3] = { i, j, k };
+        for (int a = 0; a < 3; ++a)
+        {
+          if (l[a] + 1 < n[a])
+          {
+            const float w = value(i + (a == 0), j + (a == 1), k + (a == 2));
+            if (!std::isnan(v) && !std::isnan(w) && (v >= iso) != (w >= iso))
+            {
+              ++points;
+            }
+          }
+        }
+        if (i + 1 < n[0] && j + 1 < n[1] && k + 1 < n[2])
+        {
+          int index = 0;
+          bool nan = false;
+          for (int c = 0; c < 8; ++c)
+          {
+            const float w = value(i + Corner[c][0], j + Corner[c][1], k + Corner[c][2]);
+            nan |= std::isnan(w);
+            index |= (w >= iso ? 1 : 0) << c;
+          }
+          triangles += nan ? 0 : Table.Count[index];
+        }
+      }
+}
+
+mediso::VolumeDescription Describe(const Field& f)
+{
+  mediso::VolumeDescription d;
+  d.Type = mediso::ScalarType::Float32;
+  d.Data = f.Values.data();
+  for (int a = 0; a < 3; ++a)
+  {
+    d.Dims[a] = f.Dims[a];
+  }
+  return d;
+}
+
+void TestPlanCounts()
+{
+  const Field f = MakeField(61, 53, 47, 17.0, 1.5, /*nans=*/true);
+  mediso::BlockLODVolume volume(Table.Cases, mediso::SerialFor);
+  Check(volume.SetVolume(Describe(f)), "a new volume computes block ranges");
+  Check(volume.GetRanges().NaNCount > 0, "NaN voxels are counted");
+  for (double iso : { -3.0, 0.0, 4.5 })
+  {
+    for (int level = 0; level < mediso::NumberOfLevels; ++level)
+    {
+      double points, triangles;
+      BruteForce(f, iso, level, points, triangles);
+      mediso::ExtractionPlan plan;
+      Check(volume.Plan(iso, level, plan), "a plan without abort completes");
+      const mediso::SurfaceCounts c = mediso::BlockLODVolume::CountsOf(plan);
+      std::printf("plan iso %g level %d: %g points, %g triangles (brute force %g, %g)\n", iso,
+        level, c.Points, c.Triangles, points, triangles);
+      Check(c.Points == points && c.Triangles == triangles,
+        "plan counts equal brute force at iso " + std::to_string(iso) + " level " +
+          std::to_string(level));
+    }
+  }
+  // Aborting stops the plan.
+  mediso::ExtractionPlan plan;
+  Check(!volume.Plan(0.0, 3, plan, [] { return true; }), "an abort stops the plan");
+}
+
+void TestEstimates()
+{
+  // Small volume: few active blocks, every one counted: the estimate is exact.
+  {
+    const Field f = MakeField(40, 37, 35, 11.0, 0.5, false);
+    mediso::BlockLODVolume volume(Table.Cases, mediso::SerialFor);
+    volume.SetVolume(Describe(f));
+    mediso::BlockLODEstimator estimator(volume);
+    for (int level = 0; level < mediso::NumberOfLevels; ++level)
+    {
+      double points, triangles;
+      BruteForce(f, 0.0, level, points, triangles);
+      const mediso::SurfaceEstimate e = estimator.Estimate(0.0, level);
+      Check(e.Counts.Triangles == triangles && e.Counts.Points == points,
+        "small volume: the estimate counts every active block, level " + std::to_string(level));
+      Check(estimator.HasExact(0.0, level), "a complete count is remembered as exact");
+      Check(estimator.Estimate(0.0, level).Method == mediso::EstimateMethod::Exact,
+        "asked again, the pair is exact");
+      const double active = static_cast<double>(volume.ActiveBlocks(0.0).size());
+      const double perAxis = 8.0 / mediso::LevelStride(level);
+      Check(e.Counts.Cubes == active * perAxis * perAxis * perAxis,
+        "cubes visited = active blocks x cubes per block");
+    }
+  }
+
+  // Large noisy volume: more than 2 x 256 active blocks, so counts are sampled.
+  const Field f = MakeField(161, 150, 140, 62.0, 3.0, false);
+  mediso::BlockLODVolume volume(Table.Cases, mediso::SerialFor);
+  volume.SetVolume(Describe(f));
+  mediso::BlockLODEstimator estimator(volume);
+  const double iso = 0.25;
+  const std::int64_t active = static_cast<std::int64_t>(volume.ActiveBlocks(iso).size());
+  std::printf("large volume: %lld active blocks of %lld\n", static_cast<long long>(active),
+    static_cast<long long>(volume.GetRanges().GetNumberOfBlocks()));
+  Check(active > 2 * mediso::BlockLODEstimator::SampleBlocks, "enough active blocks to sample");
+  double exact[4];
+  for (int level = 0; level < mediso::NumberOfLevels; ++level)
+  {
+    double points;
+    BruteForce(f, iso, level, points, exact[level]);
+    const mediso::SurfaceEstimate e = estimator.Estimate(iso, level);
+    const double error = (e.Counts.Triangles - exact[level]) / exact[level];
+    std::printf("sampled estimate level %d: %.0f triangles, exact %.0f (%+.2f%%)\n", level,
+      e.Counts.Triangles, exact[level], 100 * error);
+    Check(e.Method == mediso::EstimateMethod::Sampled, "a large count is sampled");
+    Check(std::fabs(error) < 0.10, "sampled estimate within 10% at level " + std::to_string(level));
+    Check(estimator.Estimate(iso, level).Counts.Triangles == e.Counts.Triangles,
+      "a sampled estimate is kept, not recounted");
+  }
+
+  // A second isovalue with two exact levels: the others are scaled by its growth.
+  const double iso2 = -0.75;
+  mediso::SurfaceCounts c1, c3;
+  mediso::ExtractionPlan plan;
+  volume.Plan(iso2, 1, plan);
+  c1 = mediso::BlockLODVolume::CountsOf(plan);
+  volume.Plan(iso2, 3, plan);
+  c3 = mediso::BlockLODVolume::CountsOf(plan);
+  estimator.RecordExact(iso2, 1, c1);
+  estimator.RecordExact(iso2, 3, c3);
+  const mediso::SurfaceEstimate e3 = estimator.Estimate(iso2, 3);
+  Check(e3.Method == mediso::EstimateMethod::Exact && e3.Counts.Triangles == c3.Triangles,
+    "a recorded pair is exact");
+  const mediso::SurfaceEstimate e2 = estimator.Estimate(iso2, 2);
+  const double growth = std::sqrt(c3.Triangles / c1.Triangles);
+  Check(e2.Method == mediso::EstimateMethod::Scaled, "two exact levels: the others are scaled");
+  Check(std::fabs(e2.Counts.Triangles - c3.Triangles / growth) < 1e-6 * c3.Triangles,
+    "level 2 scaled from level 3 by the isovalue's own growth per level");
+  Check(std::fabs(e2.Counts.Cubes - c3.Cubes / 8) < 1e-6 * c3.Cubes,
+    "cubes scale by 8 per level, from the finer of two equally near levels");
+  const mediso::SurfaceEstimate e0 = estimator.Estimate(iso2, 0);
+  Check(std::fabs(e0.Counts.Triangles - c1.Triangles / growth) < 1e-6 * c1.Triangles,
+    "level 0 scaled from level 1, its nearest known level");
+
+  // Reset forgets every count.
+  estimator.Reset();
+  Check(!estimator.HasExact(iso2, 3), "Reset forgets exact counts");
+}
+
+void TestCostModel()
+{
+  mediso::CostModel model;
+  Check(model.Predict(1e6, 1e5) ==
+      1e6 * mediso::CostModel::DefaultSecondsPerCube + 1e5 * mediso::CostModel::DefaultSecondsPerTriangle,
+    "defaults before any record");
+  model.Record(2e6, 1e5, 2e6 * 1e-9 + 1e5 * 2e-8);
+  Check(std::fabs(model.Predict(2e6, 1e5) - (2e6 * 1e-9 + 1e5 * 2e-8)) < 1e-12,
+    "one record: the prediction at that record is its time");
+  const double a = 3e-9, b = 7e-8;
+  mediso::CostModel fit;
+  const double samples[][2] = { { 1e6, 2e4 }, { 4e6, 1e5 }, { 2.5e5, 9e4 }, { 8e6, 3e5 } };
+  for (const auto& s : samples)
+  {
+    fit.Record(s[0], s[1], a * s[0] + b * s[1]);
+  }
+  const double predicted = fit.Predict(3e6, 2e5);
+  Check(std::fabs(predicted - (a * 3e6 + b * 2e5)) < 1e-9 * predicted,
+    "a linear law is recovered from its samples");
+  mediso::CostModel collinear;
+  collinear.Record(1e6, 1e5, 0.01);
+  collinear.Record(2e6, 2e5, 0.03);
+  Check(collinear.Predict(1e6, 1e5) >= 0, "collinear samples never predict a negative time");
+}
+
+void TestLayoutAndLevel()
+{
+  mediso::SurfaceLayout layout; // normals, offsets
+  Check(layout.Bytes(10, 20) == 10 * 24 + 20 * 16 + 4, "points, normals, 32-bit ids and offsets");
+  layout.Scalars = layout.BlockIds = true;
+  Check(layout.Bytes(10, 20) == 10 * 28 + 20 * 20 + 4, "scalars and block ids add 4 bytes each");
+  layout.Offsets = false;
+  layout.Normals = layout.Scalars = layout.BlockIds = false;
+  Check(layout.Bytes(10, 20) == 10 * 12 + 20 * 12, "an index buffer: 3 ids per triangle");
+  Check(!mediso::SurfaceLayout::NeedsWideIds(1e6, 7e8) &&
+      mediso::SurfaceLayout::NeedsWideIds(1e6, 7.2e8),
+    "64-bit ids once 3 x triangles passes INT32_MAX");
+  Check(mediso::SurfaceLayout().Bytes(1e6, 7.2e8) == 1e6 * 24 + 7.2e8 * 32 + 8,
+    "64-bit ids double the connectivity");
+
+  const Field f = MakeField(40, 37, 35, 11.0, 0.5, false);
+  mediso::BlockLODVolume volume(Table.Cases, mediso::SerialFor);
+  volume.SetVolume(Describe(f));
+  mediso::BlockLODEstimator estimator(volume);
+  const mediso::SurfaceLayout vtkLayout;
+  const std::vector<double> values = { -2.0, 3.0 };
+  double bytes[4];
+  for (int level = 0; level < 4; ++level)
+  {
+    bytes[level] = 0;
+    for (double v : values)
+    {
+      bytes[level] += vtkLayout.Bytes(estimator.Estimate(v, level).Counts);
+    }
+  }
+  double level0 = 0;
+  Check(estimator.ChooseLevel(values, bytes[3], vtkLayout, level0) == 3, "a budget of level 3 fits level 3");
+  Check(estimator.ChooseLevel(values, bytes[3] - 1, vtkLayout, level0) == 2, "one byte less: level 2");
+  Check(estimator.ChooseLevel(values, bytes[1], vtkLayout, level0) == 1, "budget of level 1: level 1");
+  Check(estimator.ChooseLevel(values, bytes[0] - 1, vtkLayout, level0) == -1 && level0 == bytes[0],
+    "nothing fits: -1 and level 0's bytes");
+
+  // SetVolume recomputes only for a changed description.
+  Check(!volume.SetVolume(Describe(f)), "the same volume keeps its block ranges");
+  mediso::VolumeDescription moved = Describe(f);
+  moved.Origin[1] = 2.5;
+  Check(volume.SetVolume(moved), "a moved volume recomputes");
+  moved.Stamp = 7;
+  Check(volume.SetVolume(moved), "a new stamp (values changed in place) recomputes");
+}
+} // namespace
+
+int main()
+{
+  TestPlanCounts();
+  TestEstimates();
+  TestCostModel();
+  TestLayoutAndLevel();
+  return medical_test::Finish("BlockLOD volume and estimator core: all checks passed");
+}
