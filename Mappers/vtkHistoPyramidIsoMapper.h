@@ -72,8 +72,8 @@
  * ReleaseGraphicsResources() frees every OpenGL object.
  *
  * Bad input (no scalars, cell scalars, several components, fewer than 2
- * points along an axis, an unsupported type, no isovalues) gives one error
- * or warning and nothing drawn, never a crash.
+ * points along an axis, a zero or non-finite spacing, an unsupported type,
+ * no isovalues) gives one error or warning and nothing drawn, never a crash.
  *
  * @sa vtkOpenGLHistoPyramid vtkMedicalGLCapabilities vtkBlockLODContour
  */
