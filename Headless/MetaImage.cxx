@@ -173,7 +173,13 @@ bool ReadMetaImage(const std::string& path, MetaImage& image, std::string& error
       {
         continue;
       }
-      error = path + ": not a MetaImage header (line \"" + Trim(line).substr(0, 40) + "\")";
+      std::string shown = Trim(line).substr(0, 40);
+      for (char& c : shown)
+      {
+        c = std::isprint(static_cast<unsigned char>(c)) ? c : '?';
+      }
+      error = path + ": not a MetaImage header (line " + std::to_string(lines + 1) + ": \"" +
+        shown + "\")";
       return false;
     }
     const std::string key = Trim(line.substr(0, eq));

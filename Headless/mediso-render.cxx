@@ -113,7 +113,7 @@ std::vector<double> Numbers(const std::string& text, char separator, const std::
     const double v = std::strtod(item.c_str(), &end);
     if (item.empty() || *end != '\0' || !std::isfinite(v))
     {
-      throw UsageError{ what + ": \"" + text + "\" is not a list of numbers" };
+      throw UsageError{ what + ": \"" + item + "\" is not a finite number" };
     }
     values.push_back(v);
   }
@@ -125,7 +125,7 @@ double Number(const std::string& text, const std::string& what)
   const std::vector<double> v = Numbers(text, ',', what);
   if (v.size() != 1)
   {
-    throw UsageError{ what + ": \"" + text + "\" is not a number" };
+    throw UsageError{ what + ": \"" + text + "\" is not one number" };
   }
   return v[0];
 }
