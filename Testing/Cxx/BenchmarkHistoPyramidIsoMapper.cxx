@@ -19,7 +19,7 @@
 //   BenchmarkHistoPyramidIsoMapper --input ct|ct512|phantom256|phantomN
 //     [--ct FILE.mha] [--windows 1920x1080,1024x768] [--frames 360] [--sweep 95]
 //     [--isovalues -500,400] [--methods hp,rc,fe[,hpbox][,hp1]] [--rc-factors 0.5,1.0]
-//     [--opacity 1] [--together 0|1]
+//     [--opacity 1] [--together 0|1] [--write-input FILE.mha]
 //
 // --together 1: one rotation scene per window and method with all the
 // isovalues at once (the demo's skin over bone): the first at --opacity, the
@@ -39,6 +39,7 @@
 #include "vtkImageData.h"
 #include "vtkImageReslice.h"
 #include "vtkMetaImageReader.h"
+#include "vtkMetaImageWriter.h"
 #include "vtkNew.h"
 #include "vtkPNGWriter.h"
 #include "vtkPiecewiseFunction.h"
@@ -76,6 +77,7 @@ struct Options
   std::vector<std::pair<int, int>> Windows = { { 1920, 1080 }, { 1024, 768 } };
   int Frames = 360;
   int Sweep = 95;
+  std::string WriteInput; // write the input volume as an uncompressed MetaImage, then stop
   std::vector<double> Isovalues = { -500.0, 400.0 };
   std::vector<std::string> Methods = { "hp", "rc", "fe" };
   std::vector<double> RayCastFactors = { 0.5 };
@@ -153,6 +155,8 @@ bool Parse(int argc, char* argv[], Options& opt)
       opt.Together = std::stoi(value) != 0;
     else if (name == "--images")
       opt.ImageDir = value;
+    else if (name == "--write-input")
+      opt.WriteInput = value;
     else if (name == "--windows")
     {
       opt.Windows.clear();
@@ -614,6 +618,17 @@ int main(int argc, char* argv[])
     return 2;
   }
   const double loadSeconds = Now() - loadStart;
+  if (!opt.WriteInput.empty())
+  {
+    // The same volume for other programs (mediso-render), then nothing else.
+    vtkNew<vtkMetaImageWriter> writer;
+    writer->SetInputData(image);
+    writer->SetFileName(opt.WriteInput.c_str());
+    writer->SetCompression(false);
+    writer->Write();
+    std::printf("wrote %s\n", opt.WriteInput.c_str());
+    return 0;
+  }
   vtkDataArray* scalars = image->GetPointData()->GetScalars();
   double range[2];
   scalars->GetRange(range);
