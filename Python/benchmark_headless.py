@@ -9,7 +9,7 @@ The same GPU core twice: mediso-render (its own EGL context, no X, no VTK) and
 vtkHistoPyramidIsoMapper in a VTK window (BenchmarkHistoPyramidIsoMapper --methods hp, under
 Xvfb), on the same volumes (the benchmark program writes ct512 and phantom256 as MetaImages for
 mediso-render), the same windows, isovalues, camera (VTK's ResetCamera, 1-degree azimuth steps)
-and sweep (isovalues lo + (hi - lo) i / (N + 1)). The two programs alternate, the order flipping
+and sweep (isovalues lo + (hi - lo) i / (N + 1)); the view from the front (-y), head up (+z). The two programs alternate, the order flipping
 every round. Prints, per input and window, the median frame of the rotation and the median
 isovalue change + frame of each, and mediso-render's over the mapper's. Runs on whatever GL the
 machine has: on llvmpipe here, and unchanged on a GPU machine with only a driver (give --mapper ""
@@ -76,7 +76,10 @@ def volume_for(args, name):
 
 def run_render(args, volume, window, isovalue, rotate, sweep):
     """{protocol: (median ms, build ms, primitives)} of one mediso-render run."""
-    command = [args.render, volume, "--iso", "%g" % isovalue, "--size", window, "--api", args.api]
+    # The mapper's benchmark views the volume from the front (-y), head up (+z): from VTK's
+    # default camera (+z, up +y) that is an elevation of -90 degrees.
+    command = [args.render, volume, "--iso", "%g" % isovalue, "--size", window, "--api", args.api,
+               "--elevation", "-90"]
     if rotate:
         command += ["--rotate", str(rotate)]
     if sweep:

@@ -49,6 +49,8 @@ def parse_args(argv):
     p.add_argument("--isovalues", default="-500,400", help="rotation isovalues")
     p.add_argument("--methods", default="hp", help="hp, and optionally hpbox (quads/boxes only)")
     p.add_argument("--rounds", type=int, default=3)
+    p.add_argument("--zoom", type=float, default=1.0,
+                   help="camera zoom (e.g. 30: cells wider than the largest point, quads)")
     p.add_argument("--out", default="", help="also write the table (markdown) here")
     return p.parse_args(argv)
 
@@ -80,7 +82,7 @@ def run(binary, name, args):
     command = [os.path.join(ROOT, "Testing", "Scripts", "with-xvfb.sh"), binary, "--input", name,
                "--ct", ct_path(), "--frames", str(args.frames), "--sweep", str(args.sweep),
                "--windows", args.windows, "--isovalues=" + args.isovalues,
-               "--methods", args.methods]
+               "--methods", args.methods, "--zoom", str(args.zoom)]
     env = dict(os.environ, VTK_SMP_BACKEND_IN_USE="STDThread")
     out = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
     records = [json.loads(line[len(RESULT_TAG):]) for line in out.stdout.splitlines()
@@ -127,7 +129,8 @@ def main(argv):
              "- Machine: nproc %d (%s); llvmpipe under Xvfb; STDThread" % (os.cpu_count() or 0,
                                                                           cpu_model()),
              "- %d rounds, builds alternating (order flipped every round); rotation %d frames per "
-             "isovalue, sweep %d isovalues" % (args.rounds, args.frames, args.sweep), "",
+             "isovalue, sweep %d isovalues; camera zoom %g" % (args.rounds, args.frames, args.sweep,
+                                                              args.zoom), "",
              "| input | window | measure | method | this (median s) | baseline (median s) | "
              "ratio, median of rounds | min | max |",
              "|---|---|---|---|---:|---:|---:|---:|---:|"]

@@ -19,7 +19,7 @@
 //   BenchmarkHistoPyramidIsoMapper --input ct|ct512|phantom256|phantomN
 //     [--ct FILE.mha] [--windows 1920x1080,1024x768] [--frames 360] [--sweep 95]
 //     [--isovalues -500,400] [--methods hp,rc,fe[,hpbox][,hp1]] [--rc-factors 0.5,1.0]
-//     [--opacity 1] [--together 0|1] [--write-input FILE.mha]
+//     [--opacity 1] [--together 0|1] [--zoom 1] [--write-input FILE.mha]
 //
 // --together 1: one rotation scene per window and method with all the
 // isovalues at once (the demo's skin over bone): the first at --opacity, the
@@ -82,6 +82,7 @@ struct Options
   std::vector<std::string> Methods = { "hp", "rc", "fe" };
   std::vector<double> RayCastFactors = { 0.5 };
   double Opacity = 1.0; // of every isovalue (< 1: the mapper's translucent mode)
+  double Zoom = 1.0;    // camera zoom after the reset (close zooms: the quad footprints)
   bool Together = false; // rotation with all isovalues in one scene
   std::string ImageDir;
 };
@@ -151,6 +152,8 @@ bool Parse(int argc, char* argv[], Options& opt)
       opt.RayCastFactors = Numbers(value);
     else if (name == "--opacity")
       opt.Opacity = std::min(1.0, std::max(0.01, std::stod(value)));
+    else if (name == "--zoom")
+      opt.Zoom = std::max(1e-3, std::stod(value));
     else if (name == "--together")
       opt.Together = std::stoi(value) != 0;
     else if (name == "--images")
@@ -316,6 +319,9 @@ vtkSmartPointer<vtkImageData> LoadInput(const Options& opt, std::string& label)
 
 // ---------------------------------------------------------------------------
 // Scenes: one window per method, the same camera, light and material.
+// Camera zoom after the reset (--zoom).
+double CameraZoom = 1.0;
+
 struct Scene
 {
   std::string Method; // hp, rc or fe
@@ -371,6 +377,7 @@ struct Scene
     camera->SetViewUp(0.0, 0.0, 1.0);
     camera->SetViewAngle(30.0);
     this->Renderer->ResetCamera(this->Bounds); // the image's bounds for every method
+    camera->Zoom(CameraZoom);
     this->Renderer->ResetCameraClippingRange(this->Bounds);
   }
 
@@ -605,6 +612,7 @@ int main(int argc, char* argv[])
     return 2;
   }
   SurfaceOpacity = opt.Opacity;
+  CameraZoom = opt.Zoom;
   // vtkFlyingEdges3D's threads: the STDThread backend, whatever the build's default.
   vtkSMPTools::SetBackend("STDThread");
   vtkSMPTools::Initialize(0);
