@@ -23,6 +23,7 @@
 #include "IsosurfaceRendererGL.h"
 #include "MetaImage.h"
 #include "PngWriter.h"
+#include "SceneView.h"
 #include "ThreadedFor.h"
 
 #include <algorithm>
@@ -424,52 +425,22 @@ public:
   // VTK's camera for the options, turned `extraAzimuth` degrees more.
   void SetCamera(double extraAzimuth)
   {
-    const int* d = this->Image.Dimensions;
-    // Index to world: origin + direction * (spacing * index).
-    matrix4::Matrix indexToWorld = matrix4::Identity();
-    for (int r = 0; r < 3; ++r)
-    {
-      for (int c = 0; c < 3; ++c)
-      {
-        indexToWorld[4 * r + c] = this->Image.Direction[3 * r + c] * this->Image.Spacing[c];
-      }
-      indexToWorld[4 * r + 3] = this->Image.Origin[r];
-    }
-    double bounds[6] = { HUGE_VAL, -HUGE_VAL, HUGE_VAL, -HUGE_VAL, HUGE_VAL, -HUGE_VAL };
-    for (int i = 0; i < 8; ++i)
-    {
-      const double p[4] = { (i & 1) ? d[0] - 1.0 : 0.0, (i & 2) ? d[1] - 1.0 : 0.0,
-        (i & 4) ? d[2] - 1.0 : 0.0, 1.0 };
-      const auto w = matrix4::Transform(indexToWorld, p);
-      for (int a = 0; a < 3; ++a)
-      {
-        bounds[2 * a] = std::min(bounds[2 * a], w[a]);
-        bounds[2 * a + 1] = std::max(bounds[2 * a + 1], w[a]);
-      }
-    }
-    const double aspect = static_cast<double>(this->Opt.Width) / this->Opt.Height;
+    VolumePlacement placement;
+    std::copy(this->Image.Dimensions, this->Image.Dimensions + 3, placement.Dimensions);
+    std::copy(this->Image.Origin, this->Image.Origin + 3, placement.Origin);
+    std::copy(this->Image.Spacing, this->Image.Spacing + 3, placement.Spacing);
+    std::copy(this->Image.Direction, this->Image.Direction + 9, placement.Direction);
+    double bounds[6];
+    placement.Bounds(bounds);
     Camera camera;
     camera.Parallel = this->Opt.Parallel;
-    camera.Reset(bounds, aspect);
+    camera.Reset(bounds, static_cast<double>(this->Opt.Width) / this->Opt.Height);
     camera.Azimuth(this->Opt.Azimuth + extraAzimuth);
     camera.Elevation(this->Opt.Elevation);
     camera.OrthogonalizeViewUp();
     camera.Zoom(this->Opt.Zoom);
     camera.ResetClippingRange(bounds);
-    const matrix4::Matrix indexToView = matrix4::Multiply(camera.ViewMatrix(), indexToWorld);
-    const matrix4::Matrix projection = camera.ProjectionMatrix(aspect);
-    std::copy(indexToView.begin(), indexToView.end(), this->Frame.IndexToView);
-    std::copy(projection.begin(), projection.end(), this->Frame.Projection);
-    this->Frame.Parallel = camera.Parallel;
-    this->Frame.NearPlane = camera.ClippingRange[0];
-    const int viewport[4] = { 0, 0, this->Opt.Width, this->Opt.Height };
-    std::copy(viewport, viewport + 4, this->Frame.Viewport);
-    // VTK's default light: a white headlight of intensity 1.
-    this->Frame.NumberOfLights = 1;
-    this->Frame.LightDirections[0][0] = 0.0f;
-    this->Frame.LightDirections[0][1] = 0.0f;
-    this->Frame.LightDirections[0][2] = 1.0f;
-    this->Frame.LightColors[0][0] = this->Frame.LightColors[0][1] = this->Frame.LightColors[0][2] = 1.0f;
+    SetFrameView(this->Frame, camera, placement, this->Opt.Width, this->Opt.Height);
     this->Frame.Ambient = static_cast<float>(this->Opt.Material[0]);
     this->Frame.Diffuse = static_cast<float>(this->Opt.Material[1]);
     this->Frame.Specular = static_cast<float>(this->Opt.Material[2]);

@@ -213,6 +213,27 @@ void Camera::Zoom(double factor)
   }
 }
 
+void Camera::Dolly(double factor)
+{
+  if (factor <= 0.0)
+  {
+    return;
+  }
+  double position[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    position[a] = this->FocalPoint[a] + (this->Position[a] - this->FocalPoint[a]) / factor;
+  }
+  this->SetPosition(position);
+}
+
+void Camera::SetView(const double position[3], const double focalPoint[3], const double viewUp[3])
+{
+  std::copy(focalPoint, focalPoint + 3, this->FocalPoint);
+  std::copy(viewUp, viewUp + 3, this->ViewUp);
+  this->SetPosition(position);
+}
+
 matrix4::Matrix Camera::ViewMatrix() const
 {
   return LookAt(this->Position, this->FocalPoint, this->ViewUp);

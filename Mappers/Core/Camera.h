@@ -43,6 +43,10 @@ public:
   void OrthogonalizeViewUp();
   /// Narrows the view angle (perspective) or the parallel scale by `factor`.
   void Zoom(double factor);
+  /// Moves the camera towards the focal point: the distance divided by `factor`.
+  void Dolly(double factor);
+  /// Sets position, focal point and view up at once (the view transform follows).
+  void SetView(const double position[3], const double focalPoint[3], const double viewUp[3]);
 
   /// World to view space (the camera at the origin looking down -z).
   matrix4::Matrix ViewMatrix() const;
