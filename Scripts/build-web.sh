@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Build the web page's WebAssembly module (build-web/bin/mediso.js, mediso.wasm)
+# with Debian's emscripten, installing it when missing. Idempotent.
+#
+#   Scripts/build-web.sh
+#
+# Environment: MEDISO_WEB_BUILD_DIR (default <repo>/build-web).
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+build=${MEDISO_WEB_BUILD_DIR:-$repo/build-web}
+
+packages=(emscripten nodejs)
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+if [ ${#missing[@]} -gt 0 ] && ! command -v emcc >/dev/null; then
+  echo "build-web: installing ${missing[*]}"
+  sudo=()
+  [ "$(id -u)" = 0 ] || sudo=(sudo)
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo[@]}" apt-get update -q
+  "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+# Debian's emscripten runs node for the link step; a node that is not Debian's
+# does not search Debian's module folder on its own.
+export NODE_PATH=${NODE_PATH:-/usr/share/nodejs}
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  generator=()
+  command -v ninja >/dev/null && generator=(-G Ninja)
+  emcmake cmake -S "$repo" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
+    -DMEDISO_WARNINGS_AS_ERRORS=ON >/dev/null
+fi
+cmake --build "$build" --parallel "$(nproc)"
+echo "build-web: $build/bin/mediso.js and mediso.wasm"

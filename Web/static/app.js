@@ -1,0 +1,344 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The web client (docs/web.md): the volume is fetched once; isosurfaces are then computed and
+// drawn in this browser by the same C++ core the ParaView plugin runs, compiled to WebAssembly
+// (mediso.js / mediso.wasm). Changing an isovalue, a colour or the camera sends nothing; the
+// server is asked only for what needs its libraries (further operations on a surface).
+
+const TYPES = ["int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"];
+const SIZES = [1, 1, 2, 2, 4, 4, 4, 8];
+const SKIN = [0.93, 0.75, 0.62];
+const BONE = [0.97, 0.95, 0.88];
+
+const params = new URLSearchParams(location.search);
+const token = params.get("token") || "";
+const $ = (id) => document.getElementById(id);
+
+const state = {
+  module: null,
+  viewer: null,
+  dataset: null,
+  surfaces: [],
+  path: "gpu",
+  reason: "",
+  level: 3,
+  levelNote: "",
+  bytesSent: 0,
+  bytesReceived: 0,
+  frameTimes: [],
+  lastChangeMs: 0,
+  primitives: 0,
+  triangles: 0,
+  pending: null,
+};
+
+function withToken(url) {
+  return url + (url.includes("?") ? "&" : "?") + "token=" + encodeURIComponent(token);
+}
+
+// Every request of the page's own goes through here, so that the bytes are counted.
+async function request(url) {
+  const full = withToken(url);
+  state.bytesSent += full.length + 64; // the request line and the few headers a browser adds
+  const response = await fetch(full, { cache: "no-store" });
+  if (!response.ok) {
+    throw new Error(url + ": " + response.status + " " + (await response.text()));
+  }
+  const wire = Number(response.headers.get("Content-Length") || 0);
+  const body = await response.arrayBuffer();
+  state.bytesReceived += (wire || body.byteLength) + 200;
+  return { response, body };
+}
+
+async function requestJSON(url) {
+  const { body } = await request(url);
+  return JSON.parse(new TextDecoder().decode(body));
+}
+
+function unsupported(text) {
+  $("app").hidden = true;
+  const box = $("unsupported");
+  box.hidden = false;
+  box.textContent = text;
+}
+
+// ---------------------------------------------------------------------------- the volume
+function unshuffle(shuffled, size) {
+  if (size === 1) {
+    return shuffled;
+  }
+  const n = shuffled.length / size;
+  const out = new Uint8Array(shuffled.length);
+  for (let b = 0; b < size; ++b) {
+    const plane = shuffled.subarray(b * n, (b + 1) * n);
+    for (let i = 0, o = b; i < n; ++i, o += size) {
+      out[o] = plane[i];
+    }
+  }
+  return out;
+}
+
+// The finest level (3: full) the path can afford: its texture within the GL limits, the volume
+// and the pyramid (about 1.1x the volume) within the budget.
+function chooseLevel(dataset, info, budgetMB) {
+  for (let k = 3; k >= 0; --k) {
+    const level = dataset.levels[k];
+    const d = level.dims;
+    const fitsGL = !info || Math.max(Math.ceil(d[0] / 4), d[1], d[2]) <= info.max3DTextureSize;
+    const fitsBudget = 1.1 * level.bytes <= budgetMB * 1e6;
+    if (fitsGL && fitsBudget) {
+      const why = k === 3 ? "" :
+        "the volume is sent at level " + k + " (every " + (1 << (3 - k)) + "th point, " +
+        d.join("x") + "): the full " + dataset.dims.join("x") + " volume exceeds " +
+        (fitsGL ? "" : "the WebGL limits") + (fitsGL ? "the memory budget" : "");
+      return { level: k, why };
+    }
+  }
+  return { level: 0, why: "even level 0 exceeds the budget" };
+}
+
+async function loadVolume(level) {
+  const d = state.dataset;
+  const { response, body } = await request("/api/volume/" + d.id + "?level=" + level);
+  const type = TYPES.indexOf(response.headers.get("X-Mediso-Type"));
+  const dims = response.headers.get("X-Mediso-Dims").split(",").map(Number);
+  const spacing = response.headers.get("X-Mediso-Spacing").split(",").map(Number);
+  const origin = response.headers.get("X-Mediso-Origin").split(",").map(Number);
+  const bytes = unshuffle(new Uint8Array(body), SIZES[type]);
+  const M = state.module;
+  if (state.volumePointer) {
+    M._free(state.volumePointer);
+  }
+  state.volumePointer = M._malloc(bytes.length);
+  M.HEAPU8.set(bytes, state.volumePointer);
+  state.level = level;
+  if (!state.viewer.setVolume(type, state.volumePointer, dims, spacing, origin)) {
+    throw new Error("the volume cannot be uploaded: " + state.viewer.stats().error);
+  }
+}
+
+// ---------------------------------------------------------------------------- rendering
+function defaultSurfaces(d) {
+  if (d.range[0] <= -900 && d.range[1] >= 400) { // a CT in Hounsfield units
+    return [{ value: -500, color: SKIN, opacity: 0.35 }, { value: 400, color: BONE, opacity: 1 }];
+  }
+  const v = d.range[0] + 0.3 * (d.range[1] - d.range[0]);
+  return [{ value: Number(v.toPrecision(4)), color: SKIN, opacity: 1 }];
+}
+
+// Draws now and waits for the GPU: the time of a change + frame.
+function renderNow() {
+  const viewer = state.viewer;
+  viewer.setSurfaces(state.surfaces);
+  const start = performance.now();
+  if (!viewer.render()) {
+    throw new Error("render failed: " + viewer.stats().error);
+  }
+  viewer.finish();
+  const ms = performance.now() - start;
+  state.frameTimes.push({ at: performance.now(), ms });
+  if (state.frameTimes.length > 120) {
+    state.frameTimes.shift();
+  }
+  state.primitives = viewer.stats().primitives;
+  updateReadout();
+  return ms;
+}
+
+// Frames on request (interaction), at most one per animation frame.
+function requestFrame() {
+  if (!state.pending) {
+    state.pending = requestAnimationFrame(() => {
+      state.pending = null;
+      renderNow();
+    });
+  }
+}
+
+function fps() {
+  const now = performance.now();
+  const recent = state.frameTimes.filter((f) => now - f.at < 1000);
+  if (recent.length >= 2) {
+    return recent.length / ((recent[recent.length - 1].at - recent[0].at) / 1000 || 1);
+  }
+  const last = state.frameTimes[state.frameTimes.length - 1];
+  return last ? 1000 / last.ms : 0;
+}
+
+function updateReadout() {
+  const rows = [
+    ["path", state.path.toUpperCase() + (state.reason ? " (" + state.reason + ")" : "")],
+    ["frames per second", fps().toFixed(1)],
+    ["last isovalue change", state.lastChangeMs.toFixed(1) + " ms (change + frame)"],
+    ["primitives", String(state.primitives)],
+    ["bytes received", state.bytesReceived.toLocaleString()],
+    ["bytes sent", state.bytesSent.toLocaleString()],
+  ];
+  $("readout").replaceChildren(...rows.map(([k, v]) => {
+    const tr = document.createElement("tr");
+    tr.innerHTML = "<td></td><td></td>";
+    tr.children[0].textContent = k;
+    tr.children[1].textContent = v;
+    return tr;
+  }));
+  $("overlay").textContent = fps().toFixed(1) + " fps";
+}
+
+// ---------------------------------------------------------------------------- the panel
+function hex(color) {
+  return "#" + color.map((c) => Math.round(255 * c).toString(16).padStart(2, "0")).join("");
+}
+
+function fromHex(text) {
+  return [1, 3, 5].map((i) => parseInt(text.substr(i, 2), 16) / 255);
+}
+
+function change(apply) {
+  apply();
+  state.lastChangeMs = renderNow();
+  updateReadout();
+}
+
+function buildSurfaceList() {
+  const d = state.dataset;
+  const box = $("surfaces");
+  box.replaceChildren();
+  state.surfaces.forEach((s, i) => {
+    const row = document.createElement("div");
+    row.className = "surface";
+    const value = Object.assign(document.createElement("input"),
+      { type: "number", step: "any", value: s.value });
+    const color = Object.assign(document.createElement("input"), { type: "color", value: hex(s.color) });
+    const opacity = Object.assign(document.createElement("input"),
+      { type: "number", min: 0, max: 1, step: 0.05, value: s.opacity, title: "opacity" });
+    const remove = Object.assign(document.createElement("button"), { textContent: "x" });
+    const slider = Object.assign(document.createElement("input"),
+      { type: "range", min: d.range[0], max: d.range[1], step: "any", value: s.value });
+    value.oninput = () => change(() => { s.value = Number(value.value); slider.value = value.value; });
+    slider.oninput = () => change(() => { s.value = Number(slider.value); value.value = slider.value; });
+    color.oninput = () => change(() => { s.color = fromHex(color.value); });
+    opacity.oninput = () => change(() => { s.opacity = Math.min(1, Math.max(0, Number(opacity.value))); });
+    remove.onclick = () => change(() => { state.surfaces.splice(i, 1); buildSurfaceList(); });
+    row.append(value, color, opacity, remove, slider);
+    box.append(row);
+  });
+  const pick = $("op-surface");
+  pick.replaceChildren(...state.surfaces.map((s, i) =>
+    Object.assign(document.createElement("option"), { value: i, textContent: String(s.value) })));
+}
+
+function interact(canvas) {
+  let last = null;
+  canvas.addEventListener("pointerdown", (e) => {
+    last = [e.clientX, e.clientY];
+    canvas.setPointerCapture(e.pointerId);
+  });
+  canvas.addEventListener("pointerup", () => { last = null; });
+  canvas.addEventListener("pointermove", (e) => {
+    if (!last) {
+      return;
+    }
+    const dx = e.clientX - last[0], dy = e.clientY - last[1];
+    last = [e.clientX, e.clientY];
+    state.viewer.azimuth(-0.4 * dx);
+    state.viewer.elevation(0.4 * dy);
+    requestFrame();
+  });
+  canvas.addEventListener("wheel", (e) => {
+    e.preventDefault();
+    state.viewer.dolly(Math.pow(1.1, -e.deltaY / 100));
+    requestFrame();
+  }, { passive: false });
+}
+
+// ---------------------------------------------------------------------------- start
+async function start() {
+  const probe = document.createElement("canvas").getContext("webgl2");
+  if (typeof WebAssembly !== "object" || !probe) {
+    unsupported("This page computes isosurfaces in the browser with WebAssembly and WebGL2, and " +
+      "this browser has " + (typeof WebAssembly !== "object" ? "no WebAssembly" : "no WebGL2") +
+      ". Use a current Chrome, Edge, Firefox or Safari with hardware acceleration on.");
+    return;
+  }
+  $("app").hidden = false;
+  state.module = await createMediso({ locateFile: (f) => "static/" + f });
+  const canvas = $("view");
+  state.viewer = new state.module.WebViewer("#view");
+  state.viewer.resize(canvas.width, canvas.height);
+  if (!state.viewer.ready()) {
+    unsupported("WebGL2 is here but cannot run the GPU path: " + state.viewer.error());
+    return;
+  }
+  const info = state.viewer.info();
+  const list = await requestJSON("/api/datasets");
+  state.dataset = list.datasets[0];
+  const d = state.dataset;
+  $("dataset").textContent = d.name + ": " + d.dims.join("x") + " " + d.type + ", " +
+    (d.bytes / 1e6).toFixed(1) + " MB, range " + d.range[0] + ".." + d.range[1];
+  state.path = "gpu";
+  state.reason = "WebGL2 on " + info.renderer;
+  const choice = chooseLevel(d, info, Number($("budget").value));
+  state.levelNote = choice.why;
+  $("why").textContent = choice.why;
+  await loadVolume(choice.level);
+  state.surfaces = defaultSurfaces(d);
+  buildSurfaceList();
+  interact(canvas);
+  $("add").onclick = () => change(() => {
+    state.surfaces.push({ value: d.range[0] + 0.5 * (d.range[1] - d.range[0]), color: BONE, opacity: 1 });
+    buildSurfaceList();
+  });
+  renderNow();
+}
+
+// ---------------------------------------------------------------------------- automation
+let resolveReady, rejectReady;
+const ready = new Promise((resolve, reject) => { resolveReady = resolve; rejectReady = reject; });
+
+window.mediso = {
+  ready,
+  async setIsovalues(values) {
+    change(() => {
+      state.surfaces = values.map((v, i) => ({
+        value: v,
+        color: (state.surfaces[i] || {}).color || BONE,
+        opacity: (state.surfaces[i] || {}).opacity ?? 1,
+      }));
+      buildSurfaceList();
+    });
+    return window.mediso.stats();
+  },
+  async setSurfaces(surfaces) {
+    change(() => {
+      state.surfaces = surfaces.map((s) => ({ value: s.value, color: s.color || BONE, opacity: s.opacity ?? 1 }));
+      buildSurfaceList();
+    });
+    return window.mediso.stats();
+  },
+  async setView(view) {
+    state.viewer.setView(view);
+    renderNow();
+    return state.viewer.getView();
+  },
+  getView: () => state.viewer.getView(),
+  stats: () => ({
+    path: state.path,
+    reason: state.reason,
+    level: state.level,
+    levelNote: state.levelNote,
+    primitives: state.primitives,
+    triangles: state.triangles,
+    fps: fps(),
+    lastChangeMs: state.lastChangeMs,
+    bytesSent: state.bytesSent,
+    bytesReceived: state.bytesReceived,
+    view: state.viewer ? state.viewer.getView() : null,
+    info: state.viewer ? state.viewer.info() : null,
+  }),
+  cpuCount: (values) => state.viewer.countOnCPU(values),
+};
+
+start().then(resolveReady, (error) => {
+  console.error(error);
+  unsupported("The page could not start: " + error.message);
+  rejectReady(error);
+});

@@ -1,0 +1,441 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file WebViewer.cxx
+ * @brief The web page's render module: the GPU core on the browser's WebGL2, compiled to WebAssembly.
+ *
+ * The paper's client runs "the same render module" as the server. Here that
+ * is the GPU core of Mappers/Core (mediso::HistoPyramidGL and
+ * IsosurfaceRendererGL), byte for byte the code the ParaView mapper and
+ * mediso-render run, on a WebGL2 context of a canvas, with the functions
+ * Emscripten links in (GLFunctionList.h). JavaScript (Web/static/app.js) hands
+ * it the volume once and then only parameters: isovalues, colours, the
+ * camera. WebViewer holds the scene (volume placement, camera, surfaces) and
+ * rebuilds the pyramid only when the isovalues change.
+ */
+#include "Camera.h"
+#include "GLApiFunctions.h"
+#include "GLProbe.h"
+#include "HistoPyramid.h"
+#include "HistoPyramidGL.h"
+#include "IsosurfaceRendererGL.h"
+#include "SceneView.h"
+
+#include <emscripten.h>
+#include <emscripten/bind.h>
+#include <emscripten/html5.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace
+{
+using emscripten::val;
+using namespace mediso;
+
+// The core's functions: Emscripten's own WebGL2 bindings, by name.
+void* LookUp(const char* name, void*)
+{
+#define MEDISO_LOOK_UP(f)                                                                          \
+  if (std::strcmp(name, "gl" #f) == 0)                                                             \
+  {                                                                                                \
+    return reinterpret_cast<void*>(&::gl##f);                                                      \
+  }
+  MEDISO_GL_FUNCTIONS(MEDISO_LOOK_UP)
+#undef MEDISO_LOOK_UP
+  return nullptr;
+}
+
+std::vector<double> Doubles(const val& array)
+{
+  std::vector<double> out;
+  const int n = array["length"].as<int>();
+  for (int i = 0; i < n; ++i)
+  {
+    out.push_back(array[i].as<double>());
+  }
+  return out;
+}
+
+void Triple(const val& array, double out[3])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    out[a] = array[a].as<double>();
+  }
+}
+
+val TripleVal(const double v[3])
+{
+  val out = val::array();
+  for (int a = 0; a < 3; ++a)
+  {
+    out.call<void>("push", v[a]);
+  }
+  return out;
+}
+} // namespace
+
+class WebViewer
+{
+public:
+  explicit WebViewer(const std::string& canvas)
+    : Canvas(canvas)
+  {
+    EmscriptenWebGLContextAttributes attributes;
+    emscripten_webgl_init_context_attributes(&attributes);
+    attributes.majorVersion = 2;
+    attributes.minorVersion = 0;
+    attributes.alpha = false;
+    attributes.depth = true;
+    attributes.stencil = false;
+    attributes.antialias = false;
+    attributes.preserveDrawingBuffer = true; // the image can be read after a frame (tests)
+    this->Context = emscripten_webgl_create_context(canvas.c_str(), &attributes);
+    if (this->Context <= 0)
+    {
+      this->Error = "this browser gives no WebGL2 context";
+      return;
+    }
+    emscripten_webgl_make_context_current(this->Context);
+    std::string error;
+    this->GL = GLApi::Load(LookUp, nullptr, error);
+    if (!this->GL)
+    {
+      this->Error = error;
+      return;
+    }
+    if (ProbeGL(*this->GL, error) != ProbeResult::Passed)
+    {
+      this->Error = "this WebGL2 cannot run the GPU path: " + error;
+      return;
+    }
+    this->Pyramid.reset(new HistoPyramidGL(this->GL));
+    this->Renderer.reset(new IsosurfaceRendererGL(this->GL));
+  }
+
+  ~WebViewer()
+  {
+    if (this->Context > 0)
+    {
+      emscripten_webgl_make_context_current(this->Context);
+      if (this->Pyramid)
+      {
+        this->Pyramid->Release();
+      }
+      if (this->Renderer)
+      {
+        this->Renderer->Release();
+      }
+      emscripten_webgl_destroy_context(this->Context);
+    }
+  }
+
+  bool Ready() const { return this->Error.empty(); }
+  std::string GetError() const { return this->Error; }
+
+  /// What the context is and can do: the page chooses its path from it.
+  val Info() const
+  {
+    val info = val::object();
+    if (this->GL)
+    {
+      info.set("renderer", this->GL->GetRenderer());
+      info.set("version", this->GL->GetVersion());
+      info.set("max3DTextureSize", this->GL->GetMax3DTextureSize());
+      info.set("maxTextureSize", this->GL->GetMaxTextureSize());
+      info.set("maxPointSize", this->GL->GetMaxPointSize());
+      info.set("maxVertexTextureUnits", this->GL->GetMaxVertexTextureUnits());
+    }
+    info.set("error", this->Error);
+    return info;
+  }
+
+  /**
+   * The volume: `bytes` in the module's memory (the caller keeps them alive
+   * while this viewer uses them), x fastest, of ScalarType `type`.
+   */
+  bool SetVolume(int type, std::uintptr_t bytes, const val& dims, const val& spacing,
+    const val& origin)
+  {
+    if (!this->Ready())
+    {
+      return false;
+    }
+    for (int a = 0; a < 3; ++a)
+    {
+      this->Placement.Dimensions[a] = dims[a].as<int>();
+      this->Placement.Spacing[a] = spacing[a].as<double>();
+      this->Placement.Origin[a] = origin[a].as<double>();
+    }
+    this->Type = static_cast<ScalarType>(type);
+    this->Data = reinterpret_cast<const void*>(bytes);
+    emscripten_webgl_make_context_current(this->Context);
+    std::string error;
+    if (!this->Pyramid->UploadVolume(this->Type, this->Data, this->Placement.Dimensions, nullptr,
+          error))
+    {
+      this->LastError = error;
+      return false;
+    }
+    this->BuiltValues.clear();
+    this->ResetCamera();
+    return true;
+  }
+
+  /// The isosurfaces: [{value, color: [r, g, b], opacity}], at most 8.
+  bool SetSurfaces(const val& surfaces)
+  {
+    std::vector<IsosurfaceLook> looks;
+    const int n = surfaces["length"].as<int>();
+    for (int i = 0; i < n; ++i)
+    {
+      const val s = surfaces[i];
+      IsosurfaceLook look;
+      look.Value = s["value"].as<double>();
+      const val color = s["color"];
+      for (int c = 0; c < 3; ++c)
+      {
+        look.Color[c] = color.isUndefined() ? 1.0f : color[c].as<float>();
+      }
+      look.Opacity = s["opacity"].isUndefined() ? 1.0f : s["opacity"].as<float>();
+      if (std::isfinite(look.Value) && look.Opacity > 0.0f)
+      {
+        looks.push_back(look);
+      }
+    }
+    std::sort(looks.begin(), looks.end(),
+      [](const IsosurfaceLook& a, const IsosurfaceLook& b) { return a.Value < b.Value; });
+    looks.erase(std::unique(looks.begin(), looks.end(),
+                  [](const IsosurfaceLook& a, const IsosurfaceLook& b) { return a.Value == b.Value; }),
+      looks.end());
+    if (looks.size() > static_cast<std::size_t>(MaximumIsovalues))
+    {
+      looks.resize(MaximumIsovalues);
+    }
+    this->Frame.Surfaces = looks;
+    return true;
+  }
+
+  void Resize(int width, int height)
+  {
+    this->Width = std::max(1, width);
+    this->Height = std::max(1, height);
+    emscripten_set_canvas_element_size(this->Canvas.c_str(), this->Width, this->Height);
+  }
+
+  void ResetCamera()
+  {
+    double bounds[6];
+    this->Placement.Bounds(bounds);
+    this->View = Camera();
+    this->View.Parallel = this->Parallel;
+    this->View.Reset(bounds, static_cast<double>(this->Width) / this->Height);
+  }
+  void Azimuth(double degrees) { this->View.Azimuth(degrees); }
+  void Elevation(double degrees)
+  {
+    this->View.Elevation(degrees);
+    this->View.OrthogonalizeViewUp();
+  }
+  void Zoom(double factor) { this->View.Zoom(factor); }
+  void Dolly(double factor) { this->View.Dolly(factor); }
+  void SetParallel(bool parallel)
+  {
+    this->Parallel = parallel;
+    this->View.Parallel = parallel;
+  }
+
+  /// {position, focalPoint, viewUp, viewAngle[, parallelScale]}
+  void SetView(const val& view)
+  {
+    double position[3], focal[3], up[3];
+    Triple(view["position"], position);
+    Triple(view["focalPoint"], focal);
+    Triple(view["viewUp"], up);
+    if (!view["viewAngle"].isUndefined())
+    {
+      this->View.ViewAngle = view["viewAngle"].as<double>();
+    }
+    if (!view["parallelScale"].isUndefined())
+    {
+      this->View.ParallelScale = view["parallelScale"].as<double>();
+    }
+    this->View.SetView(position, focal, up);
+  }
+
+  val GetView() const
+  {
+    val view = val::object();
+    view.set("position", TripleVal(this->View.Position));
+    view.set("focalPoint", TripleVal(this->View.FocalPoint));
+    view.set("viewUp", TripleVal(this->View.ViewUp));
+    view.set("viewAngle", this->View.ViewAngle);
+    view.set("parallelScale", this->View.ParallelScale);
+    return view;
+  }
+
+  void SetBackground(double r, double g, double b)
+  {
+    this->Background[0] = static_cast<float>(r);
+    this->Background[1] = static_cast<float>(g);
+    this->Background[2] = static_cast<float>(b);
+  }
+
+  void SetMaterial(double ambient, double diffuse, double specular, double power)
+  {
+    this->Frame.Ambient = static_cast<float>(ambient);
+    this->Frame.Diffuse = static_cast<float>(diffuse);
+    this->Frame.Specular = static_cast<float>(specular);
+    this->Frame.SpecularPower = static_cast<float>(power);
+  }
+
+  /// Draws a frame (building the pyramid first if the isovalues changed).
+  bool Render()
+  {
+    if (!this->Ready() || !this->Data)
+    {
+      return false;
+    }
+    emscripten_webgl_make_context_current(this->Context);
+    const GLApi::Functions& f = this->GL->F();
+    const double start = emscripten_get_now();
+    std::vector<double> values;
+    for (const IsosurfaceLook& s : this->Frame.Surfaces)
+    {
+      values.push_back(s.Value);
+    }
+    this->LastBuildMs = 0.0;
+    if (values != this->BuiltValues && !values.empty())
+    {
+      std::string error;
+      if (!this->Pyramid->Build(values, error))
+      {
+        this->LastError = error;
+        return false;
+      }
+      this->BuiltValues = values;
+      this->LastBuildMs = emscripten_get_now() - start;
+    }
+    double bounds[6];
+    this->Placement.Bounds(bounds);
+    this->View.ResetClippingRange(bounds);
+    SetFrameView(this->Frame, this->View, this->Placement, this->Width, this->Height);
+    f.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    f.Viewport(0, 0, this->Width, this->Height);
+    f.Enable(GL_DEPTH_TEST);
+    f.DepthFunc(GL_LEQUAL);
+    f.DepthMask(GL_TRUE);
+    const GLfloat background[4] = { this->Background[0], this->Background[1], this->Background[2],
+      1.0f };
+    const GLfloat one = 1.0f;
+    f.ClearBufferfv(GL_COLOR, 0, background);
+    f.ClearBufferfv(GL_DEPTH, 0, &one);
+    this->Stats = IsosurfaceFrameStats();
+    if (!values.empty())
+    {
+      std::string error;
+      if (!this->Renderer->Render(*this->Pyramid, this->Frame, this->Stats, error))
+      {
+        this->LastError = error;
+        return false;
+      }
+    }
+    this->LastFrameMs = emscripten_get_now() - start;
+    return true;
+  }
+
+  /// Waits for the GPU to finish (a one-pixel read-back): for timings.
+  void Finish()
+  {
+    emscripten_webgl_make_context_current(this->Context);
+    unsigned char pixel[4];
+    this->GL->F().ReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, pixel);
+  }
+
+  val GetStats() const
+  {
+    val stats = val::object();
+    stats.set("primitives", static_cast<double>(this->Stats.Primitives));
+    stats.set("footprint", std::string(this->Stats.PointFootprint ? "points" : "boxes"));
+    stats.set("firstHit", this->Stats.FirstHit);
+    stats.set("buildMs", this->LastBuildMs);
+    stats.set("frameMs", this->LastFrameMs);
+    stats.set("gpuBytes", this->Pyramid ? static_cast<double>(this->Pyramid->GetGPUMemoryBytes()) : 0.0);
+    stats.set("frameBufferBytes",
+      this->Renderer ? static_cast<double>(this->Renderer->GetFrameBufferBytes()) : 0.0);
+    stats.set("error", this->LastError);
+    return stats;
+  }
+
+  /// The CPU model's count of active (cell, isovalue) pairs (tests compare the GPU's with it).
+  double CountOnCPU(const val& isovalues) const
+  {
+    if (!this->Data)
+    {
+      return 0.0;
+    }
+    const std::vector<double> values = Doubles(isovalues);
+    std::uint64_t total = 0;
+    VisitScalarType(this->Type,
+      [&](auto tag)
+      {
+        using T = decltype(tag);
+        for (std::uint32_t n : HistoPyramid::CountCrossings(
+               static_cast<const T*>(this->Data), this->Placement.Dimensions, values))
+        {
+          total += n;
+        }
+      });
+    return static_cast<double>(total);
+  }
+
+private:
+  std::string Canvas; // the canvas's CSS selector
+  EMSCRIPTEN_WEBGL_CONTEXT_HANDLE Context = 0;
+  std::string Error;
+  std::string LastError;
+  std::shared_ptr<const GLApi> GL;
+  std::unique_ptr<HistoPyramidGL> Pyramid;
+  std::unique_ptr<IsosurfaceRendererGL> Renderer;
+  VolumePlacement Placement;
+  ScalarType Type = ScalarType::Int16;
+  const void* Data = nullptr;
+  Camera View;
+  bool Parallel = false;
+  IsosurfaceFrame Frame;
+  IsosurfaceFrameStats Stats;
+  std::vector<double> BuiltValues;
+  int Width = 640, Height = 480;
+  float Background[3] = { 0.1f, 0.12f, 0.16f };
+  double LastBuildMs = 0.0, LastFrameMs = 0.0;
+};
+
+EMSCRIPTEN_BINDINGS(mediso_web)
+{
+  emscripten::class_<WebViewer>("WebViewer")
+    .constructor<std::string>()
+    .function("ready", &WebViewer::Ready)
+    .function("error", &WebViewer::GetError)
+    .function("info", &WebViewer::Info)
+    .function("setVolume", &WebViewer::SetVolume)
+    .function("setSurfaces", &WebViewer::SetSurfaces)
+    .function("resize", &WebViewer::Resize)
+    .function("resetCamera", &WebViewer::ResetCamera)
+    .function("azimuth", &WebViewer::Azimuth)
+    .function("elevation", &WebViewer::Elevation)
+    .function("zoom", &WebViewer::Zoom)
+    .function("dolly", &WebViewer::Dolly)
+    .function("setParallel", &WebViewer::SetParallel)
+    .function("setView", &WebViewer::SetView)
+    .function("getView", &WebViewer::GetView)
+    .function("setBackground", &WebViewer::SetBackground)
+    .function("setMaterial", &WebViewer::SetMaterial)
+    .function("render", &WebViewer::Render)
+    .function("finish", &WebViewer::Finish)
+    .function("stats", &WebViewer::GetStats)
+    .function("countOnCPU", &WebViewer::CountOnCPU);
+}
