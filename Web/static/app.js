@@ -288,6 +288,7 @@ async function start() {
     buildSurfaceList();
   });
   renderNow();
+  // The "On the server" panel (Web/static/operations.js) is given what it needs here.
 }
 
 // ---------------------------------------------------------------------------- automation
