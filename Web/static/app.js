@@ -4,6 +4,8 @@
 // (mediso.js / mediso.wasm). Changing an isovalue, a colour or the camera sends nothing; the
 // server is asked only for what needs its libraries (further operations on a surface).
 
+import { setupOperations } from "./operations.js";
+
 const TYPES = ["int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"];
 const SIZES = [1, 1, 2, 2, 4, 4, 4, 8];
 const SKIN = [0.93, 0.75, 0.62];
@@ -289,6 +291,18 @@ async function start() {
   });
   renderNow();
   // The "On the server" panel (Web/static/operations.js) is given what it needs here.
+  setupOperations({
+    dataset: d,
+    token,
+    surfaces: () => state.surfaces,
+    level: () => state.level,
+    request,
+    count(sent, received) {
+      state.bytesSent += sent;
+      state.bytesReceived += received;
+      updateReadout();
+    },
+  });
 }
 
 // ---------------------------------------------------------------------------- automation

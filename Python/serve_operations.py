@@ -1,0 +1,438 @@
+"""The web server's volumes and its operations on a surface (docs/web.md, "The server").
+
+    pvpython --no-mpi Python/serve_operations.py --plugin MedicalIsosurfaces.so --results DIR \\
+        SOURCE [SOURCE ...]
+
+SOURCE is a volume file (MetaImage, VTK XML image, NIfTI .nii/.nii.gz), a DICOM series folder,
+or phantom:N (the plugin's MedicalPhantom, N^3 points). Python/serve.py opens its volumes with
+open_sources() below and starts this program once as its worker: one JSON line per job on stdin,
+JSON lines back on stdout (progress, then done, error or cancelled); SIGUSR1 cancels the job
+that runs. A job extracts the page's surface with the plugin's BlockLODContour (same volume,
+isovalue and level), applies the steps (smooth, fillHoles, clip, decimate) with VTK's filters,
+and writes the result as binary STL, binary little-endian PLY and appended-binary VTP, named by
+the job's result id, into the results folder.
+
+A process of its own, not a thread of the web server: VTK's Python wrappers keep the GIL while a
+filter runs, so a VTK thread would stop the server's event loop (every page, every other browser)
+for as long as the filter takes. Here the server stays responsive, and a crash or a filter that
+ignores abort costs only this process, which the server restarts.
+"""
+import argparse
+import json
+import os
+import signal
+import sys
+import time
+import traceback
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+PHANTOM = "phantom:"
+PHANTOM_EXTENT_MM = 192.0
+PHANTOM_DEFAULT = PHANTOM + "192"
+FORMATS = ("stl", "ply", "vtp")
+NIFTI_SUFFIXES = (".nii", ".nii.gz", ".hdr", ".img", ".hdr.gz", ".img.gz")
+
+
+def default_sources():
+    """The fetched head CT, else the phantom: what the server opens without --data."""
+    from fetch_data import resolve_cache_dir
+    ct = resolve_cache_dir(None) / "ct_head.mha"
+    return [str(ct)] if ct.is_file() else [PHANTOM_DEFAULT]
+
+
+def _has_dicom_files(folder):
+    """True when the folder holds at least one file with DICOM's 'DICM' preamble."""
+    for entry in sorted(os.listdir(folder)):
+        path = os.path.join(folder, entry)
+        try:
+            with open(path, "rb") as f:
+                if f.read(132)[128:132] == b"DICM":
+                    return True
+        except OSError:
+            continue
+    return False
+
+
+def _producer(image, name):
+    """A TrivialProducer proxy holding an image read by VTK directly (builtin session)."""
+    import paraview.simple as simple
+    producer = simple.TrivialProducer(registrationName=name)
+    producer.GetClientSideObject().SetOutput(image)
+    return producer
+
+
+def open_reader(spec, ns):
+    """A ParaView source for SOURCE, its display name and a note on the reader used.
+
+    ns holds the plugin's proxies (MedicalPhantom, BlockLODContour, and the readers the plugin
+    has: MedicalNIfTIReader for .nii.gz, MedicalDICOMSeriesReader for a series in patient space).
+    Raises ValueError with a message for the user when SOURCE cannot be opened.
+    """
+    import paraview.simple as simple
+    if spec.startswith(PHANTOM):
+        try:
+            n = int(spec[len(PHANTOM):])
+        except ValueError:
+            n = 0
+        if not 2 <= n <= 1024:
+            raise ValueError("%s: the phantom's size is an integer 2-1024" % spec)
+        phantom = ns["MedicalPhantom"](Dimensions=[n, n, n], Spacing=[PHANTOM_EXTENT_MM / n] * 3)
+        return phantom, "MedicalPhantom %d^3" % n, "the plugin's MedicalPhantom"
+    path = os.path.abspath(spec)
+    name = os.path.basename(os.path.normpath(path))
+    if os.path.isdir(path):
+        if not _has_dicom_files(path):
+            raise ValueError("%s: a folder, but it holds no DICOM files" % spec)
+        if "MedicalDICOMSeriesReader" in ns:
+            return ns["MedicalDICOMSeriesReader"](FileName=path), name, "MedicalDICOMSeriesReader"
+        return (simple.DICOMReaderdirectory(FileName=path), name,
+                "ParaView's DICOM reader (origin 0, rows and slices as vtkDICOMImageReader "
+                "orders them: the plugin's MedicalDICOMSeriesReader places a series in "
+                "patient space)")
+    if not os.path.isfile(path):
+        raise ValueError("%s: no such file or folder" % spec)
+    lower = path.lower()
+    if lower.endswith(NIFTI_SUFFIXES):
+        if "MedicalNIfTIReader" in ns:
+            return ns["MedicalNIfTIReader"](FileName=path), name, "MedicalNIfTIReader"
+        # ParaView 5.11's own NIfTI reader (the AnalyzeNIfTIReaderWriter plugin) reads only
+        # uncompressed files; VTK's reader reads both.
+        from vtkmodules.vtkIOImage import vtkNIFTIImageReader
+        reader = vtkNIFTIImageReader()
+        if not reader.CanReadFile(path):
+            raise ValueError("%s: not a NIfTI file VTK can read" % spec)
+        reader.SetFileName(path)
+        reader.Update()
+        return (_producer(reader.GetOutput(), name), name,
+                "VTK's vtkNIFTIImageReader (origin 0, no sform/qform; header scaling not applied)")
+    reader = simple.OpenDataFile(path)
+    if reader is None:
+        raise ValueError("%s: ParaView has no reader for this file" % spec)
+    return reader, name, reader.GetXMLLabel()
+
+
+def image_of(source, name):
+    """The source's vtkImageData (builtin session) and the array to contour, checked."""
+    source.UpdatePipeline()
+    image = source.GetClientSideObject().GetOutputDataObject(0)
+    if image is None or not image.IsA("vtkImageData"):
+        raise ValueError("%s: not a 3D image (%s)" % (name, image.GetClassName() if image else
+                                                      "nothing was read"))
+    dims = image.GetDimensions()
+    if min(dims) < 2:
+        raise ValueError("%s: %s points is not a 3D volume" % (name, "x".join(map(str, dims))))
+    data = image.GetPointData()
+    array = data.GetScalars()
+    if array is None or array.GetNumberOfComponents() != 1:
+        ones = [data.GetArray(i) for i in range(data.GetNumberOfArrays())
+                if data.GetArray(i) is not None and data.GetArray(i).GetNumberOfComponents() == 1]
+        if not ones:
+            raise ValueError("%s: no one-component point array to contour" % name)
+        array = ones[0]
+    if not array.GetName():
+        array.SetName("scalars")
+    return image, array
+
+
+def open_sources(specs, ns, log):
+    """[(source proxy, name, vtkImageData, vtkDataArray)] for the specs, in their order."""
+    opened = []
+    for spec in specs:
+        source, name, note = open_reader(spec, ns)
+        image, array = image_of(source, name)
+        log("%s: read with %s" % (name, note))
+        opened.append((source, name, image, array))
+    return opened
+
+
+# ---------------------------------------------------------------------------------- the worker
+class Cancelled(Exception):
+    pass
+
+
+class JobFailed(Exception):
+    pass
+
+
+class Worker:
+    """Runs jobs one at a time on the opened volumes; reports on `out` (JSON lines)."""
+
+    STAGES = ("surface", "smooth", "fillHoles", "clip", "decimate", "write")
+
+    def __init__(self, sources, ns, results, out):
+        self.sources = sources
+        self.ns = ns
+        self.results = results
+        self.out = out
+        self.contours = {}
+        self.cancel = False
+        self.job = None
+        self.errors = []
+        self.warnings = []
+        self.last = (0.0, 0.0, None)
+
+    def send(self, message):
+        self.out.write(json.dumps(message) + "\n")
+        self.out.flush()
+
+    # -- observers: progress, abort, the filters' own errors and warnings
+    def report(self, fraction, stage):
+        """A progress message, when the stage changed or 2% and 0.1 s have passed."""
+        now = time.monotonic()
+        last_fraction, last_time, last_stage = self.last
+        if stage != last_stage or (fraction - last_fraction >= 0.02 and now - last_time >= 0.1):
+            self.last = (fraction, now, stage)
+            self.send({"job": self.job, "progress": round(fraction, 4), "stage": stage})
+
+    def watch(self, algorithm, stage, index, count, span=1.0):
+        """Observers on a filter: progress (the filter's part of the job: index to index + span
+        of count parts), abort on cancel, its errors and warnings."""
+        from vtkmodules.util.misc import calldata_type
+        from vtkmodules.util.vtkConstants import VTK_STRING
+
+        def progress(caller, _event):
+            if self.cancel:
+                caller.SetAbortExecute(1)
+            else:
+                self.report((index + span * caller.GetProgress()) / count, stage)
+
+        @calldata_type(VTK_STRING)
+        def error(_caller, _event, text):
+            self.errors.append(_last_line(text))
+
+        @calldata_type(VTK_STRING)
+        def warning(_caller, _event, text):
+            self.warnings.append(_last_line(text))
+
+        algorithm.AddObserver("ProgressEvent", progress)
+        algorithm.AddObserver("ErrorEvent", error)
+        algorithm.AddObserver("WarningEvent", warning)
+        return algorithm
+
+    def run_filter(self, algorithm, stage, index, count, data, span=1.0):
+        self.watch(algorithm, stage, index, count, span)
+        algorithm.SetInputData(data)
+        self.report(index / count, stage)
+        algorithm.Update()
+        self.check(stage)
+        return algorithm.GetOutput()
+
+    def check(self, stage):
+        if self.cancel:
+            raise Cancelled()
+        if self.errors:
+            raise JobFailed("%s: %s" % (stage, self.errors[0]))
+
+    # -- the steps
+    def contour(self, index):
+        """One BlockLODContour per dataset, kept: its cache makes a repeated isovalue free."""
+        if index not in self.contours:
+            source, _, _, array = self.sources[index]
+            contour = self.ns["BlockLODContour"](Input=source,
+                                                ContourBy=["POINTS", array.GetName()],
+                                                ComputeNormals=0, AutoLOD=0)
+            self.contours[index] = contour
+        return self.contours[index]
+
+    def surface(self, job, count):
+        from vtkmodules.vtkCommonDataModel import vtkPolyData
+        contour = self.contour(job["dataset"])
+        algorithm = contour.GetClientSideObject()
+        algorithm.RemoveAllObservers()
+        self.watch(algorithm, "surface", 0, count)
+        algorithm.SetAbortExecute(0)
+        contour.Isosurfaces = [job["isovalue"]]
+        contour.LOD = job["level"]
+        self.report(0.0, "surface")
+        try:
+            contour.UpdatePipeline()
+            self.check("surface")
+        except Cancelled:
+            contour.GetClientSideObject().Modified()  # an aborted update is not a result
+            raise
+        surface = vtkPolyData()
+        surface.ShallowCopy(algorithm.GetOutputDataObject(0))
+        if surface.GetNumberOfCells() == 0:
+            raise JobFailed("no surface at isovalue %g at level %d" % (job["isovalue"],
+                                                                       job["level"]))
+        return surface
+
+    def step(self, name, params, index, count, data):
+        from vtkmodules.vtkCommonDataModel import vtkPlane
+        from vtkmodules.vtkFiltersCore import (vtkClipPolyData, vtkDecimatePro,
+                                               vtkSmoothPolyDataFilter, vtkTriangleFilter)
+        from vtkmodules.vtkFiltersModeling import vtkFillHolesFilter
+        if name == "smooth":
+            # ParaView's Smooth (Laplacian), with the relaxation factor it leaves at 0.01.
+            f = vtkSmoothPolyDataFilter()
+            f.SetNumberOfIterations(params["iterations"])
+            f.SetRelaxationFactor(params.get("relaxation", 0.01))
+            return self.run_filter(f, name, index, count, data)
+        if name == "fillHoles":
+            f = vtkFillHolesFilter()
+            f.SetHoleSize(params["size"])
+            filled = self.run_filter(f, name, index, count, data, 0.9)
+            return self.run_filter(vtkTriangleFilter(), name, index + 0.9, count, filled, 0.1)
+        if name == "clip":
+            # ParaView's Clip by a plane keeps the side behind the normal (Invert on).
+            plane = vtkPlane()
+            plane.SetOrigin(params["origin"])
+            plane.SetNormal(params["normal"])
+            f = vtkClipPolyData()
+            f.SetClipFunction(plane)
+            f.InsideOutOn()
+            clipped = self.run_filter(f, name, index, count, data, 0.9)
+            return self.run_filter(vtkTriangleFilter(), name, index + 0.9, count, clipped, 0.1)
+        if name == "decimate":
+            # ParaView's Decimate (vtkDecimatePro) with PreserveTopology on: without it the
+            # filter splits the mesh at sharp edges and a closed surface comes out with holes.
+            f = vtkDecimatePro()
+            f.SetTargetReduction(params["reduction"])
+            f.PreserveTopologyOn()
+            return self.run_filter(f, name, index, count, data)
+        raise JobFailed("unknown step %s" % name)
+
+    def write(self, rid, surface, index, count):
+        from vtkmodules.vtkCommonDataModel import vtkPolyData
+        from vtkmodules.vtkIOGeometry import vtkSTLWriter
+        from vtkmodules.vtkIOPLY import vtkPLYWriter
+        from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
+        self.report(index / count, "write")
+        bare = vtkPolyData()  # points and triangles only: the files hold the geometry
+        bare.SetPoints(surface.GetPoints())
+        bare.SetPolys(surface.GetPolys())
+        sizes = {}
+        for k, fmt in enumerate(FORMATS):
+            if fmt == "stl":
+                w = vtkSTLWriter()
+                w.SetFileTypeToBinary()
+            elif fmt == "ply":
+                w = vtkPLYWriter()
+                w.SetFileTypeToBinary()
+                w.SetDataByteOrderToLittleEndian()
+            else:
+                w = vtkXMLPolyDataWriter()
+                w.SetDataModeToAppended()
+                w.EncodeAppendedDataOff()
+            path = os.path.join(self.results, "%s.%s" % (rid, fmt))
+            part = os.path.join(self.results, "%s-part.%s" % (rid, fmt))
+            w.SetFileName(part)
+            w.SetInputData(bare)
+            self.watch(w, "write", index + k / len(FORMATS), count, 1.0 / len(FORMATS))
+            if not w.Write():
+                raise JobFailed("write: %s" % (self.errors[0] if self.errors else
+                                               "the %s writer failed" % fmt.upper()))
+            self.check("write")
+            os.replace(part, path)
+            sizes[fmt] = os.path.getsize(path)
+        return sizes
+
+    @staticmethod
+    def boundary_edges(surface):
+        from vtkmodules.vtkFiltersCore import vtkFeatureEdges
+        edges = vtkFeatureEdges()
+        edges.SetInputData(surface)
+        edges.BoundaryEdgesOn()
+        edges.FeatureEdgesOff()
+        edges.ManifoldEdgesOff()
+        edges.NonManifoldEdgesOff()
+        edges.Update()
+        return edges.GetOutput().GetNumberOfCells()
+
+    def run(self, job):
+        self.job = job["job"]
+        self.cancel = False
+        self.errors, self.warnings = [], []
+        self.last = (0.0, 0.0, None)
+        start = time.monotonic()
+        steps = job["steps"]
+        count = len(steps) + 2  # the surface, each step, the files
+        stages = []
+        try:
+            t = time.monotonic()
+            surface = self.surface(job, count)
+            stages.append({"stage": "surface", "triangles": surface.GetNumberOfCells(),
+                           "seconds": round(time.monotonic() - t, 3)})
+            for i, step in enumerate(steps):
+                (name, params), = step.items()
+                t = time.monotonic()
+                surface = self.step(name, params, i + 1, count, surface)
+                stages.append({"stage": name, "triangles": surface.GetNumberOfCells(),
+                               "seconds": round(time.monotonic() - t, 3)})
+                if surface.GetNumberOfCells() == 0:
+                    raise JobFailed("%s left no triangles" % name)
+            sizes = self.write(job["rid"], surface, count - 1, count)
+            self.send({"job": self.job, "done": True, "result": job["rid"],
+                       "triangles": surface.GetNumberOfCells(),
+                       "points": surface.GetNumberOfPoints(),
+                       "boundaryEdges": self.boundary_edges(surface),
+                       "bounds": [round(b, 4) for b in surface.GetBounds()],
+                       "bytes": sizes, "stages": stages, "warnings": self.warnings[:5],
+                       "seconds": round(time.monotonic() - start, 3)})
+        except Cancelled:
+            self.send({"job": self.job, "cancelled": True})
+        except JobFailed as e:
+            self.send({"job": self.job, "error": str(e)})
+        except Exception as e:  # a bug here must not end the worker: say it, go on
+            traceback.print_exc()
+            self.send({"job": self.job, "error": "internal error: %s: %s" % (type(e).__name__, e)})
+        finally:
+            for fmt in FORMATS:
+                part = os.path.join(self.results, "%s-part.%s" % (job["rid"], fmt))
+                if os.path.exists(part):
+                    os.remove(part)
+            self.job = None
+
+
+def _last_line(text):
+    """The message of a VTK error or warning, without the file and object it came from."""
+    lines = [line.strip() for line in str(text).strip().splitlines() if line.strip()]
+    message = lines[-1] if lines else str(text)
+    if "): " in message and message.startswith("vtk"):
+        message = message.split("): ", 1)[1]
+    return message
+
+
+def main(argv):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--plugin", required=True)
+    p.add_argument("--results", required=True, help="folder the results are written to")
+    p.add_argument("sources", nargs="+")
+    args = p.parse_args(argv)
+
+    # Messages go on the original stdout; anything a library prints goes to stderr.
+    out = os.fdopen(os.dup(1), "w")
+    os.dup2(2, 1)
+    sys.stdout = sys.stderr
+
+    worker = None
+
+    def cancel(_signum, _frame):
+        if worker is not None:
+            worker.cancel = True
+
+    signal.signal(signal.SIGUSR1, cancel)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the server ends this process itself
+
+    import paraview.simple as simple
+    ns = {"__name__": "medical_isosurfaces_proxies"}  # LoadPlugin fills a non-empty dict only
+    simple.LoadPlugin(args.plugin, ns=ns)
+    try:
+        sources = open_sources(args.sources, ns, lambda m: None)
+    except ValueError as e:
+        out.write(json.dumps({"fatal": str(e)}) + "\n")
+        out.flush()
+        return 1
+    worker = Worker(sources, ns, args.results, out)
+    worker.send({"ready": True, "datasets": [s[1] for s in sources]})
+    for line in os.fdopen(0, "r"):  # pvpython replaces sys.stdin
+        if not line.strip():
+            continue
+        job = json.loads(line)
+        worker.run(job)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

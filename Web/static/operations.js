@@ -1,0 +1,214 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The page's "On the server" panel (docs/web.md, Operations): a surface of the page, extracted
+// again by the server from the same isovalue and level, then smoothed, hole-filled, clipped and
+// decimated there with ParaView/VTK filters. Only the parameters go up, on a WebSocket opened at
+// the first request (an idle page keeps no connection); progress and the result's summary come
+// back, and the result itself only when asked for: downloads (STL, PLY, VTP), and the PLY for
+// window.mediso.showMesh when the page can draw a mesh. Every byte is counted into the readout.
+
+const $ = (id) => document.getElementById(id);
+const STAGES = {
+  queued: "waiting for the server",
+  surface: "extracting the surface",
+  smooth: "smoothing",
+  fillHoles: "filling holes",
+  clip: "clipping",
+  decimate: "decimating",
+  write: "writing the files",
+};
+const AXES = { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, 1] };
+
+// Bytes of one WebSocket frame on the wire: header, the client's mask, the payload.
+function frameBytes(payload, masked) {
+  const extended = payload > 65535 ? 8 : payload > 125 ? 2 : 0;
+  return 2 + extended + (masked ? 4 : 0) + payload;
+}
+
+function megabytes(n) {
+  return n >= 1e6 ? (n / 1e6).toFixed(1) + " MB" : Math.max(1, Math.round(n / 1e3)) + " kB";
+}
+
+/**
+ * Drives the panel. `page` gives what it needs from app.js:
+ *   dataset                  the dataset the page shows (docs/web.md's D)
+ *   token                    the session's token
+ *   surfaces()               the page's surfaces [{value, ...}]
+ *   level()                  the level the page fetched (0-3)
+ *   request(url)             app.js's counted fetch: {response, body}
+ *   count(sent, received)    adds bytes the panel moved itself (WebSocket) to the readout
+ */
+export function setupOperations(page) {
+  const section = $("op-run").closest("section");
+  const button = $("op-run");
+  const bar = $("op-progress");
+  const out = $("op-result");
+  const encoder = new TextEncoder();
+  let socket = null;
+  let opening = null;
+  let nextId = 1;
+  let current = null; // {id, isovalue, level} of the operation in flight
+
+  function setState(state, text) {
+    section.dataset.state = state;
+    out.classList.toggle("error", state === "error");
+    if (text !== undefined) {
+      out.textContent = text;
+    }
+    const busy = state === "running";
+    button.textContent = busy ? "Cancel" : "Run on the server";
+    bar.hidden = !busy;
+  }
+
+  function send(message) {
+    const text = JSON.stringify(message);
+    page.count(frameBytes(encoder.encode(text).length, true), 0);
+    socket.send(text);
+  }
+
+  function connect() {
+    if (socket && socket.readyState === WebSocket.OPEN) {
+      return Promise.resolve();
+    }
+    if (opening) {
+      return opening;
+    }
+    const url = new URL("api/ws", location.href);
+    url.protocol = location.protocol === "https:" ? "wss:" : "ws:";
+    url.search = "?token=" + encodeURIComponent(page.token);
+    opening = new Promise((resolve, reject) => {
+      const ws = new WebSocket(url);
+      // The handshake: the request line and headers a browser sends, the 101 answer.
+      page.count(url.href.length + 420, 160);
+      ws.onopen = () => { socket = ws; opening = null; resolve(); };
+      ws.onerror = () => { opening = null; reject(new Error("the server's WebSocket is not reachable")); };
+      ws.onmessage = (event) => {
+        page.count(0, frameBytes(encoder.encode(event.data).length, false));
+        receive(JSON.parse(event.data));
+      };
+      ws.onclose = (event) => {
+        socket = null;
+        if (current) {
+          current = null;
+          setState("error", "The connection to the server closed (" + event.code +
+            (event.reason ? ": " + event.reason : "") + ").");
+        }
+      };
+    });
+    return opening;
+  }
+
+  function steps() {
+    const d = page.dataset;
+    const list = [];
+    if ($("op-smooth").checked) {
+      list.push({ smooth: { iterations: Math.round(Number($("op-iterations").value)), relaxation: 0.1 } });
+    }
+    if ($("op-fill").checked) {
+      list.push({ fillHoles: { size: Number($("op-hole").value) } });
+    }
+    if ($("op-clip").checked) {
+      const centre = d.origin.map((o, a) => o + d.spacing[a] * (d.dims[a] - 1) / 2);
+      list.push({ clip: { origin: centre, normal: AXES[$("op-normal").value] } });
+    }
+    if ($("op-decimate").checked) {
+      list.push({ decimate: { reduction: Number($("op-reduction").value) } });
+    }
+    return list;
+  }
+
+  async function run() {
+    const surface = page.surfaces()[Number($("op-surface").value)];
+    if (!surface) {
+      setState("error", "Choose a surface first.");
+      return;
+    }
+    const choice = $("op-level").value;
+    const level = choice === "page" ? page.level() : Number(choice);
+    current = { id: nextId++, isovalue: surface.value, level };
+    bar.value = 0;
+    setState("running", "Sending the parameters...");
+    try {
+      await connect();
+      send({ op: "surface", id: current.id, dataset: page.dataset.id, isovalue: surface.value,
+             level, steps: steps() });
+    } catch (error) {
+      current = null;
+      setState("error", error.message);
+    }
+  }
+
+  function receive(message) {
+    if (!current || message.id !== current.id) {
+      if (message.error && message.id === null) {
+        setState("error", "The server refused a message: " + message.error);
+      }
+      return;
+    }
+    if (message.progress !== undefined) {
+      bar.value = message.progress;
+      out.textContent = (STAGES[message.stage] || message.stage) + "... " +
+        Math.round(100 * message.progress) + "%";
+    } else if (message.done) {
+      current = null;
+      showResult(message);
+    } else if (message.cancelled) {
+      current = null;
+      setState("cancelled", "Cancelled.");
+    } else if (message.error) {
+      current = null;
+      setState("error", "The server says: " + message.error);
+    }
+  }
+
+  async function download(result, format) {
+    const { body } = await page.request("/api/result/" + result.result + "?format=" + format);
+    const name = page.dataset.name.replace(/\.[^.]*$/, "").replace(/[^\w.-]+/g, "_") + "-" +
+      result.isovalue + "-level" + result.level + "." + format;
+    const link = Object.assign(document.createElement("a"), {
+      href: URL.createObjectURL(new Blob([body])), download: name });
+    document.body.append(link);
+    link.click();
+    link.remove();
+    setTimeout(() => URL.revokeObjectURL(link.href), 10000);
+  }
+
+  function showResult(result) {
+    setState("done", "");
+    section.dataset.result = result.result;
+    const closed = result.boundaryEdges === 0 ? "closed (no boundary edges)"
+      : result.boundaryEdges.toLocaleString() + " boundary edges";
+    const chain = result.stages.map((s) => s.stage + " " + s.triangles.toLocaleString()).join(" → ");
+    const summary = document.createElement("div");
+    summary.textContent = "Isovalue " + result.isovalue + " at level " + result.level + ": " +
+      result.triangles.toLocaleString() + " triangles, " + result.points.toLocaleString() +
+      " points, " + closed + ", " + result.seconds.toFixed(2) + " s on the server (" + chain + ").";
+    const links = document.createElement("div");
+    links.className = "downloads";
+    for (const format of ["stl", "ply", "vtp"]) {
+      const a = Object.assign(document.createElement("a"), {
+        href: "#", textContent: format.toUpperCase() + " (" + megabytes(result.bytes[format]) + ")" });
+      a.dataset.format = format;
+      a.onclick = (event) => {
+        event.preventDefault();
+        download(result, format).catch((error) => setState("error", error.message));
+      };
+      links.append(a, " ");
+    }
+    out.replaceChildren(summary, "Download: ", links);
+    if (window.mediso && typeof window.mediso.showMesh === "function") {
+      page.request("/api/result/" + result.result + "?format=ply")
+        .then(({ body }) => window.mediso.showMesh(body))
+        .catch((error) => setState("error", "The result could not be shown: " + error.message));
+    }
+  }
+
+  button.onclick = () => {
+    if (current && socket) {
+      send({ op: "cancel", id: current.id });
+      out.textContent = "Cancelling...";
+    } else if (!current) {
+      run();
+    }
+  };
+  setState("idle", "");
+}
