@@ -67,7 +67,7 @@ def parse_args(argv):
     p.add_argument("--host", default="127.0.0.1",
                    help="address to listen on (default 127.0.0.1: this machine only)")
     p.add_argument("--token", default="", help="the session's token (default: a random one)")
-    p.add_argument("--plugin", required=True, help="MedicalIsosurfaces.so")
+    p.add_argument("--plugin", required=True, type=os.path.abspath, help="MedicalIsosurfaces.so")
     p.add_argument("--wasm", default=os.path.join(ROOT, "build-web", "bin"),
                    help="folder of mediso.js and mediso.wasm")
     p.add_argument("--max-operation-seconds", type=float, default=900.0,
@@ -317,6 +317,7 @@ class Operations:
         self.folder = tempfile.mkdtemp(prefix="mediso-results-")
         self.queue = collections.deque()
         self.wake = asyncio.Event()
+        self.starting = asyncio.Lock()
         self.results = {}
         self.process = None
         self.running = None
@@ -329,18 +330,21 @@ class Operations:
     async def start_worker(self):
         command = [PVPYTHON, "--no-mpi", os.path.join(HERE, "serve_operations.py"),
                    "--plugin", self.args.plugin, "--results", self.folder] + self.specs
-        self.process = await asyncio.create_subprocess_exec(
+        process = await asyncio.create_subprocess_exec(
             *command, stdin=asyncio.subprocess.PIPE, stdout=asyncio.subprocess.PIPE,
             limit=1 << 20, start_new_session=True)
         try:
-            line = await asyncio.wait_for(self.process.stdout.readline(), WORKER_START_S)
+            line = await asyncio.wait_for(process.stdout.readline(), WORKER_START_S)
             message = json.loads(line) if line else {"fatal": "it exited (%s)" %
-                                                     await self.process.wait()}
+                                                     await process.wait()}
         except (asyncio.TimeoutError, ValueError) as e:
             message = {"fatal": "it did not start (%s)" % (type(e).__name__)}
         if not message.get("ready"):
-            await self.stop_worker()
+            if process.returncode is None:
+                process.kill()
+                await process.wait()
             raise RuntimeError(message.get("fatal", "no ready message"))
+        self.process = process
 
     async def stop_worker(self):
         process, self.process = self.process, None
@@ -349,6 +353,10 @@ class Operations:
             await process.wait()
 
     async def ensure_worker(self):
+        async with self.starting:  # one start at a time: at server start and for a job
+            return await self._ensure_worker()
+
+    async def _ensure_worker(self):
         if self.process is not None and self.process.returncode is None:
             return True
         for attempt in range(3):
