@@ -22,6 +22,7 @@ import os
 import secrets
 import shutil
 import signal
+import socket
 import sys
 import tempfile
 import time
@@ -685,6 +686,12 @@ def make_app(args, datasets, operations):
 
 def main(argv):
     args = parse_args(argv)
+    try:  # first: a port in use is said before any volume is read
+        family = socket.getaddrinfo(args.host, args.port, type=socket.SOCK_STREAM)[0][0]
+        listener = socket.create_server((args.host, args.port), family=family)
+    except OSError as e:
+        raise SystemExit("serve: cannot listen on %s:%d: %s" % (args.host, args.port,
+                                                                 e.strerror or e))
     import paraview.simple as simple
     ns = {"__name__": "medical_isosurfaces_proxies"}  # LoadPlugin fills a non-empty dict only
     simple.LoadPlugin(args.plugin, ns=ns)
@@ -705,11 +712,7 @@ def main(argv):
     if args.host not in ("127.0.0.1", "localhost", "::1"):
         log("listening on %s: anyone who can reach it and has the URL can use it" % args.host)
     log("open http://%s:%d/?token=%s" % (host, args.port, args.token))
-    try:
-        web.run_app(app, host=args.host, port=args.port, print=None, access_log=None)
-    except OSError as e:
-        shutil.rmtree(operations.folder, ignore_errors=True)
-        raise SystemExit("serve: cannot listen on %s:%d: %s" % (args.host, args.port, e.strerror))
+    web.run_app(app, sock=listener, print=None, access_log=None)
     return 0
 
 
