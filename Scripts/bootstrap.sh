@@ -32,6 +32,8 @@ packages=(
   # the GPU core's headless host (mediso-render, EGL tests): EGL, the Khronos
   # GLES3 headers, Mesa's EGL (surfaceless llvmpipe), zlib for PNG
   libegl-dev libgles-dev libegl-mesa0 zlib1g-dev
+  # the web server (Python/serve.py) and its browser tests (Debian's chromium, headless)
+  python3-aiohttp chromium
 )
 
 missing=()

@@ -25,6 +25,16 @@ for arg in "$@"; do
 done
 
 plugin=$("$repo/Scripts/bootstrap.sh" | tee /dev/stderr | tail -n 1)
+# The server's web framework (Python's wslink is not packaged; aiohttp is).
+if ! dpkg-query -W -f='${Status}' python3-aiohttp 2>/dev/null | grep -q "install ok installed"; then
+  echo "serve: installing python3-aiohttp" >&2
+  sudo=()
+  [ "$(id -u)" = 0 ] || sudo=(sudo)
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo[@]}" apt-get install -y -q --no-install-recommends python3-aiohttp >&2 ||
+    { "${sudo[@]}" apt-get update -q >&2 &&
+      "${sudo[@]}" apt-get install -y -q --no-install-recommends python3-aiohttp >&2; }
+fi
 "$repo/Scripts/build-web.sh" >&2
 if [ $has_data = 0 ]; then
   python3 "$repo/Python/fetch_data.py" --only ct >&2 ||

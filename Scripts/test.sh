@@ -12,6 +12,7 @@ set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 build=${MEDISO_BUILD_DIR:-$repo/build}
 "$repo/Scripts/bootstrap.sh"
+"$repo/Scripts/build-web.sh" # the page's WebAssembly module, for the browser tests
 
 if [ "${MEDISO_ASAN:-1}" != 0 ]; then
   asan="$build-asan"

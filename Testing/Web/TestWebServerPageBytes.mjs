@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The paper's claim on the wire, counted by Chrome itself (CDP network events, WebSocket frames
+// included): the page fetches the volume once, in at most 0.6x its raw bytes, and then 20
+// isovalue changes, 5 colour and opacity changes and 5 camera changes send and receive nothing
+// at all: no request, no WebSocket frame, 0 bytes; the page's own readout agrees. On the
+// server's default dataset: the head CT when it is fetched, else the phantom (said).
+import { Checks, countWire, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
+
+const checks = new Checks();
+const server = await startServer();
+const browser = await launchBrowser();
+const context = await browser.newContext({ viewport: { width: 1280, height: 800 } });
+const page = await context.newPage();
+const wire = await countWire(context, page);
+await openPage(page, server);
+
+const dataset = (await (await fetch(server.api("/api/datasets"))).json()).datasets[0];
+console.log("dataset: " + dataset.name + " " + dataset.dims.join("x") + " " + dataset.type +
+  (dataset.name.startsWith("MedicalPhantom") ? " (the head CT is not fetched: the phantom)" : ""));
+const volumes = [...wire.responses.values()].filter((r) => r.url.includes("/api/volume/"));
+checks.check(volumes.length === 1, "the volume is fetched once (" + volumes.length + ")");
+for (const v of volumes) {
+  const raw = Number(v.headers["x-mediso-raw-bytes"] || v.headers["X-Mediso-Raw-Bytes"]);
+  checks.check(v.encodedDataLength > 0 && v.encodedDataLength <= 0.6 * raw,
+    "the volume crossed in " + v.encodedDataLength + " bytes with its headers, " +
+    (v.encodedDataLength / raw).toFixed(3) + "x its " + raw + " raw bytes (at most 0.6x)");
+}
+checks.check(wire.framesSent + wire.framesReceived === 0,
+  "no WebSocket frame while the page loads and renders (" + wire.framesSent + " sent)");
+
+const before = { events: wire.events, received: wire.received, requests: wire.requests.length,
+  frames: wire.framesSent + wire.framesReceived };
+const stats0 = await page.evaluate(() => window.mediso.stats());
+const [lo, hi] = dataset.range;
+const primitives = [];
+for (let i = 0; i < 20; ++i) {
+  const v = lo + (hi - lo) * (0.15 + 0.6 * i / 19);
+  const s = await page.evaluate((value) => window.mediso.setIsovalues([value]), v);
+  primitives.push(s.primitives);
+}
+for (let i = 0; i < 5; ++i) {
+  await page.evaluate((k) => window.mediso.setSurfaces([
+    { value: -500 + 10 * k, color: [0.2 * k, 0.5, 0.9], opacity: 0.3 + 0.1 * k },
+    { value: 400, color: [1, 1, 1], opacity: 1 }]), i);
+}
+const view = await page.evaluate(() => window.mediso.getView());
+for (let i = 0; i < 5; ++i) {
+  const angle = (i + 1) * 0.3;
+  const d = view.position.map((p, a) => p - view.focalPoint[a]);
+  const r = Math.hypot(d[0], d[2]);
+  await page.evaluate((v) => window.mediso.setView(v), {
+    position: [view.focalPoint[0] + r * Math.sin(angle), view.position[1],
+      view.focalPoint[2] + r * Math.cos(angle)],
+    focalPoint: view.focalPoint, viewUp: view.viewUp, viewAngle: view.viewAngle });
+}
+await page.waitForTimeout(1500); // anything late would show up here
+const stats1 = await page.evaluate(() => window.mediso.stats());
+checks.check(new Set(primitives).size > 10,
+  "the 20 isovalue changes drew different surfaces (" + new Set(primitives).size +
+  " distinct primitive counts)");
+checks.check(wire.requests.length === before.requests,
+  "20 isovalue, 5 colour/opacity and 5 camera changes: " +
+  (wire.requests.length - before.requests) + " HTTP requests");
+checks.check(wire.framesSent + wire.framesReceived === before.frames,
+  "... " + (wire.framesSent + wire.framesReceived - before.frames) + " WebSocket frames");
+checks.check(wire.received === before.received && wire.events === before.events,
+  "... " + (wire.received - before.received) + " bytes received, " +
+  (wire.events - before.events) + " network events in all");
+checks.check(stats1.bytesSent === stats0.bytesSent && stats1.bytesReceived === stats0.bytesReceived,
+  "... and the page's readout agrees (" + stats1.bytesSent + " B sent, " +
+  stats1.bytesReceived + " B received since it loaded)");
+await checks.finish(browser, server);

@@ -1,0 +1,179 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// What the web server's browser tests share: Python/serve.py started on a free port, Debian's
+// chromium (headless, SwiftShader's WebGL2) driven by playwright-core, the page opened and
+// ready, the bytes on the wire counted by Chrome's own network events (CDP), checks that print
+// ok/FAILED and end the test. Run through Testing/Scripts/web-test.sh (npm ci first).
+import { spawn } from "node:child_process";
+import { existsSync } from "node:fs";
+import net from "node:net";
+import path from "node:path";
+import { fileURLToPath } from "node:url";
+
+export const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), "..", "..");
+
+export function skip(reason) {
+  console.log("SKIP: " + reason);
+  process.exit(125);
+}
+
+function freePort() {
+  return new Promise((resolve, reject) => {
+    const s = net.createServer();
+    s.on("error", reject);
+    s.listen(0, "127.0.0.1", () => {
+      const { port } = s.address();
+      s.close(() => resolve(port));
+    });
+  });
+}
+
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+/** Python/serve.py in pvpython; `data`: its --data values (none: the server's default). */
+export async function startServer(data = []) {
+  const plugin = process.env.MEDISO_PLUGIN || "";
+  if (!existsSync(plugin)) {
+    skip("MEDISO_PLUGIN does not name the built plugin (" + plugin + ")");
+  }
+  const wasm = path.join(process.env.MEDISO_WEB_BUILD_DIR || path.join(ROOT, "build-web"), "bin");
+  if (!existsSync(path.join(wasm, "mediso.wasm"))) {
+    skip("the page's WebAssembly module is not built in " + wasm + " (Scripts/build-web.sh)");
+  }
+  const port = await freePort();
+  const token = "t" + Math.random().toString(36).slice(2, 12);
+  const args = ["--no-mpi", path.join(ROOT, "Python", "serve.py"), "--plugin", plugin,
+    "--wasm", wasm, "--token", token, "--port", String(port),
+    ...data.flatMap((d) => ["--data", d])];
+  const child = spawn(process.env.MEDISO_PVPYTHON || "pvpython", args,
+    { stdio: ["ignore", "pipe", "pipe"] });
+  const lines = [];
+  const collect = (chunk) => lines.push(chunk.toString());
+  child.stdout.on("data", collect);
+  child.stderr.on("data", collect);
+  let exitCode = null;
+  const exited = new Promise((resolve) => child.on("exit", (code, signal) => {
+    exitCode = code ?? signal;
+    resolve();
+  }));
+  const base = "http://127.0.0.1:" + port;
+  const server = {
+    base, token, lines, url: base + "/?token=" + token,
+    api: (p) => base + p + (p.includes("?") ? "&" : "?") + "token=" + token,
+    alive: () => exitCode === null,
+    get exitCode() { return exitCode; },
+    async stop() {
+      if (exitCode === null) {
+        child.kill("SIGTERM");
+        await Promise.race([exited, sleep(30000)]);
+        if (exitCode === null) {
+          child.kill("SIGKILL");
+          await exited;
+        }
+      }
+    },
+  };
+  const deadline = Date.now() + 180000;
+  while (Date.now() < deadline && exitCode === null) {
+    try {
+      const status = await (await fetch(server.api("/api/status"))).json();
+      if (status.worker.pid) {
+        return server;
+      }
+    } catch { /* not listening yet */ }
+    await sleep(200);
+  }
+  console.log(lines.join(""));
+  await server.stop();
+  throw new Error("FAILED: the server did not start (exit " + exitCode + ")");
+}
+
+export async function launchBrowser() {
+  let chromium;
+  try {
+    ({ chromium } = await import("playwright-core"));
+  } catch (error) {
+    skip("playwright-core is not installed in Testing/Web (npm ci): " + error.message);
+  }
+  return chromium.launch({
+    executablePath: "/usr/bin/chromium",
+    args: ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+      "--disable-background-networking", "--disable-component-update", "--disable-sync",
+      "--no-first-run"],
+  });
+}
+
+/**
+ * Everything the page sends and receives, from Chrome's network events: HTTP requests (their
+ * encoded bytes as loaded, headers included) and WebSocket handshakes and frames.
+ */
+export async function countWire(context, page) {
+  const cdp = await context.newCDPSession(page);
+  const wire = { events: 0, requests: [], received: 0, framesSent: 0, framesReceived: 0,
+    frameBytesSent: 0, frameBytesReceived: 0, responses: new Map() };
+  cdp.on("Network.requestWillBeSent", (e) => {
+    wire.events++;
+    wire.requests.push({ id: e.requestId, url: e.request.url });
+  });
+  cdp.on("Network.responseReceived", (e) => {
+    wire.events++;
+    wire.responses.set(e.requestId, { url: e.response.url, headers: e.response.headers });
+  });
+  cdp.on("Network.dataReceived", () => { wire.events++; });
+  cdp.on("Network.loadingFinished", (e) => {
+    wire.events++;
+    wire.received += e.encodedDataLength;
+    const r = wire.responses.get(e.requestId);
+    if (r) {
+      r.encodedDataLength = e.encodedDataLength;
+    }
+  });
+  cdp.on("Network.webSocketCreated", () => { wire.events++; });
+  cdp.on("Network.webSocketFrameSent", (e) => {
+    wire.events++;
+    wire.framesSent++;
+    wire.frameBytesSent += Buffer.byteLength(e.response.payloadData);
+  });
+  cdp.on("Network.webSocketFrameReceived", (e) => {
+    wire.events++;
+    wire.framesReceived++;
+    wire.frameBytesReceived += Buffer.byteLength(e.response.payloadData);
+  });
+  await cdp.send("Network.enable");
+  return wire;
+}
+
+/** Opens the page and waits for its first frame (window.mediso.ready). */
+export async function openPage(page, server) {
+  page.on("console", (m) => console.log("console." + m.type() + ": " + m.text()));
+  page.on("pageerror", (e) => console.log("pageerror: " + e.message));
+  await page.goto(server.url, { waitUntil: "commit" });
+  await page.waitForFunction(() => window.mediso !== undefined, null, { timeout: 120000 });
+  await page.evaluate(() => window.mediso.ready);
+}
+
+export class Checks {
+  constructor() {
+    this.failures = 0;
+  }
+
+  check(ok, what) {
+    console.log((ok ? "ok: " : "FAILED: ") + what);
+    if (!ok) {
+      this.failures++;
+    }
+    return ok;
+  }
+
+  async finish(browser, ...servers) {
+    if (browser) {
+      await browser.close();
+    }
+    for (const server of servers) {
+      await server.stop();
+      console.log("---- server output\n" + server.lines.join("").trimEnd());
+      this.check(server.exitCode === 0, "the server ended cleanly (exit " + server.exitCode + ")");
+    }
+    console.log(this.failures + " failure(s)");
+    process.exit(this.failures ? 1 : 0);
+  }
+}
