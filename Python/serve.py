@@ -45,6 +45,7 @@ MAX_STEPS = 8
 MAX_PENDING = 4                # operations queued or running per page
 MAX_SESSIONS = 64              # WebSockets open at once
 RESULTS_PER_SESSION = 8        # the oldest result of a page goes when a ninth arrives
+MAX_RESULTS = 32               # and the oldest of all when the server holds more
 RESULT_GRACE_S = 300           # a closed page's results stay downloadable this long
 CANCEL_GRACE_S = 10            # a cancelled operation that runs on past this ends its worker
 WORKER_START_S = 300
@@ -420,7 +421,11 @@ class Operations:
         while True:
             while not self.queue:
                 self.wake.clear()
-                await self.wake.wait()
+                try:
+                    await asyncio.wait_for(self.wake.wait(), 60)
+                except asyncio.TimeoutError:
+                    pass
+                self.expire_results()
             job = self.queue.popleft()
             self.running = job
             job.running = True
@@ -444,9 +449,22 @@ class Operations:
         r = job.request
         line = {"job": job.number, "rid": job.rid, "dataset": self.index[r["dataset"].ident],
                 "isovalue": r["isovalue"], "level": r["level"], "steps": r["steps"]}
-        process = self.process
-        process.stdin.write((json.dumps(line) + "\n").encode())
-        await process.stdin.drain()
+        for attempt in (1, 2):  # a worker that died while idle is replaced once
+            if job.cancelled:  # while the worker started
+                await job.session.send({"id": ident, "cancelled": True})
+                return
+            process = self.process
+            try:
+                process.stdin.write((json.dumps(line) + "\n").encode())
+                await process.stdin.drain()
+                break
+            except (BrokenPipeError, ConnectionResetError):
+                await self.stop_worker()
+                self.restarts += 1
+                if attempt == 2 or not await self.ensure_worker():
+                    await job.session.send({"id": ident, "error": self.unavailable or
+                                            "the server's operation process is not running"})
+                    return
         started = time.monotonic()
         read = None
         while True:
@@ -515,6 +533,10 @@ class Operations:
         session.results[job.rid] = result
         while len(session.results) > RESULTS_PER_SESSION:
             _, old = session.results.popitem(last=False)
+            self.drop(old)
+        while len(self.results) > MAX_RESULTS:  # the oldest of any page
+            old = next(iter(self.results.values()))
+            old.session.results.pop(old.rid, None)
             self.drop(old)
         await session.send(summary)
 

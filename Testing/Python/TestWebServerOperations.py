@@ -7,7 +7,8 @@ with VTK, has the summary's triangles and no boundary edge (watertight), whose P
 back to the same surface; a clip opens it (boundary edges, every point behind the plane).
 Progress comes in order; a running and a queued operation cancel; two clients at once each get
 their own answers; a client that closes mid-operation stops it; a worker killed mid-operation
-gives an error and is replaced; after each the server serves the next operation.
+gives an error and is replaced, one killed while idle is replaced unseen; after each the server
+serves the next operation.
 """
 import asyncio
 import json
@@ -256,6 +257,12 @@ async def worker_killed(http):
     s = await status(http)
     checks(s["worker"]["restarts"] == 1 and s["worker"]["pid"] != pid,
            "the worker was replaced once (restarts %d)" % s["worker"]["restarts"])
+    os.kill(s["worker"]["pid"], signal.SIGKILL)  # now while it waits for work
+    await asyncio.sleep(0.5)
+    async with http.ws_connect(server.ws_url()) as ws:
+        _, answer = await webserver.operation(ws, request(3, "d0", ISO, 1))
+        checks(answer.get("done") is True, "a worker killed while idle: the next operation "
+               "runs on a new one (%s)" % answer.get("error", "done"))
 
 
 async def main(folder):
