@@ -73,16 +73,13 @@ class Encoder:
         self.writers["PNG"] = png
 
     def __call__(self):
-        """{encoding: bytes} of the image now in the view, and the seconds the first took."""
+        """{encoding: bytes} of the image now in the view."""
         self.grab.Modified()
-        sizes, seconds = {}, None
+        sizes = {}
         for name, w in self.writers.items():
-            start = time.perf_counter()
             w.Write()
-            if seconds is None:
-                seconds = time.perf_counter() - start
             sizes[name] = w.GetResult().GetNumberOfTuples()
-        return sizes, seconds
+        return sizes
 
 
 def surface_bytes(image, array, isovalue):
@@ -165,27 +162,26 @@ def main(argv):
         caps = view.GetRenderWindow().ReportCapabilities()
         renderer = next((line.split(":", 1)[1].strip() for line in caps.splitlines()
                          if "renderer string" in line), renderer)
-        per_change, change_s = {}, []
-        for v in isovalues:  # as the page's setIsovalues([v]): the first surface's looks
-            show([(v,) + scene[0][1:]])
-            start = time.perf_counter()
-            simple.Render(view)
-            sizes, encode_s = encoder()
-            change_s.append(time.perf_counter() - start)
-            for k, n in sizes.items():
-                per_change.setdefault(k, []).append(n)
+
+        def images(changes):
+            """Each change made, rendered and encoded: ({encoding: [bytes]}, [seconds])."""
+            sizes, seconds = {}, []
+            for change in changes:
+                change()
+                start = time.perf_counter()
+                simple.Render(view)
+                for k, n in encoder().items():
+                    sizes.setdefault(k, []).append(n)
+                seconds.append(time.perf_counter() - start)
+            return sizes, seconds
+
+        # As the page's setIsovalues([v]): the first surface's looks at each new value.
+        per_change, change_s = images(lambda v=v: show([(v,) + scene[0][1:]])
+                                      for v in isovalues)
         show(scene)
         simple.ResetCamera(view)
         camera = view.GetActiveCamera()
-        per_frame, frame_s = {}, []
-        for _ in range(args.frames):
-            camera.Azimuth(1.0)
-            start = time.perf_counter()
-            simple.Render(view)
-            sizes, encode_s = encoder()
-            frame_s.append(time.perf_counter() - start)
-            for k, n in sizes.items():
-                per_frame.setdefault(k, []).append(n)
+        per_frame, frame_s = images(lambda: camera.Azimuth(1.0) for _ in range(args.frames))
         results.append((size, per_change, change_s, per_frame, frame_s))
         if os.environ.get("MEDISO_BENCHMARK_IMAGE"):  # to look at what was measured
             simple.SaveScreenshot(os.environ["MEDISO_BENCHMARK_IMAGE"] % size, view)
