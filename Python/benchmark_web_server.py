@@ -27,7 +27,6 @@ import platform
 import statistics
 import sys
 import time
-import zlib
 
 SKIN = (0.93, 0.75, 0.62)
 BONE = (0.97, 0.95, 0.88)
@@ -80,6 +79,20 @@ class Encoder:
             w.Write()
             sizes[name] = w.GetResult().GetNumberOfTuples()
         return sizes
+
+
+def images(view, encoder, changes):
+    """Each change made, rendered and encoded: ({encoding: [bytes]}, [seconds])."""
+    import paraview.simple as simple
+    sizes, seconds = {}, []
+    for change in changes:
+        change()
+        start = time.perf_counter()
+        simple.Render(view)
+        for k, n in encoder().items():
+            sizes.setdefault(k, []).append(n)
+        seconds.append(time.perf_counter() - start)
+    return sizes, seconds
 
 
 def surface_bytes(image, array, isovalue):
@@ -163,25 +176,14 @@ def main(argv):
         renderer = next((line.split(":", 1)[1].strip() for line in caps.splitlines()
                          if "renderer string" in line), renderer)
 
-        def images(changes):
-            """Each change made, rendered and encoded: ({encoding: [bytes]}, [seconds])."""
-            sizes, seconds = {}, []
-            for change in changes:
-                change()
-                start = time.perf_counter()
-                simple.Render(view)
-                for k, n in encoder().items():
-                    sizes.setdefault(k, []).append(n)
-                seconds.append(time.perf_counter() - start)
-            return sizes, seconds
-
         # As the page's setIsovalues([v]): the first surface's looks at each new value.
-        per_change, change_s = images(lambda v=v: show([(v,) + scene[0][1:]])
-                                      for v in isovalues)
+        per_change, change_s = images(view, encoder, (lambda v=v: show([(v,) + scene[0][1:]])
+                                                      for v in isovalues))
         show(scene)
         simple.ResetCamera(view)
         camera = view.GetActiveCamera()
-        per_frame, frame_s = images(lambda: camera.Azimuth(1.0) for _ in range(args.frames))
+        per_frame, frame_s = images(view, encoder,
+                                    (lambda: camera.Azimuth(1.0) for _ in range(args.frames)))
         results.append((size, per_change, change_s, per_frame, frame_s))
         if os.environ.get("MEDISO_BENCHMARK_IMAGE"):  # to look at what was measured
             simple.SaveScreenshot(os.environ["MEDISO_BENCHMARK_IMAGE"] % size, view)

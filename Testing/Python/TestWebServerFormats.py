@@ -11,7 +11,6 @@ of size 1) and a port in use each stop the server with a message saying why.
 """
 import asyncio
 import gzip
-import json
 import os
 import subprocess
 import sys
