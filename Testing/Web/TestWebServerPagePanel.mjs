@@ -4,8 +4,9 @@
 // STL downloaded through the panel's link is binary, holds the summary's triangles and is
 // watertight (every edge shared by two triangles); the PLY goes to window.mediso.showMesh; the
 // WebSocket opens only at the first request and its frames (counted by CDP) are in the page's
-// readout; a server refusal (a hole size of 0) and a cancel show in the panel; the page then
-// still changes isovalues without a byte.
+// readout; a server refusal (a hole size of 0) and a cancel show in the panel; with a second
+// browser running a long operation the first one's waits, and runs when the second closes
+// mid-operation; the page then still changes isovalues without a byte.
 import { readFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
@@ -130,6 +131,30 @@ await waitState(["cancelled", "done", "error"], 60000);
 checks.check(await state() === "cancelled", "Cancel stops it: " + await page.textContent("#op-result"));
 const status = await (await fetch(server.api("/api/status"))).json();
 checks.check(!status.running && status.worker.restarts === 0, "the server is idle again");
+
+// Two browsers: a second one starts a long operation, the first queues a short one behind it
+// (and says it waits), then the second closes mid-operation: its operation stops and the first's
+// runs.
+const context2 = await browser.newContext({ viewport: { width: 1280, height: 1000 } });
+const page2 = await context2.newPage();
+await openPage(page2, server);
+await page2.fill("#op-iterations", "500");
+await page2.click("#op-run");
+await page2.waitForFunction(() => /smoothing/.test(document.getElementById("op-result").textContent),
+  null, { timeout: 120000 });
+await page.fill("#op-iterations", "5");
+await page.click("#op-run");
+await page.waitForFunction(
+  () => /waiting for the server/.test(document.getElementById("op-result").textContent),
+  null, { timeout: 60000 });
+await context2.close();
+await waitState(["done", "error", "cancelled"], 120000);
+checks.check(await state() === "done",
+  "two browsers: the first's operation waited, then ran once the second closed mid-operation");
+const after = await (await fetch(server.api("/api/status"))).json();
+checks.check(!after.running && after.worker.restarts === 0 && after.sessions === 1,
+  "the closed browser's operation was stopped by abort and its socket is gone (" +
+  JSON.stringify(after) + ")");
 
 // The page still changes isovalues without a byte.
 const events = wire.events;
