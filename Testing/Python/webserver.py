@@ -9,6 +9,7 @@ aiohttp or the plugin is missing. Everything the server prints is printed again 
 VTK error or a traceback in the server fails the test through ctest's FAIL_REGULAR_EXPRESSION.
 """
 import asyncio
+import atexit
 import os
 import secrets
 import shutil
@@ -89,6 +90,7 @@ class Server:
         self.process = subprocess.Popen(command, stdout=subprocess.PIPE,
                                         stderr=subprocess.STDOUT, text=True,
                                         stdin=subprocess.DEVNULL)
+        atexit.register(self.stop)  # whatever ends the test, the server goes with it
         self.reader = threading.Thread(target=self._read, daemon=True)
         self.reader.start()
         deadline = time.monotonic() + 180

@@ -51,6 +51,11 @@ export async function startServer(data = []) {
   child.stdout.on("data", collect);
   child.stderr.on("data", collect);
   let exitCode = null;
+  process.on("exit", () => { // whatever ends the test, the server goes with it
+    if (exitCode === null) {
+      child.kill("SIGTERM");
+    }
+  });
   const exited = new Promise((resolve) => child.on("exit", (code, signal) => {
     exitCode = code ?? signal;
     resolve();
