@@ -25,6 +25,12 @@ if [ ${#missing[@]} -gt 0 ] && ! command -v emcc >/dev/null; then
   "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
+# VTK's marching-cubes case table comes from the native build (the web build has no VTK).
+table="${MEDISO_BUILD_DIR:-$repo/build}/generated/MarchingCubesCases.cxx"
+if [ ! -f "$table" ]; then
+  "$repo/Scripts/bootstrap.sh" >/dev/null
+fi
+
 # Debian's emscripten runs node for the link step; a node that is not Debian's
 # does not search Debian's module folder on its own.
 export NODE_PATH=${NODE_PATH:-/usr/share/nodejs}
@@ -32,7 +38,7 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
   generator=()
   command -v ninja >/dev/null && generator=(-G Ninja)
   emcmake cmake -S "$repo" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
-    -DMEDISO_WARNINGS_AS_ERRORS=ON >/dev/null
+    -DMEDISO_WARNINGS_AS_ERRORS=ON "-DMEDISO_CASE_TABLE=$table" >/dev/null
 fi
 cmake --build "$build" --parallel "$(nproc)"
 echo "build-web: $build/bin/mediso.js and mediso.wasm"
