@@ -32,6 +32,8 @@ packages=(
   # the GPU core's headless host (mediso-render, EGL tests): EGL, the Khronos
   # GLES3 headers, Mesa's EGL (surfaceless llvmpipe), zlib for PNG
   libegl-dev libgles-dev libegl-mesa0 zlib1g-dev
+  # the web client: its server (aiohttp in pvpython), its browser tests (Chromium, node)
+  python3-aiohttp chromium
 )
 
 missing=()
@@ -52,6 +54,16 @@ if [ ${#missing[@]} -gt 0 ]; then
   "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
 else
   echo "bootstrap: all ${#packages[@]} Debian packages present"
+fi
+
+# node and npm (a machine may have them from elsewhere; else Debian's)
+if ! command -v npm >/dev/null; then
+  echo "bootstrap: installing Debian's nodejs and npm"
+  if [ "$(id -u)" = 0 ]; then
+    apt-get install -y -q --no-install-recommends nodejs npm
+  else
+    sudo apt-get install -y -q --no-install-recommends nodejs npm
+  fi
 fi
 
 if [ ! -f "$build/CMakeCache.txt" ]; then

@@ -28,6 +28,10 @@ if [ "${MEDISO_ASAN:-1}" != 0 ]; then
     ASAN_OPTIONS=detect_leaks=0 ctest --output-on-failure -L '^cxx-(render|egl)$')
 fi
 
+# The web client's tests: its WebAssembly module and the node packages that drive Chromium.
+"$repo/Scripts/build-web.sh"
+(cd "$repo/Testing/Web" && npm ci --no-audit --no-fund --loglevel=error)
+
 # Tests on the real CT and MRI need the data cache; without network they skip.
 python3 "$repo/Python/fetch_data.py" ||
   echo "test: real data unavailable; the tests that need it will be reported as skipped"

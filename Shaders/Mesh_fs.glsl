@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// Mesh_fs.glsl: Phong shading of a mesh, two-sided, with the isosurface
-// renderer's lighting model (HistoPyramidIso_fs.glsl's shade()): ambient,
-// diffuse and specular of the material, up to 6 lights given in view space.
+// Mesh_fs.glsl: Phong shading of a mesh with the isosurface renderer's
+// lighting model (HistoPyramidIso_fs.glsl's shade()): ambient, diffuse and
+// specular of the material, up to 6 lights given in view space. Two-sided as
+// VTK's polygon mapper: a back-facing triangle's normal is turned around.
 
 in vec3 viewPosition;
 in vec3 viewNormal;
@@ -20,12 +21,8 @@ MEDISO_OUTPUT(0) vec4 fragOutput0;
 
 void main()
 {
-  vec3 n = normalize(viewNormal);
+  vec3 n = normalize(gl_FrontFacing ? viewNormal : -viewNormal);
   vec3 toViewer = parallelProjection == 1 ? vec3(0.0, 0.0, 1.0) : -normalize(viewPosition);
-  if (dot(n, toViewer) < 0.0)
-  {
-    n = -n;
-  }
   vec3 result = ambient * color.rgb;
   for (int l = 0; l < 6; ++l)
   {

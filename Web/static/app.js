@@ -57,11 +57,13 @@ async function requestJSON(url) {
   return JSON.parse(new TextDecoder().decode(body));
 }
 
+// Says, in place of the page, why it cannot run here; the start then fails with that text.
 function unsupported(text) {
   $("app").hidden = true;
   const box = $("unsupported");
   box.hidden = false;
   box.textContent = text;
+  return new Error(text);
 }
 
 // ---------------------------------------------------------------------------- the volume
@@ -301,10 +303,9 @@ function interact(canvas) {
 async function start() {
   const probe = document.createElement("canvas").getContext("webgl2");
   if (typeof WebAssembly !== "object" || !probe) {
-    unsupported("This page computes isosurfaces in the browser with WebAssembly and WebGL2, and " +
-      "this browser has " + (typeof WebAssembly !== "object" ? "no WebAssembly" : "no WebGL2") +
+    throw unsupported("This page computes isosurfaces in the browser with WebAssembly and WebGL2, " +
+      "and this browser has " + (typeof WebAssembly !== "object" ? "no WebAssembly" : "no WebGL2") +
       ". Use a current Chrome, Edge, Firefox or Safari with hardware acceleration on.");
-    return;
   }
   $("app").hidden = false;
   state.module = await createMediso({ locateFile: (f) => "static/" + f });
@@ -315,8 +316,7 @@ async function start() {
   state.viewer = new state.module.WebViewer("#view");
   state.viewer.resize(canvas.width, canvas.height);
   if (!state.viewer.ready()) {
-    unsupported("WebGL2 is here but cannot run the GPU path: " + state.viewer.error());
-    return;
+    throw unsupported("WebGL2 is here but cannot run the GPU path: " + state.viewer.error());
   }
   const debug = probe.getExtension("WEBGL_debug_renderer_info");
   state.unmaskedRenderer = debug ? probe.getParameter(debug.UNMASKED_RENDERER_WEBGL)
@@ -354,6 +354,7 @@ async function start() {
 // ---------------------------------------------------------------------------- automation
 let resolveReady, rejectReady;
 const ready = new Promise((resolve, reject) => { resolveReady = resolve; rejectReady = reject; });
+ready.catch(() => {}); // said on the page; automation awaits it and gets the reason
 
 window.mediso = {
   ready,
@@ -414,6 +415,12 @@ window.mediso = {
     return window.mediso.stats();
   },
   estimates: () => state.viewer.estimates(),
+  // The CPU path's level of detail: 0-3, or -1 for the estimator's choice within the budget.
+  setCPULevel(level) {
+    state.viewer.setCPULevel(level);
+    state.lastChangeMs = renderNow();
+    return window.mediso.stats();
+  },
   // A surface the server made: binary PLY (vertex x, y, z; faces as index lists).
   showMesh(ply, color = [0.55, 0.8, 1.0], opacity = 1) {
     const mesh = parsePLY(ply);
@@ -511,7 +518,8 @@ function parsePLY(buffer) {
 }
 
 start().then(resolveReady, (error) => {
-  console.error(error);
-  unsupported("The page could not start: " + error.message);
+  if ($("unsupported").hidden) {
+    unsupported("The page could not start: " + error.message);
+  }
   rejectReady(error);
 });
