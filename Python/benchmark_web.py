@@ -173,8 +173,10 @@ def main(argv):
              "|---|---|---:|---:|---:|---:|---:|---:|"]
     for name, r in results.items():
         medians = {m: statistics.median(c["ms"] for c in r["methods"][m]["changes"]) for m in r["methods"]}
-        labels = {"gpu": "ours, GPU path (WebGL2 core)", "cpu": "ours, CPU path (BlockLOD wasm, level 3)",
-                  "vtkjs": "vtk.js vtkImageMarchingCubes + renderer"}
+        labels = {"gpu": "ours, GPU path (WebGL2 core)",
+                  "cpu": "ours, CPU path (BlockLOD wasm, level 3, %s thread(s))"
+                         % r["methods"]["cpu"].get("threads", "?"),
+                  "vtkjs": "vtk.js vtkImageMarchingCubes + renderer (1 thread)"}
         for m in ("gpu", "cpu", "vtkjs"):
             changes = r["methods"][m]["changes"]
             key = "primitives" if m == "gpu" else "triangles"

@@ -129,7 +129,7 @@ def open_datasets(paths):
 def make_app(args, datasets):
     token = args.token
     by_id = {d.ident: d for d in datasets}
-    wasm_files = {"mediso.js", "mediso.wasm"}
+    wasm_files = {"mediso.js", "mediso.wasm", "mediso-mt.js", "mediso-mt.wasm", "mediso-mt.worker.js"}
 
     @web.middleware
     async def authenticate(request, handler):
@@ -139,6 +139,9 @@ def make_app(args, datasets):
         response = await handler(request)
         if request.query.get("token"):
             response.set_cookie("mediso_token", token, httponly=True, samesite="Strict")
+        # Cross-origin isolation: the page may then use threads (SharedArrayBuffer).
+        response.headers["Cross-Origin-Opener-Policy"] = "same-origin"
+        response.headers["Cross-Origin-Embedder-Policy"] = "require-corp"
         return response
 
     async def index(request):

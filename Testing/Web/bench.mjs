@@ -34,7 +34,7 @@ for (const path of ["gpu", "cpu"]) {
   const stats = await page.evaluate(() => window.mediso.stats());
   ours[path] = page;
   result.methods[path] = { firstImageMs, bytesReceived: stats.bytesReceived, bytesSent: stats.bytesSent,
-    changes: [], reason: stats.reason };
+    changes: [], reason: stats.reason, threads: stats.threads };
 }
 const { page: vtkjs, start: vtkStart } = await openPage("vtkjs", config.vtkjsUrl);
 await vtkjs.waitForFunction(() => window.vtkBench, null, { timeout: 120000 });

@@ -216,6 +216,7 @@ function updateReadout() {
   const rows = [
     ["path", state.path.toUpperCase() + (state.reason ? " (" + state.reason + ")" : "")],
     ["frames per second", fps().toFixed(1)],
+    ["threads", String(state.threads)],
     ["last isovalue change", state.lastChangeMs.toFixed(1) + " ms (change + frame)"],
     state.path === "gpu" ? ["primitives", String(state.primitives)]
                          : ["triangles", String(state.triangles) + " (level " + state.cpuLevel + ")"],
@@ -300,6 +301,22 @@ function interact(canvas) {
 }
 
 // ---------------------------------------------------------------------------- start
+// The WebAssembly module: with threads where the page is cross-origin isolated (the server
+// sends the headers), else on one thread.
+async function loadModule() {
+  const threads = window.crossOriginIsolated && params.get("threads") !== "0";
+  const name = threads ? "mediso-mt" : "mediso";
+  await new Promise((resolve, reject) => {
+    const script = Object.assign(document.createElement("script"), { src: "static/" + name + ".js" });
+    script.onload = resolve;
+    script.onerror = () => reject(new Error("static/" + name + ".js cannot be loaded"));
+    document.head.append(script);
+  });
+  state.threads = threads ? navigator.hardwareConcurrency : 1;
+  const create = threads ? window.createMedisoThreads : window.createMediso;
+  return create({ locateFile: (f) => "static/" + f });
+}
+
 async function start() {
   const probe = document.createElement("canvas").getContext("webgl2");
   if (typeof WebAssembly !== "object" || !probe) {
@@ -308,7 +325,7 @@ async function start() {
       ". Use a current Chrome, Edge, Firefox or Safari with hardware acceleration on.");
   }
   $("app").hidden = false;
-  state.module = await createMediso({ locateFile: (f) => "static/" + f });
+  state.module = await loadModule();
   const canvas = $("view");
   if (params.get("size")) { // WIDTHxHEIGHT (tests, benchmarks)
     [canvas.width, canvas.height] = params.get("size").split("x").map(Number);
@@ -396,6 +413,7 @@ window.mediso = {
     path: state.path,
     reason: state.reason,
     cpuLevel: state.cpuLevel,
+    threads: state.threads,
     level: state.level,
     levelNote: state.levelNote,
     primitives: state.primitives,

@@ -31,6 +31,9 @@
 #include "IsosurfaceRendererGL.h"
 #include "MeshRenderer.h"
 #include "SceneView.h"
+#ifdef MEDISO_WEB_THREADS
+#include "ThreadedFor.h"
+#endif
 
 #include <emscripten.h>
 #include <emscripten/bind.h>
@@ -663,7 +666,11 @@ private:
 
   // The CPU path.
   bool CPUPath = false;
+#ifdef MEDISO_WEB_THREADS
+  BlockLODVolume CPUVolume{ mediso_web::MarchingCubesCases, headless::ThreadedFor };
+#else
   BlockLODVolume CPUVolume{ mediso_web::MarchingCubesCases, SerialFor };
+#endif
   BlockLODEstimator Estimator{ CPUVolume };
   SurfaceCache<CPUSurface> Cache;
   SurfaceLayout Layout{ true, false, false, false }; // normals, no scalars, ids, or offsets
