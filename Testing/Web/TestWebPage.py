@@ -10,6 +10,8 @@
 - cpu: the page's CPU path (the BlockLOD core in WebAssembly) against the plugin's
   BlockLODContour: exactly its triangles at levels 3 and 1, and images within the same threshold.
 - nowebgl: Chromium without WebGL: the page says so in words instead of staying blank.
+- budget: a client memory budget the full volume exceeds: the page fetches a coarser level of it
+  (each path its own), says so, and its bytes are that level's.
 
 The volume is the plugin's phantom at 72^3 written as a MetaImage; the page is served by
 Python/serve.py on a free local port. Exits 125 (skip) where Chromium, node or the module are
@@ -28,7 +30,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 
 parser = argparse.ArgumentParser()
-parser.add_argument("case", choices=["gpu", "cpu", "nowebgl"])
+parser.add_argument("case", choices=["gpu", "cpu", "nowebgl", "budget"])
 parser.add_argument("--plugin", required=True)
 parser.add_argument("--wasm", required=True)
 parser.add_argument("--out", required=True)
@@ -181,7 +183,25 @@ def compare(page_png, reference_png, what):
 
 
 common = [{"call": "setLook", "args": [MATERIAL]}, {"call": "setView", "args": [camera]}]
-if args.case == "nowebgl":
+if args.case == "budget":
+    # The 72^3 int16 phantom is 0.75 MB: a 0.5 MB budget takes level 2 (36^3, 0.09 MB) for the GPU
+    # path (volume and pyramid: 1.1x) and for the CPU path (half the budget for the volume).
+    server, url = start_server()
+    try:
+        results = {path: run_page(url + "&budget=0.5&path=" + path, [], "budget-" + path)
+                   for path in ("gpu", "cpu")}
+    finally:
+        server.kill()
+    for path, result in results.items():
+        stats = result["stats"]
+        print("%s: level %d, %s" % (path, stats["level"], stats["levelNote"]))
+        check(result["state"] == "ready", "%s: the page is ready" % path)
+        check(stats["level"] == 2, "%s: the volume is fetched at level 2 (got %d)" % (path, stats["level"]))
+        check("level 2" in stats["levelNote"] and "budget" in stats["levelNote"],
+              "%s: the page says why it took level 2" % path)
+        check(stats["bytesReceived"] < 0.2 * 72 ** 3 * 2,
+              "%s: the bytes received (%d) are those of the coarse level" % (path, stats["bytesReceived"]))
+elif args.case == "nowebgl":
     server, url = start_server()
     try:
         result = run_page(url, [], "nowebgl", ["--no-webgl"])
