@@ -31,6 +31,8 @@ packages=(
   cmake ninja-build g++ make python3
   # rendering without a display (Mesa llvmpipe), and tests' network namespaces
   xvfb libgl1-mesa-dri iproute2 util-linux
+  # the GUI test's screen captures (xwd) and window queries (xwininfo)
+  x11-apps x11-utils
 )
 
 missing=()
