@@ -208,15 +208,10 @@ int vtkHistoPyramidIsoRepresentation::RequestData(
     // Points at one place along an axis (or nowhere) have no surface between
     // them; said here, once per update, since such data may never reach the
     // mapper (a non-finite spacing makes non-finite bounds, which the view culls).
-    const double* spacing = image->GetSpacing();
-    if (!std::isfinite(spacing[0]) || !std::isfinite(spacing[1]) || !std::isfinite(spacing[2]) ||
-      spacing[0] == 0.0 || spacing[1] == 0.0 || spacing[2] == 0.0)
+    const std::string spacingProblem = vtkHistoPyramidIsoMapper::CheckSpacing(image->GetSpacing());
+    if (!spacingProblem.empty())
     {
-      vtkErrorMacro("the image's spacing (" << spacing[0] << ", " << spacing[1] << ", "
-                                            << spacing[2]
-                                            << ") has a zero or non-finite component: the points "
-                                               "of a volume need a non-zero, finite distance "
-                                               "along every axis; nothing is drawn.");
+      vtkErrorMacro(<< spacingProblem);
       this->Cache = nullptr;
       this->IsoMapper->RemoveAllInputConnections(0);
     }
