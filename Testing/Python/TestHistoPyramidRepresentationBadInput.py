@@ -79,12 +79,7 @@ def field(spacing=(1.0, 1.0, 1.0), axes=None):
 def show(source, isovalues, step):
     """Show as the representation, render twice; return (info, captured text,
     fraction of the image covered)."""
-    view = CreateView("RenderView")
-    view.ViewSize = [300, 300]
-    view.OrientationAxesVisibility = 0
-    view.UseColorPaletteForBackground = 0
-    view.Background = hp.BACKGROUND
-    view.EnableRenderOnInteraction = 0
+    view = hp.make_view([300, 300])
     display = Show(source, view)
     display.SetRepresentationType(hp.REPRESENTATION)
     display.IsosurfaceValues = isovalues

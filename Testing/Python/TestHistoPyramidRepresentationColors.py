@@ -39,12 +39,7 @@ LoadPlugin(args.plugin, ns=globals())
 phantom = MedicalPhantom(Dimensions=[64, 64, 64], Spacing=[3.0, 3.0, 3.0])
 phantom.UpdatePipeline()
 
-view = CreateView("RenderView")
-view.ViewSize = hp.SIZE
-view.OrientationAxesVisibility = 0
-view.UseColorPaletteForBackground = 0
-view.Background = hp.BACKGROUND
-view.EnableRenderOnInteraction = 0
+view = hp.make_view()
 display = Show(phantom, view)
 display.SetRepresentationType(hp.REPRESENTATION)
 display.IsosurfaceValues = [hp.SKIN, hp.BONE]

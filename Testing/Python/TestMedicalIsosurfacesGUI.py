@@ -36,9 +36,11 @@ import sys
 import time
 
 import numpy
-from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+from vtkmodules.util.numpy_support import numpy_to_vtk
 from vtkmodules.vtkCommonDataModel import vtkImageData
-from vtkmodules.vtkIOImage import vtkPNGReader, vtkPNGWriter
+from vtkmodules.vtkIOImage import vtkPNGWriter
+
+import HistoPyramidRepresentationChecks as hp
 
 parser = argparse.ArgumentParser()
 parser.add_argument("--paraview", required=True)
@@ -95,15 +97,6 @@ def write_png(path, pixels):
     writer.SetFileName(path)
     writer.SetInputData(image)
     writer.Write()
-
-
-def read_png(path):
-    reader = vtkPNGReader()
-    reader.SetFileName(path)
-    reader.Update()
-    image = reader.GetOutput()
-    w, h, _ = image.GetDimensions()
-    return vtk_to_numpy(image.GetPointData().GetScalars()).reshape(h, w, -1)[::-1, :, :3]
 
 
 def start_paraview(panel, xml_events=None):
@@ -231,7 +224,7 @@ if representation_screen is not None and blocklod_screen is not None:
     if not os.path.exists(args.baseline):
         check(False, "no baseline %s: look at %s and copy it there" % (args.baseline, written))
     else:
-        baseline = read_png(args.baseline)
+        baseline = hp.read_png(args.baseline)[::-1]  # bottom row first, as VTK reads it
         if check(baseline.shape == image.shape,
                  "image size %s matches the baseline's %s" % (image.shape, baseline.shape)):
             differs = (numpy.abs(baseline.astype(int) - image.astype(int)) > 40).any(axis=2)
