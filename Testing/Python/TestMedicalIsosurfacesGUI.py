@@ -12,9 +12,12 @@ as its --script:
    Properties panel down to the representation's isovalue list;
 2. "blocklod": Block LOD Contour with Auto LOD and a 1 MB budget applied: its
    panel shows the estimator's table with the level used marked;
-3. "help": as 2, then a recorded click on the panel's "?" button, which must open
-   ParaView's help window; the plugin's help collection (--qch) must hold the
-   filter's and the source's pages.
+3. "help": as 2, then recorded events: with Auto LOD the level control is
+   disabled and shows the level used, the budget enabled; Auto LOD unchecked,
+   the level is enabled and shows its setting, the budget disabled (QtTesting
+   checks); then a click on the panel's "?" button, which must open ParaView's
+   help window; the plugin's help collection (--qch) must hold the filter's and
+   the source's pages.
 For 1 and 2, once the scene script has written its status (what the proxies
 say, checked here), the screen is captured (xwd) until two captures a second
 apart agree; the window's area above the status bar (which shows the memory in
@@ -193,9 +196,24 @@ if check(status is not None, "blocklod: the scene script ran (status written)"):
           % (status["chosen_level"], megabytes))
 
 # --- 3. the "?" button opens the plugin's documentation ----------------------
-help_click = ('<pqevent object="pqClientMainWindow/propertiesDock/propertiesPanel/Help" '
+# Before the click, the level-of-detail controls: with Auto LOD the level is
+# disabled and shows the level used (2), the budget enabled; unchecked, the
+# level is enabled and shows its setting (1), the budget disabled. A failed
+# check makes QtTesting print a "critical:" line, which fails the test.
+levels = ("pqClientMainWindow/propertiesDock/propertiesPanel/scrollArea/qt_scrollarea_viewport/"
+          "scrollAreaWidgetContents/PropertiesFrame/ProxyPanel/medical_blocklod_levels")
+checks = [("LOD", "enabled", "false"), ("MemoryBudget", "enabled", "true"), ("LOD", "value", "2"),
+          None,
+          ("LOD", "enabled", "true"), ("MemoryBudget", "enabled", "false"), ("LOD", "value", "1")]
+events = []
+for entry in checks:
+    if entry is None:
+        events.append('<pqevent object="%s/AutoLOD" command="set_boolean" arguments="false" />' % levels)
+    else:
+        events.append('<pqcheck object="%s/%s" property="%s" arguments="%s" />' % ((levels,) + entry))
+events.append('<pqevent object="pqClientMainWindow/propertiesDock/propertiesPanel/Help" '
               'command="activate" arguments="" />')
-process, status_path, log = start_paraview("help", help_click)
+process, status_path, log = start_paraview("help", "\n".join(events))
 status = wait_for(status_path, process, 120)
 opened = False
 deadline = time.time() + 60
