@@ -25,6 +25,8 @@ packages=(
   libhdf5-dev libgdal-dev libnetcdf-dev libgl2ps-dev libglew-dev libtheora-dev libtiff-dev
   # the GUI panel widgets (pqComponents) and the plugin's documentation (Qt help)
   libxml2-dev libboost-dev qhelpgenerator-qt5
+  # DCMTK writes the DICOM series the reader test opens
+  dcmtk
   # toolchain (python3 runs the data script and the offline format test)
   cmake ninja-build g++ make python3
   # rendering without a display (Mesa llvmpipe), and tests' network namespaces
@@ -34,6 +36,8 @@ packages=(
   libegl-dev libgles-dev libegl-mesa0 zlib1g-dev
   # the web client: its server (aiohttp in pvpython), its browser tests (Chromium, node)
   python3-aiohttp chromium
+  # the GUI test's screen captures (xwd) and window queries (xwininfo)
+  x11-apps x11-utils
 )
 
 missing=()
