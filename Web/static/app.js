@@ -29,6 +29,8 @@ const state = {
   bytesReceived: 0,
   frameTimes: [],
   lastChangeMs: 0,
+  lastFrameMs: 0,
+  buildMs: 0,
   primitives: 0,
   triangles: 0,
   pending: null,
@@ -184,7 +186,9 @@ function renderNow() {
   if (state.frameTimes.length > 120) {
     state.frameTimes.shift();
   }
+  state.lastFrameMs = ms;
   const stats = viewer.stats();
+  state.buildMs = stats.buildMs;
   state.primitives = stats.primitives;
   state.triangles = stats.triangles;
   state.cpuLevel = stats.cpuLevel;
@@ -420,6 +424,10 @@ window.mediso = {
     triangles: state.triangles,
     fps: fps(),
     lastChangeMs: state.lastChangeMs,
+    // the last frame's time, and the part of it that built the pyramid or the surfaces (0 when
+    // only the camera or the looks changed)
+    lastFrameMs: state.lastFrameMs,
+    buildMs: state.buildMs,
     bytesSent: state.bytesSent,
     bytesReceived: state.bytesReceived,
     view: state.viewer ? state.viewer.getView() : null,
