@@ -152,15 +152,10 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     sayOnce(true, msg.str());
     return;
   }
-  const double* spacing = image->GetSpacing();
-  if (!std::isfinite(spacing[0]) || !std::isfinite(spacing[1]) || !std::isfinite(spacing[2]) ||
-    spacing[0] == 0.0 || spacing[1] == 0.0 || spacing[2] == 0.0)
+  const std::string spacingProblem = CheckSpacing(image->GetSpacing());
+  if (!spacingProblem.empty())
   {
-    std::ostringstream msg;
-    msg << "the image's spacing (" << spacing[0] << ", " << spacing[1] << ", " << spacing[2]
-        << ") has a zero or non-finite component: the points of a volume need a non-zero, "
-           "finite distance along every axis; nothing is drawn.";
-    sayOnce(true, msg.str());
+    sayOnce(true, spacingProblem);
     return;
   }
   int cellFlag = 0;

@@ -72,8 +72,10 @@
 #include "vtkOpenGLHistoPyramidIsosurfaces.h"  // For Surface
 #include "vtkVolumeMapper.h"
 
+#include <cmath>   // For std::isfinite
 #include <cstdint> // For std::uint64_t
 #include <memory>  // For std::unique_ptr
+#include <sstream> // For std::ostringstream
 #include <string>  // For std::string
 #include <vector>  // For std::vector
 
@@ -234,6 +236,13 @@ public:
   vtkGetMacro(Opacity, double);
   ///@}
 
+  /**
+   * Why an image of this spacing holds no surface (a zero or non-finite
+   * component: its points would not be apart along that axis), as the
+   * message Render() gives for it; empty when the spacing is fine.
+   */
+  static std::string CheckSpacing(const double spacing[3]);
+
   void Render(vtkRenderer* ren, vtkVolume* vol) override;
   void ReleaseGraphicsResources(vtkWindow* win) override;
 
@@ -272,6 +281,23 @@ private:
   struct Internals;
   std::unique_ptr<Internals> Impl;
 };
+
+//------------------------------------------------------------------------------
+inline std::string vtkHistoPyramidIsoMapper::CheckSpacing(const double spacing[3])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!std::isfinite(spacing[a]) || spacing[a] == 0.0)
+    {
+      std::ostringstream msg;
+      msg << "the image's spacing (" << spacing[0] << ", " << spacing[1] << ", " << spacing[2]
+          << ") has a zero or non-finite component: the points of a volume need a non-zero, "
+             "finite distance along every axis; nothing is drawn.";
+      return msg.str();
+    }
+  }
+  return std::string();
+}
 
 //------------------------------------------------------------------------------
 inline void vtkHistoPyramidIsoMapper::SetNumberOfSurfaceColors(int number)

@@ -45,7 +45,6 @@ pqBlockLODLevelWidget::pqBlockLODLevelWidget(
   , Caption(new QLabel(this))
   , Connections(vtkEventQtSlotConnect::New())
 {
-  this->setShowLabel(false);
   this->setObjectName("BlockLODLevels");
   this->AutoLOD->setObjectName("AutoLOD");
   this->Level->setObjectName("LOD");
@@ -55,6 +54,7 @@ pqBlockLODLevelWidget::pqBlockLODLevelWidget(
   this->Caption->setObjectName("EstimatesCaption");
 
   this->Level->setRange(0, NumberOfLevels - 1);
+  this->Level->setMinimumWidth(this->Level->fontMetrics().horizontalAdvance(QStringLiteral("0000")) + 30);
   this->Level->setToolTip(tr("Level of detail when Auto LOD is off: 0, 1, 2, 3 sample the volume "
                              "with cube edges of 8, 4, 2, 1 voxels (3 is full resolution)."));
   this->AutoLOD->setToolTip(tr("Use the highest level whose estimated output fits the memory "
@@ -192,7 +192,7 @@ void pqBlockLODLevelWidget::updateEstimates()
       const double s = seconds.GetAsDouble(level);
       cells << locale.toString(static_cast<qlonglong>(t + 0.5))
             << locale.toString(megabytes.GetAsDouble(level), 'f', megabytes.GetAsDouble(level) < 10.0 ? 2 : 1)
-            << (s == 0.0 && t > 0.0 ? tr("cached") : locale.toString(s, 'f', 3));
+            << (s == 0.0 && t > 0.0 ? tr("cached") : locale.toString(s, 'f', s < 0.01 ? 4 : 3));
     }
     else
     {

@@ -50,7 +50,6 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   , ColorEachSurface(new QCheckBox(tr("Color Each Surface"), this))
   , Connections(vtkEventQtSlotConnect::New())
 {
-  this->setShowLabel(false);
   this->setObjectName("MedicalIsosurfaceList");
   this->Table->setObjectName("Isosurfaces");
   this->RangeLabel->setObjectName("DataRange");

@@ -567,7 +567,8 @@ class Operations:
 def make_app(args, datasets, operations):
     token = args.token
     by_id = {d.ident: d for d in datasets}
-    wasm_files = {"mediso.js", "mediso.wasm"}
+    wasm_files = {"mediso.js", "mediso.wasm", "mediso-mt.js", "mediso-mt.wasm",
+                  "mediso-mt.worker.js"}
     sessions = set()
     counter = [0]
 
@@ -577,9 +578,12 @@ def make_app(args, datasets, operations):
         if not given or not secrets.compare_digest(given.encode(), token.encode()):
             return web.Response(status=403, text="403: this server needs the token of its URL\n")
         response = await handler(request)
-        if request.query.get("token") and isinstance(response, web.StreamResponse) \
-                and not response.prepared:
-            response.set_cookie("mediso_token", token, httponly=True, samesite="Strict")
+        if isinstance(response, web.StreamResponse) and not response.prepared:  # not a socket
+            if request.query.get("token"):
+                response.set_cookie("mediso_token", token, httponly=True, samesite="Strict")
+            # Cross-origin isolation: the page may then use threads (SharedArrayBuffer).
+            response.headers["Cross-Origin-Opener-Policy"] = "same-origin"
+            response.headers["Cross-Origin-Embedder-Policy"] = "require-corp"
         return response
 
     async def index(request):

@@ -203,6 +203,20 @@ int vtkHistoPyramidIsoRepresentation::RequestData(
   {
     return 0;
   }
+  if (auto* image = vtkImageData::SafeDownCast(this->Cache))
+  {
+    // Points at one place along an axis (or nowhere) have no surface between
+    // them; said here, once per update, since such data may never reach the
+    // mapper (a non-finite spacing makes non-finite bounds, which the view culls).
+    const std::string spacingProblem = vtkHistoPyramidIsoMapper::CheckSpacing(image->GetSpacing());
+    if (!spacingProblem.empty())
+    {
+      vtkErrorMacro(<< spacingProblem);
+      this->Cache = nullptr;
+      this->IsoMapper->RemoveAllInputConnections(0);
+    }
+    return 1;
+  }
   auto* grid = vtkRectilinearGrid::SafeDownCast(this->Cache);
   if (!grid)
   {

@@ -25,6 +25,8 @@ packages=(
   libhdf5-dev libgdal-dev libnetcdf-dev libgl2ps-dev libglew-dev libtheora-dev libtiff-dev
   # the GUI panel widgets (pqComponents) and the plugin's documentation (Qt help)
   libxml2-dev libboost-dev qhelpgenerator-qt5
+  # DCMTK writes the DICOM series the reader test opens
+  dcmtk
   # toolchain (python3 runs the data script and the offline format test)
   cmake ninja-build g++ make python3
   # rendering without a display (Mesa llvmpipe), and tests' network namespaces
@@ -32,8 +34,10 @@ packages=(
   # the GPU core's headless host (mediso-render, EGL tests): EGL, the Khronos
   # GLES3 headers, Mesa's EGL (surfaceless llvmpipe), zlib for PNG
   libegl-dev libgles-dev libegl-mesa0 zlib1g-dev
-  # the web server (Python/serve.py) and its browser tests (Debian's chromium, headless)
+  # the web client: its server (aiohttp in pvpython), its browser tests (Chromium, node)
   python3-aiohttp chromium
+  # the GUI test's screen captures (xwd) and window queries (xwininfo)
+  x11-apps x11-utils
 )
 
 missing=()
@@ -54,6 +58,16 @@ if [ ${#missing[@]} -gt 0 ]; then
   "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
 else
   echo "bootstrap: all ${#packages[@]} Debian packages present"
+fi
+
+# node and npm (a machine may have them from elsewhere; else Debian's)
+if ! command -v npm >/dev/null; then
+  echo "bootstrap: installing Debian's nodejs and npm"
+  if [ "$(id -u)" = 0 ]; then
+    apt-get install -y -q --no-install-recommends nodejs npm
+  else
+    sudo apt-get install -y -q --no-install-recommends nodejs npm
+  fi
 fi
 
 if [ ! -f "$build/CMakeCache.txt" ]; then

@@ -25,14 +25,28 @@ if [ ${#missing[@]} -gt 0 ] && ! command -v emcc >/dev/null; then
   "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
+# VTK's marching-cubes case table comes from the native build (the web build has no VTK).
+table="${MEDISO_BUILD_DIR:-$repo/build}/generated/MarchingCubesCases.cxx"
+if [ ! -f "$table" ]; then
+  "$repo/Scripts/bootstrap.sh" >/dev/null
+fi
+
 # Debian's emscripten runs node for the link step; a node that is not Debian's
 # does not search Debian's module folder on its own.
 export NODE_PATH=${NODE_PATH:-/usr/share/nodejs}
-if [ ! -f "$build/CMakeCache.txt" ]; then
-  generator=()
-  command -v ninja >/dev/null && generator=(-G Ninja)
-  emcmake cmake -S "$repo" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
-    -DMEDISO_WARNINGS_AS_ERRORS=ON >/dev/null
-fi
-cmake --build "$build" --parallel "$(nproc)"
-echo "build-web: $build/bin/mediso.js and mediso.wasm"
+# Two modules: mediso (one thread) and mediso-mt (threads, for cross-origin
+# isolated pages); the threaded one compiles every object with -pthread.
+for threads in OFF ON; do
+  dir=$build
+  [ "$threads" = ON ] && dir=$build/threads
+  if [ ! -f "$dir/CMakeCache.txt" ]; then
+    generator=()
+    command -v ninja >/dev/null && generator=(-G Ninja)
+    emcmake cmake -S "$repo" -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
+      -DMEDISO_WARNINGS_AS_ERRORS=ON "-DMEDISO_CASE_TABLE=$table" \
+      "-DMEDISO_WEB_THREADS=$threads" >/dev/null
+  fi
+  cmake --build "$dir" --parallel "$(nproc)"
+done
+cp -p "$build"/threads/bin/mediso-mt.* "$build/bin/"
+echo "build-web: $build/bin: mediso.js, mediso.wasm, mediso-mt.js, mediso-mt.wasm, mediso-mt.worker.js"

@@ -12,7 +12,6 @@ set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 build=${MEDISO_BUILD_DIR:-$repo/build}
 "$repo/Scripts/bootstrap.sh"
-"$repo/Scripts/build-web.sh" # the page's WebAssembly module, for the browser tests
 
 if [ "${MEDISO_ASAN:-1}" != 0 ]; then
   asan="$build-asan"
@@ -28,6 +27,10 @@ if [ "${MEDISO_ASAN:-1}" != 0 ]; then
     ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -L '^cxx$' &&
     ASAN_OPTIONS=detect_leaks=0 ctest --output-on-failure -L '^cxx-(render|egl)$')
 fi
+
+# The web client's tests: its WebAssembly module and the node packages that drive Chromium.
+"$repo/Scripts/build-web.sh"
+(cd "$repo/Testing/Web" && npm ci --no-audit --no-fund --loglevel=error)
 
 # Tests on the real CT and MRI need the data cache; without network they skip.
 python3 "$repo/Python/fetch_data.py" ||

@@ -27,7 +27,7 @@ if (CMAKE_SCRIPT_MODE_FILE)
   return()
 endif ()
 
-set(_mediso_embed_script "${CMAKE_CURRENT_LIST_FILE}")
+set(_mediso_embed_script "${CMAKE_CURRENT_LIST_FILE}" CACHE INTERNAL "Shaders/EmbedShaders.cmake")
 
 function(mediso_embed_shaders)
   cmake_parse_arguments(ARG "" "TARGET;HEADER" "FILES" ${ARGN})

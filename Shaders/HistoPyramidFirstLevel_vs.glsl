@@ -8,10 +8,10 @@
 // active tiles along x into rectangles, two triangles each, given here in
 // atlas texels. Everything else keeps its 0 and costs no fragment.
 
-in vec2 atlasCorner;       // a rectangle's corner, in atlas texels
+in vec2 vertexInput0;       // a rectangle's corner, in atlas texels
 uniform vec2 atlasSize;    // level 1's atlas, in texels
 
 void main()
 {
-  gl_Position = vec4(2.0 * atlasCorner / atlasSize - 1.0, 0.0, 1.0);
+  gl_Position = vec4(2.0 * vertexInput0 / atlasSize - 1.0, 0.0, 1.0);
 }

@@ -432,6 +432,27 @@ void footprint(ivec3 c, vec3 boxLo, vec3 boxHi)
 #endif
 }
 
+// Whether the whole cell [c, c + 1] lies outside the view: all its corners
+// beyond one of the clip volume's planes (the near plane included). The
+// surface box lies in the cell, so its footprint would be off screen too;
+// testing here skips the corner gradients' fetches for such cells, most of
+// the cells in a close zoom.
+bool cellOffScreen(ivec3 c)
+{
+  vec4 origin = indexToClip * vec4(vec3(c), 1.0);
+  bvec4 allPlus = bvec4(true);  // x > w, y > w, z > w, (unused)
+  bvec4 allMinus = bvec4(true); // x < -w, y < -w, z < -w, (unused)
+  for (int i = 0; i < 8; ++i)
+  {
+    vec4 p = origin + float(i & 1) * indexToClip[0] + float((i >> 1) & 1) * indexToClip[1] +
+      float((i >> 2) & 1) * indexToClip[2];
+    allPlus = bvec4(allPlus.x && p.x > p.w, allPlus.y && p.y > p.w, allPlus.z && p.z > p.w, false);
+    allMinus =
+      bvec4(allMinus.x && p.x < -p.w, allMinus.y && p.y < -p.w, allMinus.z && p.z < -p.w, false);
+  }
+  return any(allPlus) || any(allMinus);
+}
+
 void main()
 {
   uint index = uint(MEDISO_PRIMITIVE);
@@ -508,7 +529,7 @@ void main()
     vIsovalue = bit == 1 && rank == 0 && vIsovalue < 0 ? t : vIsovalue;
     rank -= bit;
   }
-  if (oneRankPerCell == 1 && index != 0u)
+  if ((oneRankPerCell == 1 && index != 0u) || (vIsovalue >= 0 && cellOffScreen(cell)))
   {
     vIsovalue = -1;
   }

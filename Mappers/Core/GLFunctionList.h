@@ -30,13 +30,15 @@
 
 // clang-format off
 #define MEDISO_GL_FUNCTIONS(X)                                                                     \
-  X(ActiveTexture) X(AttachShader) X(BindBuffer) X(BindFramebuffer) X(BindRenderbuffer)             \
+  X(ActiveTexture) X(AttachShader) X(BindAttribLocation) X(BindBuffer) X(BindFramebuffer)          \
+  X(BindRenderbuffer)                                                                              \
   X(BindSampler) X(BindTexture) X(BindVertexArray) X(BlendEquationSeparate)                         \
   X(BlendFuncSeparate) X(BufferData) X(CheckFramebufferStatus) X(ClearBufferfv)                     \
   X(ClearBufferuiv) X(ColorMask) X(CompileShader) X(CreateProgram) X(CreateShader)                  \
   X(DeleteBuffers) X(DeleteFramebuffers) X(DeleteProgram) X(DeleteRenderbuffers)                    \
   X(DeleteShader) X(DeleteTextures) X(DeleteVertexArrays) X(DepthFunc) X(DepthMask) X(Disable)      \
-  X(DisableVertexAttribArray) X(DrawArrays) X(DrawArraysInstanced) X(DrawBuffers) X(Enable)         \
+  X(DisableVertexAttribArray) X(DrawArrays) X(DrawArraysInstanced) X(DrawBuffers) X(DrawElements)   \
+  X(Enable)                                                                                        \
   X(EnableVertexAttribArray) X(Finish) X(FramebufferRenderbuffer) X(FramebufferTexture2D)           \
   X(FramebufferTextureLayer) X(GenBuffers) X(GenFramebuffers) X(GenRenderbuffers)                   \
   X(GenTextures) X(GenVertexArrays) X(GetBooleanv) X(GetError) X(GetFloatv) X(GetIntegerv)          \

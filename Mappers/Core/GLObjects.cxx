@@ -229,6 +229,13 @@ std::unique_ptr<Program> BuildProgram(const GLApi& gl, const std::string& define
   const GLuint id = f.CreateProgram();
   f.AttachShader(id, vs);
   f.AttachShader(id, fs);
+  // Vertex inputs named vertexInputN take location N (the programs that have
+  // attributes set their vertex arrays up so).
+  for (int n = 0; n < 4; ++n)
+  {
+    const std::string name = "vertexInput" + std::to_string(n);
+    f.BindAttribLocation(id, static_cast<GLuint>(n), name.c_str());
+  }
   if (!gl.IsES())
   {
     // GLSL 1.50 has no layout locations for outputs: bind them by name.

@@ -81,8 +81,10 @@ private:
 
 /**
  * Compiles and links a program from a vertex and a fragment shader (each
- * already composed; the prelude and `defines` are put in front). Returns
- * null, with the compiler's log in @a error, when it does not build.
+ * already composed; the prelude and `defines` are put in front). Vertex
+ * inputs named vertexInputN get location N, fragment outputs named
+ * fragOutputN location N. Returns null, with the compiler's log in @a error,
+ * when it does not build.
  */
 std::unique_ptr<Program> BuildProgram(const GLApi& gl, const std::string& defines,
   const std::string& vertex, const std::string& fragment, std::string& error);

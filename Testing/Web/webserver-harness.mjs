@@ -35,7 +35,7 @@ export async function startServer(data = []) {
   if (!existsSync(plugin)) {
     skip("MEDISO_PLUGIN does not name the built plugin (" + plugin + ")");
   }
-  const wasm = path.join(process.env.MEDISO_WEB_BUILD_DIR || path.join(ROOT, "build-web"), "bin");
+  const wasm = process.env.MEDISO_WEB_BINARY_DIR || path.join(ROOT, "build-web", "bin");
   if (!existsSync(path.join(wasm, "mediso.wasm"))) {
     skip("the page's WebAssembly module is not built in " + wasm + " (Scripts/build-web.sh)");
   }
@@ -92,19 +92,15 @@ export async function startServer(data = []) {
   throw new Error("FAILED: the server did not start (exit " + exitCode + ")");
 }
 
+/** Debian's chromium as the page's own tests launch it (page.mjs). */
 export async function launchBrowser() {
-  let chromium;
+  let page;
   try {
-    ({ chromium } = await import("playwright-core"));
+    page = await import("./page.mjs");
   } catch (error) {
     skip("playwright-core is not installed in Testing/Web (npm ci): " + error.message);
   }
-  return chromium.launch({
-    executablePath: "/usr/bin/chromium",
-    args: ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-      "--disable-background-networking", "--disable-component-update", "--disable-sync",
-      "--no-first-run"],
-  });
+  return page.launch();
 }
 
 /**

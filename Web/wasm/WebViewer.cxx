@@ -11,14 +11,29 @@
  * it the volume once and then only parameters: isovalues, colours, the
  * camera. WebViewer holds the scene (volume placement, camera, surfaces) and
  * rebuilds the pyramid only when the isovalues change.
+ *
+ * The CPU path, for clients whose GPU cannot afford the GPU path (a software
+ * rasteriser, small limits): the BlockLOD core (Filters/Core, the code of
+ * ParaView's BlockLODContour, with VTK's case table generated at build
+ * time) extracts each surface at the level of detail its memory estimator
+ * fits in the client's budget; surfaces are cached per (isovalue, level) and
+ * drawn as triangles (MeshRenderer). A surface the server made is drawn beside
+ * either path.
  */
+#include "BlockLODCache.h"
+#include "BlockLODEstimator.h"
+#include "BlockLODVolume.h"
 #include "Camera.h"
 #include "GLApiFunctions.h"
 #include "GLProbe.h"
 #include "HistoPyramid.h"
 #include "HistoPyramidGL.h"
 #include "IsosurfaceRendererGL.h"
+#include "MeshRenderer.h"
 #include "SceneView.h"
+#ifdef MEDISO_WEB_THREADS
+#include "ThreadedFor.h"
+#endif
 
 #include <emscripten.h>
 #include <emscripten/bind.h>
@@ -31,10 +46,29 @@
 #include <string>
 #include <vector>
 
+namespace mediso_web
+{
+extern const int MarchingCubesCases[256][16];
+}
+
 namespace
 {
 using emscripten::val;
 using namespace mediso;
+
+/// A surface of the CPU path, as drawn.
+struct CPUSurface
+{
+  std::vector<float> Points, Normals;
+  std::vector<std::uint32_t> Triangles;
+  double Bytes() const
+  {
+    return 4.0 * (this->Points.size() + this->Normals.size() + this->Triangles.size());
+  }
+};
+
+/// Mesh slots: the CPU path's surfaces, then the server's result.
+constexpr int ResultSlot = MaximumIsovalues;
 
 // The core's functions: Emscripten's own WebGL2 bindings, by name.
 void* LookUp(const char* name, void*)
@@ -115,6 +149,7 @@ public:
     }
     this->Pyramid.reset(new HistoPyramidGL(this->GL));
     this->Renderer.reset(new IsosurfaceRendererGL(this->GL));
+    this->Meshes.reset(new web::MeshRenderer(this->GL));
   }
 
   ~WebViewer()
@@ -129,6 +164,10 @@ public:
       if (this->Renderer)
       {
         this->Renderer->Release();
+      }
+      if (this->Meshes)
+      {
+        this->Meshes->Release();
       }
       emscripten_webgl_destroy_context(this->Context);
     }
@@ -182,8 +221,99 @@ public:
       return false;
     }
     this->BuiltValues.clear();
+    VolumeDescription description;
+    description.Type = this->Type;
+    description.Data = this->Data;
+    std::copy(this->Placement.Dimensions, this->Placement.Dimensions + 3, description.Dims);
+    std::copy(this->Placement.Origin, this->Placement.Origin + 3, description.Origin);
+    std::copy(this->Placement.Spacing, this->Placement.Spacing + 3, description.Spacing);
+    description.Stamp = ++this->VolumeStamp;
+    this->CPUVolume.SetVolume(description);
+    this->Estimator.Reset();
+    this->Cache.Clear();
+    this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
     this->ResetCamera();
     return true;
+  }
+
+  /// "gpu" or "cpu": which path draws.
+  void SetPath(const std::string& path) { this->CPUPath = path == "cpu"; }
+
+  /// The CPU path's level of detail: 0-3, or -1 to let the estimator choose
+  /// within the budget.
+  void SetCPULevel(int level) { this->RequestedLevel = std::max(-1, std::min(3, level)); }
+
+  /// The client's memory budget (bytes) for the CPU path's surfaces and their cache.
+  void SetBudget(double bytes) { this->Budget = std::max(0.0, bytes); }
+
+  /// The estimator's table for the current isovalues: per level, triangles, MB and seconds.
+  val Estimates()
+  {
+    val table = val::array();
+    for (int level = 0; level < 4; ++level)
+    {
+      double triangles = 0.0, bytes = 0.0, seconds = 0.0;
+      for (const IsosurfaceLook& s : this->Frame.Surfaces)
+      {
+        const SurfaceEstimate e = this->Estimator.Estimate(s.Value, level);
+        triangles += e.Counts.Triangles;
+        bytes += this->Layout.Bytes(e.Counts);
+        seconds += this->Estimator.EstimateSeconds(s.Value, level);
+      }
+      val row = val::object();
+      row.set("level", level);
+      row.set("triangles", triangles);
+      row.set("mb", bytes / 1e6);
+      row.set("seconds", seconds);
+      table.call<void>("push", row);
+    }
+    return table;
+  }
+
+  /// A surface the server made (world coordinates): `points` 3 floats each,
+  /// `triangles` 3 indices each, in the module's memory; normals are made here.
+  void SetResultMesh(std::uintptr_t points, double numberOfPoints, std::uintptr_t triangles,
+    double numberOfTriangles, const val& color, double opacity)
+  {
+    const float* p = reinterpret_cast<const float*>(points);
+    const std::uint32_t* t = reinterpret_cast<const std::uint32_t*>(triangles);
+    const std::int64_t np = static_cast<std::int64_t>(numberOfPoints);
+    const std::int64_t nt = static_cast<std::int64_t>(numberOfTriangles);
+    std::vector<float> normals(3 * static_cast<std::size_t>(np), 0.0f);
+    for (std::int64_t i = 0; i < nt; ++i)
+    {
+      const std::uint32_t a = t[3 * i], b = t[3 * i + 1], c = t[3 * i + 2];
+      if (a >= np || b >= np || c >= np)
+      {
+        this->LastError = "the server's surface has a triangle with a point it does not have";
+        return;
+      }
+      float e1[3], e2[3];
+      for (int k = 0; k < 3; ++k)
+      {
+        e1[k] = p[3 * b + k] - p[3 * a + k];
+        e2[k] = p[3 * c + k] - p[3 * a + k];
+      }
+      const float n[3] = { e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0] };
+      for (std::uint32_t v : { a, b, c })
+      {
+        for (int k = 0; k < 3; ++k)
+        {
+          normals[3 * v + k] += n[k]; // area-weighted
+        }
+      }
+    }
+    emscripten_webgl_make_context_current(this->Context);
+    this->Meshes->SetMesh(ResultSlot, p, normals.data(), np, t, nt);
+    const float rgb[3] = { color[0].as<float>(), color[1].as<float>(), color[2].as<float>() };
+    this->Meshes->SetLook(ResultSlot, rgb, static_cast<float>(opacity), true);
+  }
+
+  void ClearResultMesh()
+  {
+    emscripten_webgl_make_context_current(this->Context);
+    this->Meshes->Clear(ResultSlot);
   }
 
   /// The isosurfaces: [{value, color: [r, g, b], opacity}], at most 8.
@@ -309,7 +439,15 @@ public:
       values.push_back(s.Value);
     }
     this->LastBuildMs = 0.0;
-    if (values != this->BuiltValues && !values.empty())
+    if (this->CPUPath)
+    {
+      if (!this->UpdateCPUSurfaces())
+      {
+        return false;
+      }
+      this->LastBuildMs = emscripten_get_now() - start;
+    }
+    else if (values != this->BuiltValues && !values.empty())
     {
       std::string error;
       if (!this->Pyramid->Build(values, error))
@@ -335,10 +473,19 @@ public:
     f.ClearBufferfv(GL_COLOR, 0, background);
     f.ClearBufferfv(GL_DEPTH, 0, &one);
     this->Stats = IsosurfaceFrameStats();
-    if (!values.empty())
+    std::string error;
+    if (!this->CPUPath && !values.empty() &&
+      !this->Renderer->Render(*this->Pyramid, this->Frame, this->Stats, error))
     {
-      std::string error;
-      if (!this->Renderer->Render(*this->Pyramid, this->Frame, this->Stats, error))
+      this->LastError = error;
+      return false;
+    }
+    // The CPU path's surfaces and the server's result, in world coordinates.
+    if (this->Meshes->GetNumberOfMeshes() > 0)
+    {
+      const double aspect = static_cast<double>(this->Width) / std::max(1, this->Height);
+      const matrix4::Matrix modelToView = matrix4::Multiply(this->View.ViewMatrix(), this->PlacementModel());
+      if (!this->Meshes->Render(this->Frame, modelToView, this->View.ProjectionMatrix(aspect), error))
       {
         this->LastError = error;
         return false;
@@ -359,7 +506,11 @@ public:
   val GetStats() const
   {
     val stats = val::object();
-    stats.set("primitives", static_cast<double>(this->Stats.Primitives));
+    stats.set("path", std::string(this->CPUPath ? "cpu" : "gpu"));
+    stats.set("primitives", this->CPUPath ? 0.0 : static_cast<double>(this->Stats.Primitives));
+    stats.set("triangles", this->CPUPath ? this->ShownTriangles : 0.0);
+    stats.set("cpuLevel", this->CPULevel);
+    stats.set("cacheMB", this->Cache.GetBytes() / 1e6);
     stats.set("footprint", std::string(this->Stats.PointFootprint ? "points" : "boxes"));
     stats.set("firstHit", this->Stats.FirstHit);
     stats.set("buildMs", this->LastBuildMs);
@@ -394,6 +545,106 @@ public:
   }
 
 private:
+  // The CPU path's model transform: the volume's direction about its origin
+  // (the BlockLOD core places points at origin + spacing * index).
+  matrix4::Matrix PlacementModel() const
+  {
+    matrix4::Matrix m = matrix4::Identity();
+    const double* d = this->Placement.Direction;
+    const double* o = this->Placement.Origin;
+    for (int r = 0; r < 3; ++r)
+    {
+      double shift = o[r];
+      for (int c = 0; c < 3; ++c)
+      {
+        m[4 * r + c] = d[3 * r + c];
+        shift -= d[3 * r + c] * o[c];
+      }
+      m[4 * r + 3] = shift;
+    }
+    return m;
+  }
+
+  // The CPU path: the level (requested, or the estimator's within the
+  // budget), each surface extracted or taken from the cache, uploaded when
+  // it changed.
+  bool UpdateCPUSurfaces()
+  {
+    std::vector<double> values;
+    for (const IsosurfaceLook& s : this->Frame.Surfaces)
+    {
+      values.push_back(s.Value);
+    }
+    int level = this->RequestedLevel;
+    if (level < 0)
+    {
+      double level0Bytes = 0.0;
+      level = this->Estimator.ChooseLevel(values, this->Budget, this->Layout, level0Bytes);
+      if (level < 0)
+      {
+        this->LastError = "not even level 0 of these isosurfaces fits the memory budget (" +
+          std::to_string(level0Bytes / 1e6) + " MB needed)";
+        level = 0;
+      }
+    }
+    this->CPULevel = level;
+    std::vector<SurfaceKey> keep;
+    for (double v : values)
+    {
+      keep.push_back(SurfaceKey{ v, level });
+    }
+    this->ShownTriangles = 0.0;
+    for (int slot = 0; slot < MaximumIsovalues; ++slot)
+    {
+      if (slot >= static_cast<int>(values.size()))
+      {
+        this->Meshes->Clear(slot);
+        this->ShownKeys[slot] = SurfaceKey{ NAN, -1 };
+        continue;
+      }
+      const SurfaceKey key = keep[slot];
+      CPUSurface* surface = this->Cache.Find(key);
+      if (!surface)
+      {
+        CPUSurface made;
+        const double start = emscripten_get_now();
+        ExtractionPlan plan;
+        if (!this->CPUVolume.Plan(key.Isovalue, key.Level, plan))
+        {
+          this->LastError = "the extraction stopped";
+          return false;
+        }
+        const SurfaceCounts counts = BlockLODVolume::CountsOf(plan);
+        made.Points.resize(3 * static_cast<std::size_t>(plan.GetNumberOfPoints()));
+        made.Normals.resize(made.Points.size());
+        made.Triangles.resize(3 * static_cast<std::size_t>(plan.GetNumberOfTriangles()));
+        SurfaceBuffers<std::int32_t> out;
+        out.Points = made.Points.data();
+        out.Normals = made.Normals.data();
+        out.Connectivity = reinterpret_cast<std::int32_t*>(made.Triangles.data());
+        this->CPUVolume.Generate(plan, out);
+        this->Estimator.RecordExact(key.Isovalue, key.Level, counts);
+        this->Estimator.GetCostModel().Record(
+          counts.Cubes, counts.Triangles, (emscripten_get_now() - start) / 1000.0);
+        const double bytes = made.Bytes();
+        this->Cache.Insert(key, std::move(made), bytes);
+        this->Cache.Evict(std::max(this->Budget / 4.0, 0.0), keep);
+        surface = this->Cache.Find(key);
+      }
+      if (!(this->ShownKeys[slot] == key))
+      {
+        this->Meshes->SetMesh(slot, surface->Points.data(), surface->Normals.data(),
+          static_cast<std::int64_t>(surface->Points.size() / 3), surface->Triangles.data(),
+          static_cast<std::int64_t>(surface->Triangles.size() / 3));
+        this->ShownKeys[slot] = key;
+      }
+      const IsosurfaceLook& look = this->Frame.Surfaces[slot];
+      this->Meshes->SetLook(slot, look.Color, look.Opacity, true);
+      this->ShownTriangles += static_cast<double>(surface->Triangles.size() / 3);
+    }
+    return true;
+  }
+
   std::string Canvas; // the canvas's CSS selector
   EMSCRIPTEN_WEBGL_CONTEXT_HANDLE Context = 0;
   std::string Error;
@@ -412,6 +663,24 @@ private:
   int Width = 640, Height = 480;
   float Background[3] = { 0.1f, 0.12f, 0.16f };
   double LastBuildMs = 0.0, LastFrameMs = 0.0;
+
+  // The CPU path.
+  bool CPUPath = false;
+#ifdef MEDISO_WEB_THREADS
+  BlockLODVolume CPUVolume{ mediso_web::MarchingCubesCases, headless::ThreadedFor };
+#else
+  BlockLODVolume CPUVolume{ mediso_web::MarchingCubesCases, SerialFor };
+#endif
+  BlockLODEstimator Estimator{ CPUVolume };
+  SurfaceCache<CPUSurface> Cache;
+  SurfaceLayout Layout{ true, false, false, false }; // normals, no scalars, ids, or offsets
+  std::vector<SurfaceKey> ShownKeys = std::vector<SurfaceKey>(MaximumIsovalues, SurfaceKey{ NAN, -1 });
+  std::uint64_t VolumeStamp = 0;
+  int RequestedLevel = -1;
+  int CPULevel = 3;
+  double Budget = 1e9;
+  double ShownTriangles = 0.0;
+  std::unique_ptr<web::MeshRenderer> Meshes;
 };
 
 EMSCRIPTEN_BINDINGS(mediso_web)
@@ -437,5 +706,11 @@ EMSCRIPTEN_BINDINGS(mediso_web)
     .function("render", &WebViewer::Render)
     .function("finish", &WebViewer::Finish)
     .function("stats", &WebViewer::GetStats)
-    .function("countOnCPU", &WebViewer::CountOnCPU);
+    .function("countOnCPU", &WebViewer::CountOnCPU)
+    .function("setPath", &WebViewer::SetPath)
+    .function("setCPULevel", &WebViewer::SetCPULevel)
+    .function("setBudget", &WebViewer::SetBudget)
+    .function("estimates", &WebViewer::Estimates)
+    .function("setResultMesh", &WebViewer::SetResultMesh)
+    .function("clearResultMesh", &WebViewer::ClearResultMesh);
 }

@@ -1,0 +1,216 @@
+#!/usr/bin/env python3
+"""The web client against vtk.js in the same browser: isovalue change + frame, first image, bytes.
+
+    python3 Python/benchmark_web.py [--inputs ct,ct512] [--sweep 10] [--size 800x600] [--out FILE.md]
+
+In one headless Chromium (Debian's, software WebGL2: SwiftShader), on the same volume and canvas
+size: the page's GPU path (the core on WebGL2), its CPU path (the BlockLOD core in WebAssembly at
+level 3, full resolution) and vtk.js 37 (`vtkImageMarchingCubes` + its WebGL renderer, the way
+Glance and the vtk.js examples draw isosurfaces) take the same isovalues in turn, the order turning
+every step; a change is timed from the call to the finished frame (a pixel read back). Also the
+time from opening each page to its first image, and the bytes the page received for the volume
+against its raw bytes. The page is served by Python/serve.py (pvpython), vtk.js's page by a static
+server; vtk.js reads the same raw values. ct512 is the CT resampled to 512x512x216
+(BenchmarkHistoPyramidIsoMapper --write-input). Not a test: it prints a table.
+"""
+import argparse
+import json
+import os
+import shutil
+import socket
+import statistics
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from machine_info import cpu_model, load_average  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+WEB = os.path.join(ROOT, "Testing", "Web")
+TYPES = {"MET_CHAR": "int8", "MET_UCHAR": "uint8", "MET_SHORT": "int16", "MET_USHORT": "uint16",
+         "MET_INT": "int32", "MET_UINT": "uint32", "MET_FLOAT": "float32", "MET_DOUBLE": "float64"}
+
+
+def progress(message):
+    print("web-bench: " + message, flush=True)
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--inputs", default="ct,ct512")
+    p.add_argument("--sweep", type=int, default=10, help="isovalues, equidistant inside the range")
+    p.add_argument("--size", default="800x600")
+    p.add_argument("--plugin", default=os.path.join(ROOT, "build", "lib", "paraview-5.11", "plugins",
+                                                    "MedicalIsosurfaces", "MedicalIsosurfaces.so"))
+    p.add_argument("--wasm", default=os.path.join(ROOT, "build-web", "bin"))
+    p.add_argument("--work", default=os.path.join(ROOT, "build", "bench-web"))
+    p.add_argument("--out", default="")
+    return p.parse_args(argv)
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def read_mha(path):
+    """Header fields and the raw values (little-endian) of an uncompressed MetaImage."""
+    with open(path, "rb") as f:
+        data = f.read()
+    fields = {}
+    at = 0
+    while True:
+        end = data.index(b"\n", at)
+        line = data[at:end].decode()
+        at = end + 1
+        key, _, value = line.partition("=")
+        fields[key.strip()] = value.strip()
+        if key.strip() == "ElementDataFile":
+            break
+    dims = [int(v) for v in fields["DimSize"].split()]
+    kind = TYPES[fields["ElementType"]]
+    size = {"int8": 1, "uint8": 1, "int16": 2, "uint16": 2, "int32": 4, "uint32": 4, "float32": 4,
+            "float64": 8}[kind]
+    if fields["ElementDataFile"] == "LOCAL":
+        raw = data[at:at + dims[0] * dims[1] * dims[2] * size]
+    else:
+        with open(os.path.join(os.path.dirname(path), fields["ElementDataFile"]), "rb") as f:
+            raw = f.read()
+    spacing = [float(v) for v in fields.get("ElementSpacing", "1 1 1").split()]
+    origin = [float(v) for v in fields.get("Offset", "0 0 0").split()]
+    return {"dims": dims, "type": kind, "spacing": spacing, "origin": origin}, raw
+
+
+def volume_path(name):
+    data = os.environ.get("MEDISO_DATA_DIR") or os.path.expanduser("~/.cache/medical-isosurfaces")
+    if name == "ct":
+        return os.path.join(data, "ct_head.mha")
+    path = os.path.join(ROOT, "build", "bench-volumes", name + ".mha")
+    if not os.path.isfile(path):
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        subprocess.run([os.path.join(ROOT, "build", "bin", "BenchmarkHistoPyramidIsoMapper"), "--input",
+                        name, "--ct", volume_path("ct"), "--write-input", path], check=True,
+                       stdout=subprocess.DEVNULL)
+    return path
+
+
+def run_input(args, name):
+    path = volume_path(name)
+    header, raw = read_mha(path)
+    work = os.path.join(args.work, name)
+    os.makedirs(work, exist_ok=True)
+    with open(os.path.join(work, "volume.raw"), "wb") as f:
+        f.write(raw)
+    subprocess.run([os.path.join(WEB, "node_modules", ".bin", "esbuild"),
+                    os.path.join(WEB, "bench", "vtkjs-bench.mjs"), "--bundle", "--format=iife",
+                    "--minify", "--log-level=warning", "--outfile=" + os.path.join(work, "vtkjs-bench.js")],
+                   check=True)
+    shutil.copy(os.path.join(WEB, "bench", "vtkjs.html"), work)
+    port, static_port = free_port(), free_port()
+    token = "bench-%d" % port
+    server = subprocess.Popen([shutil.which("pvpython"), "--no-mpi", os.path.join(HERE, "serve.py"),
+                               "--plugin", args.plugin, "--wasm", args.wasm, "--data", path,
+                               "--port", str(port), "--token", token],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    static = subprocess.Popen([sys.executable, "-m", "http.server", str(static_port), "--bind",
+                               "127.0.0.1", "--directory", work],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        for line in server.stdout:
+            if "open http" in line:
+                break
+        lo_hi = None
+        # the isovalues: equidistant inside the data range (its ends left out)
+        import array
+        values = array.array({"int8": "b", "uint8": "B", "int16": "h", "uint16": "H", "int32": "i",
+                              "uint32": "I", "float32": "f", "float64": "d"}[header["type"]])
+        values.frombytes(raw)
+        lo_hi = (min(values), max(values))
+        isovalues = [lo_hi[0] + (lo_hi[1] - lo_hi[0]) * (i + 1) / (args.sweep + 1)
+                     for i in range(args.sweep)]
+        size = [int(v) for v in args.size.split("x")]
+        config = {"pageUrl": "http://127.0.0.1:%d/?token=%s" % (port, token),
+                  "vtkjsUrl": "http://127.0.0.1:%d/vtkjs.html" % static_port,
+                  "volume": {"url": "volume.raw", **header}, "size": size, "isovalues": isovalues}
+        config_file = os.path.join(work, "config.json")
+        out_file = os.path.join(work, "result.json")
+        with open(config_file, "w") as f:
+            json.dump(config, f)
+        progress("%s: %d isovalues, %s" % (name, args.sweep, args.size))
+        subprocess.run(["node", os.path.join(WEB, "bench.mjs"), config_file, out_file], check=True,
+                       cwd=WEB, timeout=3600)
+        with open(out_file) as f:
+            result = json.load(f)
+    finally:
+        server.kill()
+        static.kill()
+    result["raw_bytes"] = len(raw)
+    result["header"] = header
+    return result
+
+
+def main(argv):
+    args = parse_args(argv)
+    started = time.strftime("%Y-%m-%d %H:%M:%S")
+    load_before = load_average()
+    t0 = time.perf_counter()
+    results = {name: run_input(args, name) for name in args.inputs.split(",")}
+    chromium = subprocess.run(["/usr/bin/chromium", "--version"], stdout=subprocess.PIPE,
+                              stderr=subprocess.DEVNULL, text=True).stdout.strip()
+    lines = ["# The web client against vtk.js", "",
+             "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv),
+             "- Started %s, %.0f s; load average %s before, %s after" % (
+                 started, time.perf_counter() - t0, load_before, load_average()),
+             "- Machine: nproc %d (%s); %s headless, software WebGL2 (SwiftShader)" % (
+                 os.cpu_count() or 0, cpu_model(), chromium),
+             "- Canvas %s; %d isovalues per input, the three methods in turn" % (args.size, args.sweep), "",
+             "| input | method | median change + frame ms | min | max | / vtk.js | first image ms | "
+             "elements (median) |",
+             "|---|---|---:|---:|---:|---:|---:|---:|"]
+    for name, r in results.items():
+        medians = {m: statistics.median(c["ms"] for c in r["methods"][m]["changes"]) for m in r["methods"]}
+        labels = {"gpu": "ours, GPU path (WebGL2 core)",
+                  "cpu": "ours, CPU path (BlockLOD wasm, level 3, %s thread(s))"
+                         % r["methods"]["cpu"].get("threads", "?"),
+                  "vtkjs": "vtk.js vtkImageMarchingCubes + renderer (1 thread)"}
+        for m in ("gpu", "cpu", "vtkjs"):
+            changes = r["methods"][m]["changes"]
+            key = "primitives" if m == "gpu" else "triangles"
+            elements = statistics.median(c.get(key, 0) for c in changes)
+            lines.append("| %s %s | %s | %.1f | %.1f | %.1f | %.2fx | %.0f | %d %s |" % (
+                name, "x".join(map(str, r["header"]["dims"])), labels[m], medians[m],
+                min(c["ms"] for c in changes), max(c["ms"] for c in changes),
+                medians[m] / medians["vtkjs"], r["methods"][m]["firstImageMs"], elements,
+                "cells" if m == "gpu" else "triangles"))
+    lines += ["", "Where the GPU path's time goes (medians over the sweep): the pyramid's build within a "
+              "change (its passes and the read-back of its total, which waits for them), and a frame "
+              "of the same surface with nothing rebuilt (the drawing alone).", "",
+              "| input | change + frame ms | build ms | draw-only frame ms | primitives |",
+              "|---|---:|---:|---:|---:|"]
+    for name, r in results.items():
+        changes = r["methods"]["gpu"]["changes"]
+        med = lambda key: statistics.median(c.get(key, 0) for c in changes)  # noqa: E731
+        lines.append("| %s | %.1f | %.1f | %.1f | %d |" % (name, med("ms"), med("buildMs"), med("drawMs"),
+                                                         med("primitives")))
+    lines += ["", "| input | volume's raw bytes | bytes the page received before its first image "
+              "(the volume, once) | / raw | bytes sent + received during the sweep (page's count) |",
+              "|---|---:|---:|---:|---:|"]
+    for name, r in results.items():
+        gpu = r["methods"]["gpu"]
+        during = (gpu["bytesSentAfter"] - gpu["bytesSent"]) + (gpu["bytesReceivedAfter"] - gpu["bytesReceived"])
+        lines.append("| %s | %d | %d | %.2fx | %d |" % (
+            name, r["raw_bytes"], gpu["bytesReceived"], gpu["bytesReceived"] / r["raw_bytes"], during))
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if args.out:
+        with open(args.out, "w") as f:
+            f.write(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

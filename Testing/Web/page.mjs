@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Drives the web client in Debian's Chromium (headless, software WebGL2) for the tests and the
+// benchmark: opens URL, waits for window.mediso.ready (or the page's "unsupported" message),
+// runs a list of window.mediso calls, and writes what happened as JSON.
+//   node page.mjs URL OUT.json [--actions FILE.json] [--shot CANVAS.png] [--no-webgl]
+// Actions: [{"call": "setSurfaces", "args": [[...]]}, {"call": "shot", "args": ["x.png"]}, ...];
+// each call's result goes to "results". Chromium is /usr/bin/chromium (MEDISO_CHROMIUM
+// overrides); playwright-core downloads no browser.
+import { chromium } from "playwright-core";
+import { readFileSync, writeFileSync } from "node:fs";
+
+export const chromiumArgs = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+  "--disable-background-networking", "--disable-component-update", "--disable-sync",
+  "--no-first-run", "--disable-features=Translate,MediaRouter"];
+
+export async function launch({ webgl = true } = {}) {
+  return chromium.launch({
+    executablePath: process.env.MEDISO_CHROMIUM || "/usr/bin/chromium",
+    headless: true,
+    args: webgl ? chromiumArgs : [...chromiumArgs, "--disable-3d-apis"],
+  });
+}
+
+// Opens the page and waits until it has drawn its first frame or said why it cannot.
+export async function open(browser, url, log = () => {}) {
+  const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
+  page.on("console", (m) => log("console: " + m.text()));
+  page.on("pageerror", (e) => log("pageerror: " + e.message));
+  await page.goto(url, { waitUntil: "commit" });
+  await page.waitForFunction(() => window.mediso || !document.getElementById("unsupported")?.hidden,
+    null, { timeout: 120000 });
+  const state = await page.evaluate(() => window.mediso.ready.then(() => "ready", (e) => "failed: " + e.message));
+  const unsupported = await page.evaluate(() => {
+    const box = document.getElementById("unsupported");
+    return box && !box.hidden ? box.textContent : "";
+  });
+  return { page, state, unsupported };
+}
+
+async function main() {
+  const [url, out, ...rest] = process.argv.slice(2);
+  const option = (name) => {
+    const i = rest.indexOf(name);
+    return i >= 0 ? rest[i + 1] : undefined;
+  };
+  const actions = option("--actions") ? JSON.parse(readFileSync(option("--actions"), "utf8")) : [];
+  const browser = await launch({ webgl: !rest.includes("--no-webgl") });
+  const logs = [];
+  const started = Date.now();
+  const { page, state, unsupported } = await open(browser, url, (line) => logs.push(line));
+  const result = { state, unsupported, readyMs: Date.now() - started, results: [], logs };
+  if (state === "ready") {
+    for (const action of actions) {
+      if (action.call === "shot") {
+        await page.locator("#view").screenshot({ path: action.args[0] });
+        result.results.push(action.args[0]);
+        continue;
+      }
+      result.results.push(await page.evaluate(
+        ([call, args]) => Promise.resolve(window.mediso[call](...args)), [action.call, action.args || []]));
+    }
+    result.stats = await page.evaluate(() => window.mediso.stats());
+    if (option("--shot")) {
+      await page.locator("#view").screenshot({ path: option("--shot") });
+    }
+  }
+  writeFileSync(out, JSON.stringify(result, null, 1));
+  await browser.close();
+}
+
+if (import.meta.url === "file://" + process.argv[1]) {
+  main().catch((e) => {
+    console.error(e);
+    process.exit(1);
+  });
+}
