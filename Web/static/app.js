@@ -376,7 +376,9 @@ async function start() {
     dataset: d,
     token,
     surfaces: () => state.surfaces,
-    level: () => state.level,
+    // The page's surfaces as a level of the whole volume: the GPU path draws the fetched level
+    // in full, the CPU path its own level of that.
+    level: () => (state.path === "cpu" ? Math.max(0, state.cpuLevel + state.level - 3) : state.level),
     request,
     count(sent, received) {
       state.bytesSent += sent;

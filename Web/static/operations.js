@@ -33,7 +33,7 @@ function megabytes(n) {
  *   dataset                  the dataset the page shows (docs/web.md's D)
  *   token                    the session's token
  *   surfaces()               the page's surfaces [{value, ...}]
- *   level()                  the level the page fetched (0-3)
+ *   level()                  the level of the whole volume its surfaces are drawn at (0-3)
  *   request(url)             app.js's counted fetch: {response, body}
  *   count(sent, received)    adds bytes the panel moved itself (WebSocket) to the readout
  */
