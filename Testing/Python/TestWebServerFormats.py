@@ -70,7 +70,13 @@ def write(folder):
         w.SetInputData(image(values))
         w.Write()
         written.append((path, values, exact))
-    dicom = dicom_series(folder, written[0][0])
+    plain = os.path.join(folder, "plain.mha")  # the DICOM writer reads uncompressed MetaImage
+    w = vtkMetaImageWriter()
+    w.SetFileName(plain)
+    w.SetCompression(False)
+    w.SetInputData(image(written[0][1]))
+    w.Write()
+    dicom = dicom_series(folder, plain)
     if dicom:
         written.append((dicom, written[0][1], False))
     return written
@@ -87,11 +93,11 @@ def dicom_series(folder, mha):
               "MedicalDICOMSeriesReader, from the gui branch): the folder case is not run")
         return None
     out = os.path.join(folder, "dicom")
-    run = subprocess.run([sys.executable if False else "python3", script, "--mha", mha, "--out",
-                          out], capture_output=True, text=True)
+    run = subprocess.run(["python3", script, "--mha", mha, "--out", out], capture_output=True,
+                         text=True)
     if run.returncode != 0:
         print("note: write_dicom_series.py could not write the series (%s): the folder case "
-              "is not run" % run.stdout.strip()[-200:])
+              "is not run" % (run.stdout + run.stderr).strip()[-200:])
         return None
     return out
 
