@@ -20,6 +20,7 @@ ignores abort costs only this process, which the server restarts.
 import argparse
 import json
 import os
+import shutil
 import signal
 import sys
 import time
@@ -173,8 +174,7 @@ class Worker:
         self.last = (0.0, 0.0, None)
 
     def send(self, message):
-        self.out.write(json.dumps(message) + "\n")
-        self.out.flush()
+        emit(self.out, message, self.results)
 
     # -- observers: progress, abort, the filters' own errors and warnings
     def report(self, fraction, stage):
@@ -394,6 +394,23 @@ def _last_line(text):
     return message
 
 
+def server_gone(results):
+    """The end of input, or of output: the server is gone (a worker it replaces it ends with
+    SIGKILL instead). Its results go with it, even when it was killed before it could remove them
+    itself."""
+    shutil.rmtree(results, ignore_errors=True)
+
+
+def emit(out, message, results):
+    """One message to the server; the worker ends quietly when the server is gone."""
+    try:
+        out.write(json.dumps(message) + "\n")
+        out.flush()
+    except BrokenPipeError:
+        server_gone(results)
+        os._exit(0)  # nothing left to flush: the pipe is closed
+
+
 def main(argv):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--plugin", required=True)
@@ -421,8 +438,7 @@ def main(argv):
     try:
         sources = open_sources(args.sources, ns, lambda m: None)
     except ValueError as e:
-        out.write(json.dumps({"fatal": str(e)}) + "\n")
-        out.flush()
+        emit(out, {"fatal": str(e)}, args.results)
         return 1
     worker = Worker(sources, ns, args.results, out)
     worker.send({"ready": True, "datasets": [s[1] for s in sources]})
@@ -431,6 +447,7 @@ def main(argv):
             continue
         job = json.loads(line)
         worker.run(job)
+    server_gone(args.results)
     return 0
 
 

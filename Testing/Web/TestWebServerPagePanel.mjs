@@ -29,6 +29,7 @@ await page.evaluate((iso) => {
   window.mediso.showMesh = (buffer) => {
     window.shownMesh = new TextDecoder().decode(new Uint8Array(buffer, 0, 300));
     window.shownBytes = buffer.byteLength;
+    window.shownCount = (window.shownCount || 0) + 1;
     return own ? own(buffer) : undefined;
   };
   const progress = document.getElementById("op-progress");
@@ -155,6 +156,9 @@ const after = await (await fetch(server.api("/api/status"))).json();
 checks.check(!after.running && after.worker.restarts === 0 && after.sessions === 1,
   "the closed browser's operation was stopped by abort and its socket is gone (" +
   JSON.stringify(after) + ")");
+
+// (Its result then goes to the page's mesh display: that fetch ends before the count below.)
+await page.waitForFunction(() => window.shownCount === 2, null, { timeout: 60000 });
 
 // The page still changes isovalues without a byte.
 const events = wire.events;
