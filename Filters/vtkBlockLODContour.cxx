@@ -35,7 +35,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <map>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -233,9 +232,10 @@ struct vtkBlockLODContour::vtkInternals
   mediso::SurfaceLayout CacheLayout;
   bool WarnedMissing = false; // NaN or infinite values, once per input
 
-  // What the last RequestData planned and generated.
-  std::map<double, mediso::ExtractionPlan> Plans;
-  std::map<double, double> PlanSeconds;
+  // What the last RequestData planned (one plan per isovalue, kept between
+  // updates so that their buffers are reused, not faulted in again) and generated.
+  std::vector<mediso::ExtractionPlan> Plans;
+  std::vector<double> PlanSeconds;
   std::vector<vtkSmartPointer<vtkPolyData>> Surfaces;
 
   // Cells that are not ghosts, as an inclusive cell index range per axis:
@@ -360,6 +360,8 @@ struct vtkBlockLODContour::vtkInternals
     }
     this->Estimator.Reset();
     this->Cache.Clear();
+    this->Plans.clear(); // sized for the old input
+    this->PlanSeconds.clear();
     this->WarnedMissing = false;
     return true;
   }
@@ -483,8 +485,6 @@ int vtkBlockLODContour::RequestData(
     return 0;
   }
   vtkInternals& in = *this->Internals;
-  in.Plans.clear();
-  in.PlanSeconds.clear();
   in.Surfaces.clear();
 
   // Check: an array the core can read, on a grid it can contour.
@@ -779,23 +779,25 @@ bool vtkBlockLODContour::PlanLevel(const std::vector<double>& values, int& level
   auto abort = [this]() { return this->GetAbortExecute() != 0; };
   for (;;)
   {
-    in.Plans.clear();
+    in.Plans.resize(values.size());
+    in.PlanSeconds.assign(values.size(), 0.0);
     double bytes = 0;
-    for (double v : values)
+    for (std::size_t i = 0; i < values.size(); ++i)
     {
+      const double v = values[i];
       const mediso::SurfaceKey key{ v, level };
       if (in.Cache.Contains(key))
       {
         bytes += in.Cache.EntryBytes(key);
         continue;
       }
-      mediso::ExtractionPlan& plan = in.Plans[v];
+      mediso::ExtractionPlan& plan = in.Plans[i];
       const double start = Now();
       if (!in.Volume.Plan(v, level, plan, abort) || this->CheckAbort())
       {
         return false;
       }
-      in.PlanSeconds[v] = Now() - start;
+      in.PlanSeconds[i] = Now() - start;
       const mediso::SurfaceCounts exact = mediso::BlockLODVolume::CountsOf(plan);
       in.Estimator.RecordExact(v, level, exact);
       bytes += layout.Bytes(exact);
@@ -836,9 +838,9 @@ bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int le
   vtkInternals& in = *this->Internals;
   const mediso::SurfaceLayout layout = OutputLayout(this);
   std::vector<mediso::SurfaceKey> used;
-  for (double v : values)
+  for (std::size_t i = 0; i < values.size(); ++i)
   {
-    const mediso::SurfaceKey key{ v, level };
+    const mediso::SurfaceKey key{ values[i], level };
     used.push_back(key);
     if (vtkSmartPointer<vtkPolyData>* cached = in.Cache.Find(key))
     {
@@ -846,11 +848,11 @@ bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int le
       in.Surfaces.push_back(*cached);
       continue;
     }
-    const mediso::ExtractionPlan& plan = in.Plans[v];
+    const mediso::ExtractionPlan& plan = in.Plans[i];
     const double start = Now();
     SurfaceArrays arrays =
       AllocateSurface(plan.GetNumberOfPoints(), plan.GetNumberOfTriangles(), layout);
-    auto generate = [&](auto* connectivity) {
+      auto generate = [&](auto* connectivity) {
       mediso::SurfaceBuffers<std::remove_pointer_t<decltype(connectivity)>> buffers;
       buffers.Points = arrays.Points;
       buffers.Normals = arrays.Normals;
@@ -870,7 +872,7 @@ bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int le
     ++this->NumberOfExtractions;
     const mediso::SurfaceCounts counts = mediso::BlockLODVolume::CountsOf(plan);
     in.Estimator.GetCostModel().Record(
-      counts.Cubes, counts.Triangles, in.PlanSeconds[v] + (Now() - start));
+      counts.Cubes, counts.Triangles, in.PlanSeconds[i] + (Now() - start));
     in.Surfaces.push_back(arrays.Surface);
     if (this->CacheMemoryLimit > 0)
     {

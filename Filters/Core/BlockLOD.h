@@ -23,11 +23,14 @@
  * - Points live on the cut edges of the sample grid. Each edge belongs to
  *   exactly one block (the one holding its lower end, faces going to the
  *   block above them, except on the volume's last face), and that block is
- *   always visited, because it holds both ends of the edge. Pass 1 marks each
- *   block's cut edges in a bit mask and counts triangles; a prefix sum over
+ *   always visited, because it holds both ends of the edge. Pass 1 classifies
+ *   a block's samples into one bit mask per row of samples, from which the
+ *   cut edges of a row are a few bit operations and the cases of a row's
+ *   cubes one 8 x 8 bit transpose; it marks each block's cut edges and cut
+ *   cubes in bit masks and counts triangles; a prefix sum over
  *   the visited blocks gives every block its first point and first triangle;
  *   the output is allocated once; pass 2 writes the points of owned edges in
- *   bit order and the triangles of every cube, finding a point's id as
+ *   bit order and the triangles of every cut cube, finding a point's id as
  *   "first point of the owner block + rank of the edge's bit". Points on
  *   shared edges are therefore merged within and across blocks, at every
  *   level: the surface is watertight (no duplicate points, no cracks).
@@ -204,9 +207,11 @@ struct ExtractionPlan
   std::vector<std::int64_t> TriangleOffset; ///< Per active block (+1): first triangle.
   std::vector<std::uint64_t> EdgeBits;      ///< Per active block: owned cut edges.
   std::vector<std::uint32_t> EdgeRank;      ///< Per active block and word: bits before it.
-  std::vector<std::uint8_t> CubeCases;      ///< Per active block: case of each cube.
+  std::vector<std::uint64_t> CutCubes;      ///< Per active block: cubes that make triangles.
+  std::vector<std::uint8_t> CubeCases;      ///< Per active block: case of each cut cube.
   int WordsPerBlock = 0;
-  int CubesPerBlock = 0; ///< (8 / stride)^3: stride of CubeCases.
+  int CubeWordsPerBlock = 0; ///< Stride of CutCubes.
+  int CubesPerBlock = 0;     ///< (8 / stride)^3: stride of CubeCases.
 
   std::int64_t GetNumberOfPoints() const
   {
