@@ -34,20 +34,17 @@
  *    CacheMemoryLimit (least recently used surfaces go first). Asking again
  *    for a cached pair costs no extraction (see GetNumberOfExtractions()).
  * -# Estimates. EstimateTriangles()/EstimateMegabytes()/EstimateSeconds()
- *    predict a pair's output before extracting it. Exact for a cached or
- *    planned pair. For a new pair, the cut cubes and cut edges are counted
- *    exactly on an evenly spread sample of about 256 active blocks and scaled
- *    to all active blocks (exact when there are fewer); the paper used a fixed
- *    2 triangles per cube instead. When two levels of the isovalue are already
- *    known and counting would be approximate, the estimate is scaled from them
- *    by that isovalue's own growth per level: marching-cubes surfaces grow
- *    about 4x per level when smooth (not the 8x of the paper's Table 1), but
- *    thin structures such as cortical bone grow nearer 2x at coarse levels and
- *    8x when they first appear, so no global factor is used. Bytes are those
- *    the output vtkPolyData holds (points, normals, scalars, connectivity,
- *    offsets, block ids); seconds follow a cost model (per visited cube and
- *    per triangle) fitted to this filter's own extractions, the paper's
- *    future work.
+ *    predict a pair's output before extracting it (BlockLODEstimator.h).
+ *    Exact for a cached or planned pair, and for a new pair whose active
+ *    blocks can all be counted within a fixed amount of work (levels 0 and 1
+ *    almost always). Otherwise the cut cubes and edges are counted on a spread
+ *    sample of active blocks together with the finest coarser level whose
+ *    count is exact, and scaled by that level's exact count (a ratio
+ *    estimate); the paper used a fixed 2 triangles per cube instead. Bytes are
+ *    those the output vtkPolyData holds (points, normals, scalars,
+ *    connectivity, offsets, block ids); seconds follow a cost model (per
+ *    visited cube and per triangle) fitted to this filter's own extractions,
+ *    the paper's future work.
  * -# AutoLOD. With AutoLOD on, the filter picks the highest level whose
  *    estimated output fits MemoryBudget (MB, all isovalues together). Exact
  *    counts are known before any output is allocated, so an underestimate
@@ -210,9 +207,10 @@ public:
   ///@}
 
   /**
-   * How the last estimate was made: 0 exact (cached or planned pair), 1 scaled
-   * from another level of the same isovalue, 2 counted on sampled blocks,
-   * -1 none.
+   * How the last estimate was made: 0 exact (cached, planned or every active
+   * block counted), 1 counted on sampled blocks and scaled by the exact count
+   * of a coarser level of the same isovalue, 2 counted on sampled blocks and
+   * scaled up to all active blocks, -1 none.
    */
   vtkGetMacro(LastEstimateMethod, int);
 

@@ -941,52 +941,47 @@ std::vector<std::int32_t> ListActiveBlocks(const BlockRanges& ranges, double iso
 }
 
 template <typename T>
-SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
-  TriangleCaseTable cases, double isovalue, int level, int sampleStep, const ParallelFor& parallel)
+BlockSums CountBlocks(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
+  const std::vector<std::int32_t>& blocks, double isovalue, int level, int auxLevel,
+  const ParallelFor& parallel)
 {
-  return CountSampled(volume, ranges, cases, ListActiveBlocks(ranges, isovalue), isovalue, level,
-    sampleStep, parallel);
-}
-
-template <typename T>
-SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
-  TriangleCaseTable cases, const std::vector<std::int32_t>& active, double isovalue, int level,
-  int sampleStep, const ParallelFor& parallel)
-{
-  SampledCounts result;
-  result.ActiveBlocks = static_cast<std::int64_t>(active.size());
-  sampleStep = std::max(1, sampleStep);
-  const std::int64_t sampled = (result.ActiveBlocks + sampleStep - 1) / sampleStep;
-  result.SampledBlocks = sampled;
-  std::vector<std::int64_t> points(sampled, 0), triangles(sampled, 0);
-  const TriangleCounts counts(cases);
-  const int stride = LevelStride(level);
+  const std::int64_t n = static_cast<std::int64_t>(blocks.size());
+  // Per block: level points and triangles, auxiliary points and triangles.
+  std::vector<std::int64_t> counts(4 * n, 0);
+  const TriangleCounts table(cases);
   const AboveIsovalue<T> above(isovalue);
-  const int words = WordsPerBlock(level);
-  parallel(0, sampled, [&](std::int64_t s0, std::int64_t s1) {
+  const int levels[2] = { level, auxLevel };
+  parallel(0, n, [&](std::int64_t b0, std::int64_t b1) {
     BlockRows rows;
-    std::vector<std::uint64_t> bits(words);
-    for (std::int64_t s = s0; s < s1; ++s)
+    std::vector<std::uint64_t> bits(WordsPerBlock(NumberOfLevels - 1));
+    for (std::int64_t b = b0; b < b1; ++b)
     {
-      const BlockSamples samples(ranges, active[s * sampleStep], stride);
-      ClassifyRows(volume, samples, above, rows);
-      std::fill(bits.begin(), bits.end(), 0);
-      const BlockCounts c = CountBlock(rows, samples, OwnedSamples(volume, samples), counts,
-        bits.data(), words, nullptr, nullptr);
-      points[s] = c.Points;
-      triangles[s] = c.Triangles;
+      for (int which = 0; which < 2 && levels[which] >= 0; ++which)
+      {
+        const BlockSamples samples(ranges, blocks[b], LevelStride(levels[which]));
+        ClassifyRows(volume, samples, above, rows);
+        const int words = WordsPerBlock(levels[which]);
+        std::fill(bits.begin(), bits.begin() + words, 0);
+        const BlockCounts c = CountBlock(rows, samples, OwnedSamples(volume, samples), table,
+          bits.data(), words, nullptr, nullptr);
+        counts[4 * b + 2 * which] = c.Points;
+        counts[4 * b + 2 * which + 1] = c.Triangles;
+      }
     }
   });
-  double p = 0, t = 0;
-  for (std::int64_t s = 0; s < sampled; ++s)
+  BlockSums sums;
+  sums.Blocks = n;
+  for (std::int64_t b = 0; b < n; ++b)
   {
-    p += static_cast<double>(points[s]);
-    t += static_cast<double>(triangles[s]);
+    const std::int64_t* c = counts.data() + 4 * b;
+    const bool auxPoints = auxLevel < 0 || c[2] > 0;
+    const bool auxTriangles = auxLevel < 0 || c[3] > 0;
+    (auxPoints ? sums.Points : sums.RestPoints) += static_cast<double>(c[0]);
+    (auxTriangles ? sums.Triangles : sums.RestTriangles) += static_cast<double>(c[1]);
+    sums.AuxPoints += static_cast<double>(c[2]);
+    sums.AuxTriangles += static_cast<double>(c[3]);
   }
-  const double scale = sampled > 0 ? static_cast<double>(result.ActiveBlocks) / sampled : 0.0;
-  result.Points = p * scale;
-  result.Triangles = t * scale;
-  return result;
+  return sums;
 }
 
 #define MEDISO_INSTANTIATE(T)                                                                      \
@@ -1000,9 +995,7 @@ SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
   template void GenerateSurface<T, std::int64_t>(const Volume<T>&, const BlockRanges&,            \
     TriangleCaseTable, const ExtractionPlan&, const SurfaceBuffers<std::int64_t>&,                 \
     const ParallelFor&);                                                                           \
-  template SampledCounts CountSampled<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable,  \
-    double, int, int, const ParallelFor&);                                                         \
-  template SampledCounts CountSampled<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable,  \
+  template BlockSums CountBlocks<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable,       \
     const std::vector<std::int32_t>&, double, int, int, const ParallelFor&)
 
 MEDISO_FOR_EACH_SCALAR_TYPE(MEDISO_INSTANTIATE);

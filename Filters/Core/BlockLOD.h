@@ -249,29 +249,29 @@ template <typename T, typename IdType>
 void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
   const ExtractionPlan& plan, const SurfaceBuffers<IdType>& out, const ParallelFor& parallel);
 
-/// Counts for an estimate: exact when every active block is counted, else
-/// scaled from every `sampleStep`-th active block (spread over the volume).
-struct SampledCounts
+/// Sums of point and triangle counts over a list of blocks, for exact counts
+/// and for the estimator's samples (BlockLODEstimator.h). With an auxiliary
+/// (coarser) level, the level's counts are split by whether the block's
+/// auxiliary count is positive: Points and Triangles over blocks with a
+/// positive auxiliary count (every block without an auxiliary level), Rest*
+/// over the others, Aux* the auxiliary level's counts over all of them.
+struct BlockSums
 {
-  std::int64_t ActiveBlocks = 0;
-  std::int64_t SampledBlocks = 0;
+  std::int64_t Blocks = 0;
   double Points = 0;
   double Triangles = 0;
+  double RestPoints = 0;
+  double RestTriangles = 0;
+  double AuxPoints = 0;
+  double AuxTriangles = 0;
 };
 
-/// Counts cut cubes' triangles and cut edges at a level over a sample of the
-/// active blocks (no allocation proportional to the output).
+/// Counts cut edges (points) and triangles of a level, and of `auxLevel`
+/// (-1: none), on the given blocks (no allocation proportional to the output).
 template <typename T>
-SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
-  TriangleCaseTable cases, double isovalue, int level, int sampleStep,
+BlockSums CountBlocks(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
+  const std::vector<std::int32_t>& blocks, double isovalue, int level, int auxLevel,
   const ParallelFor& parallel);
-
-/// The same, with the isovalue's active blocks already listed (linear indices
-/// in increasing order, as ListActiveBlocks gives them).
-template <typename T>
-SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
-  TriangleCaseTable cases, const std::vector<std::int32_t>& active, double isovalue, int level,
-  int sampleStep, const ParallelFor& parallel);
 
 /// Linear indices of the blocks active for an isovalue, in increasing order.
 std::vector<std::int32_t> ListActiveBlocks(const BlockRanges& ranges, double isovalue);

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 
 namespace mediso
 {
@@ -100,53 +99,58 @@ SurfaceEstimate BlockLODEstimator::Estimate(double isovalue, int level)
     e.Method = EstimateMethod::Exact;
     return e;
   }
-  std::vector<int> known;
-  for (int l = 0; l < NumberOfLevels; ++l)
-  {
-    auto it = this->Exact.find(SurfaceKey{ isovalue, l });
-    if (it != this->Exact.end() && it->second.Triangles > 0)
-    {
-      known.push_back(l);
-    }
-  }
-  // Scale only where counting would be approximate: with few active blocks
-  // every block is counted, which is exact and cheap.
-  const std::int64_t active =
-    static_cast<std::int64_t>(this->Volume.ActiveBlocks(isovalue).size());
-  if (known.size() >= 2 && !this->Sampled.count(key) && active / SampleBlocks > 1)
-  {
-    // The two known levels nearest to the requested one, the finer first on a tie.
-    std::sort(known.begin(), known.end(), [level](int a, int b) {
-      const int da = std::abs(a - level), db = std::abs(b - level);
-      return da < db || (da == db && a > b);
-    });
-    const SurfaceCounts& a = this->Exact[SurfaceKey{ isovalue, known[0] }];
-    const SurfaceCounts& b = this->Exact[SurfaceKey{ isovalue, known[1] }];
-    const double growth = std::pow(a.Triangles / b.Triangles, 1.0 / (known[0] - known[1]));
-    const double f = std::pow(growth, level - known[0]);
-    e.Counts.Triangles = a.Triangles * f;
-    e.Counts.Points = a.Points * f;
-    e.Counts.Cubes = a.Cubes * std::pow(8.0, level - known[0]);
-    e.Method = EstimateMethod::Scaled;
-    return e;
-  }
-  e.Method = EstimateMethod::Sampled;
   auto sampled = this->Sampled.find(key);
   if (sampled != this->Sampled.end())
   {
-    e.Counts = sampled->second;
+    return sampled->second;
+  }
+  if (this->Volume.ExactCountCost(isovalue, level) <= this->SampleBudget)
+  {
+    e.Counts = this->Volume.CountExact(isovalue, level);
+    e.Method = EstimateMethod::Exact;
+    this->RecordExact(isovalue, level, e.Counts);
     return e;
   }
-  bool complete = false;
-  e.Counts = this->Volume.CountSampled(isovalue, level, SampleBlocks, complete);
-  if (complete)
+  // The auxiliary level: the finest coarser level whose counts are exact, or
+  // affordable to make exact.
+  int aux = -1;
+  for (int a = level - 1; a >= 0 && aux < 0; --a)
   {
-    this->RecordExact(isovalue, level, e.Counts); // every active block counted
+    if (!this->HasExact(isovalue, a) && this->Volume.ExactCountCost(isovalue, a) <= this->SampleBudget)
+    {
+      this->RecordExact(isovalue, a, this->Volume.CountExact(isovalue, a));
+    }
+    aux = this->HasExact(isovalue, a) ? a : -1;
+  }
+  const double perBlock =
+    BlockLODVolume::BlockCost(level) + (aux >= 0 ? BlockLODVolume::BlockCost(aux) : 0.0);
+  const std::int64_t samples =
+    std::max<std::int64_t>(MinimumSamples, static_cast<std::int64_t>(this->SampleBudget / perBlock));
+  const BlockSums sums = this->Volume.CountSample(isovalue, level, aux, samples);
+  const double active = static_cast<double>(this->Volume.ActiveBlocks(isovalue).size());
+  const double expand = sums.Blocks > 0 ? active / static_cast<double>(sums.Blocks) : 0.0;
+  if (aux >= 0)
+  {
+    // Ratio estimate on the blocks the auxiliary level cuts (its exact total
+    // times the sample's ratio), plus the others scaled up from the sample.
+    const SurfaceCounts& known = this->Exact[SurfaceKey{ isovalue, aux }];
+    auto combine = [expand](double total, double sum, double auxSum, double rest) {
+      return (auxSum > 0 ? total * sum / auxSum : expand * sum) + expand * rest;
+    };
+    e.Counts.Points = combine(known.Points, sums.Points, sums.AuxPoints, sums.RestPoints);
+    e.Counts.Triangles =
+      combine(known.Triangles, sums.Triangles, sums.AuxTriangles, sums.RestTriangles);
+    e.Method = EstimateMethod::Scaled;
   }
   else
   {
-    this->Sampled[key] = e.Counts;
+    e.Counts.Points = expand * (sums.Points + sums.RestPoints);
+    e.Counts.Triangles = expand * (sums.Triangles + sums.RestTriangles);
+    e.Method = EstimateMethod::Sampled;
   }
+  const double cubesPerAxis = BlockCells / LevelStride(level);
+  e.Counts.Cubes = active * cubesPerAxis * cubesPerAxis * cubesPerAxis;
+  this->Sampled[key] = e;
   return e;
 }
 

@@ -13,15 +13,19 @@
  *   records (defaults until two are recorded; one record rescales them).
  * - BlockLODEstimator predicts an (isovalue, level) pair's counts before it is
  *   extracted, in this order:
- *   -# exact, for a pair whose plan was recorded (RecordExact);
- *   -# scaled from two exact levels of the same isovalue by that isovalue's
- *      own growth per level (smooth surfaces grow about 4x per level, thin
- *      structures nearer 2x at coarse levels and 8x where they first appear,
- *      so no global factor is used), when counting would be approximate;
- *   -# counted on a spread sample of about SampleBlocks active blocks and
- *      scaled to all of them (exact when there are no more; the paper used a
- *      fixed 2 triangles per cube instead).
- *   Sampled counts are kept until Reset() (the input changed).
+ *   -# exact, for a pair whose plan was recorded (RecordExact), or that can be
+ *      counted on every active block within SampleBudget (levels 0 and 1 on
+ *      their small coarse copies, finer levels with few active blocks);
+ *   -# counted on a jittered systematic sample of active blocks (as many as
+ *      the budget pays for), together with the finest coarser level whose
+ *      count is exact (made exact within the budget when it is not): the
+ *      blocks that level cuts give a ratio estimate (its exact count times
+ *      the sample's ratio of the two levels' counts: per-block counts of two
+ *      levels move together, so the ratio varies far less than the counts),
+ *      the blocks it does not cut are scaled up from the sample;
+ *   -# without such a level, the sample scaled up to all active blocks (the
+ *      paper used a fixed 2 triangles per cube instead).
+ *   Sampled estimates are kept until Reset() (the input changed).
  * - ChooseLevel() picks the highest level whose estimated output, all
  *   isovalues together, fits a byte budget (AutoLOD). A host plans the chosen
  *   level before allocating and drops a level when the exact bytes do not fit,
@@ -83,9 +87,9 @@ private:
 enum class EstimateMethod
 {
   None = -1,
-  Exact = 0,
-  Scaled = 1,
-  Sampled = 2
+  Exact = 0,   ///< Every active block counted, or the pair planned.
+  Scaled = 1,  ///< Sampled, scaled by the exact count of a coarser level.
+  Sampled = 2  ///< Sampled, scaled up to all active blocks.
 };
 
 struct SurfaceEstimate
@@ -97,8 +101,11 @@ struct SurfaceEstimate
 class BlockLODEstimator
 {
 public:
-  /// Active blocks counted for a sampled estimate.
-  static constexpr std::int64_t SampleBlocks = 256;
+  /// The work one estimate may do by default, in BlockLODVolume::BlockCost()
+  /// units: about 1024 blocks of level 3 (a millisecond or two on 2 cores).
+  static constexpr double DefaultSampleBudget = 13.0 * 1024;
+  /// The fewest blocks a sampled estimate counts, whatever the budget.
+  static constexpr std::int64_t MinimumSamples = 256;
 
   explicit BlockLODEstimator(BlockLODVolume& volume);
 
@@ -121,14 +128,20 @@ public:
   int ChooseLevel(const std::vector<double>& isovalues, double budgetBytes,
     const SurfaceLayout& layout, double& level0Bytes);
 
+  /// The work one estimate may do (see DefaultSampleBudget); a change
+  /// applies to estimates not made yet.
+  void SetSampleBudget(double budget) { this->SampleBudget = budget; }
+  double GetSampleBudget() const { return this->SampleBudget; }
+
   CostModel& GetCostModel() { return this->Cost; }
   const CostModel& GetCostModel() const { return this->Cost; }
 
 private:
   BlockLODVolume& Volume;
   std::map<SurfaceKey, SurfaceCounts> Exact;
-  std::map<SurfaceKey, SurfaceCounts> Sampled;
+  std::map<SurfaceKey, SurfaceEstimate> Sampled;
   CostModel Cost;
+  double SampleBudget = DefaultSampleBudget;
 };
 
 } // namespace mediso

@@ -8,8 +8,9 @@
 //   cube of each level's sample grid (with NaN voxels and a size that is no
 //   multiple of 8);
 // - estimates per level: exact (every active block counted) on a small volume;
-//   sampled on a large one, within 10% of the exact count; scaled from two
-//   exact levels by the isovalue's own growth; recorded exact counts returned;
+//   on a large one, exact, or by ratio to an exact coarser level, or sampled,
+//   as the budget allows, each within its tolerance of a brute-force count;
+//   recorded exact counts returned and used as the ratio's level;
 // - the cost model reproduces a linear law from its samples, rescales its
 //   defaults from one sample and stays non-negative on collinear samples;
 // - the byte layout and the AutoLOD level choice;
@@ -192,7 +193,7 @@ void TestPlanCounts()
 
 void TestEstimates()
 {
-  // Small volume: few active blocks, every one counted: the estimate is exact.
+  // Small volume: every level counted on every active block: exact.
   {
     const Field f = MakeField(40, 37, 35, 11.0, 0.5, false);
     mediso::BlockLODVolume volume(Table.Cases, mediso::SerialFor);
@@ -203,70 +204,87 @@ void TestEstimates()
       double points, triangles;
       BruteForce(f, 0.0, level, points, triangles);
       const mediso::SurfaceEstimate e = estimator.Estimate(0.0, level);
-      Check(e.Counts.Triangles == triangles && e.Counts.Points == points,
-        "small volume: the estimate counts every active block, level " + std::to_string(level));
-      Check(estimator.HasExact(0.0, level), "a complete count is remembered as exact");
-      Check(estimator.Estimate(0.0, level).Method == mediso::EstimateMethod::Exact,
-        "asked again, the pair is exact");
-      const double active = static_cast<double>(volume.ActiveBlocks(0.0).size());
-      const double perAxis = 8.0 / mediso::LevelStride(level);
-      Check(e.Counts.Cubes == active * perAxis * perAxis * perAxis,
-        "cubes visited = active blocks x cubes per block");
+      Check(e.Method == mediso::EstimateMethod::Exact && e.Counts.Triangles == triangles &&
+          e.Counts.Points == points,
+        "small volume: exact counts at level " + std::to_string(level));
+      Check(estimator.HasExact(0.0, level), "an exact count is remembered");
+      // Cubes visited: what the plan of the pair visits (levels 0 and 1 are
+      // counted on the coarse copies the plans read).
+      mediso::ExtractionPlan plan;
+      volume.Plan(0.0, level, plan);
+      const double planned = mediso::BlockLODVolume::CountsOf(plan).Cubes;
+      const double fullBlocks = static_cast<double>(volume.ActiveBlocks(0.0).size()) * 512;
+      Check(level == 2 || e.Counts.Cubes == (level == 3 ? fullBlocks : planned),
+        "estimated cubes are the cubes the plan visits, level " + std::to_string(level));
     }
   }
 
-  // Large noisy volume: more than 2 x 256 active blocks, so counts are sampled.
+  // Large noisy volume (more active blocks than the budget counts at level 3).
   const Field f = MakeField(161, 150, 140, 62.0, 3.0, false);
   mediso::BlockLODVolume volume(Table.Cases, mediso::SerialFor);
   volume.SetVolume(Describe(f));
-  mediso::BlockLODEstimator estimator(volume);
   const double iso = 0.25;
   const std::int64_t active = static_cast<std::int64_t>(volume.ActiveBlocks(iso).size());
   std::printf("large volume: %lld active blocks of %lld\n", static_cast<long long>(active),
     static_cast<long long>(volume.GetRanges().GetNumberOfBlocks()));
-  Check(active > 2 * mediso::BlockLODEstimator::SampleBlocks, "enough active blocks to sample");
   double exact[4];
   for (int level = 0; level < mediso::NumberOfLevels; ++level)
   {
     double points;
     BruteForce(f, iso, level, points, exact[level]);
-    const mediso::SurfaceEstimate e = estimator.Estimate(iso, level);
-    const double error = (e.Counts.Triangles - exact[level]) / exact[level];
-    std::printf("sampled estimate level %d: %.0f triangles, exact %.0f (%+.2f%%)\n", level,
-      e.Counts.Triangles, exact[level], 100 * error);
-    Check(e.Method == mediso::EstimateMethod::Sampled, "a large count is sampled");
-    Check(std::fabs(error) < 0.10, "sampled estimate within 10% at level " + std::to_string(level));
-    Check(estimator.Estimate(iso, level).Counts.Triangles == e.Counts.Triangles,
-      "a sampled estimate is kept, not recounted");
+  }
+  const char* methods[] = { "exact", "ratio to an exact coarser level", "sampled" };
+  // Budgets: the default (levels 0-2 exact, level 3 by ratio to level 2), a
+  // small one (level 1 exact, levels 2-3 by ratio to it), none (sampled).
+  const double budgets[] = { mediso::BlockLODEstimator::DefaultSampleBudget, 3000.0, 0.0 };
+  const mediso::EstimateMethod expected[3][4] = {
+    { mediso::EstimateMethod::Exact, mediso::EstimateMethod::Exact, mediso::EstimateMethod::Exact,
+      mediso::EstimateMethod::Scaled },
+    { mediso::EstimateMethod::Exact, mediso::EstimateMethod::Exact, mediso::EstimateMethod::Scaled,
+      mediso::EstimateMethod::Scaled },
+    { mediso::EstimateMethod::Sampled, mediso::EstimateMethod::Sampled,
+      mediso::EstimateMethod::Sampled, mediso::EstimateMethod::Sampled }
+  };
+  const double tolerance[3] = { 0.03, 0.06, 0.10 };
+  for (int b = 0; b < 3; ++b)
+  {
+    mediso::BlockLODEstimator estimator(volume);
+    estimator.SetSampleBudget(budgets[b]);
+    for (int level = 0; level < mediso::NumberOfLevels; ++level)
+    {
+      const mediso::SurfaceEstimate e = estimator.Estimate(iso, level);
+      const double error = (e.Counts.Triangles - exact[level]) / exact[level];
+      std::printf("budget %g, level %d: %.0f triangles (%s), exact %.0f (%+.2f%%)\n", budgets[b],
+        level, e.Counts.Triangles, methods[static_cast<int>(e.Method)], exact[level], 100 * error);
+      Check(e.Method == expected[b][level],
+        "budget " + std::to_string(budgets[b]) + ", level " + std::to_string(level) + ": method");
+      Check(std::fabs(error) <= tolerance[b],
+        "budget " + std::to_string(budgets[b]) + ", level " + std::to_string(level) + ": error");
+      Check(estimator.Estimate(iso, level).Counts.Triangles == e.Counts.Triangles,
+        "an estimate is kept, not recounted");
+    }
   }
 
-  // A second isovalue with two exact levels: the others are scaled by its growth.
+  // A recorded exact count of a coarser level is the auxiliary even when the
+  // budget pays for nothing.
   const double iso2 = -0.75;
-  mediso::SurfaceCounts c1, c3;
   mediso::ExtractionPlan plan;
   volume.Plan(iso2, 1, plan);
-  c1 = mediso::BlockLODVolume::CountsOf(plan);
-  volume.Plan(iso2, 3, plan);
-  c3 = mediso::BlockLODVolume::CountsOf(plan);
+  const mediso::SurfaceCounts c1 = mediso::BlockLODVolume::CountsOf(plan);
+  mediso::BlockLODEstimator estimator(volume);
+  estimator.SetSampleBudget(0.0);
   estimator.RecordExact(iso2, 1, c1);
-  estimator.RecordExact(iso2, 3, c3);
-  const mediso::SurfaceEstimate e3 = estimator.Estimate(iso2, 3);
-  Check(e3.Method == mediso::EstimateMethod::Exact && e3.Counts.Triangles == c3.Triangles,
+  Check(estimator.Estimate(iso2, 1).Method == mediso::EstimateMethod::Exact &&
+      estimator.Estimate(iso2, 1).Counts.Triangles == c1.Triangles,
     "a recorded pair is exact");
-  const mediso::SurfaceEstimate e2 = estimator.Estimate(iso2, 2);
-  const double growth = std::sqrt(c3.Triangles / c1.Triangles);
-  Check(e2.Method == mediso::EstimateMethod::Scaled, "two exact levels: the others are scaled");
-  Check(std::fabs(e2.Counts.Triangles - c3.Triangles / growth) < 1e-6 * c3.Triangles,
-    "level 2 scaled from level 3 by the isovalue's own growth per level");
-  Check(std::fabs(e2.Counts.Cubes - c3.Cubes / 8) < 1e-6 * c3.Cubes,
-    "cubes scale by 8 per level, from the finer of two equally near levels");
-  const mediso::SurfaceEstimate e0 = estimator.Estimate(iso2, 0);
-  Check(std::fabs(e0.Counts.Triangles - c1.Triangles / growth) < 1e-6 * c1.Triangles,
-    "level 0 scaled from level 1, its nearest known level");
+  Check(estimator.Estimate(iso2, 3).Method == mediso::EstimateMethod::Scaled,
+    "a recorded coarser level scales the sample");
+  Check(estimator.Estimate(iso2, 0).Method == mediso::EstimateMethod::Sampled,
+    "no coarser level below level 0: plain sample");
 
   // Reset forgets every count.
   estimator.Reset();
-  Check(!estimator.HasExact(iso2, 3), "Reset forgets exact counts");
+  Check(!estimator.HasExact(iso2, 1), "Reset forgets exact counts");
 }
 
 void TestCostModel()
