@@ -35,6 +35,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -218,6 +219,14 @@ mediso::SurfaceLayout OutputLayout(vtkBlockLODContour* self)
   return layout;
 }
 
+// The cost model of EstimateSeconds(): it describes the machine, not an input,
+// so every filter of the process learns into and predicts from the same one.
+struct
+{
+  std::mutex Mutex;
+  mediso::CostModel Model;
+} SharedCost;
+
 double Now()
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -233,10 +242,11 @@ struct vtkBlockLODContour::vtkInternals
   bool WarnedMissing = false; // NaN or infinite values, once per input
 
   // What the last RequestData planned (one plan per isovalue, kept between
-  // updates so that their buffers are reused, not faulted in again) and generated.
+  // updates so that their buffers are reused, not faulted in again) and
+  // generated, and the counts of the pairs it extracted (for the cost model).
   std::vector<mediso::ExtractionPlan> Plans;
-  std::vector<double> PlanSeconds;
   std::vector<vtkSmartPointer<vtkPolyData>> Surfaces;
+  mediso::SurfaceCounts Extracted;
 
   // Cells that are not ghosts, as an inclusive cell index range per axis:
   // ghost layers of a structured piece are whole slabs at its faces. Without
@@ -361,7 +371,6 @@ struct vtkBlockLODContour::vtkInternals
     this->Estimator.Reset();
     this->Cache.Clear();
     this->Plans.clear(); // sized for the old input
-    this->PlanSeconds.clear();
     this->WarnedMissing = false;
     return true;
   }
@@ -466,8 +475,12 @@ double vtkBlockLODContour::EstimateSeconds(double isovalue, int level)
   }
   const mediso::SurfaceEstimate e = in.Estimator.Estimate(isovalue, level);
   this->LastEstimateMethod = static_cast<int>(e.Method);
-  return e.Method == mediso::EstimateMethod::None ? -1.0
-                                                  : in.Estimator.GetCostModel().Predict(e.Counts);
+  if (e.Method == mediso::EstimateMethod::None)
+  {
+    return -1.0;
+  }
+  std::lock_guard<std::mutex> lock(SharedCost.Mutex);
+  return SharedCost.Model.Predict(level, e.Counts);
 }
 
 //------------------------------------------------------------------------------
@@ -486,6 +499,8 @@ int vtkBlockLODContour::RequestData(
   }
   vtkInternals& in = *this->Internals;
   in.Surfaces.clear();
+  in.Extracted = mediso::SurfaceCounts();
+  const double start = Now();
 
   // Check: an array the core can read, on a grid it can contour.
   vtkDataArray* array = this->CheckInput(input, inputVector);
@@ -494,10 +509,13 @@ int vtkBlockLODContour::RequestData(
     return 1;
   }
   // Refresh block ranges (kept while the input stays the same).
-  if (in.Refresh(vtkInternals::Describe(input, array, inputVector[0]->GetInformationObject(0))))
+  const bool refreshed =
+    in.Refresh(vtkInternals::Describe(input, array, inputVector[0]->GetInformationObject(0)));
+  if (refreshed)
   {
     ++this->NumberOfBlockRangeComputations;
   }
+  const int coarseCopies = in.Volume.GetNumberOfCoarseCopies();
   this->UpdateProgress(0.1);
   const std::vector<double> values = this->IsovaluesWithSurface();
   if (values.empty())
@@ -521,6 +539,13 @@ int vtkBlockLODContour::RequestData(
   }
   this->UpdateProgress(0.9);
   this->AssembleOutput(output);
+  // The cost model learns from updates that extracted something and did no
+  // one-time work (block ranges, coarse copies).
+  if (in.Extracted.Cubes > 0 && !refreshed && in.Volume.GetNumberOfCoarseCopies() == coarseCopies)
+  {
+    std::lock_guard<std::mutex> lock(SharedCost.Mutex);
+    SharedCost.Model.Record(level, in.Extracted.Cubes, in.Extracted.Triangles, Now() - start);
+  }
   this->UpdateProgress(1.0);
   return 1;
 }
@@ -780,7 +805,6 @@ bool vtkBlockLODContour::PlanLevel(const std::vector<double>& values, int& level
   for (;;)
   {
     in.Plans.resize(values.size());
-    in.PlanSeconds.assign(values.size(), 0.0);
     double bytes = 0;
     for (std::size_t i = 0; i < values.size(); ++i)
     {
@@ -792,12 +816,10 @@ bool vtkBlockLODContour::PlanLevel(const std::vector<double>& values, int& level
         continue;
       }
       mediso::ExtractionPlan& plan = in.Plans[i];
-      const double start = Now();
       if (!in.Volume.Plan(v, level, plan, abort) || this->CheckAbort())
       {
         return false;
       }
-      in.PlanSeconds[i] = Now() - start;
       const mediso::SurfaceCounts exact = mediso::BlockLODVolume::CountsOf(plan);
       in.Estimator.RecordExact(v, level, exact);
       bytes += layout.Bytes(exact);
@@ -849,7 +871,6 @@ bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int le
       continue;
     }
     const mediso::ExtractionPlan& plan = in.Plans[i];
-    const double start = Now();
     SurfaceArrays arrays =
       AllocateSurface(plan.GetNumberOfPoints(), plan.GetNumberOfTriangles(), layout);
       auto generate = [&](auto* connectivity) {
@@ -871,8 +892,8 @@ bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int le
     }
     ++this->NumberOfExtractions;
     const mediso::SurfaceCounts counts = mediso::BlockLODVolume::CountsOf(plan);
-    in.Estimator.GetCostModel().Record(
-      counts.Cubes, counts.Triangles, in.PlanSeconds[i] + (Now() - start));
+    in.Extracted.Cubes += counts.Cubes;
+    in.Extracted.Triangles += counts.Triangles;
     in.Surfaces.push_back(arrays.Surface);
     if (this->CacheMemoryLimit > 0)
     {

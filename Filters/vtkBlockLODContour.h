@@ -42,9 +42,10 @@
  *    count is exact, and scaled by that level's exact count (a ratio
  *    estimate); the paper used a fixed 2 triangles per cube instead. Bytes are
  *    those the output vtkPolyData holds (points, normals, scalars,
- *    connectivity, offsets, block ids); seconds follow a cost model (per
- *    visited cube and per triangle) fitted to this filter's own extractions,
- *    the paper's future work.
+ *    connectivity, offsets, block ids); seconds (the paper's future work)
+ *    are those of an update that extracts the pair, from a cost model (per
+ *    visited cube, per triangle and per update) fitted to the updates of
+ *    every vtkBlockLODContour in the process (it describes the machine).
  * -# AutoLOD. With AutoLOD on, the filter picks the highest level whose
  *    estimated output fits MemoryBudget (MB, all isovalues together). Exact
  *    counts are known before any output is allocated, so an underestimate

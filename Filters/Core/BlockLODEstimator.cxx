@@ -22,45 +22,103 @@ double SurfaceLayout::Bytes(double points, double triangles) const
   return points * perPoint + triangles * perTriangle + (this->Offsets ? id : 0.0);
 }
 
-void CostModel::Record(double cubes, double triangles, double seconds)
+double CostModel::Default(double cubes, double triangles)
 {
-  this->Sxx += cubes * cubes;
-  this->Sxy += cubes * triangles;
-  this->Syy += triangles * triangles;
-  this->Sxt += cubes * seconds;
-  this->Syt += triangles * seconds;
+  return DefaultSecondsPerCube * cubes + DefaultSecondsPerTriangle * triangles +
+    DefaultSecondsPerUpdate;
+}
+
+void CostModel::Fit::Record(double cubes, double triangles, double seconds)
+{
+  const double x[3] = { cubes, triangles, 1.0 };
+  const double w = 1.0 / (seconds * seconds);
+  for (int i = 0; i < 3; ++i)
+  {
+    for (int j = 0; j < 3; ++j)
+    {
+      this->Normal[i][j] = Memory * this->Normal[i][j] + w * x[i] * x[j];
+    }
+    this->Right[i] = Memory * this->Right[i] + w * x[i] * seconds;
+  }
+  const double guess = Default(cubes, triangles);
+  this->ScaleNumerator = Memory * this->ScaleNumerator + w * guess * seconds;
+  this->ScaleDenominator = Memory * this->ScaleDenominator + w * guess * guess;
   ++this->Samples;
 }
 
-double CostModel::Predict(double cubes, double triangles) const
+bool CostModel::Fit::Solve(double abc[3]) const
 {
-  double a = DefaultSecondsPerCube, b = DefaultSecondsPerTriangle;
-  const double det = this->Sxx * this->Syy - this->Sxy * this->Sxy;
-  if (this->Samples >= 2 && det > 1e-12 * this->Sxx * this->Syy)
+  if (this->Samples < 3)
   {
-    a = (this->Sxt * this->Syy - this->Syt * this->Sxy) / det;
-    b = (this->Syt * this->Sxx - this->Sxt * this->Sxy) / det;
-    if (a < 0 || b < 0)
+    return false;
+  }
+  // Gauss-Jordan elimination with partial pivoting.
+  double m[3][4];
+  for (int i = 0; i < 3; ++i)
+  {
+    for (int j = 0; j < 3; ++j)
     {
-      // Degenerate fit (nearly collinear samples): one rate per cube-or-triangle.
-      const double scale = (this->Sxt + this->Syt) / (this->Sxx + this->Syy);
-      a = std::max(0.0, scale);
-      b = std::max(0.0, scale);
+      m[i][j] = this->Normal[i][j];
+    }
+    m[i][3] = this->Right[i];
+  }
+  for (int c = 0; c < 3; ++c)
+  {
+    int pivot = c;
+    for (int r = c + 1; r < 3; ++r)
+    {
+      pivot = std::fabs(m[r][c]) > std::fabs(m[pivot][c]) ? r : pivot;
+    }
+    std::swap(m[c], m[pivot]);
+    // Relative to the column's own scale (cubes are ~1e6, the constant 1).
+    if (!(std::fabs(m[c][c]) > 1e-12 * std::fabs(this->Normal[c][c])))
+    {
+      return false;
+    }
+    for (int r = 0; r < 3; ++r)
+    {
+      if (r != c)
+      {
+        const double f = m[r][c] / m[c][c];
+        for (int k = c; k < 4; ++k)
+        {
+          m[r][k] -= f * m[c][k];
+        }
+      }
     }
   }
-  else if (this->Samples == 1 && this->Sxx + this->Syy > 0)
+  for (int i = 0; i < 3; ++i)
   {
-    // One sample: keep the defaults' ratio, match its time.
-    const double predicted = std::sqrt(this->Sxx) * a + std::sqrt(this->Syy) * b;
-    const double measured = this->Sxt / std::max(1e-30, std::sqrt(this->Sxx));
-    if (predicted > 0 && this->Sxx > 0)
+    abc[i] = m[i][3] / m[i][i];
+    if (!(abc[i] >= 0))
     {
-      const double f = measured / predicted;
-      a *= f;
-      b *= f;
+      return false;
     }
   }
-  return a * cubes + b * triangles;
+  return true;
+}
+
+void CostModel::Record(int level, double cubes, double triangles, double seconds)
+{
+  if (!(seconds > 0) || level < 0 || level >= NumberOfLevels)
+  {
+    return;
+  }
+  this->Levels[level].Record(cubes, triangles, seconds);
+  this->All.Record(cubes, triangles, seconds);
+}
+
+double CostModel::Predict(int level, double cubes, double triangles) const
+{
+  double abc[3];
+  if ((level >= 0 && level < NumberOfLevels && this->Levels[level].Solve(abc)) ||
+    this->All.Solve(abc))
+  {
+    return abc[0] * cubes + abc[1] * triangles + abc[2];
+  }
+  const double scale =
+    this->All.ScaleDenominator > 0 ? this->All.ScaleNumerator / this->All.ScaleDenominator : 1.0;
+  return scale * Default(cubes, triangles);
 }
 
 BlockLODEstimator::BlockLODEstimator(BlockLODVolume& volume)
@@ -154,10 +212,10 @@ SurfaceEstimate BlockLODEstimator::Estimate(double isovalue, int level)
   return e;
 }
 
-double BlockLODEstimator::EstimateSeconds(double isovalue, int level)
+double BlockLODEstimator::EstimateSeconds(double isovalue, int level, const CostModel& model)
 {
   const SurfaceEstimate e = this->Estimate(isovalue, level);
-  return e.Method == EstimateMethod::None ? -1.0 : this->Cost.Predict(e.Counts);
+  return e.Method == EstimateMethod::None ? -1.0 : model.Predict(level, e.Counts);
 }
 
 int BlockLODEstimator::ChooseLevel(const std::vector<double>& isovalues, double budgetBytes,

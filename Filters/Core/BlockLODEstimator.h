@@ -63,24 +63,52 @@ struct SurfaceLayout
   bool operator!=(const SurfaceLayout& o) const { return !(*this == o); }
 };
 
-/// Seconds of an extraction from the cubes it visits and the triangles it makes.
+/// Seconds of an update that extracts surfaces at a level, from the cubes it
+/// visits and the triangles it makes: A * cubes + B * triangles + C (C: the
+/// update's fixed work, such as checks, estimates and output assembly). A, B
+/// and C are fitted by least squares on relative errors (weights
+/// 1 / seconds^2: a 10 ms update counts as much as a 1 s one) to the host's
+/// records, older records fading by Memory per new one so the fit follows the
+/// machine's load. A level's own fit predicts once it has three records (the
+/// levels' costs per cube differ); before that, the fit over all levels;
+/// before that (or when a fit is not positive), the defaults scaled to match
+/// the records.
 class CostModel
 {
 public:
-  /// Rates until the host's own extractions are recorded (a 2-core machine).
+  /// Rates until the host's own updates are recorded (a 2-core machine).
   static constexpr double DefaultSecondsPerCube = 4.0e-9;
-  static constexpr double DefaultSecondsPerTriangle = 6.0e-8;
+  static constexpr double DefaultSecondsPerTriangle = 1.2e-8;
+  static constexpr double DefaultSecondsPerUpdate = 1.0e-3;
+  /// Weight a record keeps when a new one arrives.
+  static constexpr double Memory = 0.97;
 
-  void Record(double cubes, double triangles, double seconds);
-  double Predict(double cubes, double triangles) const;
-  double Predict(const SurfaceCounts& c) const { return this->Predict(c.Cubes, c.Triangles); }
-  int GetNumberOfSamples() const { return this->Samples; }
+  void Record(int level, double cubes, double triangles, double seconds);
+  double Predict(int level, double cubes, double triangles) const;
+  double Predict(int level, const SurfaceCounts& c) const
+  {
+    return this->Predict(level, c.Cubes, c.Triangles);
+  }
+  int GetNumberOfSamples() const { return this->All.Samples; }
   void Reset() { *this = CostModel(); }
 
 private:
-  // Sums of the normal equations of the least-squares fit.
-  double Sxx = 0, Sxy = 0, Syy = 0, Sxt = 0, Syt = 0;
-  int Samples = 0;
+  // Weighted normal equations of (cubes, triangles, 1) -> seconds, and of the
+  // one-parameter fit "scale * defaults".
+  struct Fit
+  {
+    double Normal[3][3] = { { 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 } };
+    double Right[3] = { 0, 0, 0 };
+    double ScaleNumerator = 0;
+    double ScaleDenominator = 0;
+    int Samples = 0;
+    void Record(double cubes, double triangles, double seconds);
+    // The fitted A, B, C when there are 3 records and they are all >= 0.
+    bool Solve(double abc[3]) const;
+  };
+  static double Default(double cubes, double triangles);
+  Fit Levels[NumberOfLevels];
+  Fit All;
 };
 
 /// How an estimate was made (values as vtkBlockLODContour::GetLastEstimateMethod()).
@@ -109,8 +137,7 @@ public:
 
   explicit BlockLODEstimator(BlockLODVolume& volume);
 
-  /// Forgets every count (the volume changed). The cost model is kept: it
-  /// describes the machine, not the input.
+  /// Forgets every count (the volume changed).
   void Reset();
 
   /// Counts of an (isovalue, level) pair (see the file's description).
@@ -119,8 +146,8 @@ public:
   void RecordExact(double isovalue, int level, const SurfaceCounts& counts);
   bool HasExact(double isovalue, int level) const;
 
-  /// Predicted seconds to extract a pair (plan and generate).
-  double EstimateSeconds(double isovalue, int level);
+  /// Predicted seconds of an update that extracts a pair, by a cost model.
+  double EstimateSeconds(double isovalue, int level, const CostModel& model);
 
   /// The highest level whose estimated bytes for all `isovalues` together fit
   /// `budgetBytes`, or -1 when not even level 0 fits; `level0Bytes` receives
@@ -133,14 +160,11 @@ public:
   void SetSampleBudget(double budget) { this->SampleBudget = budget; }
   double GetSampleBudget() const { return this->SampleBudget; }
 
-  CostModel& GetCostModel() { return this->Cost; }
-  const CostModel& GetCostModel() const { return this->Cost; }
 
 private:
   BlockLODVolume& Volume;
   std::map<SurfaceKey, SurfaceCounts> Exact;
   std::map<SurfaceKey, SurfaceEstimate> Sampled;
-  CostModel Cost;
   double SampleBudget = DefaultSampleBudget;
 };
 

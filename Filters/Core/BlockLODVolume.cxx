@@ -40,6 +40,7 @@ struct BlockLODVolume::Typed
   // Counts on full-volume blocks.
   virtual BlockSums CountFull(const std::vector<std::int32_t>& blocks, double isovalue, int level,
     int auxLevel) = 0;
+  int CoarseCopies = 0; // made so far
 };
 
 namespace
@@ -119,6 +120,7 @@ struct BlockLODVolume::TypedImpl : BlockLODVolume::Typed
       c.Samples = MakeCoarseCopy(this->Full, level, c.Values, this->Parallel);
       ComputeBlockRanges(c.Samples, c.Ranges, this->Parallel);
       c.Built = true;
+      ++this->CoarseCopies;
     }
     f(c.Samples, c.Ranges);
   }
@@ -202,6 +204,11 @@ void BlockLODVolume::Reset()
 bool BlockLODVolume::IsValid() const
 {
   return this->Valid;
+}
+
+int BlockLODVolume::GetNumberOfCoarseCopies() const
+{
+  return this->Impl ? this->Impl->CoarseCopies : 0;
 }
 
 bool BlockLODVolume::SetVolume(const VolumeDescription& description)

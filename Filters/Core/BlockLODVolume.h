@@ -90,6 +90,8 @@ public:
   void Reset();
   bool IsValid() const;
   const VolumeDescription& GetDescription() const { return this->Description; }
+  /// Coarse copies made since SetVolume() (a host can tell one-time work).
+  int GetNumberOfCoarseCopies() const;
   /// Block ranges of the full volume (value range, NaN count, per-block min/max).
   const BlockRanges& GetRanges() const { return this->Ranges; }
 

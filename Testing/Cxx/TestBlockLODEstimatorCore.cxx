@@ -289,27 +289,61 @@ void TestEstimates()
 
 void TestCostModel()
 {
-  mediso::CostModel model;
-  Check(model.Predict(1e6, 1e5) ==
-      1e6 * mediso::CostModel::DefaultSecondsPerCube + 1e5 * mediso::CostModel::DefaultSecondsPerTriangle,
+  using mediso::CostModel;
+  CostModel model;
+  Check(model.Predict(3, 1e6, 1e5) == 1e6 * CostModel::DefaultSecondsPerCube +
+        1e5 * CostModel::DefaultSecondsPerTriangle + CostModel::DefaultSecondsPerUpdate,
     "defaults before any record");
-  model.Record(2e6, 1e5, 2e6 * 1e-9 + 1e5 * 2e-8);
-  Check(std::fabs(model.Predict(2e6, 1e5) - (2e6 * 1e-9 + 1e5 * 2e-8)) < 1e-12,
-    "one record: the prediction at that record is its time");
-  const double a = 3e-9, b = 7e-8;
-  mediso::CostModel fit;
-  const double samples[][2] = { { 1e6, 2e4 }, { 4e6, 1e5 }, { 2.5e5, 9e4 }, { 8e6, 3e5 } };
+  const double first = 2.0 * model.Predict(3, 2e6, 1e5);
+  model.Record(3, 2e6, 1e5, first);
+  Check(std::fabs(model.Predict(3, 2e6, 1e5) - first) < 1e-12,
+    "one record: the defaults scaled to its time");
+
+  // A law with a fixed part is recovered from records of it, the oldest
+  // weighing least (they fade) but still consistent.
+  const double a = 3e-9, b = 7e-8, c = 2e-3;
+  CostModel fit;
+  const double samples[][2] = { { 1e6, 2e4 }, { 4e6, 1e5 }, { 2.5e5, 9e4 }, { 8e6, 3e5 },
+    { 3e6, 5e5 } };
   for (const auto& s : samples)
   {
-    fit.Record(s[0], s[1], a * s[0] + b * s[1]);
+    fit.Record(3, s[0], s[1], a * s[0] + b * s[1] + c);
   }
-  const double predicted = fit.Predict(3e6, 2e5);
-  Check(std::fabs(predicted - (a * 3e6 + b * 2e5)) < 1e-9 * predicted,
-    "a linear law is recovered from its samples");
-  mediso::CostModel collinear;
-  collinear.Record(1e6, 1e5, 0.01);
-  collinear.Record(2e6, 2e5, 0.03);
-  Check(collinear.Predict(1e6, 1e5) >= 0, "collinear samples never predict a negative time");
+  const double predicted = fit.Predict(3, 3e6, 2e5);
+  Check(std::fabs(predicted - (a * 3e6 + b * 2e5 + c)) < 1e-9 * predicted,
+    "a linear law with a fixed part is recovered from its records");
+
+  // The fit follows a change of the machine's speed: after enough records at
+  // twice the time, predictions are near twice the law.
+  for (int k = 0; k < 200; ++k)
+  {
+    const auto& s = samples[k % 5];
+    fit.Record(3, s[0], s[1], 2 * (a * s[0] + b * s[1] + c));
+  }
+  const double slower = fit.Predict(3, 3e6, 2e5);
+  Check(std::fabs(slower / (2 * (a * 3e6 + b * 2e5 + c)) - 1) < 0.01,
+    "older records fade: the fit follows a slower machine");
+
+  // A level's own fit, once it has three records; the fit of all levels before.
+  CostModel levels;
+  for (const auto& s : samples)
+  {
+    levels.Record(1, s[0], s[1], 3 * (a * s[0] + b * s[1] + c));
+  }
+  levels.Record(2, 1e6, 1e5, a * 1e6 + b * 1e5 + c);
+  Check(std::fabs(levels.Predict(1, 3e6, 2e5) / (3 * (a * 3e6 + b * 2e5 + c)) - 1) < 1e-6,
+    "a level with three records: its own fit");
+  Check(std::fabs(levels.Predict(2, 3e6, 2e5) / levels.Predict(0, 3e6, 2e5) - 1) < 1e-12,
+    "a level with fewer: the fit of all levels");
+
+  // Records that cannot separate the terms (one size only) still predict that size.
+  CostModel collinear;
+  for (int k = 0; k < 5; ++k)
+  {
+    collinear.Record(3, 1e6, 1e5, 0.01);
+  }
+  Check(std::fabs(collinear.Predict(3, 1e6, 1e5) - 0.01) < 1e-6, "collinear records: their time");
+  Check(collinear.Predict(3, 2e6, 2e5) > 0, "never a negative time");
 }
 
 void TestLayoutAndLevel()
