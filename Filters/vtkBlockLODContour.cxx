@@ -15,6 +15,8 @@
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkInformationDoubleVectorKey.h"
+#include "vtkInformationInformationVectorKey.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
 #include "vtkMarchingCubesTriangleCases.h"
@@ -150,8 +152,8 @@ SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const
     out.Surface->GetCellData()->AddArray(ids);
   }
   vtkNew<vtkCellArray> polys;
-  const bool small = !mediso::SurfaceLayout::NeedsWideIds(
-    static_cast<double>(points), static_cast<double>(triangles));
+  const bool small =
+    layout.IdBytesFor(static_cast<double>(points), static_cast<double>(triangles)) == 4;
   auto fillOffsets = [triangles](auto* offsets) {
     vtkSMPTools::For(0, triangles + 1, [offsets](vtkIdType b, vtkIdType e) {
       for (vtkIdType i = b; i < e; ++i)
@@ -216,6 +218,7 @@ mediso::SurfaceLayout OutputLayout(vtkBlockLODContour* self)
   layout.Scalars = self->GetComputeScalars();
   layout.BlockIds = self->GetGenerateBlockIds();
   layout.Offsets = true; // vtkCellArray: offsets and connectivity
+  layout.IdBytes = self->GetCompactIds() ? 4 : 8;
   return layout;
 }
 
@@ -226,6 +229,75 @@ struct
   std::mutex Mutex;
   mediso::CostModel Model;
 } SharedCost;
+
+// Stores a vector array's ranges in VTK's range cache (per component and of
+// the length, finite or not: the array holds only finite values).
+void CacheRanges(vtkDataArray* array, const mediso::VectorRange& range)
+{
+  if (!array || range.IsEmpty())
+  {
+    return;
+  }
+  vtkInformation* info = array->GetInformation();
+  for (vtkInformationInformationVectorKey* key :
+    { vtkAbstractArray::PER_COMPONENT(), vtkAbstractArray::PER_FINITE_COMPONENT() })
+  {
+    vtkNew<vtkInformationVector> components;
+    components->SetNumberOfInformationObjects(3);
+    for (int c = 0; c < 3; ++c)
+    {
+      const double r[2] = { range.Min[c], range.Max[c] };
+      components->GetInformationObject(c)->Set(vtkDataArray::COMPONENT_RANGE(), r, 2);
+    }
+    info->Set(key, components);
+  }
+  const double length[2] = { std::sqrt(range.MinLength2), std::sqrt(range.MaxLength2) };
+  info->Set(vtkDataArray::L2_NORM_RANGE(), length, 2);
+  info->Set(vtkDataArray::L2_NORM_FINITE_RANGE(), length, 2);
+}
+
+// The same for a one-component array of a known range.
+void CacheRanges(vtkDataArray* array, double lo, double hi)
+{
+  if (!array)
+  {
+    return;
+  }
+  vtkInformation* info = array->GetInformation();
+  const double r[2] = { lo, hi };
+  for (vtkInformationInformationVectorKey* key :
+    { vtkAbstractArray::PER_COMPONENT(), vtkAbstractArray::PER_FINITE_COMPONENT() })
+  {
+    vtkNew<vtkInformationVector> components;
+    components->SetNumberOfInformationObjects(1);
+    components->GetInformationObject(0)->Set(vtkDataArray::COMPONENT_RANGE(), r, 2);
+    info->Set(key, components);
+  }
+  info->Set(vtkDataArray::L2_NORM_RANGE(), r, 2);
+  info->Set(vtkDataArray::L2_NORM_FINITE_RANGE(), r, 2);
+}
+
+// The cached ranges of a 3-component array as a VectorRange (GetRange reads
+// the cache; the array is read only where a range is not cached).
+mediso::VectorRange RangesOf(vtkDataArray* array)
+{
+  mediso::VectorRange range;
+  if (!array || array->GetNumberOfTuples() == 0)
+  {
+    return range;
+  }
+  double r[2];
+  for (int c = 0; c < 3; ++c)
+  {
+    array->GetRange(r, c);
+    range.Min[c] = r[0];
+    range.Max[c] = r[1];
+  }
+  array->GetRange(r, -1);
+  range.MinLength2 = r[0] * r[0];
+  range.MaxLength2 = r[1] * r[1];
+  return range;
+}
 
 double Now()
 {
@@ -873,13 +945,15 @@ bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int le
     const mediso::ExtractionPlan& plan = in.Plans[i];
     SurfaceArrays arrays =
       AllocateSurface(plan.GetNumberOfPoints(), plan.GetNumberOfTriangles(), layout);
-      auto generate = [&](auto* connectivity) {
+      mediso::SurfaceRanges written;
+    auto generate = [&](auto* connectivity) {
       mediso::SurfaceBuffers<std::remove_pointer_t<decltype(connectivity)>> buffers;
       buffers.Points = arrays.Points;
       buffers.Normals = arrays.Normals;
       buffers.Scalars = arrays.Scalars;
       buffers.BlockIds = arrays.BlockIds;
       buffers.Connectivity = connectivity;
+      buffers.Ranges = &written;
       in.Volume.Generate(plan, buffers);
     };
     if (arrays.Connectivity32)
@@ -890,6 +964,11 @@ bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int le
     {
       generate(arrays.Connectivity64);
     }
+    vtkPolyData* surface = arrays.Surface;
+    CacheRanges(surface->GetPoints()->GetData(), written.Points);
+    CacheRanges(surface->GetPointData()->GetNormals(), written.Normals);
+    const double iso = static_cast<float>(values[i]); // the scalars' value, as stored
+    CacheRanges(surface->GetPointData()->GetScalars(), iso, iso);
     ++this->NumberOfExtractions;
     const mediso::SurfaceCounts counts = mediso::BlockLODVolume::CountsOf(plan);
     in.Extracted.Cubes += counts.Cubes;
@@ -925,9 +1004,19 @@ void vtkBlockLODContour::AssembleOutput(vtkPolyData* output)
       triangles += p->GetNumberOfPolys();
     }
     SurfaceArrays all = AllocateSurface(points, triangles, OutputLayout(this));
+    mediso::SurfaceRanges merged;
+    double scalars[2] = { 1e300, -1e300 };
     std::int64_t p0 = 0, t0 = 0;
     for (const auto& p : pieces)
     {
+      merged.Points.Merge(RangesOf(p->GetPoints()->GetData()));
+      merged.Normals.Merge(RangesOf(p->GetPointData()->GetNormals()));
+      if (vtkDataArray* s = p->GetPointData()->GetScalars())
+      {
+        const double* r = s->GetRange();
+        scalars[0] = std::min(scalars[0], r[0]);
+        scalars[1] = std::max(scalars[1], r[1]);
+      }
       const std::int64_t np = p->GetNumberOfPoints();
       const std::int64_t nt = p->GetNumberOfPolys();
       auto copy = [&](vtkDataArray* a, float* dst, int comps) {
@@ -944,22 +1033,37 @@ void vtkBlockLODContour::AssembleOutput(vtkPolyData* output)
         std::memcpy(all.BlockIds + t0, p->GetCellData()->GetArray("BlockId")->GetVoidPointer(0),
           sizeof(std::int32_t) * nt);
       }
+      // The piece's ids shifted by its first point (each piece is stored in
+      // the width the merged surface has or a narrower one).
+      auto shift = [&](const auto* from, auto* to) {
+        vtkSMPTools::For(0, 3 * nt, [&](vtkIdType b, vtkIdType e) {
+          for (vtkIdType i = b; i < e; ++i)
+          {
+            to[3 * t0 + i] = static_cast<std::remove_reference_t<decltype(*to)>>(from[i] + p0);
+          }
+        });
+      };
       vtkDataArray* conn = p->GetPolys()->GetConnectivityArray();
-      for (std::int64_t i = 0; i < 3 * nt; ++i)
+      vtkTypeInt32Array* conn32 = vtkTypeInt32Array::FastDownCast(conn);
+      vtkTypeInt64Array* conn64 = vtkTypeInt64Array::FastDownCast(conn);
+      if (all.Connectivity32 && conn32)
       {
-        const std::int64_t id = static_cast<std::int64_t>(conn->GetComponent(i, 0)) + p0;
-        if (all.Connectivity32)
-        {
-          all.Connectivity32[3 * t0 + i] = static_cast<std::int32_t>(id);
-        }
-        else
-        {
-          all.Connectivity64[3 * t0 + i] = id;
-        }
+        shift(conn32->GetPointer(0), all.Connectivity32);
+      }
+      else if (all.Connectivity64 && conn32)
+      {
+        shift(conn32->GetPointer(0), all.Connectivity64);
+      }
+      else if (all.Connectivity64 && conn64)
+      {
+        shift(conn64->GetPointer(0), all.Connectivity64);
       }
       p0 += np;
       t0 += nt;
     }
+    CacheRanges(all.Surface->GetPoints()->GetData(), merged.Points);
+    CacheRanges(all.Surface->GetPointData()->GetNormals(), merged.Normals);
+    CacheRanges(all.Surface->GetPointData()->GetScalars(), scalars[0], scalars[1]);
     output->ShallowCopy(all.Surface);
   }
 

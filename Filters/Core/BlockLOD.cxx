@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <type_traits>
 
 namespace mediso
@@ -753,10 +754,16 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
   auto fullIndex = [&volume, fullVolume](int axis, int c) {
     return fullVolume ? c : volume.FullIndex(axis, c);
   };
+  std::mutex rangesMutex;
+  if (out.Ranges)
+  {
+    *out.Ranges = SurfaceRanges();
+  }
   parallel(0, numActive, [&](std::int64_t a0, std::int64_t a1) {
     // Point id of each of the block's own cut edges, by bit: filled while the
     // points are written, so most triangle vertices are one load.
     std::vector<IdType> ownIds(static_cast<std::size_t>(words) * 64);
+    SurfaceRanges written; // ranges of this range of blocks, merged at its end
     for (std::int64_t a = a0; a < a1; ++a)
     {
       const std::int64_t block = plan.ActiveBlocks[a];
@@ -814,6 +821,14 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
             for (int c = 0; c < 3; ++c)
             {
               nn[c] = static_cast<float>(g[c] * inv);
+            }
+          }
+          if (out.Ranges)
+          {
+            written.Points.Add(x);
+            if (out.Normals)
+            {
+              written.Normals.Add(out.Normals + 3 * pid);
             }
           }
           if (out.Scalars)
@@ -922,6 +937,12 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
           }
         }
       }
+    }
+    if (out.Ranges)
+    {
+      std::lock_guard<std::mutex> lock(rangesMutex);
+      out.Ranges->Points.Merge(written.Points);
+      out.Ranges->Normals.Merge(written.Normals);
     }
   });
 }

@@ -231,6 +231,48 @@ bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, Triangle
   double isovalue, int level, ExtractionPlan& plan, const ParallelFor& parallel,
   const std::function<bool()>& abort = {});
 
+/// The value range of 3-component vectors (points, normals): per component,
+/// and of their length. A host can hand these to its arrays (VTK caches array
+/// ranges), so that nothing downstream reads the arrays again to find them.
+struct VectorRange
+{
+  double Min[3] = { 1e300, 1e300, 1e300 };
+  double Max[3] = { -1e300, -1e300, -1e300 };
+  double MinLength2 = 1e300; ///< Squared lengths.
+  double MaxLength2 = -1e300;
+  bool IsEmpty() const { return this->Min[0] > this->Max[0]; }
+  void Add(const float v[3])
+  {
+    double length2 = 0;
+    for (int c = 0; c < 3; ++c)
+    {
+      const double x = v[c];
+      this->Min[c] = x < this->Min[c] ? x : this->Min[c];
+      this->Max[c] = x > this->Max[c] ? x : this->Max[c];
+      length2 += x * x;
+    }
+    this->MinLength2 = length2 < this->MinLength2 ? length2 : this->MinLength2;
+    this->MaxLength2 = length2 > this->MaxLength2 ? length2 : this->MaxLength2;
+  }
+  void Merge(const VectorRange& o)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      this->Min[c] = o.Min[c] < this->Min[c] ? o.Min[c] : this->Min[c];
+      this->Max[c] = o.Max[c] > this->Max[c] ? o.Max[c] : this->Max[c];
+    }
+    this->MinLength2 = o.MinLength2 < this->MinLength2 ? o.MinLength2 : this->MinLength2;
+    this->MaxLength2 = o.MaxLength2 > this->MaxLength2 ? o.MaxLength2 : this->MaxLength2;
+  }
+};
+
+/// Ranges of what pass 2 wrote.
+struct SurfaceRanges
+{
+  VectorRange Points;
+  VectorRange Normals; ///< Empty without normals.
+};
+
 /// Where pass 2 writes. Arrays are sized from the plan; optional ones may be null.
 template <typename IdType>
 struct SurfaceBuffers
@@ -242,6 +284,7 @@ struct SurfaceBuffers
   std::int32_t* BlockIds = nullptr; ///< 1 per triangle (linear block index, on the whole
                                     ///< volume's grid for a piece), or null.
   IdType FirstPointId = 0;         ///< Added to every point id (several isovalues in one output).
+  SurfaceRanges* Ranges = nullptr; ///< Receives the written points' and normals' ranges, or null.
 };
 
 /// Pass 2: writes the surface of a completed plan.

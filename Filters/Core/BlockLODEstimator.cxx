@@ -15,7 +15,7 @@ bool SurfaceLayout::NeedsWideIds(double points, double triangles)
 
 double SurfaceLayout::Bytes(double points, double triangles) const
 {
-  const double id = NeedsWideIds(points, triangles) ? 8.0 : 4.0;
+  const double id = this->IdBytesFor(points, triangles);
   const double perPoint = 12.0 + (this->Normals ? 12.0 : 0.0) + (this->Scalars ? 4.0 : 0.0);
   const double perTriangle =
     (this->Offsets ? 4.0 : 3.0) * id + (this->BlockIds ? 4.0 : 0.0); // ids (+ offset)

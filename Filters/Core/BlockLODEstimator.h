@@ -5,12 +5,11 @@
  * paper's answer to a client's memory limit, and the level choice it drives.
  *
  * - SurfaceLayout turns point and triangle counts into the bytes a host's
- *   output holds (float points, optional float normals and scalars, 32-bit
- *   connectivity while ids fit, else 64-bit, optional offsets as in a
- *   vtkCellArray, optional 32-bit block ids per triangle).
- * - CostModel predicts the seconds of an extraction as A * cubes visited +
- *   B * triangles, A and B fitted by least squares to the extractions the host
- *   records (defaults until two are recorded; one record rescales them).
+ *   output holds (float points, optional float normals and scalars, 64-bit
+ *   ids or 32-bit ones while they fit, optional offsets as in a vtkCellArray,
+ *   optional 32-bit block ids per triangle).
+ * - CostModel predicts the seconds of an update that extracts a pair, from
+ *   the cubes it visits and the triangles it makes (see the class).
  * - BlockLODEstimator predicts an (isovalue, level) pair's counts before it is
  *   extracted, in this order:
  *   -# exact, for a pair whose plan was recorded (RecordExact), or that can be
@@ -50,15 +49,22 @@ struct SurfaceLayout
   bool Scalars = false;  ///< 1 float per point.
   bool BlockIds = false; ///< 1 int32 per triangle.
   bool Offsets = true;   ///< 1 id per triangle and 1 more (vtkCellArray); off for an index buffer.
+  /// 8: 64-bit ids; 4: 32-bit ids while they fit (else 64-bit).
+  int IdBytes = 8;
 
   /// True when point ids or connectivity entries do not fit 32-bit ids.
   static bool NeedsWideIds(double points, double triangles);
+  /// Bytes of one id for a surface of this size.
+  int IdBytesFor(double points, double triangles) const
+  {
+    return this->IdBytes == 4 && !NeedsWideIds(points, triangles) ? 4 : 8;
+  }
   double Bytes(double points, double triangles) const;
   double Bytes(const SurfaceCounts& c) const { return this->Bytes(c.Points, c.Triangles); }
   bool operator==(const SurfaceLayout& o) const
   {
     return this->Normals == o.Normals && this->Scalars == o.Scalars &&
-      this->BlockIds == o.BlockIds && this->Offsets == o.Offsets;
+      this->BlockIds == o.BlockIds && this->Offsets == o.Offsets && this->IdBytes == o.IdBytes;
   }
   bool operator!=(const SurfaceLayout& o) const { return !(*this == o); }
 };

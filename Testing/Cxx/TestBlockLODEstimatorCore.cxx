@@ -348,8 +348,10 @@ void TestCostModel()
 
 void TestLayoutAndLevel()
 {
-  mediso::SurfaceLayout layout; // normals, offsets
-  Check(layout.Bytes(10, 20) == 10 * 24 + 20 * 16 + 4, "points, normals, 32-bit ids and offsets");
+  mediso::SurfaceLayout layout; // normals, offsets, 64-bit ids
+  Check(layout.Bytes(10, 20) == 10 * 24 + 20 * 32 + 8, "points, normals, 64-bit ids and offsets");
+  layout.IdBytes = 4;
+  Check(layout.Bytes(10, 20) == 10 * 24 + 20 * 16 + 4, "32-bit ids and offsets while they fit");
   layout.Scalars = layout.BlockIds = true;
   Check(layout.Bytes(10, 20) == 10 * 28 + 20 * 20 + 4, "scalars and block ids add 4 bytes each");
   layout.Offsets = false;
@@ -358,8 +360,10 @@ void TestLayoutAndLevel()
   Check(!mediso::SurfaceLayout::NeedsWideIds(1e6, 7e8) &&
       mediso::SurfaceLayout::NeedsWideIds(1e6, 7.2e8),
     "64-bit ids once 3 x triangles passes INT32_MAX");
-  Check(mediso::SurfaceLayout().Bytes(1e6, 7.2e8) == 1e6 * 24 + 7.2e8 * 32 + 8,
-    "64-bit ids double the connectivity");
+  mediso::SurfaceLayout compact;
+  compact.IdBytes = 4;
+  Check(compact.Bytes(1e6, 7.2e8) == 1e6 * 24 + 7.2e8 * 32 + 8,
+    "compact ids widen to 64 bits past INT32_MAX");
 
   const Field f = MakeField(40, 37, 35, 11.0, 0.5, false);
   mediso::BlockLODVolume volume(Table.Cases, mediso::SerialFor);
