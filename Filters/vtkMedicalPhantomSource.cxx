@@ -54,10 +54,17 @@ struct FillSlicesFunctor
   }
 };
 
-// Output bytes, as a double so that absurd sizes cannot overflow.
+// Bytes generating a whole grid takes, as doubles so that absurd sizes
+// cannot overflow: the int16 output, and one row of doubles per thread
+// (FillSlicesFunctor's scratch).
 double OutputBytes(const int dims[3])
 {
   return static_cast<double>(dims[0]) * dims[1] * dims[2] * sizeof(std::int16_t);
+}
+
+double ScratchBytes(const int dims[3], int threads)
+{
+  return static_cast<double>(threads) * dims[0] * sizeof(double);
 }
 } // namespace
 
@@ -88,21 +95,27 @@ std::string vtkMedicalPhantomSource::CheckParameters()
       return msg.str();
     }
   }
-  double limitMiB = this->MemoryLimit;
+  constexpr double BytesPerMB = 1.0e6;
+  double limitMB = this->MemoryLimit;
   const char* limitSource = "the MemoryLimit property";
-  if (limitMiB <= 0.0)
+  if (limitMB <= 0.0)
   {
     vtksys::SystemInformation info;
     info.RunMemoryCheck();
-    limitMiB = static_cast<double>(info.GetAvailablePhysicalMemory());
-    limitSource = "the physical memory available on this host";
+    // vtksys reports MiB.
+    limitMB = static_cast<double>(info.GetAvailablePhysicalMemory()) * 1048576.0 / BytesPerMB;
+    limitSource = "the physical memory of this host";
   }
-  const double needMiB = OutputBytes(this->Dimensions) / (1024.0 * 1024.0);
-  if (needMiB > limitMiB)
+  const int threads = std::max(1, vtkSMPTools::GetEstimatedNumberOfThreads());
+  const double outputMB = OutputBytes(this->Dimensions) / BytesPerMB;
+  const double scratchMB = ScratchBytes(this->Dimensions, threads) / BytesPerMB;
+  if (outputMB + scratchMB > limitMB)
   {
     msg << "dimensions " << this->Dimensions[0] << " x " << this->Dimensions[1] << " x "
-        << this->Dimensions[2] << " need " << needMiB << " MiB, more than " << limitMiB
-        << " MiB (" << limitSource << ")";
+        << this->Dimensions[2] << " need " << outputMB + scratchMB << " MB (the output, "
+        << outputMB << " MB, and a row of " << this->Dimensions[0] << " doubles for each of "
+        << threads << " thread(s), " << scratchMB << " MB), more than " << limitMB << " MB ("
+        << limitSource << ")";
     return msg.str();
   }
   return std::string();
@@ -211,5 +224,5 @@ void vtkMedicalPhantomSource::PrintSelf(ostream& os, vtkIndent indent)
      << this->Origin[2] << "\n";
   os << indent << "NoiseStandardDeviation: " << this->NoiseStandardDeviation << "\n";
   os << indent << "Seed: " << this->Seed << "\n";
-  os << indent << "MemoryLimit: " << this->MemoryLimit << "\n";
+  os << indent << "MemoryLimit: " << this->MemoryLimit << " MB\n";
 }

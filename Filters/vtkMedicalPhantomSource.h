@@ -91,9 +91,10 @@ public:
 
   ///@{
   /**
-   * Upper bound, in MiB, on the memory the output may take. 0 (the default)
-   * means the physical memory currently available on this machine. A request
-   * over the bound is refused with an error and an empty output.
+   * Upper bound, in MB (10^6 bytes), on the memory generation takes: the
+   * output and a row of doubles per thread. 0 (the default) means the
+   * physical memory of this machine. A request over the bound is refused
+   * with an error and an empty output.
    */
   vtkSetClampMacro(MemoryLimit, double, 0.0, 1.0e12);
   vtkGetMacro(MemoryLimit, double);

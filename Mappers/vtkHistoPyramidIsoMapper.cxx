@@ -457,6 +457,12 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     sayOnce(true, msg.str());
     return;
   }
+  const std::string spacingProblem = CheckSpacing(image->GetSpacing());
+  if (!spacingProblem.empty())
+  {
+    sayOnce(true, spacingProblem);
+    return;
+  }
   int cellFlag = 0;
   vtkDataArray* scalars = vtkDataArray::SafeDownCast(this->GetScalars(
     image, this->ScalarMode, this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag));
@@ -485,26 +491,48 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
 
-  // 2. The isovalues and their looks, in increasing order, invisible ones
-  //    (opacity 0) and NaN ones left out.
+  // 2. The isovalues and their looks, in increasing order; invisible ones
+  //    (opacity 0) and NaN ones left out. A value's index in the property's
+  //    list picks its surface colour and opacity.
   vtkVolumeProperty* property = vol->GetProperty();
   vtkContourValues* values = property->GetIsoSurfaceValues();
-  std::vector<double> requested;
+  std::vector<std::pair<double, int>> requested; // value, index in the property's list
+  int notANumber = 0;
   for (int i = 0; values && i < values->GetNumberOfContours(); ++i)
   {
     const double v = values->GetValue(i);
-    if (!std::isnan(v))
+    if (std::isnan(v))
     {
-      requested.push_back(v);
+      ++notANumber;
+    }
+    else
+    {
+      requested.emplace_back(v, i);
     }
   }
-  std::sort(requested.begin(), requested.end());
-  requested.erase(std::unique(requested.begin(), requested.end()), requested.end());
+  if (notANumber > 0)
+  {
+    std::ostringstream msg;
+    msg << notANumber << " of the " << values->GetNumberOfContours()
+        << " isovalues " << (notANumber == 1 ? "is" : "are")
+        << " not a number (NaN): an isosurface needs a numeric value; "
+        << (requested.empty() ? "nothing is drawn." : "the others are drawn.");
+    sayOnce(false, msg.str());
+  }
+  std::stable_sort(requested.begin(), requested.end(),
+    [](const std::pair<double, int>& a, const std::pair<double, int>& b) { return a.first < b.first; });
+  requested.erase(std::unique(requested.begin(), requested.end(),
+                    [](const std::pair<double, int>& a, const std::pair<double, int>& b)
+                    { return a.first == b.first; }),
+    requested.end());
   if (requested.empty())
   {
-    sayOnce(false,
-      "no isovalues: set them with vtkVolumeProperty::GetIsoSurfaceValues() "
-      "(ParaView: the representation's Isosurfaces); nothing is drawn.");
+    if (notANumber == 0)
+    {
+      sayOnce(false,
+        "no isovalues: set them with vtkVolumeProperty::GetIsoSurfaceValues() "
+        "(ParaView: the representation's Isosurfaces); nothing is drawn.");
+    }
     return;
   }
   if (requested.size() > static_cast<std::size_t>(vtkOpenGLHistoPyramid::MaximumNumberOfIsovalues))
@@ -517,20 +545,39 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   }
   std::vector<Surface> surfaces;
   vtkPiecewiseFunction* opacity = property->GetScalarOpacity(0);
-  for (double v : requested)
+  for (const auto& entry : requested)
   {
+    const double v = entry.first;
+    const std::size_t index = static_cast<std::size_t>(entry.second);
     Surface s;
     s.Value = v;
-    if (property->GetColorChannels(0) == 1)
+    s.Opacity = 1.0;
+    if (this->ColorSource == TransferFunctionColors)
     {
-      const double gray = property->GetGrayTransferFunction(0)->GetValue(v);
-      s.Color[0] = s.Color[1] = s.Color[2] = gray;
+      if (property->GetColorChannels(0) == 1)
+      {
+        const double gray = property->GetGrayTransferFunction(0)->GetValue(v);
+        s.Color[0] = s.Color[1] = s.Color[2] = gray;
+      }
+      else
+      {
+        property->GetRGBTransferFunction(0)->GetColor(v, s.Color);
+      }
+      s.Opacity = opacity ? opacity->GetValue(v) : 1.0;
+    }
+    else if (this->ColorSource == SurfaceColors && 3 * index < this->SurfaceColorValues.size())
+    {
+      std::copy_n(&this->SurfaceColorValues[3 * index], 3, s.Color);
     }
     else
     {
-      property->GetRGBTransferFunction(0)->GetColor(v, s.Color);
+      std::copy_n(this->SolidColor, 3, s.Color);
     }
-    s.Opacity = opacity ? std::min(1.0, std::max(0.0, opacity->GetValue(v))) : 1.0;
+    if (index < this->SurfaceOpacityValues.size())
+    {
+      s.Opacity *= this->SurfaceOpacityValues[index];
+    }
+    s.Opacity = std::min(1.0, std::max(0.0, s.Opacity * this->Opacity));
     if (s.Opacity > 0.0)
     {
       surfaces.push_back(s);

@@ -40,7 +40,8 @@
  *    pass of opaque frames, see FirstHitPass, its colour and depth go to
  *    the mapper's own buffers and are composited after).
  * -# Colour and opacity of each isovalue come from the property's colour and
- *    scalar opacity transfer functions at that value. When all are opaque,
+ *    scalar opacity transfer functions at that value, or from colours and
+ *    opacities given per surface (SetColorSource()). When all are opaque,
  *    each primitive draws one isovalue, front to back, with depth writes
  *    (in the first-hit pass each cell is one primitive that takes the
  *    nearest hit of its isovalues).
@@ -72,8 +73,9 @@
  * ReleaseGraphicsResources() frees every OpenGL object.
  *
  * Bad input (no scalars, cell scalars, several components, fewer than 2
- * points along an axis, an unsupported type, no isovalues) gives one error
- * or warning and nothing drawn, never a crash.
+ * points along an axis, a zero or non-finite spacing, an unsupported type,
+ * no isovalues, isovalues that are not numbers) gives one error or warning
+ * and nothing drawn, never a crash.
  *
  * @sa vtkOpenGLHistoPyramid vtkMedicalGLCapabilities vtkBlockLODContour
  */
@@ -83,8 +85,10 @@
 #include "MedicalIsosurfacesMappersModule.h" // For export macro
 #include "vtkVolumeMapper.h"
 
+#include <cmath>   // For std::isfinite
 #include <cstdint> // For std::uint64_t
 #include <memory>  // For std::unique_ptr
+#include <sstream> // For std::ostringstream
 #include <string>  // For std::string
 #include <vector>  // For std::vector
 
@@ -212,6 +216,48 @@ public:
   /// Triangles of the last fallback frame (0 on the GPU path).
   vtkGetMacro(NumberOfFallbackTriangles, std::uint64_t);
 
+  /// Where each isovalue's colour and opacity come from (see SetColorSource()).
+  enum ColorSourceType
+  {
+    TransferFunctionColors = 0, ///< The property's colour and scalar opacity functions at the value.
+    SolidColors = 1,            ///< SolidColor for every isovalue.
+    SurfaceColors = 2           ///< SurfaceColor(i) for the i-th isovalue.
+  };
+
+  ///@{
+  /**
+   * The colour of each isosurface: from the vtkVolumeProperty's colour
+   * transfer function at the isovalue and its opacity multiplied by the
+   * scalar opacity function there (TransferFunctionColors, the default), one
+   * SolidColor for all (SolidColors), or SurfaceColor(i) for the i-th value
+   * of vtkVolumeProperty::GetIsoSurfaceValues(), in the order given there
+   * (SurfaceColors; values past the colours set take SolidColor). Whatever
+   * the source, surface i's opacity is further multiplied by
+   * SurfaceOpacity(i) (1 where none is set) and by Opacity: an application
+   * can give each surface its own colour and opacity without editing
+   * transfer functions. A surface of opacity 0 is not drawn.
+   */
+  vtkSetClampMacro(ColorSource, int, TransferFunctionColors, SurfaceColors);
+  vtkGetMacro(ColorSource, int);
+  vtkSetVector3Macro(SolidColor, double);
+  vtkGetVector3Macro(SolidColor, double);
+  void SetNumberOfSurfaceColors(int number);
+  int GetNumberOfSurfaceColors() const { return static_cast<int>(this->SurfaceColorValues.size() / 3); }
+  void SetSurfaceColor(int i, double r, double g, double b);
+  void SetNumberOfSurfaceOpacities(int number);
+  int GetNumberOfSurfaceOpacities() const { return static_cast<int>(this->SurfaceOpacityValues.size()); }
+  void SetSurfaceOpacity(int i, double opacity);
+  vtkSetClampMacro(Opacity, double, 0.0, 1.0);
+  vtkGetMacro(Opacity, double);
+  ///@}
+
+  /**
+   * Why an image of this spacing holds no surface (a zero or non-finite
+   * component: its points would not be apart along that axis), as the
+   * message Render() gives for it; empty when the spacing is fine.
+   */
+  static std::string CheckSpacing(const double spacing[3]);
+
   void Render(vtkRenderer* ren, vtkVolume* vol) override;
   void ReleaseGraphicsResources(vtkWindow* win) override;
 
@@ -239,6 +285,11 @@ private:
   std::uint64_t LastBuildTiles = 0;
   std::uint64_t NumberOfVolumeUploads = 0;
   std::uint64_t NumberOfFallbackTriangles = 0;
+  int ColorSource = TransferFunctionColors;
+  double SolidColor[3] = { 1.0, 1.0, 1.0 };
+  std::vector<double> SurfaceColorValues;   // r, g, b per surface
+  std::vector<double> SurfaceOpacityValues; // one per surface
+  double Opacity = 1.0;
 
   struct Surface; // one isovalue and its colour and opacity
   bool RenderGPU(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image, vtkDataArray* scalars,
@@ -252,5 +303,83 @@ private:
   struct Internals;
   std::unique_ptr<Internals> Impl;
 };
+
+//------------------------------------------------------------------------------
+inline std::string vtkHistoPyramidIsoMapper::CheckSpacing(const double spacing[3])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!std::isfinite(spacing[a]) || spacing[a] == 0.0)
+    {
+      std::ostringstream msg;
+      msg << "the image's spacing (" << spacing[0] << ", " << spacing[1] << ", " << spacing[2]
+          << ") has a zero or non-finite component: the points of a volume need a non-zero, "
+             "finite distance along every axis; nothing is drawn.";
+      return msg.str();
+    }
+  }
+  return std::string();
+}
+
+//------------------------------------------------------------------------------
+inline void vtkHistoPyramidIsoMapper::SetNumberOfSurfaceColors(int number)
+{
+  const std::size_t size = 3 * static_cast<std::size_t>(number > 0 ? number : 0);
+  if (size != this->SurfaceColorValues.size())
+  {
+    this->SurfaceColorValues.resize(size, 1.0);
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+inline void vtkHistoPyramidIsoMapper::SetSurfaceColor(int i, double r, double g, double b)
+{
+  if (i < 0)
+  {
+    return;
+  }
+  if (static_cast<std::size_t>(i) >= this->SurfaceColorValues.size() / 3)
+  {
+    this->SetNumberOfSurfaceColors(i + 1);
+  }
+  double* color = &this->SurfaceColorValues[3 * static_cast<std::size_t>(i)];
+  if (color[0] != r || color[1] != g || color[2] != b)
+  {
+    color[0] = r;
+    color[1] = g;
+    color[2] = b;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+inline void vtkHistoPyramidIsoMapper::SetNumberOfSurfaceOpacities(int number)
+{
+  const std::size_t size = static_cast<std::size_t>(number > 0 ? number : 0);
+  if (size != this->SurfaceOpacityValues.size())
+  {
+    this->SurfaceOpacityValues.resize(size, 1.0);
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+inline void vtkHistoPyramidIsoMapper::SetSurfaceOpacity(int i, double opacity)
+{
+  if (i < 0)
+  {
+    return;
+  }
+  if (static_cast<std::size_t>(i) >= this->SurfaceOpacityValues.size())
+  {
+    this->SetNumberOfSurfaceOpacities(i + 1);
+  }
+  if (this->SurfaceOpacityValues[static_cast<std::size_t>(i)] != opacity)
+  {
+    this->SurfaceOpacityValues[static_cast<std::size_t>(i)] = opacity;
+    this->Modified();
+  }
+}
 
 #endif

@@ -1,9 +1,48 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkHistoPyramidIsoRepresentation.h"
 
+#include "vtkCellData.h"
+#include "vtkDataArray.h"
+#include "vtkFieldData.h"
 #include "vtkHistoPyramidIsoMapper.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVLODVolume.h"
+#include "vtkPointData.h"
+#include "vtkRectilinearGrid.h"
+#include "vtkResampleToImage.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace
+{
+// Whether the coordinates are evenly spaced (relative tolerance 1e-6 of the
+// axis' extent), and their spacing then.
+bool EvenSpacing(vtkDataArray* coordinates, double& spacing)
+{
+  const vtkIdType n = coordinates->GetNumberOfTuples();
+  if (n < 2)
+  {
+    spacing = 1.0;
+    return true;
+  }
+  const double first = coordinates->GetComponent(0, 0);
+  const double last = coordinates->GetComponent(n - 1, 0);
+  spacing = (last - first) / static_cast<double>(n - 1);
+  const double tolerance = 1e-6 * std::abs(last - first);
+  for (vtkIdType i = 1; i < n - 1; ++i)
+  {
+    if (std::abs(coordinates->GetComponent(i, 0) - (first + spacing * i)) > tolerance)
+    {
+      return false;
+    }
+  }
+  return true;
+}
+}
 
 vtkStandardNewMacro(vtkHistoPyramidIsoRepresentation);
 
@@ -61,6 +100,52 @@ bool vtkHistoPyramidIsoRepresentation::GetFirstHitPass()
 }
 
 //------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetDiffuseColor(double r, double g, double b)
+{
+  this->IsoMapper->SetSolidColor(r, g, b);
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetOpacity(double opacity)
+{
+  this->IsoMapper->SetOpacity(opacity);
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetColorEachSurface(bool each)
+{
+  if (this->ColorEachSurface != each)
+  {
+    this->ColorEachSurface = each;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetNumberOfSurfaceColors(int number)
+{
+  this->IsoMapper->SetNumberOfSurfaceColors(number);
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetSurfaceColor(int i, double r, double g, double b)
+{
+  this->IsoMapper->SetSurfaceColor(i, r, g, b);
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetNumberOfSurfaceOpacities(int number)
+{
+  this->IsoMapper->SetNumberOfSurfaceOpacities(number);
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetSurfaceOpacity(int i, double opacity)
+{
+  this->IsoMapper->SetSurfaceOpacity(i, opacity);
+}
+
+//------------------------------------------------------------------------------
 const char* vtkHistoPyramidIsoRepresentation::GetFootprint()
 {
   return this->IsoMapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath
@@ -111,20 +196,120 @@ double vtkHistoPyramidIsoRepresentation::GetFrameBufferBytes()
 }
 
 //------------------------------------------------------------------------------
+int vtkHistoPyramidIsoRepresentation::RequestData(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (!this->Superclass::RequestData(request, inputVector, outputVector))
+  {
+    return 0;
+  }
+  if (auto* image = vtkImageData::SafeDownCast(this->Cache))
+  {
+    // Points at one place along an axis (or nowhere) have no surface between
+    // them; said here, once per update, since such data may never reach the
+    // mapper (a non-finite spacing makes non-finite bounds, which the view culls).
+    const std::string spacingProblem = vtkHistoPyramidIsoMapper::CheckSpacing(image->GetSpacing());
+    if (!spacingProblem.empty())
+    {
+      vtkErrorMacro(<< spacingProblem);
+      this->Cache = nullptr;
+      this->IsoMapper->RemoveAllInputConnections(0);
+    }
+    return 1;
+  }
+  auto* grid = vtkRectilinearGrid::SafeDownCast(this->Cache);
+  if (!grid)
+  {
+    return 1;
+  }
+  int extent[6];
+  grid->GetExtent(extent);
+  vtkDataArray* axes[3] = { grid->GetXCoordinates(), grid->GetYCoordinates(),
+    grid->GetZCoordinates() };
+  double spacing[3];
+  bool even = true;
+  for (int a = 0; a < 3; ++a)
+  {
+    even = axes[a] && EvenSpacing(axes[a], spacing[a]) && even;
+  }
+  vtkNew<vtkImageData> image;
+  if (even)
+  {
+    // The same points and data, described by origin and spacing.
+    image->SetExtent(extent);
+    image->SetSpacing(spacing);
+    image->SetOrigin(axes[0]->GetComponent(0, 0) - spacing[0] * extent[0],
+      axes[1]->GetComponent(0, 0) - spacing[1] * extent[2],
+      axes[2]->GetComponent(0, 0) - spacing[2] * extent[4]);
+    image->GetPointData()->ShallowCopy(grid->GetPointData());
+    image->GetCellData()->ShallowCopy(grid->GetCellData());
+    image->GetFieldData()->ShallowCopy(grid->GetFieldData());
+  }
+  else
+  {
+    // Uneven coordinates: sample onto an even grid as fine as the finest
+    // spacing along each axis, at most 4 times the axis' points and 1024.
+    int dimensions[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      const vtkIdType n = axes[a] ? axes[a]->GetNumberOfTuples() : 1;
+      double finest = VTK_DOUBLE_MAX;
+      for (vtkIdType i = 1; i < n; ++i)
+      {
+        finest = std::min(
+          finest, std::abs(axes[a]->GetComponent(i, 0) - axes[a]->GetComponent(i - 1, 0)));
+      }
+      const double length =
+        n > 1 ? std::abs(axes[a]->GetComponent(n - 1, 0) - axes[a]->GetComponent(0, 0)) : 0.0;
+      double wanted = finest > 0.0 ? std::ceil(length / finest) + 1.0 : static_cast<double>(n);
+      wanted = std::min({ wanted, 4.0 * static_cast<double>(n), 1024.0 });
+      dimensions[a] = std::max(static_cast<int>(n), static_cast<int>(wanted));
+    }
+    vtkNew<vtkResampleToImage> resample;
+    resample->SetInputDataObject(grid);
+    resample->SetSamplingDimensions(dimensions);
+    resample->Update();
+    image->ShallowCopy(resample->GetOutput());
+    // vtkResampleToImage marks the points it could not sample; every point
+    // of a rectilinear grid's box can be, so the mask carries nothing.
+    image->GetPointData()->RemoveArray("vtkValidPointMask");
+    std::ostringstream msg;
+    msg << "HistoPyramid Isosurface draws image data: this rectilinear grid's coordinates are "
+           "not evenly spaced, so it was resampled onto an even "
+        << dimensions[0] << "x" << dimensions[1] << "x" << dimensions[2]
+        << " grid (the surfaces are those of the resampled data; Resample To Image "
+           "chooses the grid yourself).";
+    if (msg.str() != this->LastResampleMessage)
+    {
+      this->LastResampleMessage = msg.str();
+      vtkWarningMacro(<< msg.str());
+    }
+  }
+  this->Cache = image;
+  this->IsoMapper->SetInputData(image);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
 void vtkHistoPyramidIsoRepresentation::UpdateMapperParameters()
 {
   this->Superclass::UpdateMapperParameters();
 
   // The base class hides the volume when no colour array is chosen (volume
-  // mappers need one). An isosurface needs only scalars: use the active ones.
-  // This runs only for a visible representation, so showing the actor here
-  // never overrides the user's Visibility.
-  if (!this->Actor->GetVisibility())
+  // mappers need one). An isosurface needs only scalars: use the active ones,
+  // in the solid colour. This runs only for a visible representation, so
+  // showing the actor here never overrides the user's Visibility.
+  const bool solid = !this->Actor->GetVisibility();
+  if (solid)
   {
     this->IsoMapper->SetScalarModeToUsePointData();
     this->IsoMapper->SelectScalarArray(static_cast<const char*>(nullptr));
     this->Actor->SetVisibility(true);
   }
+  this->IsoMapper->SetColorSource(this->ColorEachSurface
+      ? vtkHistoPyramidIsoMapper::SurfaceColors
+      : (solid ? vtkHistoPyramidIsoMapper::SolidColors
+               : vtkHistoPyramidIsoMapper::TransferFunctionColors));
 }
 
 //------------------------------------------------------------------------------

@@ -27,9 +27,20 @@
  * with remote rendering that is the server's representation, which is the
  * one ParaView's information properties are pulled from.
  *
- * When no colour array is chosen (Solid Color), the base class would hide the
- * volume; this representation contours the input's active point scalars
- * instead, so the type shows a surface as soon as it is selected.
+ * Colours: with a colour array chosen, each isovalue takes the colour map's
+ * colour and the opacity map's opacity at its value; with none (Solid Color)
+ * every surface takes the solid colour (SetDiffuseColor) and the input's
+ * active point scalars are contoured (the base class would hide the volume),
+ * so the type shows a surface as soon as it is selected. With
+ * ColorEachSurface on, surface i takes SurfaceColor(i) instead, whatever the
+ * colouring. Each surface's opacity is further multiplied by
+ * SurfaceOpacity(i) and by Opacity, so surfaces get their own colour and
+ * opacity without editing transfer-function points.
+ *
+ * Input: image data. A vtkRectilinearGrid (which ParaView's image-data
+ * display also takes) is drawn as the image data it describes when its
+ * coordinates are evenly spaced, and resampled onto an even grid (with one
+ * warning saying so) when they are not.
  *
  * @sa vtkHistoPyramidIsoMapper vtkImageVolumeRepresentation
  */
@@ -39,6 +50,8 @@
 #include "MedicalIsosurfacesRepresentationsModule.h" // For export macro
 #include "vtkImageVolumeRepresentation.h"
 #include "vtkNew.h" // For vtkNew
+
+#include <string> // For std::string
 
 class vtkHistoPyramidIsoMapper;
 
@@ -85,14 +98,30 @@ public:
 
   ///@{
   /**
+   * Colouring of the surfaces (see the class description): the solid colour,
+   * one colour per surface (used when ColorEachSurface is on), an opacity per
+   * surface, and a global opacity multiplier. Surface i is the i-th value of
+   * IsosurfaceValues.
+   */
+  void SetDiffuseColor(double r, double g, double b);
+  void SetOpacity(double opacity);
+  void SetColorEachSurface(bool each);
+  void SetNumberOfSurfaceColors(int number);
+  void SetSurfaceColor(int i, double r, double g, double b);
+  void SetNumberOfSurfaceOpacities(int number);
+  void SetSurfaceOpacity(int i, double opacity);
+  ///@}
+
+  ///@{
+  /**
    * What the last frame rendered on this process did: the path ("gpu",
    * "fallback", or "none" before the first frame and when nothing was drawn),
    * why the GPU path is not used (empty while it is), the primitives (active
    * cell-isovalue pairs) of a GPU frame, the triangles of a fallback frame,
    * the pyramid builds so far, the GPU memory held and the first-hit
-   * buffers, in bytes, and the
-   * footprint of the last GPU frame ("points", "boxes"; "none" when the
-   * last frame was not a GPU one).
+   * buffers (in bytes, and in MB of 10^6 bytes), and the footprint of the
+   * last GPU frame ("points", "boxes"; "none" when the last frame was not a
+   * GPU one).
    * Counts are doubles for the ServerManager's information helpers.
    */
   const char* GetRenderPath();
@@ -103,6 +132,8 @@ public:
   double GetNumberOfPyramidBuilds();
   double GetGPUMemoryBytes();
   double GetFrameBufferBytes();
+  double GetGPUMemoryMB() { return this->GetGPUMemoryBytes() / 1.0e6; }
+  double GetFrameBufferMB() { return this->GetFrameBufferBytes() / 1.0e6; }
   ///@}
 
 protected:
@@ -117,11 +148,19 @@ protected:
    */
   void UpdateMapperParameters() override;
 
+  /**
+   * The base class's data cache, with a rectilinear grid replaced by the
+   * image data it describes (resampled when its spacing is uneven).
+   */
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
 private:
   vtkHistoPyramidIsoRepresentation(const vtkHistoPyramidIsoRepresentation&) = delete;
   void operator=(const vtkHistoPyramidIsoRepresentation&) = delete;
 
   vtkNew<vtkHistoPyramidIsoMapper> IsoMapper;
+  bool ColorEachSurface = false;
+  std::string LastResampleMessage;
 };
 
 #endif

@@ -23,10 +23,16 @@ packages=(
   qtbase5-dev qttools5-dev libqt5svg5-dev libqt5opengl5-dev qtxmlpatterns5-dev-tools
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev
   libhdf5-dev libgdal-dev libnetcdf-dev libgl2ps-dev libglew-dev libtheora-dev libtiff-dev
+  # the GUI panel widgets (pqComponents) and the plugin's documentation (Qt help)
+  libxml2-dev libboost-dev qhelpgenerator-qt5
+  # DCMTK writes the DICOM series the reader test opens
+  dcmtk
   # toolchain (python3 runs the data script and the offline format test)
   cmake ninja-build g++ make python3
   # rendering without a display (Mesa llvmpipe), and tests' network namespaces
   xvfb libgl1-mesa-dri iproute2 util-linux
+  # the GUI test's screen captures (xwd) and window queries (xwininfo)
+  x11-apps x11-utils
 )
 
 missing=()

@@ -116,9 +116,11 @@ void TestPiecesJoin()
 }
 
 // Each bad parameter set must raise exactly a clear error and give an empty output.
-void TestBadInput(const char* label, int nx, int ny, int nz, double spacing, const char* expected)
+void TestBadInput(const char* label, int nx, int ny, int nz, double spacing, const char* expected,
+  double memoryLimitMB = 0.0)
 {
   vtkNew<vtkMedicalPhantomSource> source;
+  source->SetMemoryLimit(memoryLimitMB);
   vtkNew<vtkTest::ErrorObserver> errors;
   source->AddObserver(vtkCommand::ErrorEvent, errors);
   source->SetDimensions(nx, ny, nz);
@@ -140,7 +142,10 @@ int TestMedicalPhantomSource(int, char*[])
   TestBadInput("zero dimension", 0, 64, 64, 1.0, "at least 2 points");
   TestBadInput("negative dimension", 64, -3, 64, 1.0, "at least 2 points");
   TestBadInput("2D request", 64, 64, 1, 1.0, "3D volume");
-  TestBadInput("absurd size", 100000, 100000, 100000, 1.0, "MiB");
+  TestBadInput("absurd size", 100000, 100000, 100000, 1.0, "MB");
+  // The output (17.2 GB) fits a 20 GB limit; a row of 2^31 doubles per
+  // thread (17.2 GB each) does not: the check must count it.
+  TestBadInput("row scratch", 2147483647, 2, 2, 1.0, "a row of 2147483647 doubles", 20000.0);
   TestBadInput("negative spacing", 16, 16, 16, -1.0, "spacing");
   return medical_test::Finish("vtkMedicalPhantomSource: all checks passed");
 }

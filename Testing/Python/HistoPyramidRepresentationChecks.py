@@ -23,14 +23,20 @@ SKIN, BONE = -500.0, 400.0
 from clientserver import Checks as Checker  # noqa: E402,F401
 
 
-def make_scene(source):
-    """Render view + the source shown as the HistoPyramid Isosurface representation."""
+def make_view(size=SIZE):
+    """A render view with the tests' fixed size and background, no orientation axes."""
     view = CreateView("RenderView")
-    view.ViewSize = SIZE
+    view.ViewSize = size
     view.OrientationAxesVisibility = 0
     view.UseColorPaletteForBackground = 0
     view.Background = BACKGROUND
     view.EnableRenderOnInteraction = 0
+    return view
+
+
+def make_scene(source):
+    """Render view + the source shown as the HistoPyramid Isosurface representation."""
+    view = make_view()
     display = Show(source, view)
     display.SetRepresentationType(REPRESENTATION)
     ColorBy(display, ("POINTS", "HU"))

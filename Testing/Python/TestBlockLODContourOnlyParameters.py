@@ -14,7 +14,7 @@ in remote rendering mode, after set-up:
   whatever the volume size: the two sizes' frames are within 25% of each
   other, while their surfaces differ about 16 times;
 - no step of the session sends geometry or volume data client->server.
-Prints the per-step table (the README's table comes from this output).
+Prints the per-step table (docs/clientserver.md's table comes from this output).
 """
 import os
 import sys

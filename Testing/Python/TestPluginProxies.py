@@ -95,7 +95,8 @@ cases = [
     ("zero dimension", dict(Dimensions=[0, 32, 32]), "at least 2 points"),
     ("negative dimension", dict(Dimensions=[32, -5, 32]), "at least 2 points"),
     ("2D request", dict(Dimensions=[32, 32, 1]), "3D volume"),
-    ("absurd size", dict(Dimensions=[100000, 100000, 100000]), "MiB"),
+    ("absurd size", dict(Dimensions=[100000, 100000, 100000]), "MB"),
+    ("row scratch", dict(Dimensions=[2147483647, 2, 2], MemoryLimit=20000), "a row of 2147483647 doubles"),
 ]
 for label, props, needle in cases:
     capture = vtkStringOutputWindow()

@@ -1,0 +1,221 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "pqBlockLODLevelWidget.h"
+
+#include "vtkCommand.h"
+#include "vtkEventQtSlotConnect.h"
+#include "vtkSMPropertyGroup.h"
+#include "vtkSMPropertyHelper.h"
+#include "vtkSMProxy.h"
+#include "vtkSMUncheckedPropertyHelper.h"
+
+#include <QCheckBox>
+#include <QDoubleSpinBox>
+#include <QFont>
+#include <QGridLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QLocale>
+#include <QSignalBlocker>
+#include <QSpinBox>
+#include <QTableWidget>
+
+namespace
+{
+constexpr int NumberOfLevels = 4;
+
+enum Column
+{
+  LevelColumn = 0,
+  TrianglesColumn = 1,
+  MegabytesColumn = 2,
+  SecondsColumn = 3,
+  UsedColumn = 4
+};
+}
+
+//------------------------------------------------------------------------------
+pqBlockLODLevelWidget::pqBlockLODLevelWidget(
+  vtkSMProxy* smproxy, vtkSMPropertyGroup* smgroup, QWidget* parentObject)
+  : Superclass(smproxy, smgroup, parentObject)
+  , AutoLOD(new QCheckBox(tr("Auto LOD"), this))
+  , Level(new QSpinBox(this))
+  , LevelNote(new QLabel(this))
+  , MemoryBudget(new QDoubleSpinBox(this))
+  , Table(new QTableWidget(NumberOfLevels, 5, this))
+  , Caption(new QLabel(this))
+  , Connections(vtkEventQtSlotConnect::New())
+{
+  this->setObjectName("BlockLODLevels");
+  this->AutoLOD->setObjectName("AutoLOD");
+  this->Level->setObjectName("LOD");
+  this->LevelNote->setObjectName("LevelNote");
+  this->MemoryBudget->setObjectName("MemoryBudget");
+  this->Table->setObjectName("Estimates");
+  this->Caption->setObjectName("EstimatesCaption");
+
+  this->Level->setRange(0, NumberOfLevels - 1);
+  this->Level->setMinimumWidth(this->Level->fontMetrics().horizontalAdvance(QStringLiteral("0000")) + 30);
+  this->Level->setToolTip(tr("Level of detail when Auto LOD is off: 0, 1, 2, 3 sample the volume "
+                             "with cube edges of 8, 4, 2, 1 voxels (3 is full resolution)."));
+  this->AutoLOD->setToolTip(tr("Use the highest level whose estimated output fits the memory "
+                               "budget; the level used is marked in the table."));
+  this->MemoryBudget->setRange(0.0, 1.0e9);
+  this->MemoryBudget->setDecimals(1);
+  this->MemoryBudget->setSuffix(tr(" MB"));
+  this->MemoryBudget->setToolTip(tr("Memory the output surface may take with Auto LOD, in MB "
+                                    "(10^6 bytes), all isovalues together."));
+
+  this->Table->setHorizontalHeaderLabels(
+    { tr("Level"), tr("Triangles"), tr("MB"), tr("Seconds"), QString() });
+  this->Table->verticalHeader()->setVisible(false);
+  this->Table->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  this->Table->setSelectionMode(QAbstractItemView::NoSelection);
+  this->Table->setFocusPolicy(Qt::NoFocus);
+  QHeaderView* header = this->Table->horizontalHeader();
+  header->setSectionResizeMode(QHeaderView::Stretch);
+  header->setSectionResizeMode(LevelColumn, QHeaderView::ResizeToContents);
+  header->setSectionResizeMode(UsedColumn, QHeaderView::ResizeToContents);
+  int height = header->sizeHint().height() + 2 * this->Table->frameWidth();
+  for (int level = 0; level < NumberOfLevels; ++level)
+  {
+    height += this->Table->verticalHeader()->sectionSize(level);
+  }
+  this->Table->setFixedHeight(height);
+  this->Caption->setWordWrap(true);
+
+  auto* layout = new QGridLayout(this);
+  layout->setContentsMargins(0, 0, 0, 0);
+  layout->addWidget(this->AutoLOD, 0, 0, 1, 3);
+  layout->addWidget(new QLabel(tr("LOD"), this), 1, 0);
+  layout->addWidget(this->Level, 1, 1);
+  layout->addWidget(this->LevelNote, 1, 2);
+  layout->addWidget(new QLabel(tr("Memory Budget"), this), 2, 0);
+  layout->addWidget(this->MemoryBudget, 2, 1, 1, 2);
+  layout->addWidget(this->Table, 3, 0, 1, 3);
+  layout->addWidget(this->Caption, 4, 0, 1, 3);
+  layout->setColumnStretch(2, 1);
+
+  this->addPropertyLink(this->AutoLOD, "AutoLOD");
+  this->addPropertyLink(this->Level, "LOD");
+  this->addPropertyLink(this->MemoryBudget, "MemoryBudget");
+  QObject::connect(
+    this->AutoLOD, &QCheckBox::toggled, this, &pqBlockLODLevelWidget::updateEnabledState);
+
+  // The estimates are information properties: pulled from the filter after
+  // each of its updates (whoever ran it: Apply, a script, an animation).
+  for (const char* function :
+    { "EstimatedTriangles", "EstimatedMB", "EstimatedSeconds", "ChosenLevel" })
+  {
+    if (vtkSMProperty* info = smgroup->GetProperty(function))
+    {
+      this->Connections->Connect(info, vtkCommand::ModifiedEvent, this, SLOT(updateEstimates()));
+    }
+  }
+  this->Connections->Connect(
+    smproxy, vtkCommand::UpdateDataEvent, this, SLOT(pullEstimates()));
+  this->pullEstimates();
+}
+
+//------------------------------------------------------------------------------
+void pqBlockLODLevelWidget::pullEstimates()
+{
+  vtkSMPropertyGroup* group = this->propertyGroup();
+  for (const char* function :
+    { "EstimatedTriangles", "EstimatedMB", "EstimatedSeconds", "ChosenLevel" })
+  {
+    if (vtkSMProperty* info = group->GetProperty(function))
+    {
+      this->proxy()->UpdatePropertyInformation(info);
+    }
+  }
+  this->updateEstimates();
+}
+
+//------------------------------------------------------------------------------
+pqBlockLODLevelWidget::~pqBlockLODLevelWidget()
+{
+  this->Connections->Disconnect();
+  this->Connections->Delete();
+}
+
+//------------------------------------------------------------------------------
+void pqBlockLODLevelWidget::updateEnabledState()
+{
+  const bool automatic = this->AutoLOD->isChecked();
+  this->MemoryBudget->setEnabled(automatic);
+  this->Level->setEnabled(!automatic);
+
+  // With Auto LOD the control shows the level used, without touching the
+  // LOD setting (signals blocked, so the property link does not see it).
+  vtkSMPropertyGroup* group = this->propertyGroup();
+  const int chosen = vtkSMPropertyHelper(group->GetProperty("ChosenLevel")).GetAsInt();
+  const QSignalBlocker blocker(this->Level);
+  if (automatic)
+  {
+    if (chosen >= 0)
+    {
+      this->Level->setValue(chosen);
+      this->LevelNote->setText(tr("used by Auto LOD"));
+    }
+    else
+    {
+      this->LevelNote->setText(tr("chosen on Apply"));
+    }
+  }
+  else
+  {
+    this->Level->setValue(vtkSMUncheckedPropertyHelper(group->GetProperty("LOD")).GetAsInt());
+    this->LevelNote->clear();
+  }
+}
+
+//------------------------------------------------------------------------------
+void pqBlockLODLevelWidget::updateEstimates()
+{
+  vtkSMPropertyGroup* group = this->propertyGroup();
+  vtkSMPropertyHelper triangles(group->GetProperty("EstimatedTriangles"));
+  vtkSMPropertyHelper megabytes(group->GetProperty("EstimatedMB"));
+  vtkSMPropertyHelper seconds(group->GetProperty("EstimatedSeconds"));
+  const int chosen = vtkSMPropertyHelper(group->GetProperty("ChosenLevel")).GetAsInt();
+  const bool known = triangles.GetNumberOfElements() == NumberOfLevels &&
+    megabytes.GetNumberOfElements() == NumberOfLevels &&
+    seconds.GetNumberOfElements() == NumberOfLevels && chosen >= 0;
+
+  const QLocale locale;
+  for (int level = 0; level < NumberOfLevels; ++level)
+  {
+    QStringList cells;
+    cells << tr("%1 (%2 vox)").arg(level).arg(8 >> level);
+    if (known)
+    {
+      const double t = triangles.GetAsDouble(level);
+      const double s = seconds.GetAsDouble(level);
+      cells << locale.toString(static_cast<qlonglong>(t + 0.5))
+            << locale.toString(megabytes.GetAsDouble(level), 'f', megabytes.GetAsDouble(level) < 10.0 ? 2 : 1)
+            << (s == 0.0 && t > 0.0 ? tr("cached") : locale.toString(s, 'f', s < 0.01 ? 4 : 3));
+    }
+    else
+    {
+      cells << QString("-") << QString("-") << QString("-");
+    }
+    cells << (level == chosen ? tr("\u25c0 used") : QString());
+    for (int column = 0; column < cells.size(); ++column)
+    {
+      auto* item = new QTableWidgetItem(cells[column]);
+      item->setTextAlignment(
+        (column == LevelColumn ? Qt::AlignLeft : Qt::AlignRight) | Qt::AlignVCenter);
+      if (level == chosen)
+      {
+        QFont font = item->font();
+        font.setBold(true);
+        item->setFont(font);
+      }
+      this->Table->setItem(level, column, item);
+    }
+  }
+  this->Caption->setText(known
+      ? tr("Estimates for the first isovalue before extraction (MB = 10^6 bytes); "
+           "updated on Apply.")
+      : tr("Estimates appear after Apply."));
+  this->updateEnabledState();
+}

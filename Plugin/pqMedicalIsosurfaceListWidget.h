@@ -1,0 +1,103 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   pqMedicalIsosurfaceListWidget
+ * @brief   The "HistoPyramid Isosurface" representation's isovalue list.
+ *
+ * A property-group widget (panel_widget="medical_isosurface_list") that
+ * shows one row per isosurface: its value, its colour and its opacity, with
+ * the data range of the contoured array above the table. It edits three
+ * properties of the display together, so that row i is always the value,
+ * colour and opacity of the same surface:
+ *
+ * - the display's IsosurfaceValues (shared with the Volume representation
+ *   type, so the list carries over when switching types);
+ * - the group's "Colors" (r, g, b per row; used when "Color Each Surface",
+ *   the group's "ColorEachSurface", is checked);
+ * - the group's "Opacities" (one per row; multiplies the solid colour's or
+ *   the colour map's opacity).
+ *
+ * The range is the one of the array the representation contours: the
+ * colouring array when one is chosen, else the input's active point
+ * scalars; it is refreshed when the data or the colouring changes.
+ */
+#ifndef pqMedicalIsosurfaceListWidget_h
+#define pqMedicalIsosurfaceListWidget_h
+
+#include "pqPropertyGroupWidget.h"
+
+#include <QColor>
+#include <QList>
+#include <QVariant>
+#include <vector>
+
+class QCheckBox;
+class QLabel;
+class QPushButton;
+class QTableWidget;
+class vtkEventQtSlotConnect;
+
+class pqMedicalIsosurfaceListWidget : public pqPropertyGroupWidget
+{
+  Q_OBJECT
+  Q_PROPERTY(QList<QVariant> values READ values WRITE setValues)
+  Q_PROPERTY(QList<QVariant> colors READ colors WRITE setColors)
+  Q_PROPERTY(QList<QVariant> opacities READ opacities WRITE setOpacities)
+  typedef pqPropertyGroupWidget Superclass;
+
+public:
+  pqMedicalIsosurfaceListWidget(
+    vtkSMProxy* proxy, vtkSMPropertyGroup* group, QWidget* parent = nullptr);
+  ~pqMedicalIsosurfaceListWidget() override;
+
+  ///@{
+  /// The rows as the three properties hold them.
+  QList<QVariant> values() const;
+  QList<QVariant> colors() const;
+  QList<QVariant> opacities() const;
+  void setValues(const QList<QVariant>& values);
+  void setColors(const QList<QVariant>& colors);
+  void setOpacities(const QList<QVariant>& opacities);
+  ///@}
+
+Q_SIGNALS:
+  void valuesChanged();
+  void colorsChanged();
+  void opacitiesChanged();
+
+private Q_SLOTS:
+  void addRow();
+  void removeRows();
+  void cellEdited(int row, int column);
+  void cellDoubleClicked(int row, int column);
+  void updateRange();
+  /// Rebuilds the table from Rows without signalling an edit.
+  void updateTable();
+
+private:
+  Q_DISABLE_COPY(pqMedicalIsosurfaceListWidget)
+
+  struct Row
+  {
+    double Value = 0.0;
+    QColor Color;
+    double Opacity = 1.0;
+  };
+
+  /// Tells the links that every column changed (rows added, removed, edited).
+  void rowsEdited();
+  /// The colour a new row starts with (a fixed palette, skin and bone first).
+  static QColor defaultColor(int row);
+
+  std::vector<Row> Rows;
+  double Range[2] = { 0.0, 0.0 };
+  bool HasRange = false;
+  bool Updating = false;
+  QTableWidget* Table;
+  QLabel* RangeLabel;
+  QPushButton* AddButton;
+  QPushButton* RemoveButton;
+  QCheckBox* ColorEachSurface;
+  vtkEventQtSlotConnect* Connections;
+};
+
+#endif

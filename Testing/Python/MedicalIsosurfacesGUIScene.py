@@ -1,0 +1,81 @@
+"""The scene TestMedicalIsosurfacesGUI shows in the real ParaView GUI (paraview --script).
+
+Environment (set by the driver, Testing/Python/TestMedicalIsosurfacesGUI.py):
+    MEDISO_GUI_PANEL   "representation": the phantom shown as HistoPyramid
+                       Isosurface, selected, its panel showing the isovalue list
+                       (skin 0.4 opaque over bone, a colour each);
+                       "blocklod": Block LOD Contour with Auto LOD applied,
+                       selected, its panel showing the estimator's table
+    MEDISO_GUI_STATUS  where to write what the proxies say, as JSON, once the
+                       scene is set up (the driver waits for this file)
+
+The plugin is loaded by ParaView from PV_PLUGIN_PATH, as a user would.
+"""
+import json
+import os
+
+from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
+
+panel = os.environ["MEDISO_GUI_PANEL"]
+status_path = os.environ["MEDISO_GUI_STATUS"]
+
+view = GetActiveViewOrCreate("RenderView")
+view.OrientationAxesVisibility = 0
+view.UseColorPaletteForBackground = 0
+view.Background = [0.1, 0.1, 0.15]
+
+head = MedicalPhantom(Dimensions=[64, 64, 64], Spacing=[3.0, 3.0, 3.0])
+display = Show(head, view)
+status = {"panel": panel}
+if panel == "representation":
+    display.SetRepresentationType("HistoPyramid Isosurface")
+    display.IsosurfaceValues = [-500.0, 400.0]
+    display.HistoPyramidColorEachSurface = 1
+    display.HistoPyramidSurfaceColors = [0.93, 0.75, 0.62, 0.96, 0.94, 0.86]
+    display.HistoPyramidSurfaceOpacities = [0.4, 1.0]
+    view.CameraPosition = [94.5, -300.0, 94.5]
+    view.CameraFocalPoint = [94.5, 94.5, 94.5]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
+    view.ResetCamera()
+    Render(view)
+    sub = display.SMProxy.GetProperty("HistoPyramidRenderPath").GetParent()
+    sub.UpdatePropertyInformation()
+    status.update({
+        "representation": display.GetProperty("Representation").GetData(),
+        "color_array": str(display.ColorArrayName[1]),
+        "isovalues": list(display.IsosurfaceValues),
+        "surface_colors": list(display.HistoPyramidSurfaceColors),
+        "surface_opacities": list(display.HistoPyramidSurfaceOpacities),
+        "color_each_surface": display.HistoPyramidColorEachSurface,
+        "render_path": display.GetProperty("HistoPyramidRenderPath")[0],
+        "primitives": display.GetProperty("HistoPyramidPrimitives")[0],
+        "triangles": display.GetProperty("HistoPyramidFallbackTriangles")[0],
+    })
+    SetActiveSource(head)
+else:
+    Hide(head, view)
+    contour = BlockLODContour(Input=head, ContourBy=["POINTS", "HU"], Isosurfaces=[400.0], LOD=1)
+    contour.AutoLOD = 1
+    contour.MemoryBudget = 1.0  # MB: level 3 (about 1.2 MB here) does not fit, level 2 does
+    contour_display = Show(contour, view)
+    view.CameraPosition = [94.5, -300.0, 94.5]
+    view.CameraFocalPoint = [94.5, 94.5, 94.5]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
+    view.ResetCamera()
+    Render(view)
+    contour.UpdatePropertyInformation()
+    status.update({
+        "auto_lod": contour.AutoLOD,
+        "lod": contour.LOD,
+        "memory_budget": contour.MemoryBudget,
+        "chosen_level": contour.GetProperty("ChosenLevel")[0],
+        "estimated_triangles": list(contour.GetProperty("EstimatedTriangles")),
+        "estimated_mb": list(contour.GetProperty("EstimatedMB")),
+        "estimated_seconds": list(contour.GetProperty("EstimatedSeconds")),
+        "triangles": contour.GetDataInformation().GetNumberOfCells(),
+    })
+    SetActiveSource(contour)
+
+with open(status_path + ".part", "w") as f:
+    json.dump(status, f, indent=1)
+os.replace(status_path + ".part", status_path)

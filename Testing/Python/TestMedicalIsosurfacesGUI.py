@@ -1,0 +1,260 @@
+"""GUI test: the real ParaView GUI shows the plugin's panels (run under Xvfb, by pvpython).
+
+    pvpython TestMedicalIsosurfacesGUI.py --paraview PATH --plugin-dir DIR --settings INI
+                                          --baseline PNG --out DIR [--qch FILE]
+
+Starts the `paraview` executable three times, each with a fresh home holding
+Testing/Data/GUI/ParaView5.11.0.ini (no welcome dialog, a left dock wide enough
+to read), the plugin on PV_PLUGIN_PATH, and Testing/Python/MedicalIsosurfacesGUIScene.py
+as its --script:
+1. "representation": the phantom as HistoPyramid Isosurface, skin (opacity 0.4)
+   over bone, a colour each; a recorded event (--test-script) scrolls the
+   Properties panel down to the representation's isovalue list;
+2. "blocklod": Block LOD Contour with Auto LOD and a 1 MB budget applied: its
+   panel shows the estimator's table with the level used marked;
+3. "help": as 2, then recorded events: with Auto LOD the level control is
+   disabled and shows the level used, the budget enabled; Auto LOD unchecked,
+   the level is enabled and shows its setting, the budget disabled (QtTesting
+   checks); then a click on the panel's "?" button, which must open ParaView's
+   help window; the plugin's help collection (--qch) must hold the filter's and
+   the source's pages.
+For 1 and 2, once the scene script has written its status (what the proxies
+say, checked here), the screen is captured (xwd) until two captures a second
+apart agree; the window's area above the status bar (which shows the memory in
+use) is cropped, and the two crops side by side are compared with the baseline
+image: at most 0.5% of the pixels may differ by more than 40 in a channel. The
+image is written to --out whatever the result (to make or update the baseline:
+look at it, then copy it to Testing/Data/Baseline/). Anything paraview prints
+that looks like a VTK error or warning fails the test.
+Skipped (exit 125) without xwd and xwininfo (Debian: x11-apps, x11-utils).
+"""
+import argparse
+import json
+import os
+import shutil
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+
+import numpy
+from vtkmodules.util.numpy_support import numpy_to_vtk
+from vtkmodules.vtkCommonDataModel import vtkImageData
+from vtkmodules.vtkIOImage import vtkPNGWriter
+
+import HistoPyramidRepresentationChecks as hp
+
+parser = argparse.ArgumentParser()
+parser.add_argument("--paraview", required=True)
+parser.add_argument("--plugin-dir", required=True)
+parser.add_argument("--settings", required=True)
+parser.add_argument("--baseline", required=True)
+parser.add_argument("--out", required=True)
+parser.add_argument("--qch", help="the plugin's built help collection")
+args = parser.parse_args()
+
+for tool in ("xwd", "xwininfo"):
+    if not shutil.which(tool):
+        print("SKIP: %s is not installed (apt-get install x11-apps x11-utils)" % tool)
+        sys.exit(125)
+
+here = os.path.dirname(os.path.abspath(__file__))
+scene = os.path.join(here, "MedicalIsosurfacesGUIScene.py")
+NAME = "TestMedicalIsosurfacesGUI"
+# The main window's area on the 1920x1080 screen, less the status bar.
+CROP = (0, 0, 1400, 1020)  # x, y, width, height
+failures = []
+
+
+def check(ok, what):
+    if not ok:
+        failures.append(what)
+        print("FAILED: " + what)
+    return ok
+
+
+def capture():
+    """The Xvfb screen as an (h, w, 3) uint8 array (xwd of the root window,
+    TrueColor, 24 or 32 bits per pixel)."""
+    raw = subprocess.run(["xwd", "-root", "-silent"], capture_output=True, check=True).stdout
+    header = numpy.frombuffer(raw[:100], dtype=">u4")
+    header_size, width, height = int(header[0]), int(header[4]), int(header[5])
+    byte_order, bits_per_pixel, bytes_per_line = int(header[7]), int(header[11]), int(header[12])
+    colormap_entries = int(header[19])
+    step = bits_per_pixel // 8
+    start = header_size + 12 * colormap_entries
+    rows = numpy.frombuffer(raw[start:start + height * bytes_per_line], dtype=numpy.uint8)
+    pixels = rows.reshape(height, bytes_per_line)[:, :step * width].reshape(height, width, step)
+    # Masks 0xff0000, 0xff00, 0xff: least significant byte first is B, G, R.
+    return pixels[:, :, [2, 1, 0]] if byte_order == 0 else pixels[:, :, step - 3:step]
+
+
+def write_png(path, pixels):
+    h, w, _ = pixels.shape
+    image = vtkImageData()
+    image.SetDimensions(w, h, 1)
+    array = numpy_to_vtk(numpy.ascontiguousarray(pixels[::-1]).reshape(-1, 3), deep=True)
+    image.GetPointData().SetScalars(array)
+    writer = vtkPNGWriter()
+    writer.SetFileName(path)
+    writer.SetInputData(image)
+    writer.Write()
+
+
+def start_paraview(panel, xml_events=None):
+    home = os.path.join(args.out, "%s-home-%s" % (NAME, panel))
+    shutil.rmtree(home, ignore_errors=True)
+    os.makedirs(os.path.join(home, ".config", "ParaView"))
+    shutil.copy(args.settings, os.path.join(home, ".config", "ParaView", "ParaView5.11.0.ini"))
+    runtime = os.path.join(home, "runtime")
+    os.makedirs(runtime, mode=0o700)
+    status = os.path.join(home, "status.json")
+    env = dict(os.environ, HOME=home, XDG_CONFIG_HOME=os.path.join(home, ".config"),
+               XDG_RUNTIME_DIR=runtime, PV_PLUGIN_PATH=args.plugin_dir,
+               MEDISO_GUI_PANEL="blocklod" if panel == "help" else panel,
+               MEDISO_GUI_STATUS=status)
+    command = [args.paraview, "-geometry", "1400x1050+0+0", "--script=" + scene]
+    if xml_events:
+        events = os.path.join(home, "events.xml")
+        with open(events, "w") as f:
+            f.write('<?xml version="1.0" ?>\n<pqevents>\n%s\n</pqevents>\n' % xml_events)
+        command.append("--test-script=" + events)
+    log = open(os.path.join(home, "paraview.log"), "w")
+    process = subprocess.Popen(command, env=env, stdout=log, stderr=subprocess.STDOUT)
+    return process, status, log
+
+
+def wait_for(path, process, seconds):
+    deadline = time.time() + seconds
+    while time.time() < deadline and process.poll() is None:
+        if os.path.exists(path):
+            with open(path) as f:
+                return json.load(f)
+        time.sleep(0.5)
+    return None
+
+
+def stop_paraview(panel, process, log):
+    """Kill paraview (SIGKILL: nothing more to print) and check what it printed."""
+    if process.poll() is None:
+        process.send_signal(signal.SIGKILL)
+    process.wait()
+    log.close()
+    with open(log.name) as f:
+        lines = f.read().splitlines()
+    bad = [line for line in lines
+           if "ERROR" in line or "Warning: In" in line or " ERR|" in line or " WARN|" in line
+           or "critical:" in line or "Traceback" in line]
+    check(not bad, "%s: paraview printed no error or warning (got %r)" % (panel, bad[:5]))
+
+
+def stable_screen(seconds=60):
+    """Captures a second apart until two agree; the last one."""
+    x, y, w, h = CROP
+    previous = None
+    deadline = time.time() + seconds
+    while time.time() < deadline:
+        time.sleep(1.0)
+        screen = capture()[y:y + h, x:x + w]
+        if previous is not None and numpy.array_equal(screen, previous):
+            return screen
+        previous = screen
+    print("note: the screen never settled for two captures in %d s; using the last" % seconds)
+    return previous
+
+
+# --- 1. the representation's isovalue list ------------------------------------
+scroll = ('<pqevent object="pqClientMainWindow/propertiesDock/propertiesPanel/scrollArea/'
+          'qt_scrollarea_vcontainer/1QScrollBar0" command="set_int" arguments="285" />')
+process, status_path, log = start_paraview("representation", scroll)
+status = wait_for(status_path, process, 120)
+representation_screen = stable_screen() if status else None
+stop_paraview("representation", process, log)
+if check(status is not None, "representation: the scene script ran (status written)"):
+    check(status["representation"] == "HistoPyramid Isosurface" and status["color_array"] == ""
+          and status["isovalues"] == [-500.0, 400.0],
+          "representation: HistoPyramid Isosurface, Solid Color, isovalues -500 and 400 (%s)" % status)
+    check(status["render_path"] in ("gpu", "fallback")
+          and (status["primitives"] > 1000 or status["triangles"] > 1000),
+          "representation: drawn (path %s, %d primitives, %d triangles)"
+          % (status["render_path"], status["primitives"], status["triangles"]))
+
+# --- 2. Block LOD Contour's estimator table -----------------------------------
+process, status_path, log = start_paraview("blocklod")
+status = wait_for(status_path, process, 120)
+blocklod_screen = stable_screen() if status else None
+stop_paraview("blocklod", process, log)
+if check(status is not None, "blocklod: the scene script ran (status written)"):
+    triangles = status["estimated_triangles"]
+    megabytes = status["estimated_mb"]
+    check(status["auto_lod"] == 1 and len(triangles) == 4 and len(megabytes) == 4
+          and all(0 < triangles[i] < triangles[i + 1] for i in range(3)),
+          "blocklod: Auto LOD on, four growing estimates (%s)" % triangles)
+    check(status["chosen_level"] == 2 and megabytes[2] <= 1.0 < megabytes[3],
+          "blocklod: the budget of 1 MB chose level 2, the highest that fits (%s, %s MB)"
+          % (status["chosen_level"], megabytes))
+
+# --- 3. the "?" button opens the plugin's documentation ----------------------
+# Before the click, the level-of-detail controls: with Auto LOD the level is
+# disabled and shows the level used (2), the budget enabled; unchecked, the
+# level is enabled and shows its setting (1), the budget disabled. A failed
+# check makes QtTesting print a "critical:" line, which fails the test.
+levels = ("pqClientMainWindow/propertiesDock/propertiesPanel/scrollArea/qt_scrollarea_viewport/"
+          "scrollAreaWidgetContents/PropertiesFrame/ProxyPanel/medical_blocklod_levels")
+checks = [("LOD", "enabled", "false"), ("MemoryBudget", "enabled", "true"), ("LOD", "value", "2"),
+          None,
+          ("LOD", "enabled", "true"), ("MemoryBudget", "enabled", "false"), ("LOD", "value", "1")]
+events = []
+for entry in checks:
+    if entry is None:
+        events.append('<pqevent object="%s/AutoLOD" command="set_boolean" arguments="false" />' % levels)
+    else:
+        events.append('<pqcheck object="%s/%s" property="%s" arguments="%s" />' % ((levels,) + entry))
+events.append('<pqevent object="pqClientMainWindow/propertiesDock/propertiesPanel/Help" '
+              'command="activate" arguments="" />')
+process, status_path, log = start_paraview("help", "\n".join(events))
+status = wait_for(status_path, process, 120)
+opened = False
+deadline = time.time() + 60
+while status and not opened and time.time() < deadline:
+    time.sleep(1.0)
+    info = subprocess.run(["xwininfo", "-name", "ParaView Online Help"],
+                          capture_output=True, text=True)
+    opened = info.returncode == 0 and "IsViewable" in info.stdout
+stop_paraview("help", process, log)
+check(opened, "help: the '?' button of Block LOD Contour opens ParaView's help window")
+if args.qch:
+    try:
+        pages = {row[0] for row in sqlite3.connect(args.qch).execute("SELECT Name FROM FileNameTable")}
+    except sqlite3.Error as error:
+        pages = set()
+        print("note: %s: %s" % (args.qch, error))
+    check({"filters.BlockLODContour.html", "sources.MedicalPhantom.html"} <= pages,
+          "help: the plugin's help collection holds its pages (%s)" % sorted(pages))
+
+# --- the image ---------------------------------------------------------------
+if representation_screen is not None and blocklod_screen is not None:
+    image = numpy.concatenate([representation_screen, blocklod_screen], axis=1)
+    written = os.path.join(args.out, NAME + ".png")
+    write_png(written, image)
+    print("wrote %s" % written)
+    if not os.path.exists(args.baseline):
+        check(False, "no baseline %s: look at %s and copy it there" % (args.baseline, written))
+    else:
+        baseline = hp.read_png(args.baseline)[::-1]  # bottom row first, as VTK reads it
+        if check(baseline.shape == image.shape,
+                 "image size %s matches the baseline's %s" % (image.shape, baseline.shape)):
+            differs = (numpy.abs(baseline.astype(int) - image.astype(int)) > 40).any(axis=2)
+            fraction = float(differs.mean())
+            check(fraction <= 0.005, "%.3f%% of the pixels differ from the baseline (at most 0.5%%)"
+                  % (100 * fraction))
+            if fraction > 0:
+                diff = numpy.where(differs[:, :, None], [255, 0, 255], image // 3).astype(numpy.uint8)
+                write_png(os.path.join(args.out, NAME + "-diff.png"), diff)
+            print("%.3f%% of the pixels differ from the baseline" % (100 * fraction))
+
+if failures:
+    print("%d check(s) failed" % len(failures))
+    sys.exit(1)
+print("GUI: all checks passed")
