@@ -568,6 +568,7 @@ def run_child(args):
                 i = lod_info(warm[level])
                 record("warm%d" % level, "BlockLOD warm change", level, s, p, g, i["triangles"],
                        i["out_mb"])
+                rows["warm%d" % level].setdefault("est_s", []).append(i["est_s"][level])
         # Cache hits: alternate between two isovalues already extracted at the level.
         for level in (0, 3):
             missed = 0
@@ -860,7 +861,7 @@ def report(args, results, skipped, command, started, wall, load_before, load_aft
         "|error| <= 10%. MB: EstimatedMB vs the output's GetMemorySize (KiB * 1024 / 10^6). "
         "Seconds: the filter's predicted extraction time vs the measured update.")
     pooled_ours, pooled_paper = [], []
-    est_summary, est_under, seconds_summary = {}, {}, {}
+    est_summary, est_under, seconds_summary, seconds_median_summary = {}, {}, {}, {}
     for r in results:
         sw = r["sweep"]
         out("")
@@ -966,6 +967,29 @@ def report(args, results, skipped, command, started, wall, load_before, load_aft
         seconds_summary[r["input"]] = (within, len(errs))
     lines.extend(table(["input", "pairs over 10 ms", "within 25%", "median |err|",
                         "95th pct |err|", "worst |err|", "median err"], rows))
+    out("")
+    out("A sweep's pair is one update, so a stall (another process holding a core for a time "
+        "slice, ~20 ms here) lands on it whole. The warm changes of table 1 repeat each pair "
+        "%s times: their median measured time against their median prediction, for the "
+        "(isovalue, level) pairs over 10 ms:" % "/".join(sorted({str(r["repeats"]) for r in results})))
+    rows = []
+    for r in results:
+        errs = []
+        for block in r["cold"]:
+            for row in block.get("rows", []):
+                if row["key"].startswith("warm") and row.get("est_s"):
+                    measured = statistics.median(row["times"])
+                    predicted = statistics.median(row["est_s"])
+                    if measured > TARGET_SECONDS_MIN and predicted > 0:
+                        errs.append(predicted / measured - 1.0)
+        if not errs:
+            continue
+        within, median, p95, worst = distribution(errs, TARGET_SECONDS_TOL)
+        rows.append([r["input"], len(errs), fmt_pct(within), fmt_pct(median), fmt_pct(worst),
+                     ", ".join("%+.0f%%" % (100 * e) for e in errs)])
+        seconds_median_summary[r["input"]] = (within, len(errs))
+    lines.extend(table(["input", "pairs over 10 ms (medians)", "within 25%", "median |err|",
+                        "worst |err|", "errors"], rows))
 
     # (3c) ParaView: isovalue change to a rendered frame
     if any("frames" in r for r in results):
@@ -1064,11 +1088,13 @@ def report(args, results, skipped, command, started, wall, load_before, load_aft
             rows.append(["estimator never under the actual count by more than 10%",
                          "%s, %d pairs" % (key, pairs), "%d pairs under" % est_under[key],
                          "yes" if est_under[key] == 0 else "no", "-"])
-    for key, (fraction, pairs) in seconds_summary.items():
-        rows.append(["EstimatedSeconds within 25% for pairs over 10 ms",
-                     "%s, %d pairs" % (key, pairs), fmt_pct(fraction),
-                     "yes" if fraction >= 1.0 else "no",
-                     "%d of %d outside" % (round((1.0 - fraction) * pairs), pairs)])
+    for label, summary in (("sweep pairs, one update each", seconds_summary),
+                           ("warm changes, median of the runs", seconds_median_summary)):
+        for key, (fraction, pairs) in summary.items():
+            rows.append(["EstimatedSeconds within 25% for pairs over 10 ms (%s)" % label,
+                         "%s, %d pairs" % (key, pairs), fmt_pct(fraction),
+                         "yes" if fraction >= 1.0 else "no",
+                         "%d of %d outside" % (round((1.0 - fraction) * pairs), pairs)])
     for r in results:
         for row in r.get("frames", {}).get("ratios", []):
             rows.append(["(info) change+frame in ParaView, BlockLOD L3 / %s" % row["peer"],

@@ -28,10 +28,10 @@ double CostModel::Default(double cubes, double triangles)
     DefaultSecondsPerUpdate;
 }
 
-void CostModel::Fit::Record(double cubes, double triangles, double seconds)
+void CostModel::Fit::Record(double cubes, double triangles, double seconds, double weight)
 {
   const double x[3] = { cubes, triangles, 1.0 };
-  const double w = 1.0 / (seconds * seconds);
+  const double w = weight;
   for (int i = 0; i < 3; ++i)
   {
     for (int j = 0; j < 3; ++j)
@@ -104,8 +104,18 @@ void CostModel::Record(int level, double cubes, double triangles, double seconds
   {
     return;
   }
-  this->Levels[level].Record(cubes, triangles, seconds);
-  this->All.Record(cubes, triangles, seconds);
+  // Relative errors: weights 1 / expected^2, the expectation being the
+  // current prediction (the measured time itself would give a spuriously fast
+  // record the largest weight).
+  const double expected = std::max(1e-6, this->Predict(level, cubes, triangles));
+  const double ratio = seconds / expected;
+  double weight = 1.0 / (expected * expected);
+  if (this->All.Samples >= 3 && (ratio > 2.0 || ratio < 0.5))
+  {
+    weight *= OutlierWeight;
+  }
+  this->Levels[level].Record(cubes, triangles, seconds, weight);
+  this->All.Record(cubes, triangles, seconds, weight);
 }
 
 double CostModel::Predict(int level, double cubes, double triangles) const

@@ -72,13 +72,14 @@ struct SurfaceLayout
 /// Seconds of an update that extracts surfaces at a level, from the cubes it
 /// visits and the triangles it makes: A * cubes + B * triangles + C (C: the
 /// update's fixed work, such as checks, estimates and output assembly). A, B
-/// and C are fitted by least squares on relative errors (weights
-/// 1 / seconds^2: a 10 ms update counts as much as a 1 s one) to the host's
-/// records, older records fading by Memory per new one so the fit follows the
+/// and C are fitted by least squares on relative errors (weights 1 / the
+/// predicted seconds^2: a 10 ms update counts as much as a 1 s one) to the
+/// host's records, older records fading by Memory per new one so the fit follows the
 /// machine's load. A level's own fit predicts once it has three records (the
 /// levels' costs per cube differ); before that, the fit over all levels;
 /// before that (or when a fit is not positive), the defaults scaled to match
-/// the records.
+/// the records. A record more than twice off the prediction (a disturbed
+/// update: another process held a core) counts a tenth.
 class CostModel
 {
 public:
@@ -88,6 +89,8 @@ public:
   static constexpr double DefaultSecondsPerUpdate = 1.0e-3;
   /// Weight a record keeps when a new one arrives.
   static constexpr double Memory = 0.97;
+  /// Weight of a record more than twice off the prediction.
+  static constexpr double OutlierWeight = 0.1;
 
   void Record(int level, double cubes, double triangles, double seconds);
   double Predict(int level, double cubes, double triangles) const;
@@ -108,7 +111,7 @@ private:
     double ScaleNumerator = 0;
     double ScaleDenominator = 0;
     int Samples = 0;
-    void Record(double cubes, double triangles, double seconds);
+    void Record(double cubes, double triangles, double seconds, double weight);
     // The fitted A, B, C when there are 3 records and they are all >= 0.
     bool Solve(double abc[3]) const;
   };

@@ -324,6 +324,22 @@ void TestCostModel()
   Check(std::fabs(slower / (2 * (a * 3e6 + b * 2e5 + c)) - 1) < 0.01,
     "older records fade: the fit follows a slower machine");
 
+  // Records far off the fit (a disturbed update, or a clock glitch) count a
+  // tenth: the fit stays near the law.
+  CostModel steady;
+  for (int k = 0; k < 20; ++k)
+  {
+    const auto& s = samples[k % 5];
+    steady.Record(3, s[0], s[1], a * s[0] + b * s[1] + c);
+  }
+  for (int k = 0; k < 3; ++k)
+  {
+    steady.Record(3, 3e6, 2e5, 0.2 * (a * 3e6 + b * 2e5 + c));
+  }
+  const double kept = steady.Predict(3, 3e6, 2e5) / (a * 3e6 + b * 2e5 + c);
+  std::printf("after three records at 0.2x the law: prediction %.2fx the law\n", kept);
+  Check(std::fabs(kept - 1) < 0.2, "records far off the fit count little");
+
   // A level's own fit, once it has three records; the fit of all levels before.
   CostModel levels;
   for (const auto& s : samples)
