@@ -149,6 +149,8 @@ def parse_args(argv=None):
     parser.add_argument("--json", default="", help="write the raw measurements to this file")
     parser.add_argument("--pvpython", default="",
                         help="interpreter for the child processes (default: pvpython on PATH)")
+    parser.add_argument("--report-from", default="",
+                        help="print the tables of a run saved with --json, measuring nothing")
     parser.add_argument("--child", default="", help=argparse.SUPPRESS)
     parser.add_argument("--child-result", default="", help=argparse.SUPPRESS)
     return parser.parse_args(argv)
@@ -1091,7 +1093,7 @@ def report(args, results, skipped, command, started, wall, load_before, load_aft
     for label, summary in (("sweep pairs, one update each", seconds_summary),
                            ("warm changes, median of the runs", seconds_median_summary)):
         for key, (fraction, pairs) in summary.items():
-            rows.append(["EstimatedSeconds within 25% for pairs over 10 ms (%s)" % label,
+            rows.append(["EstimatedSeconds within 25%% for pairs over 10 ms (%s)" % label,
                          "%s, %d pairs" % (key, pairs), fmt_pct(fraction),
                          "yes" if fraction >= 1.0 else "no",
                          "%d of %d outside" % (round((1.0 - fraction) * pairs), pairs)])
@@ -1240,7 +1242,13 @@ def run_parent(args, argv):
         progress("%s finished in %.0f s" % (name, result["child_wall_s"]))
         results.append(result)
     wall = time.perf_counter() - t0
-    lines = report(args, results, skipped, command, started, wall, load_before, load_average())
+    load_after = load_average()
+    if args.json:  # first, so that the measurements survive a failing report
+        with open(args.json, "w") as f:
+            json.dump(dict(command=command, results=results, skipped=skipped, started=started,
+                           wall=wall, load_before=load_before, load_after=load_after), f)
+        progress("wrote " + args.json)
+    lines = report(args, results, skipped, command, started, wall, load_before, load_after)
     text = "\n".join(lines) + "\n"
     sys.stdout.write("\n" + text)
     sys.stdout.flush()
@@ -1248,10 +1256,6 @@ def run_parent(args, argv):
         with open(args.out, "w") as f:
             f.write(text)
         progress("wrote " + args.out)
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(dict(command=command, results=results, skipped=skipped), f)
-        progress("wrote " + args.json)
     return 0 if results else 1
 
 
@@ -1260,6 +1264,13 @@ def main():
     args = parse_args(argv)
     if args.child:
         return run_child(args)
+    if args.report_from:
+        with open(args.report_from) as f:
+            saved = json.load(f)
+        lines = report(args, saved["results"], saved["skipped"], saved["command"],
+                       saved["started"], saved["wall"], saved["load_before"], saved["load_after"])
+        sys.stdout.write("\n".join(lines) + "\n")
+        return 0
     return run_parent(args, argv)
 
 

@@ -48,7 +48,7 @@ void CostModel::Fit::Record(double cubes, double triangles, double seconds, doub
 
 bool CostModel::Fit::Solve(double abc[3]) const
 {
-  if (this->Samples < 3)
+  if (this->Samples < MinimumRecords)
   {
     return false;
   }
@@ -104,13 +104,13 @@ void CostModel::Record(int level, double cubes, double triangles, double seconds
   {
     return;
   }
-  // Relative errors: weights 1 / expected^2, the expectation being the
-  // current prediction (the measured time itself would give a spuriously fast
-  // record the largest weight).
+  // Relative errors: weights 1 / seconds^2, seconds no less than the
+  // prediction so that a spuriously fast record does not weigh the most.
   const double expected = std::max(1e-6, this->Predict(level, cubes, triangles));
   const double ratio = seconds / expected;
-  double weight = 1.0 / (expected * expected);
-  if (this->All.Samples >= 3 && (ratio > 2.0 || ratio < 0.5))
+  const double scale = std::max(seconds, expected);
+  double weight = 1.0 / (scale * scale);
+  if (this->Levels[level].Samples >= 3 && (ratio > 2.0 || ratio < 0.5))
   {
     weight *= OutlierWeight;
   }
@@ -120,15 +120,29 @@ void CostModel::Record(int level, double cubes, double triangles, double seconds
 
 double CostModel::Predict(int level, double cubes, double triangles) const
 {
-  double abc[3];
-  if ((level >= 0 && level < NumberOfLevels && this->Levels[level].Solve(abc)) ||
-    this->All.Solve(abc))
+  if (level < 0 || level >= NumberOfLevels)
   {
-    return abc[0] * cubes + abc[1] * triangles + abc[2];
+    return -1.0;
   }
+  // The defaults scaled to the level's records (or to all records before the
+  // level has one): one parameter, stable from the first record.
+  const Fit& own = this->Levels[level];
+  const Fit& scaleFit = own.ScaleDenominator > 0 ? own : this->All;
   const double scale =
-    this->All.ScaleDenominator > 0 ? this->All.ScaleNumerator / this->All.ScaleDenominator : 1.0;
-  return scale * Default(cubes, triangles);
+    scaleFit.ScaleDenominator > 0 ? scaleFit.ScaleNumerator / scaleFit.ScaleDenominator : 1.0;
+  const double scaled = scale * Default(cubes, triangles);
+  // The level's own three-term fit once it has enough records, unless it
+  // strays far from the scaled defaults (a fit of few, noisy records).
+  double abc[3];
+  if (own.Solve(abc))
+  {
+    const double fitted = abc[0] * cubes + abc[1] * triangles + abc[2];
+    if (fitted > scaled / 3 && fitted < scaled * 3)
+    {
+      return fitted;
+    }
+  }
+  return scaled;
 }
 
 BlockLODEstimator::BlockLODEstimator(BlockLODVolume& volume)

@@ -70,16 +70,18 @@ struct SurfaceLayout
 };
 
 /// Seconds of an update that extracts surfaces at a level, from the cubes it
-/// visits and the triangles it makes: A * cubes + B * triangles + C (C: the
-/// update's fixed work, such as checks, estimates and output assembly). A, B
-/// and C are fitted by least squares on relative errors (weights 1 / the
-/// predicted seconds^2: a 10 ms update counts as much as a 1 s one) to the
-/// host's records, older records fading by Memory per new one so the fit follows the
-/// machine's load. A level's own fit predicts once it has three records (the
-/// levels' costs per cube differ); before that, the fit over all levels;
-/// before that (or when a fit is not positive), the defaults scaled to match
-/// the records. A record more than twice off the prediction (a disturbed
-/// update: another process held a core) counts a tenth.
+/// visits and the triangles it makes. Defaults A * cubes + B * triangles + C
+/// (C: the update's fixed work, such as checks, estimates and output
+/// assembly) are scaled to match the level's records (one parameter, stable
+/// from the first record; the records of all levels before the level has
+/// one). Once a level has MinimumRecords records, its own A, B and C, fitted
+/// by least squares, predict instead, unless they stray more than 3x from the
+/// scaled defaults. Fits are on relative errors (weights 1 / seconds^2,
+/// seconds no less than the prediction: a 10 ms update counts as much as a
+/// 1 s one, a spuriously fast one no more), older records fading by Memory per
+/// new one so the model follows the machine's load; a record more than twice
+/// off the prediction (a disturbed update: another process held a core)
+/// counts a tenth.
 class CostModel
 {
 public:
@@ -91,6 +93,8 @@ public:
   static constexpr double Memory = 0.97;
   /// Weight of a record more than twice off the prediction.
   static constexpr double OutlierWeight = 0.1;
+  /// Records a fit needs before it predicts (three would fit any three points).
+  static constexpr int MinimumRecords = 5;
 
   void Record(int level, double cubes, double triangles, double seconds);
   double Predict(int level, double cubes, double triangles) const;
@@ -112,7 +116,7 @@ private:
     double ScaleDenominator = 0;
     int Samples = 0;
     void Record(double cubes, double triangles, double seconds, double weight);
-    // The fitted A, B, C when there are 3 records and they are all >= 0.
+    // The fitted A, B, C when there are MinimumRecords records and all are >= 0.
     bool Solve(double abc[3]) const;
   };
   static double Default(double cubes, double triangles);

@@ -340,17 +340,19 @@ void TestCostModel()
   std::printf("after three records at 0.2x the law: prediction %.2fx the law\n", kept);
   Check(std::fabs(kept - 1) < 0.2, "records far off the fit count little");
 
-  // A level's own fit, once it has three records; the fit of all levels before.
+  // Before a level has records, the defaults scaled to all records; then to
+  // its own; then its own fit.
   CostModel levels;
   for (const auto& s : samples)
   {
     levels.Record(1, s[0], s[1], 3 * (a * s[0] + b * s[1] + c));
   }
-  levels.Record(2, 1e6, 1e5, a * 1e6 + b * 1e5 + c);
   Check(std::fabs(levels.Predict(1, 3e6, 2e5) / (3 * (a * 3e6 + b * 2e5 + c)) - 1) < 1e-6,
-    "a level with three records: its own fit");
-  Check(std::fabs(levels.Predict(2, 3e6, 2e5) / levels.Predict(0, 3e6, 2e5) - 1) < 1e-12,
-    "a level with fewer: the fit of all levels");
+    "a level with enough records: its own fit");
+  const double unseen = levels.Predict(2, 3e6, 2e5);
+  levels.Record(2, 1e6, 1e5, 0.5 * levels.Predict(2, 1e6, 1e5));
+  Check(std::fabs(levels.Predict(2, 3e6, 2e5) / unseen - 0.5) < 1e-6,
+    "a level's first record rescales the defaults for that level");
 
   // Records that cannot separate the terms (one size only) still predict that size.
   CostModel collinear;
