@@ -21,6 +21,7 @@
 #include "vtkIntArray.h"
 #include "vtkMarchingCubesTriangleCases.h"
 #include "vtkMatrix3x3.h"
+#include "vtkMedicalCoreScalarType.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -67,40 +68,6 @@ void SMPFor(std::int64_t begin, std::int64_t end, const mediso::RangeBody& body)
   vtkSMPTools::For(begin, end, grain, [&](vtkIdType b, vtkIdType e) { body(b, e); });
 }
 
-// The core's scalar type of a VTK array type; false when the core has none.
-bool CoreScalarType(int vtkType, mediso::ScalarType& type)
-{
-  switch (vtkType)
-  {
-    case VTK_CHAR:
-    case VTK_SIGNED_CHAR:
-      type = mediso::ScalarType::Int8;
-      return true;
-    case VTK_UNSIGNED_CHAR:
-      type = mediso::ScalarType::UInt8;
-      return true;
-    case VTK_SHORT:
-      type = mediso::ScalarType::Int16;
-      return true;
-    case VTK_UNSIGNED_SHORT:
-      type = mediso::ScalarType::UInt16;
-      return true;
-    case VTK_INT:
-      type = mediso::ScalarType::Int32;
-      return true;
-    case VTK_UNSIGNED_INT:
-      type = mediso::ScalarType::UInt32;
-      return true;
-    case VTK_FLOAT:
-      type = mediso::ScalarType::Float32;
-      return true;
-    case VTK_DOUBLE:
-      type = mediso::ScalarType::Float64;
-      return true;
-    default:
-      return false;
-  }
-}
 
 // An output vtkPolyData sized for `points` and `triangles`, with raw pointers
 // to fill. Connectivity is 32-bit when it fits.
@@ -383,7 +350,7 @@ struct vtkBlockLODContour::vtkInternals
     vtkImageData* input, vtkDataArray* array, vtkInformation* inInfo)
   {
     mediso::VolumeDescription d;
-    CoreScalarType(array->GetDataType(), d.Type);
+    vtkMedicalCoreScalarType(array->GetDataType(), d.Type);
     d.Data = array->GetVoidPointer(0);
     d.Stamp = array->GetMTime();
     int extent[6];
@@ -763,7 +730,7 @@ vtkDataArray* vtkBlockLODContour::CheckInput(vtkImageData* input, vtkInformation
     return nullptr;
   }
   mediso::ScalarType type;
-  if (!CoreScalarType(array->GetDataType(), type) || !array->HasStandardMemoryLayout() ||
+  if (!vtkMedicalCoreScalarType(array->GetDataType(), type) || !array->HasStandardMemoryLayout() ||
     array->GetNumberOfTuples() != static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2])
   {
     vtkErrorMacro("Array '" << name << "' of type " << array->GetDataTypeAsString()
