@@ -15,10 +15,13 @@
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkInformationDoubleVectorKey.h"
+#include "vtkInformationInformationVectorKey.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
 #include "vtkMarchingCubesTriangleCases.h"
 #include "vtkMatrix3x3.h"
+#include "vtkMedicalCoreScalarType.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -35,7 +38,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <map>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -65,40 +68,6 @@ void SMPFor(std::int64_t begin, std::int64_t end, const mediso::RangeBody& body)
   vtkSMPTools::For(begin, end, grain, [&](vtkIdType b, vtkIdType e) { body(b, e); });
 }
 
-// The core's scalar type of a VTK array type; false when the core has none.
-bool CoreScalarType(int vtkType, mediso::ScalarType& type)
-{
-  switch (vtkType)
-  {
-    case VTK_CHAR:
-    case VTK_SIGNED_CHAR:
-      type = mediso::ScalarType::Int8;
-      return true;
-    case VTK_UNSIGNED_CHAR:
-      type = mediso::ScalarType::UInt8;
-      return true;
-    case VTK_SHORT:
-      type = mediso::ScalarType::Int16;
-      return true;
-    case VTK_UNSIGNED_SHORT:
-      type = mediso::ScalarType::UInt16;
-      return true;
-    case VTK_INT:
-      type = mediso::ScalarType::Int32;
-      return true;
-    case VTK_UNSIGNED_INT:
-      type = mediso::ScalarType::UInt32;
-      return true;
-    case VTK_FLOAT:
-      type = mediso::ScalarType::Float32;
-      return true;
-    case VTK_DOUBLE:
-      type = mediso::ScalarType::Float64;
-      return true;
-    default:
-      return false;
-  }
-}
 
 // An output vtkPolyData sized for `points` and `triangles`, with raw pointers
 // to fill. Connectivity is 32-bit when it fits.
@@ -150,8 +119,8 @@ SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const
     out.Surface->GetCellData()->AddArray(ids);
   }
   vtkNew<vtkCellArray> polys;
-  const bool small = !mediso::SurfaceLayout::NeedsWideIds(
-    static_cast<double>(points), static_cast<double>(triangles));
+  const bool small =
+    layout.IdBytesFor(static_cast<double>(points), static_cast<double>(triangles)) == 4;
   auto fillOffsets = [triangles](auto* offsets) {
     vtkSMPTools::For(0, triangles + 1, [offsets](vtkIdType b, vtkIdType e) {
       for (vtkIdType i = b; i < e; ++i)
@@ -216,7 +185,85 @@ mediso::SurfaceLayout OutputLayout(vtkBlockLODContour* self)
   layout.Scalars = self->GetComputeScalars();
   layout.BlockIds = self->GetGenerateBlockIds();
   layout.Offsets = true; // vtkCellArray: offsets and connectivity
+  layout.IdBytes = self->GetCompactIds() ? 4 : 8;
   return layout;
+}
+
+// The cost model of EstimateSeconds(): it describes the machine, not an input,
+// so every filter of the process learns into and predicts from the same one.
+struct
+{
+  std::mutex Mutex;
+  mediso::CostModel Model;
+} SharedCost;
+
+// Stores a vector array's ranges in VTK's range cache (per component and of
+// the length, finite or not: the array holds only finite values).
+void CacheRanges(vtkDataArray* array, const mediso::VectorRange& range)
+{
+  if (!array || range.IsEmpty())
+  {
+    return;
+  }
+  vtkInformation* info = array->GetInformation();
+  for (vtkInformationInformationVectorKey* key :
+    { vtkAbstractArray::PER_COMPONENT(), vtkAbstractArray::PER_FINITE_COMPONENT() })
+  {
+    vtkNew<vtkInformationVector> components;
+    components->SetNumberOfInformationObjects(3);
+    for (int c = 0; c < 3; ++c)
+    {
+      const double r[2] = { range.Min[c], range.Max[c] };
+      components->GetInformationObject(c)->Set(vtkDataArray::COMPONENT_RANGE(), r, 2);
+    }
+    info->Set(key, components);
+  }
+  const double length[2] = { std::sqrt(range.MinLength2), std::sqrt(range.MaxLength2) };
+  info->Set(vtkDataArray::L2_NORM_RANGE(), length, 2);
+  info->Set(vtkDataArray::L2_NORM_FINITE_RANGE(), length, 2);
+}
+
+// The same for a one-component array of a known range.
+void CacheRanges(vtkDataArray* array, double lo, double hi)
+{
+  if (!array)
+  {
+    return;
+  }
+  vtkInformation* info = array->GetInformation();
+  const double r[2] = { lo, hi };
+  for (vtkInformationInformationVectorKey* key :
+    { vtkAbstractArray::PER_COMPONENT(), vtkAbstractArray::PER_FINITE_COMPONENT() })
+  {
+    vtkNew<vtkInformationVector> components;
+    components->SetNumberOfInformationObjects(1);
+    components->GetInformationObject(0)->Set(vtkDataArray::COMPONENT_RANGE(), r, 2);
+    info->Set(key, components);
+  }
+  info->Set(vtkDataArray::L2_NORM_RANGE(), r, 2);
+  info->Set(vtkDataArray::L2_NORM_FINITE_RANGE(), r, 2);
+}
+
+// The cached ranges of a 3-component array as a VectorRange (GetRange reads
+// the cache; the array is read only where a range is not cached).
+mediso::VectorRange RangesOf(vtkDataArray* array)
+{
+  mediso::VectorRange range;
+  if (!array || array->GetNumberOfTuples() == 0)
+  {
+    return range;
+  }
+  double r[2];
+  for (int c = 0; c < 3; ++c)
+  {
+    array->GetRange(r, c);
+    range.Min[c] = r[0];
+    range.Max[c] = r[1];
+  }
+  array->GetRange(r, -1);
+  range.MinLength2 = r[0] * r[0];
+  range.MaxLength2 = r[1] * r[1];
+  return range;
 }
 
 double Now()
@@ -233,10 +280,12 @@ struct vtkBlockLODContour::vtkInternals
   mediso::SurfaceLayout CacheLayout;
   bool WarnedMissing = false; // NaN or infinite values, once per input
 
-  // What the last RequestData planned and generated.
-  std::map<double, mediso::ExtractionPlan> Plans;
-  std::map<double, double> PlanSeconds;
+  // What the last RequestData planned (one plan per isovalue, kept between
+  // updates so that their buffers are reused, not faulted in again) and
+  // generated, and the counts of the pairs it extracted (for the cost model).
+  std::vector<mediso::ExtractionPlan> Plans;
   std::vector<vtkSmartPointer<vtkPolyData>> Surfaces;
+  mediso::SurfaceCounts Extracted;
 
   // Cells that are not ghosts, as an inclusive cell index range per axis:
   // ghost layers of a structured piece are whole slabs at its faces. Without
@@ -301,7 +350,7 @@ struct vtkBlockLODContour::vtkInternals
     vtkImageData* input, vtkDataArray* array, vtkInformation* inInfo)
   {
     mediso::VolumeDescription d;
-    CoreScalarType(array->GetDataType(), d.Type);
+    vtkMedicalCoreScalarType(array->GetDataType(), d.Type);
     d.Data = array->GetVoidPointer(0);
     d.Stamp = array->GetMTime();
     int extent[6];
@@ -360,6 +409,7 @@ struct vtkBlockLODContour::vtkInternals
     }
     this->Estimator.Reset();
     this->Cache.Clear();
+    this->Plans.clear(); // sized for the old input
     this->WarnedMissing = false;
     return true;
   }
@@ -464,8 +514,12 @@ double vtkBlockLODContour::EstimateSeconds(double isovalue, int level)
   }
   const mediso::SurfaceEstimate e = in.Estimator.Estimate(isovalue, level);
   this->LastEstimateMethod = static_cast<int>(e.Method);
-  return e.Method == mediso::EstimateMethod::None ? -1.0
-                                                  : in.Estimator.GetCostModel().Predict(e.Counts);
+  if (e.Method == mediso::EstimateMethod::None)
+  {
+    return -1.0;
+  }
+  std::lock_guard<std::mutex> lock(SharedCost.Mutex);
+  return SharedCost.Model.Predict(level, e.Counts);
 }
 
 //------------------------------------------------------------------------------
@@ -483,9 +537,9 @@ int vtkBlockLODContour::RequestData(
     return 0;
   }
   vtkInternals& in = *this->Internals;
-  in.Plans.clear();
-  in.PlanSeconds.clear();
   in.Surfaces.clear();
+  in.Extracted = mediso::SurfaceCounts();
+  const double start = Now();
 
   // Check: an array the core can read, on a grid it can contour.
   vtkDataArray* array = this->CheckInput(input, inputVector);
@@ -494,10 +548,13 @@ int vtkBlockLODContour::RequestData(
     return 1;
   }
   // Refresh block ranges (kept while the input stays the same).
-  if (in.Refresh(vtkInternals::Describe(input, array, inputVector[0]->GetInformationObject(0))))
+  const bool refreshed =
+    in.Refresh(vtkInternals::Describe(input, array, inputVector[0]->GetInformationObject(0)));
+  if (refreshed)
   {
     ++this->NumberOfBlockRangeComputations;
   }
+  const int coarseCopies = in.Volume.GetNumberOfCoarseCopies();
   this->UpdateProgress(0.1);
   const std::vector<double> values = this->IsovaluesWithSurface();
   if (values.empty())
@@ -521,6 +578,13 @@ int vtkBlockLODContour::RequestData(
   }
   this->UpdateProgress(0.9);
   this->AssembleOutput(output);
+  // The cost model learns from updates that extracted something and did no
+  // one-time work (block ranges, coarse copies).
+  if (in.Extracted.Cubes > 0 && !refreshed && in.Volume.GetNumberOfCoarseCopies() == coarseCopies)
+  {
+    std::lock_guard<std::mutex> lock(SharedCost.Mutex);
+    SharedCost.Model.Record(level, in.Extracted.Cubes, in.Extracted.Triangles, Now() - start);
+  }
   this->UpdateProgress(1.0);
   return 1;
 }
@@ -666,7 +730,7 @@ vtkDataArray* vtkBlockLODContour::CheckInput(vtkImageData* input, vtkInformation
     return nullptr;
   }
   mediso::ScalarType type;
-  if (!CoreScalarType(array->GetDataType(), type) || !array->HasStandardMemoryLayout() ||
+  if (!vtkMedicalCoreScalarType(array->GetDataType(), type) || !array->HasStandardMemoryLayout() ||
     array->GetNumberOfTuples() != static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2])
   {
     vtkErrorMacro("Array '" << name << "' of type " << array->GetDataTypeAsString()
@@ -779,23 +843,22 @@ bool vtkBlockLODContour::PlanLevel(const std::vector<double>& values, int& level
   auto abort = [this]() { return this->GetAbortExecute() != 0; };
   for (;;)
   {
-    in.Plans.clear();
+    in.Plans.resize(values.size());
     double bytes = 0;
-    for (double v : values)
+    for (std::size_t i = 0; i < values.size(); ++i)
     {
+      const double v = values[i];
       const mediso::SurfaceKey key{ v, level };
       if (in.Cache.Contains(key))
       {
         bytes += in.Cache.EntryBytes(key);
         continue;
       }
-      mediso::ExtractionPlan& plan = in.Plans[v];
-      const double start = Now();
+      mediso::ExtractionPlan& plan = in.Plans[i];
       if (!in.Volume.Plan(v, level, plan, abort) || this->CheckAbort())
       {
         return false;
       }
-      in.PlanSeconds[v] = Now() - start;
       const mediso::SurfaceCounts exact = mediso::BlockLODVolume::CountsOf(plan);
       in.Estimator.RecordExact(v, level, exact);
       bytes += layout.Bytes(exact);
@@ -836,9 +899,9 @@ bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int le
   vtkInternals& in = *this->Internals;
   const mediso::SurfaceLayout layout = OutputLayout(this);
   std::vector<mediso::SurfaceKey> used;
-  for (double v : values)
+  for (std::size_t i = 0; i < values.size(); ++i)
   {
-    const mediso::SurfaceKey key{ v, level };
+    const mediso::SurfaceKey key{ values[i], level };
     used.push_back(key);
     if (vtkSmartPointer<vtkPolyData>* cached = in.Cache.Find(key))
     {
@@ -846,10 +909,10 @@ bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int le
       in.Surfaces.push_back(*cached);
       continue;
     }
-    const mediso::ExtractionPlan& plan = in.Plans[v];
-    const double start = Now();
+    const mediso::ExtractionPlan& plan = in.Plans[i];
     SurfaceArrays arrays =
       AllocateSurface(plan.GetNumberOfPoints(), plan.GetNumberOfTriangles(), layout);
+      mediso::SurfaceRanges written;
     auto generate = [&](auto* connectivity) {
       mediso::SurfaceBuffers<std::remove_pointer_t<decltype(connectivity)>> buffers;
       buffers.Points = arrays.Points;
@@ -857,6 +920,7 @@ bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int le
       buffers.Scalars = arrays.Scalars;
       buffers.BlockIds = arrays.BlockIds;
       buffers.Connectivity = connectivity;
+      buffers.Ranges = &written;
       in.Volume.Generate(plan, buffers);
     };
     if (arrays.Connectivity32)
@@ -867,10 +931,15 @@ bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int le
     {
       generate(arrays.Connectivity64);
     }
+    vtkPolyData* surface = arrays.Surface;
+    CacheRanges(surface->GetPoints()->GetData(), written.Points);
+    CacheRanges(surface->GetPointData()->GetNormals(), written.Normals);
+    const double iso = static_cast<float>(values[i]); // the scalars' value, as stored
+    CacheRanges(surface->GetPointData()->GetScalars(), iso, iso);
     ++this->NumberOfExtractions;
     const mediso::SurfaceCounts counts = mediso::BlockLODVolume::CountsOf(plan);
-    in.Estimator.GetCostModel().Record(
-      counts.Cubes, counts.Triangles, in.PlanSeconds[v] + (Now() - start));
+    in.Extracted.Cubes += counts.Cubes;
+    in.Extracted.Triangles += counts.Triangles;
     in.Surfaces.push_back(arrays.Surface);
     if (this->CacheMemoryLimit > 0)
     {
@@ -902,9 +971,19 @@ void vtkBlockLODContour::AssembleOutput(vtkPolyData* output)
       triangles += p->GetNumberOfPolys();
     }
     SurfaceArrays all = AllocateSurface(points, triangles, OutputLayout(this));
+    mediso::SurfaceRanges merged;
+    double scalars[2] = { 1e300, -1e300 };
     std::int64_t p0 = 0, t0 = 0;
     for (const auto& p : pieces)
     {
+      merged.Points.Merge(RangesOf(p->GetPoints()->GetData()));
+      merged.Normals.Merge(RangesOf(p->GetPointData()->GetNormals()));
+      if (vtkDataArray* s = p->GetPointData()->GetScalars())
+      {
+        const double* r = s->GetRange();
+        scalars[0] = std::min(scalars[0], r[0]);
+        scalars[1] = std::max(scalars[1], r[1]);
+      }
       const std::int64_t np = p->GetNumberOfPoints();
       const std::int64_t nt = p->GetNumberOfPolys();
       auto copy = [&](vtkDataArray* a, float* dst, int comps) {
@@ -921,22 +1000,37 @@ void vtkBlockLODContour::AssembleOutput(vtkPolyData* output)
         std::memcpy(all.BlockIds + t0, p->GetCellData()->GetArray("BlockId")->GetVoidPointer(0),
           sizeof(std::int32_t) * nt);
       }
+      // The piece's ids shifted by its first point (each piece is stored in
+      // the width the merged surface has or a narrower one).
+      auto shift = [&](const auto* from, auto* to) {
+        vtkSMPTools::For(0, 3 * nt, [&](vtkIdType b, vtkIdType e) {
+          for (vtkIdType i = b; i < e; ++i)
+          {
+            to[3 * t0 + i] = static_cast<std::remove_reference_t<decltype(*to)>>(from[i] + p0);
+          }
+        });
+      };
       vtkDataArray* conn = p->GetPolys()->GetConnectivityArray();
-      for (std::int64_t i = 0; i < 3 * nt; ++i)
+      vtkTypeInt32Array* conn32 = vtkTypeInt32Array::FastDownCast(conn);
+      vtkTypeInt64Array* conn64 = vtkTypeInt64Array::FastDownCast(conn);
+      if (all.Connectivity32 && conn32)
       {
-        const std::int64_t id = static_cast<std::int64_t>(conn->GetComponent(i, 0)) + p0;
-        if (all.Connectivity32)
-        {
-          all.Connectivity32[3 * t0 + i] = static_cast<std::int32_t>(id);
-        }
-        else
-        {
-          all.Connectivity64[3 * t0 + i] = id;
-        }
+        shift(conn32->GetPointer(0), all.Connectivity32);
+      }
+      else if (all.Connectivity64 && conn32)
+      {
+        shift(conn32->GetPointer(0), all.Connectivity64);
+      }
+      else if (all.Connectivity64 && conn64)
+      {
+        shift(conn64->GetPointer(0), all.Connectivity64);
       }
       p0 += np;
       t0 += nt;
     }
+    CacheRanges(all.Surface->GetPoints()->GetData(), merged.Points);
+    CacheRanges(all.Surface->GetPointData()->GetNormals(), merged.Normals);
+    CacheRanges(all.Surface->GetPointData()->GetScalars(), scalars[0], scalars[1]);
     output->ShallowCopy(all.Surface);
   }
 

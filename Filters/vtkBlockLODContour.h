@@ -34,20 +34,18 @@
  *    CacheMemoryLimit (least recently used surfaces go first). Asking again
  *    for a cached pair costs no extraction (see GetNumberOfExtractions()).
  * -# Estimates. EstimateTriangles()/EstimateMegabytes()/EstimateSeconds()
- *    predict a pair's output before extracting it. Exact for a cached or
- *    planned pair. For a new pair, the cut cubes and cut edges are counted
- *    exactly on an evenly spread sample of about 256 active blocks and scaled
- *    to all active blocks (exact when there are fewer); the paper used a fixed
- *    2 triangles per cube instead. When two levels of the isovalue are already
- *    known and counting would be approximate, the estimate is scaled from them
- *    by that isovalue's own growth per level: marching-cubes surfaces grow
- *    about 4x per level when smooth (not the 8x of the paper's Table 1), but
- *    thin structures such as cortical bone grow nearer 2x at coarse levels and
- *    8x when they first appear, so no global factor is used. Bytes are those
- *    the output vtkPolyData holds (points, normals, scalars, connectivity,
- *    offsets, block ids); seconds follow a cost model (per visited cube and
- *    per triangle) fitted to this filter's own extractions, the paper's
- *    future work.
+ *    predict a pair's output before extracting it (BlockLODEstimator.h).
+ *    Exact for a cached or planned pair, and for a new pair whose active
+ *    blocks can all be counted within a fixed amount of work (levels 0 and 1
+ *    almost always). Otherwise the cut cubes and edges are counted on a spread
+ *    sample of active blocks together with the finest coarser level whose
+ *    count is exact, and scaled by that level's exact count (a ratio
+ *    estimate); the paper used a fixed 2 triangles per cube instead. Bytes are
+ *    those the output vtkPolyData holds (points, normals, scalars,
+ *    connectivity, offsets, block ids); seconds (the paper's future work)
+ *    are those of an update that extracts the pair, from a cost model (per
+ *    visited cube, per triangle and per update) fitted to the updates of
+ *    every vtkBlockLODContour in the process (it describes the machine).
  * -# AutoLOD. With AutoLOD on, the filter picks the highest level whose
  *    estimated output fits MemoryBudget (MB, all isovalues together). Exact
  *    counts are known before any output is allocated, so an underestimate
@@ -55,12 +53,15 @@
  *    level and warns. If even level 0 does not fit, it reports an error and
  *    produces nothing.
  *
- * Output: triangles (32-bit connectivity when it fits), point normals
- * ("Normals", optional), the isovalue as point scalars (optional), the block
- * id of each triangle ("BlockId", optional), and field data
- * "BlockLODLevel" (the level used), "BlockLODEstimatedTriangles",
- * "BlockLODEstimatedMB" and "BlockLODEstimatedSeconds" (4 values each, levels
- * 0..3, for the first isovalue).
+ * Output: triangles (64-bit connectivity, VTK's own; 32-bit while it fits
+ * with CompactIds), point normals ("Normals", optional), the isovalue as
+ * point scalars (optional), the block id of each triangle ("BlockId",
+ * optional), and field data "BlockLODLevel" (the level used),
+ * "BlockLODEstimatedTriangles", "BlockLODEstimatedMB" and
+ * "BlockLODEstimatedSeconds" (4 values each, levels 0..3, for the first
+ * isovalue). The points', normals' and scalars' value ranges are measured
+ * while they are written and stored with the arrays (VTK's range cache), so
+ * ParaView's data information and color maps do not read them again.
  *
  * Parallel pieces: every level samples the whole volume's grid (multiples of
  * the level's stride from the whole extent's origin, and the whole extent's
@@ -192,6 +193,19 @@ public:
 
   ///@{
   /**
+   * Store the triangles' point ids in 32 bits while they fit (a third less
+   * output memory) instead of VTK's own 64-bit vtkIdType. Default off: VTK's
+   * mappers and filters read 64-bit cell arrays in place but copy 32-bit ones
+   * cell by cell (ParaView's upload of a 650k-triangle surface takes about
+   * 30 ms longer), so compact ids suit a memory-bound client, not a renderer.
+   */
+  vtkSetMacro(CompactIds, bool);
+  vtkGetMacro(CompactIds, bool);
+  vtkBooleanMacro(CompactIds, bool);
+  ///@}
+
+  ///@{
+  /**
    * Memory (MB) the triangle cache may hold; 0 disables caching. Default 512.
    */
   vtkSetClampMacro(CacheMemoryLimit, double, 0.0, 1.0e9);
@@ -210,9 +224,10 @@ public:
   ///@}
 
   /**
-   * How the last estimate was made: 0 exact (cached or planned pair), 1 scaled
-   * from another level of the same isovalue, 2 counted on sampled blocks,
-   * -1 none.
+   * How the last estimate was made: 0 exact (cached, planned or every active
+   * block counted), 1 counted on sampled blocks and scaled by the exact count
+   * of a coarser level of the same isovalue, 2 counted on sampled blocks and
+   * scaled up to all active blocks, -1 none.
    */
   vtkGetMacro(LastEstimateMethod, int);
 
@@ -268,6 +283,7 @@ protected:
   bool ComputeNormals = true;
   bool ComputeScalars = false;
   bool GenerateBlockIds = false;
+  bool CompactIds = false;
   double CacheMemoryLimit = 512.0;
 
   int ChosenLevel = -1;

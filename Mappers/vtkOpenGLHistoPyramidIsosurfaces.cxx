@@ -8,6 +8,7 @@
 #include "vtkLightCollection.h"
 #include "vtkMath.h"
 #include "vtkMatrix4x4.h"
+#include "vtkMedicalCoreScalarType.h"
 #include "vtkMedicalGLCapabilities.h"
 #include "vtkMedicalGLUtilities.h"
 #include "vtkNew.h"
@@ -34,42 +35,6 @@ namespace
 {
 using namespace medical_gl;
 
-// The core's name for a VTK scalar type; false for a type it does not take.
-bool CoreScalarType(int vtkType, mediso::ScalarType& type)
-{
-  switch (vtkType)
-  {
-    case VTK_CHAR:
-      type = std::numeric_limits<char>::is_signed ? mediso::ScalarType::Int8 : mediso::ScalarType::UInt8;
-      return true;
-    case VTK_SIGNED_CHAR:
-      type = mediso::ScalarType::Int8;
-      return true;
-    case VTK_UNSIGNED_CHAR:
-      type = mediso::ScalarType::UInt8;
-      return true;
-    case VTK_SHORT:
-      type = mediso::ScalarType::Int16;
-      return true;
-    case VTK_UNSIGNED_SHORT:
-      type = mediso::ScalarType::UInt16;
-      return true;
-    case VTK_INT:
-      type = mediso::ScalarType::Int32;
-      return true;
-    case VTK_UNSIGNED_INT:
-      type = mediso::ScalarType::UInt32;
-      return true;
-    case VTK_FLOAT:
-      type = mediso::ScalarType::Float32;
-      return true;
-    case VTK_DOUBLE:
-      type = mediso::ScalarType::Float64;
-      return true;
-    default:
-      return false;
-  }
-}
 
 void ParallelFor(std::int64_t begin, std::int64_t end,
   const std::function<void(std::int64_t, std::int64_t)>& body)
@@ -213,7 +178,7 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
     return false;
   }
   mediso::ScalarType type;
-  if (!CoreScalarType(scalars->GetDataType(), type))
+  if (!vtkMedicalCoreScalarType(scalars->GetDataType(), type))
   {
     reason = std::string("the GPU path does not take ") + scalars->GetDataTypeAsString() + " data";
     return false;

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <type_traits>
 
 namespace mediso
@@ -60,7 +61,11 @@ inline bool IsMissing(T v)
   }
 }
 
-// The samples of one block at one level (see BlockLOD.h).
+// The samples of one block at one level (see BlockLOD.h), and the block's
+// bit layouts: cut edges as bit Axis * L^3 + (k * L + j) * L + i of a mask of
+// L = 8 / stride + 1 samples per axis (one plane of bits per axis, so that a
+// row of samples' x-, y- or z-edges is a run of bits), cubes as bit
+// (k * C + j) * C + i of C = 8 / stride cubes per axis.
 struct BlockSamples
 {
   int First[3];
@@ -68,14 +73,19 @@ struct BlockSamples
   int Count[3]; // samples along each axis (cubes = Count - 1)
   bool LastBlock[3];
   int Stride;
-  int Layout; // samples per axis of the bit layout: 8 / stride + 1
+  int Layout;      // L
+  int LayoutCube;  // L^3: bits per axis plane
+  int CubeShift;   // log2(C)
 
   BlockSamples(const BlockRanges& ranges, std::int64_t block, int stride)
     : Stride(stride)
     , Layout(BlockCells / stride + 1)
+    , LayoutCube(Layout * Layout * Layout)
+    , CubeShift(stride == 1 ? 3 : (stride == 2 ? 2 : (stride == 4 ? 1 : 0)))
   {
     const std::int64_t b[3] = { block % ranges.Blocks[0],
-      (block / ranges.Blocks[0]) % ranges.Blocks[1], block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]) };
+      (block / ranges.Blocks[0]) % ranges.Blocks[1],
+      block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]) };
     for (int a = 0; a < 3; ++a)
     {
       this->First[a] = static_cast<int>(b[a]) * BlockCells;
@@ -88,38 +98,125 @@ struct BlockSamples
   {
     return std::min(this->First[axis] + sample * this->Stride, this->Last[axis]);
   }
-  bool Owns(const int l[3]) const
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      if (l[a] == this->Count[a] - 1 && !this->LastBlock[a])
-      {
-        return false;
-      }
-    }
-    return true;
-  }
   int Bit(int i, int j, int k, int axis) const
   {
-    return ((k * this->Layout + j) * this->Layout + i) * 3 + axis;
+    return axis * this->LayoutCube + (k * this->Layout + j) * this->Layout + i;
+  }
+  // Samples along an axis whose edges (to the next sample) this block owns:
+  // all but the last, unless the block is the volume's last along the axis.
+  int Own(int axis) const
+  {
+    return this->LastBlock[axis] ? this->Count[axis] : this->Count[axis] - 1;
   }
 };
 
+int LayoutOf(int level)
+{
+  return BlockCells / LevelStride(level) + 1;
+}
+
 int WordsPerBlock(int level)
 {
-  const int layout = BlockCells / LevelStride(level) + 1;
+  const int layout = LayoutOf(level);
   return (3 * layout * layout * layout + 63) / 64;
 }
 
-// Per-sample classification of a gathered block: 1 when value >= iso, 0 when
-// below, NaNFlag when missing (NaN or infinite).
-constexpr std::uint8_t NaNFlag = 2;
+int CubeWordsPerBlock(int level)
+{
+  const int cubes = BlockCells / LevelStride(level);
+  return (cubes * cubes * cubes + 63) / 64;
+}
+
+inline int PopCount64(std::uint64_t x)
+{
+#if defined(__POPCNT__)
+  return __builtin_popcountll(x);
+#else
+  // Without the POPCNT instruction (x86-64 baseline) the builtin is a libgcc
+  // call; this SWAR count is inlined.
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+  return static_cast<int>((x * 0x0101010101010101ull) >> 56);
+#endif
+}
+
+// Transposes an 8 x 8 bit matrix held in 64 bits (bit 8 r + c is row r,
+// column c): Hacker's Delight, "Transposing a Bit Matrix".
+inline std::uint64_t TransposeBits8x8(std::uint64_t x)
+{
+  std::uint64_t t = (x ^ (x >> 7)) & 0x00AA00AA00AA00AAull;
+  x = x ^ t ^ (t << 7);
+  t = (x ^ (x >> 14)) & 0x0000CCCC0000CCCCull;
+  x = x ^ t ^ (t << 14);
+  t = (x ^ (x >> 28)) & 0x00000000F0F0F0F0ull;
+  return x ^ t ^ (t << 28);
+}
+
+// ORs a run of at most 16 bits into a bit mask at bit `at`.
+inline void OrBits(std::uint64_t* words, int at, std::uint32_t run)
+{
+  const int shift = at & 63;
+  words[at >> 6] |= static_cast<std::uint64_t>(run) << shift;
+  if (shift > 48)
+  {
+    // Past this word only when the run reaches beyond bit 63 (then the next
+    // word belongs to the same mask).
+    const std::uint64_t high = static_cast<std::uint64_t>(run) >> (64 - shift);
+    if (high)
+    {
+      words[(at >> 6) + 1] |= high;
+    }
+  }
+}
+
+// "value >= isovalue" for a sample type. For integer types the test is
+// v >= ceil(isovalue) in integers (no conversion of every sample to double).
+template <typename T>
+class AboveIsovalue
+{
+public:
+  explicit AboveIsovalue(double isovalue)
+    : Isovalue(isovalue)
+  {
+    if constexpr (std::is_integral<T>::value)
+    {
+      const double lo = static_cast<double>(std::numeric_limits<T>::lowest());
+      const double hi = static_cast<double>(std::numeric_limits<T>::max()) + 1.0; // never reached
+      const double c = std::ceil(isovalue);
+      this->Threshold = static_cast<std::int64_t>(c == c ? std::min(hi, std::max(lo, c)) : hi);
+    }
+  }
+  bool operator()(T v) const
+  {
+    if constexpr (std::is_integral<T>::value)
+    {
+      return static_cast<std::int64_t>(v) >= this->Threshold;
+    }
+    else
+    {
+      return static_cast<double>(v) >= this->Isovalue;
+    }
+  }
+
+private:
+  double Isovalue;
+  std::int64_t Threshold = 0;
+};
+
+// A block's samples classified against the isovalue, one bit mask per row of
+// samples along x: bit i of row (j, k) is sample i.
+struct BlockRows
+{
+  std::uint16_t Above[BlockCells + 1][BlockCells + 1];   // [k][j]: value >= isovalue
+  std::uint16_t Missing[BlockCells + 1][BlockCells + 1]; // [k][j]: NaN or infinite
+};
 
 // Classifies a block's samples straight from the data (no copy of the values).
 template <typename T>
-void Classify(const Volume<T>& v, const BlockSamples& s, double iso, std::vector<std::uint8_t>& flags)
+void ClassifyRows(
+  const Volume<T>& v, const BlockSamples& s, const AboveIsovalue<T>& above, BlockRows& rows)
 {
-  flags.resize(static_cast<std::size_t>(s.Count[0]) * s.Count[1] * s.Count[2]);
   const std::int64_t sx = v.Dims[0];
   const std::int64_t sxy = sx * v.Dims[1];
   int xs[BlockCells + 1];
@@ -127,20 +224,20 @@ void Classify(const Volume<T>& v, const BlockSamples& s, double iso, std::vector
   {
     xs[i] = s.Point(0, i);
   }
-  std::uint8_t* out = flags.data();
   for (int k = 0; k < s.Count[2]; ++k)
   {
     const std::int64_t zoff = s.Point(2, k) * sxy;
     for (int j = 0; j < s.Count[1]; ++j)
     {
       const T* row = v.Data + zoff + s.Point(1, j) * sx;
+      std::uint32_t a = 0, m = 0;
       if (s.Stride == 1)
       {
         const T* r = row + xs[0];
         for (int i = 0; i < s.Count[0]; ++i)
         {
-          const T value = r[i];
-          *out++ = IsMissing(value) ? NaNFlag : static_cast<std::uint8_t>(static_cast<double>(value) >= iso);
+          a |= static_cast<std::uint32_t>(above(r[i])) << i;
+          m |= static_cast<std::uint32_t>(IsMissing(r[i])) << i;
         }
       }
       else
@@ -148,144 +245,168 @@ void Classify(const Volume<T>& v, const BlockSamples& s, double iso, std::vector
         for (int i = 0; i < s.Count[0]; ++i)
         {
           const T value = row[xs[i]];
-          *out++ = IsMissing(value) ? NaNFlag : static_cast<std::uint8_t>(static_cast<double>(value) >= iso);
+          a |= static_cast<std::uint32_t>(above(value)) << i;
+          m |= static_cast<std::uint32_t>(IsMissing(value)) << i;
         }
       }
+      rows.Above[k][j] = static_cast<std::uint16_t>(a & ~m);
+      rows.Missing[k][j] = static_cast<std::uint16_t>(m);
     }
   }
 }
 
-// Pass-1 work on one block: the case of every cube (into `cubeCases` when not
-// null; 0 for a cube with a NaN corner), the triangle count, and the owned cut
-// edges (into `bits` when not null). Returns the number of owned cut edges.
-// Which samples of a block start an owned cube along each axis (all of them
-// without ghost cells).
+// Which samples of a block start owned cubes and owned edges, as bit masks
+// along each axis (every bit set without ghost cells). Start[a] bit l: the
+// cube starting at sample l along a is owned. Around[a] bit l: the cube
+// starting at l or at l - 1 is (an edge there is used by an owned cube).
+// Sample -1 is the last sample of the block below, whose cubes use the edges
+// on this block's lower face (which this block owns).
 struct OwnedSamples
 {
-  bool Any = false; // false: every cube is owned
-  // Starts[a][l + 1] for samples l = -1 .. Count - 1: sample -1 is the last
-  // sample of the block below, whose cubes use the edges on this block's
-  // lower face (which this block owns).
-  bool Starts[3][BlockCells + 2];
+  std::uint32_t Start[3];
+  std::uint32_t Around[3];
 
   template <typename T>
   OwnedSamples(const Volume<T>& v, const BlockSamples& s)
-    : Any(v.HasGhostCells())
   {
+    const bool ghosts = v.HasGhostCells();
     for (int a = 0; a < 3; ++a)
     {
+      this->Start[a] = this->Around[a] = 0xFFFFu;
+      if (!ghosts)
+      {
+        continue;
+      }
+      this->Start[a] = this->Around[a] = 0;
+      bool previous = false; // sample l - 1 starts an owned cube
       for (int l = -1; l < s.Count[a]; ++l)
       {
         const int p = l < 0 ? s.First[a] - s.Stride : s.Point(a, l);
-        this->Starts[a][l + 1] = p >= 0 && p >= v.OwnedCells[2 * a] && p <= v.OwnedCells[2 * a + 1];
+        const bool starts = p >= 0 && p >= v.OwnedCells[2 * a] && p <= v.OwnedCells[2 * a + 1];
+        if (l >= 0)
+        {
+          this->Start[a] |= static_cast<std::uint32_t>(starts) << l;
+          this->Around[a] |= static_cast<std::uint32_t>(starts || previous) << l;
+        }
+        previous = starts;
       }
     }
-  }
-  bool Cube(int i, int j, int k) const
-  {
-    return !this->Any ||
-      (this->Starts[0][i + 1] && this->Starts[1][j + 1] && this->Starts[2][k + 1]);
-  }
-  // An edge from sample l along `axis` is used by an owned cube: the cube
-  // starting at l along the axis, and at l - 1 or l along the other two.
-  bool Edge(const int l[3], int axis) const
-  {
-    if (!this->Any)
-    {
-      return true;
-    }
-    for (int b = 0; b < 3; ++b)
-    {
-      const bool here = this->Starts[b][l[b] + 1];
-      const bool before = b != axis && this->Starts[b][l[b]];
-      if (!(here || before))
-      {
-        return false;
-      }
-    }
-    return true;
   }
 };
 
-std::int64_t CountBlock(const std::vector<std::uint8_t>& flags, const BlockSamples& s,
-  const OwnedSamples& owned, const TriangleCounts& counts, std::int64_t& triangles,
-  std::uint8_t* cubeCases, std::uint64_t* bits)
+// Pass-1 work on one classified block: the owned cut edges (into `edgeBits`,
+// WordsPerBlock words, cleared by the caller) and the cut cubes with their
+// cases (into `cutCubes` and `cubeCases` when not null; a cube with a missing
+// corner is never cut). Returns the owned cut edges (points: the bits set)
+// and the triangles.
+struct BlockCounts
+{
+  std::int64_t Points = 0;
+  std::int64_t Triangles = 0;
+};
+
+BlockCounts CountBlock(const BlockRows& rows, const BlockSamples& s, const OwnedSamples& owned,
+  const TriangleCounts& counts, std::uint64_t* edgeBits, int words, std::uint64_t* cutCubes,
+  std::uint8_t* cubeCases)
 {
   const int* n = s.Count;
-  const int sx = n[0];
-  const int sxy = n[0] * n[1];
-  const int corner[8] = { 0, 1, 1 + sx, sx, sxy, 1 + sxy, 1 + sx + sxy, sx + sxy };
-  std::int64_t tris = 0;
-  int cube = 0;
+  const int own[3] = { s.Own(0), s.Own(1), s.Own(2) };
+  const int L = s.Layout;
+  // Samples that start an edge or cube along x, and samples with owned edges along y, z.
+  const std::uint32_t startX = ((1u << (n[0] - 1)) - 1) & owned.Start[0];
+  const std::uint32_t ownX = ((1u << own[0]) - 1) & owned.Around[0];
+  BlockCounts result;
+  auto bit = [](std::uint32_t mask, int l) { return (mask >> l) & 1u; };
+  for (int k = 0; k < n[2]; ++k)
+  {
+    for (int j = 0; j < n[1]; ++j)
+    {
+      const std::uint32_t a = rows.Above[k][j];
+      const std::uint32_t m = rows.Missing[k][j];
+      const int rowBit = (k * L + j) * L;
+      if (j < own[1] && k < own[2] && bit(owned.Around[1], j) && bit(owned.Around[2], k))
+      {
+        const std::uint32_t cut = (a ^ (a >> 1)) & ~(m | (m >> 1)) & startX;
+        if (cut)
+        {
+          OrBits(edgeBits, rowBit, cut);
+        }
+      }
+      if (j + 1 < n[1] && k < own[2] && bit(owned.Start[1], j) && bit(owned.Around[2], k))
+      {
+        const std::uint32_t cut =
+          (a ^ rows.Above[k][j + 1]) & ~(m | rows.Missing[k][j + 1]) & ownX;
+        if (cut)
+        {
+          OrBits(edgeBits, s.LayoutCube + rowBit, cut);
+        }
+      }
+      if (k + 1 < n[2] && j < own[1] && bit(owned.Around[1], j) && bit(owned.Start[2], k))
+      {
+        const std::uint32_t cut =
+          (a ^ rows.Above[k + 1][j]) & ~(m | rows.Missing[k + 1][j]) & ownX;
+        if (cut)
+        {
+          OrBits(edgeBits, 2 * s.LayoutCube + rowBit, cut);
+        }
+      }
+    }
+  }
   for (int k = 0; k + 1 < n[2]; ++k)
   {
+    if (!bit(owned.Start[2], k))
+    {
+      continue;
+    }
     for (int j = 0; j + 1 < n[1]; ++j)
     {
-      const std::uint8_t* f = flags.data() + k * sxy + j * sx;
-      for (int i = 0; i + 1 < n[0]; ++i, ++f, ++cube)
+      if (!bit(owned.Start[1], j))
       {
-        int index = 0;
-        int nan = 0;
-        for (int c = 0; c < 8; ++c)
-        {
-          const int v = f[corner[c]];
-          index |= (v & 1) << c;
-          nan |= v & NaNFlag;
-        }
-        index = (nan || !owned.Cube(i, j, k)) ? 0 : index;
-        tris += counts.Count[index];
+        continue;
+      }
+      const std::uint32_t r00 = rows.Above[k][j], r10 = rows.Above[k][j + 1];
+      const std::uint32_t r01 = rows.Above[k + 1][j], r11 = rows.Above[k + 1][j + 1];
+      const std::uint32_t any = r00 | r10 | r01 | r11;
+      const std::uint32_t all = r00 & r10 & r01 & r11;
+      const std::uint32_t missing = rows.Missing[k][j] | rows.Missing[k][j + 1] |
+        rows.Missing[k + 1][j] | rows.Missing[k + 1][j + 1];
+      std::uint32_t cut =
+        (any | (any >> 1)) & ~(all & (all >> 1)) & ~(missing | (missing >> 1)) & startX;
+      if (!cut)
+      {
+        continue;
+      }
+      // The cases of the row's (up to 8) cubes at once: byte c of `corners`
+      // holds corner c of every cube (bit i: cube i); transposed, byte i is
+      // cube i's case.
+      const std::uint64_t corners = std::uint64_t(r00 & 0xFF) |
+        std::uint64_t((r00 >> 1) & 0xFF) << 8 | std::uint64_t((r10 >> 1) & 0xFF) << 16 |
+        std::uint64_t(r10 & 0xFF) << 24 | std::uint64_t(r01 & 0xFF) << 32 |
+        std::uint64_t((r01 >> 1) & 0xFF) << 40 | std::uint64_t((r11 >> 1) & 0xFF) << 48 |
+        std::uint64_t(r11 & 0xFF) << 56;
+      const std::uint64_t cubeCasesOfRow = TransposeBits8x8(corners);
+      const int rowCube = ((k << s.CubeShift) + j) << s.CubeShift;
+      for (; cut; cut &= cut - 1)
+      {
+        const int i = __builtin_ctz(cut);
+        const std::uint32_t c = static_cast<std::uint32_t>(cubeCasesOfRow >> (8 * i)) & 0xFF;
+        result.Triangles += counts.Count[c];
         if (cubeCases)
         {
-          cubeCases[cube] = static_cast<std::uint8_t>(index);
+          const int cube = rowCube + i;
+          cubeCases[cube] = static_cast<std::uint8_t>(c);
+          cutCubes[cube >> 6] |= std::uint64_t(1) << (cube & 63);
         }
       }
     }
   }
-  triangles = tris;
-
-  std::int64_t points = 0;
-  const int step[3] = { 1, sx, sxy };
-  // Owned samples: all but the last along an axis, unless the block is the
-  // volume's last along that axis.
-  const int own[3] = { s.LastBlock[0] ? n[0] : n[0] - 1, s.LastBlock[1] ? n[1] : n[1] - 1,
-    s.LastBlock[2] ? n[2] : n[2] - 1 };
-  for (int k = 0; k < own[2]; ++k)
+  // Points counted per word of the mask, not per row: fewer bit counts.
+  for (int w = 0; w < words; ++w)
   {
-    for (int j = 0; j < own[1]; ++j)
-    {
-      for (int i = 0; i < own[0]; ++i)
-      {
-        const int idx = k * sxy + j * sx + i;
-        const int f0 = flags[idx];
-        if (f0 == NaNFlag)
-        {
-          continue;
-        }
-        const int l[3] = { i, j, k };
-        for (int a = 0; a < 3; ++a)
-        {
-          if (l[a] + 1 >= n[a])
-          {
-            continue;
-          }
-          const int f1 = flags[idx + step[a]];
-          if (f1 != NaNFlag && f1 != f0 && owned.Edge(l, a))
-          {
-            ++points;
-            if (bits)
-            {
-              const int bit = s.Bit(i, j, k, a);
-              bits[bit >> 6] |= std::uint64_t(1) << (bit & 63);
-            }
-          }
-        }
-      }
-    }
+    result.Points += PopCount64(edgeBits[w]);
   }
-  return points;
+  return result;
 }
-
-
 
 // Negative gradient of the original data at a point, by central differences
 // over the level's stride (one-sided on the boundary), in world units. At full
@@ -301,6 +422,7 @@ struct GradientOperator
   std::int64_t Step[3];
   int Interior[3];        // full-index distance between the neighbours of an interior sample
   double InvInterior[3];  // 1 / (that distance * spacing): no division in the common case
+  int InteriorLast[3];    // last index whose neighbours are both interior-spaced samples
 
   GradientOperator(const Volume<T>& v, int stride)
     : V(v)
@@ -313,12 +435,28 @@ struct GradientOperator
     {
       this->Interior[a] = 2 * stride * v.SampleStride;
       this->InvInterior[a] = 1.0 / (this->Interior[a] * v.Spacing[a]);
+      // A coarse copy's last sample may sit closer than its stride (the
+      // volume's last point off the level's grid): keep it off the fast path.
+      this->InteriorLast[a] = v.Dims[a] - 1 - stride - (v.SampleStride > 1 ? 1 : 0);
     }
   }
 
   void operator()(const int p[3], double g[3]) const
   {
     const std::int64_t at = p[0] + p[1] * this->Step[1] + p[2] * this->Step[2];
+    const int s = this->Stride;
+    if (p[0] >= s && p[1] >= s && p[2] >= s && p[0] <= this->InteriorLast[0] &&
+      p[1] <= this->InteriorLast[1] && p[2] <= this->InteriorLast[2])
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        const std::int64_t d = s * this->Step[a];
+        g[a] = (static_cast<double>(this->V.Data[at - d]) -
+                 static_cast<double>(this->V.Data[at + d])) *
+          this->InvInterior[a];
+      }
+      return;
+    }
     for (int a = 0; a < 3; ++a)
     {
       const int lo = std::max(0, p[a] - this->Stride);
@@ -333,19 +471,6 @@ struct GradientOperator
   }
 };
 
-inline int PopCount64(std::uint64_t x)
-{
-#if defined(__POPCNT__)
-  return __builtin_popcountll(x);
-#else
-  // Without the POPCNT instruction (x86-64 baseline) the builtin is a libgcc
-  // call; this SWAR count is inlined.
-  x = x - ((x >> 1) & 0x5555555555555555ull);
-  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
-  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
-  return static_cast<int>((x * 0x0101010101010101ull) >> 56);
-#endif
-}
 } // namespace
 
 void SerialFor(std::int64_t begin, std::int64_t end, const RangeBody& body)
@@ -524,13 +649,17 @@ bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, Triangle
   const int words = plan.WordsPerBlock;
   const int cubesPerAxis = BlockCells / stride;
   plan.CubesPerBlock = cubesPerAxis * cubesPerAxis * cubesPerAxis;
-  plan.CubeCases.assign(numActive * plan.CubesPerBlock, 0);
+  plan.CubeWordsPerBlock = CubeWordsPerBlock(level);
+  // Cases are read only where a cube's bit is set: no need to clear them.
+  plan.CubeCases.resize(numActive * plan.CubesPerBlock);
+  plan.CutCubes.assign(numActive * plan.CubeWordsPerBlock, 0);
   plan.EdgeBits.assign(numActive * words, 0);
   plan.EdgeRank.assign(numActive * words, 0);
   plan.PointOffset.assign(numActive + 1, 0);
   plan.TriangleOffset.assign(numActive + 1, 0);
 
   const TriangleCounts counts(cases);
+  const AboveIsovalue<T> above(isovalue);
   std::atomic<bool> aborted(false);
   parallel(0, numActive, [&](std::int64_t a0, std::int64_t a1) {
     if (aborted || (abort && abort()))
@@ -538,16 +667,17 @@ bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, Triangle
       aborted = true;
       return;
     }
-    std::vector<std::uint8_t> flags;
+    BlockRows rows;
     for (std::int64_t a = a0; a < a1; ++a)
     {
       const BlockSamples samples(ranges, plan.ActiveBlocks[a], stride);
-      Classify(volume, samples, isovalue, flags);
+      ClassifyRows(volume, samples, above, rows);
       std::uint64_t* bits = plan.EdgeBits.data() + a * words;
-      std::int64_t triangles = 0;
-      plan.PointOffset[a + 1] = CountBlock(flags, samples, OwnedSamples(volume, samples), counts,
-        triangles, plan.CubeCases.data() + a * plan.CubesPerBlock, bits);
-      plan.TriangleOffset[a + 1] = triangles;
+      const BlockCounts c = CountBlock(rows, samples, OwnedSamples(volume, samples), counts, bits,
+        words, plan.CutCubes.data() + a * plan.CubeWordsPerBlock,
+        plan.CubeCases.data() + a * plan.CubesPerBlock);
+      plan.PointOffset[a + 1] = c.Points;
+      plan.TriangleOffset[a + 1] = c.Triangles;
       std::uint32_t* rank = plan.EdgeRank.data() + a * words;
       std::uint32_t before = 0;
       for (int w = 0; w < words; ++w)
@@ -576,25 +706,64 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
   const int stride = LevelStride(plan.Level);
   const int words = plan.WordsPerBlock;
   const double iso = plan.Isovalue;
+  const int layout = LayoutOf(plan.Level);
+  const int layoutCube = layout * layout * layout;
+  // (i, j, k, axis) of every edge bit, packed 4 bits each: no divisions per point.
+  std::vector<std::uint16_t> bitCoords(3 * layoutCube);
+  for (int bit = 0; bit < 3 * layoutCube; ++bit)
+  {
+    const int cell = bit % layoutCube;
+    bitCoords[bit] = static_cast<std::uint16_t>((cell % layout) | ((cell / layout) % layout) << 4 |
+      (cell / (layout * layout)) << 8 | (bit / layoutCube) << 12);
+  }
+  // Each cube edge's origin (relative to the cube's lower corner), axis, and
+  // bit relative to the cube's lower corner's bit.
   int edgeOrigin[12][3];
   int edgeAxis[12];
+  int edgeBit[12];
   for (int e = 0; e < 12; ++e)
   {
-    for (int a = 0; a < 3; ++a)
+    for (int c = 0; c < 3; ++c)
     {
-      edgeOrigin[e][a] = CornerOffset[EdgeCorners[e][0]][a];
+      edgeOrigin[e][c] = CornerOffset[EdgeCorners[e][0]][c];
     }
     edgeAxis[e] = EdgeAxis(e);
+    edgeBit[e] = edgeAxis[e] * layoutCube + (edgeOrigin[e][2] * layout + edgeOrigin[e][1]) * layout +
+      edgeOrigin[e][0];
+  }
+  // Per case, the bit of each triangle vertex's edge relative to the cube's
+  // lower corner's bit, and the number of vertices.
+  std::int16_t caseBits[256][15];
+  int caseVertices[256];
+  for (int c = 0; c < 256; ++c)
+  {
+    int v = 0;
+    for (; v < 15 && cases[c][v] >= 0; ++v)
+    {
+      caseBits[c][v] = static_cast<std::int16_t>(edgeBit[cases[c][v]]);
+    }
+    caseVertices[c] = v - v % 3;
   }
   const std::int64_t numActive = static_cast<std::int64_t>(plan.ActiveBlocks.size());
 
   const std::int64_t sx = volume.Dims[0];
   const std::int64_t sxy = sx * volume.Dims[1];
+  const std::int64_t step[3] = { 1, sx, sxy };
   const GradientOperator<T> gradient(volume, stride);
+  const bool fullVolume = volume.SampleStride == 1;
+  auto fullIndex = [&volume, fullVolume](int axis, int c) {
+    return fullVolume ? c : volume.FullIndex(axis, c);
+  };
+  std::mutex rangesMutex;
+  if (out.Ranges)
+  {
+    *out.Ranges = SurfaceRanges();
+  }
   parallel(0, numActive, [&](std::int64_t a0, std::int64_t a1) {
     // Point id of each of the block's own cut edges, by bit: filled while the
     // points are written, so most triangle vertices are one load.
     std::vector<IdType> ownIds(static_cast<std::size_t>(words) * 64);
+    SurfaceRanges written; // ranges of this range of blocks, merged at its end
     for (std::int64_t a = a0; a < a1; ++a)
     {
       const std::int64_t block = plan.ActiveBlocks[a];
@@ -604,26 +773,28 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
       // Points of the owned cut edges, in bit order (values read in place).
       const std::uint64_t* bits = plan.EdgeBits.data() + a * words;
       std::int64_t pid = plan.PointOffset[a];
-      const int layout = s.Layout;
       for (int w = 0; w < words; ++w)
       {
         for (std::uint64_t m = bits[w]; m; m &= m - 1)
         {
           const int bit = w * 64 + __builtin_ctzll(m);
-          const int axis = bit % 3;
-          const int cell = bit / 3;
-          const int l[3] = { cell % layout, (cell / layout) % layout, cell / (layout * layout) };
-          const int p0[3] = { s.Point(0, l[0]), s.Point(1, l[1]), s.Point(2, l[2]) };
+          const int packed = bitCoords[bit];
+          const int axis = packed >> 12;
+          // The edge's ends (an edge never starts at a block's last sample,
+          // so its far end is one stride on) and the crossing on it.
+          const int p0[3] = { s.First[0] + (packed & 15) * stride,
+            s.First[1] + ((packed >> 4) & 15) * stride, s.First[2] + ((packed >> 8) & 15) * stride };
           int p1[3] = { p0[0], p0[1], p0[2] };
-          p1[axis] = s.Point(axis, l[axis] + 1);
-          const double v0 = static_cast<double>(volume.Data[p0[0] + p0[1] * sx + p0[2] * sxy]);
-          const double v1 = static_cast<double>(volume.Data[p1[0] + p1[1] * sx + p1[2] * sxy]);
+          p1[axis] = std::min(p0[axis] + stride, s.Last[axis]);
+          const std::int64_t at0 = p0[0] + p0[1] * sx + p0[2] * sxy;
+          const double v0 = static_cast<double>(volume.Data[at0]);
+          const double v1 = static_cast<double>(volume.Data[at0 + (p1[axis] - p0[axis]) * step[axis]]);
           const double t = (iso - v0) / (v1 - v0);
           float* x = out.Points + 3 * pid;
           for (int c = 0; c < 3; ++c)
           {
-            const double f0 = volume.FullIndex(c, p0[c]);
-            const double index = f0 + t * (volume.FullIndex(c, p1[c]) - f0);
+            const double f0 = fullIndex(c, p0[c]);
+            const double index = c == axis ? f0 + t * (fullIndex(c, p1[c]) - f0) : f0;
             x[c] = static_cast<float>(volume.Origin[c] + volume.Spacing[c] * index);
           }
           if (out.Normals)
@@ -652,6 +823,14 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
               nn[c] = static_cast<float>(g[c] * inv);
             }
           }
+          if (out.Ranges)
+          {
+            written.Points.Add(x);
+            if (out.Normals)
+            {
+              written.Normals.Add(out.Normals + 3 * pid);
+            }
+          }
           if (out.Scalars)
           {
             out.Scalars[pid] = static_cast<float>(iso);
@@ -668,6 +847,7 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
         (block / ranges.Blocks[0]) % ranges.Blocks[1],
         block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]) };
       const std::uint8_t* cubeCase = plan.CubeCases.data() + a * plan.CubesPerBlock;
+      const std::uint64_t* cutCubes = plan.CutCubes.data() + a * plan.CubeWordsPerBlock;
       // Block ids on the whole volume's grid for a piece (extraction runs at
       // stride 1 on the level's volume, so cube (i, j, k) starts at sample
       // First + (i, j, k)); the local block otherwise.
@@ -688,15 +868,10 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
           (volume.GlobalOffset[2] + s.First[2] + k) / BlockCells };
         return static_cast<std::int32_t>((g[2] * globalBlocks[1] + g[1]) * globalBlocks[0] + g[0]);
       };
-      auto pointId = [&](int i, int j, int k, int edge) -> IdType {
+      // The id of a vertex on a neighbour's edge: that block's first point
+      // plus the rank of the edge's bit among its owned cut edges.
+      auto neighbourId = [&](int i, int j, int k, int edge) -> IdType {
         int l[3] = { i + edgeOrigin[edge][0], j + edgeOrigin[edge][1], k + edgeOrigin[edge][2] };
-        if (!((l[0] == n[0] - 1 && !s.LastBlock[0]) || (l[1] == n[1] - 1 && !s.LastBlock[1]) ||
-              (l[2] == n[2] - 1 && !s.LastBlock[2])))
-        {
-          return ownIds[s.Bit(l[0], l[1], l[2], edgeAxis[edge])];
-        }
-        // The edge starts on an upper face: a neighbour block owns it; its id is
-        // that block's first point plus the rank of the edge's bit.
         std::int64_t owner[3] = { bxyz[0], bxyz[1], bxyz[2] };
         for (int d = 0; d < 3; ++d)
         {
@@ -705,6 +880,10 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
             ++owner[d];
             l[d] = 0;
           }
+        }
+        if (owner[0] == bxyz[0] && owner[1] == bxyz[1] && owner[2] == bxyz[2])
+        {
+          return ownIds[s.Bit(l[0], l[1], l[2], edgeAxis[edge])];
         }
         const std::int64_t oa = plan.ActiveIndex[(owner[2] * ranges.Blocks[1] + owner[1]) *
             ranges.Blocks[0] + owner[0]];
@@ -715,34 +894,55 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
         const std::uint64_t below = wordBits[bit >> 6] & ((std::uint64_t(1) << (bit & 63)) - 1);
         return first + static_cast<IdType>(wordRank[bit >> 6] + PopCount64(below));
       };
-      int cube = 0;
-      for (int k = 0; k + 1 < n[2]; ++k)
+      // Cubes whose upper corner lies on an upper face that a neighbour owns.
+      const int lastOwned[3] = { s.LastBlock[0] ? n[0] : n[0] - 2,
+        s.LastBlock[1] ? n[1] : n[1] - 2, s.LastBlock[2] ? n[2] : n[2] - 2 };
+      const int cubeMask = (1 << s.CubeShift) - 1;
+      for (int w = 0; w < plan.CubeWordsPerBlock; ++w)
       {
-        for (int j = 0; j + 1 < n[1]; ++j)
+        for (std::uint64_t m = cutCubes[w]; m; m &= m - 1)
         {
-          for (int i = 0; i + 1 < n[0]; ++i, ++cube)
+          const int cube = w * 64 + __builtin_ctzll(m);
+          const int i = cube & cubeMask;
+          const int j = (cube >> s.CubeShift) & cubeMask;
+          const int k = cube >> (2 * s.CubeShift);
+          const int c = cubeCase[cube];
+          const int* edges = cases[c];
+          const std::int64_t firstTriangle = tid;
+          IdType* tri = out.Connectivity + 3 * tid;
+          if (i < lastOwned[0] && j < lastOwned[1] && k < lastOwned[2])
           {
-            const int c = cubeCase[cube];
-            if (c == 0 || c == 255)
+            // Every vertex on one of this block's own edges.
+            const IdType* ids = ownIds.data() + (k * layout + j) * layout + i;
+            const std::int16_t* vertexBits = caseBits[c];
+            for (int v = 0; v < caseVertices[c]; v += 3, ++tid, tri += 3)
             {
-              continue;
+              tri[0] = ids[vertexBits[v]];
+              tri[1] = ids[vertexBits[v + 1]];
+              tri[2] = ids[vertexBits[v + 2]];
             }
-            const int* edges = cases[c];
-            const std::int32_t id = out.BlockIds ? blockId(i, j, k) : 0;
-            for (int e = 0; e < 15 && edges[e] >= 0; e += 3, ++tid)
+          }
+          else
+          {
+            for (int e = 0; e < 15 && edges[e] >= 0; e += 3, ++tid, tri += 3)
             {
-              IdType* tri = out.Connectivity + 3 * tid;
-              tri[0] = pointId(i, j, k, edges[e]);
-              tri[1] = pointId(i, j, k, edges[e + 1]);
-              tri[2] = pointId(i, j, k, edges[e + 2]);
-              if (out.BlockIds)
-              {
-                out.BlockIds[tid] = id;
-              }
+              tri[0] = neighbourId(i, j, k, edges[e]);
+              tri[1] = neighbourId(i, j, k, edges[e + 1]);
+              tri[2] = neighbourId(i, j, k, edges[e + 2]);
             }
+          }
+          if (out.BlockIds)
+          {
+            std::fill(out.BlockIds + firstTriangle, out.BlockIds + tid, blockId(i, j, k));
           }
         }
       }
+    }
+    if (out.Ranges)
+    {
+      std::lock_guard<std::mutex> lock(rangesMutex);
+      out.Ranges->Points.Merge(written.Points);
+      out.Ranges->Normals.Merge(written.Normals);
     }
   });
 }
@@ -762,46 +962,47 @@ std::vector<std::int32_t> ListActiveBlocks(const BlockRanges& ranges, double iso
 }
 
 template <typename T>
-SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
-  TriangleCaseTable cases, double isovalue, int level, int sampleStep, const ParallelFor& parallel)
+BlockSums CountBlocks(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
+  const std::vector<std::int32_t>& blocks, double isovalue, int level, int auxLevel,
+  const ParallelFor& parallel)
 {
-  return CountSampled(volume, ranges, cases, ListActiveBlocks(ranges, isovalue), isovalue, level,
-    sampleStep, parallel);
-}
-
-template <typename T>
-SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
-  TriangleCaseTable cases, const std::vector<std::int32_t>& active, double isovalue, int level,
-  int sampleStep, const ParallelFor& parallel)
-{
-  SampledCounts result;
-  result.ActiveBlocks = static_cast<std::int64_t>(active.size());
-  sampleStep = std::max(1, sampleStep);
-  const std::int64_t sampled = (result.ActiveBlocks + sampleStep - 1) / sampleStep;
-  result.SampledBlocks = sampled;
-  std::vector<std::int64_t> points(sampled, 0), triangles(sampled, 0);
-  const TriangleCounts counts(cases);
-  const int stride = LevelStride(level);
-  parallel(0, sampled, [&](std::int64_t s0, std::int64_t s1) {
-    std::vector<std::uint8_t> flags;
-    for (std::int64_t s = s0; s < s1; ++s)
+  const std::int64_t n = static_cast<std::int64_t>(blocks.size());
+  // Per block: level points and triangles, auxiliary points and triangles.
+  std::vector<std::int64_t> counts(4 * n, 0);
+  const TriangleCounts table(cases);
+  const AboveIsovalue<T> above(isovalue);
+  const int levels[2] = { level, auxLevel };
+  parallel(0, n, [&](std::int64_t b0, std::int64_t b1) {
+    BlockRows rows;
+    std::vector<std::uint64_t> bits(WordsPerBlock(NumberOfLevels - 1));
+    for (std::int64_t b = b0; b < b1; ++b)
     {
-      const BlockSamples samples(ranges, active[s * sampleStep], stride);
-      Classify(volume, samples, isovalue, flags);
-      points[s] = CountBlock(
-        flags, samples, OwnedSamples(volume, samples), counts, triangles[s], nullptr, nullptr);
+      for (int which = 0; which < 2 && levels[which] >= 0; ++which)
+      {
+        const BlockSamples samples(ranges, blocks[b], LevelStride(levels[which]));
+        ClassifyRows(volume, samples, above, rows);
+        const int words = WordsPerBlock(levels[which]);
+        std::fill(bits.begin(), bits.begin() + words, 0);
+        const BlockCounts c = CountBlock(rows, samples, OwnedSamples(volume, samples), table,
+          bits.data(), words, nullptr, nullptr);
+        counts[4 * b + 2 * which] = c.Points;
+        counts[4 * b + 2 * which + 1] = c.Triangles;
+      }
     }
   });
-  double p = 0, t = 0;
-  for (std::int64_t s = 0; s < sampled; ++s)
+  BlockSums sums;
+  sums.Blocks = n;
+  for (std::int64_t b = 0; b < n; ++b)
   {
-    p += static_cast<double>(points[s]);
-    t += static_cast<double>(triangles[s]);
+    const std::int64_t* c = counts.data() + 4 * b;
+    const bool auxPoints = auxLevel < 0 || c[2] > 0;
+    const bool auxTriangles = auxLevel < 0 || c[3] > 0;
+    (auxPoints ? sums.Points : sums.RestPoints) += static_cast<double>(c[0]);
+    (auxTriangles ? sums.Triangles : sums.RestTriangles) += static_cast<double>(c[1]);
+    sums.AuxPoints += static_cast<double>(c[2]);
+    sums.AuxTriangles += static_cast<double>(c[3]);
   }
-  const double scale = sampled > 0 ? static_cast<double>(result.ActiveBlocks) / sampled : 0.0;
-  result.Points = p * scale;
-  result.Triangles = t * scale;
-  return result;
+  return sums;
 }
 
 #define MEDISO_INSTANTIATE(T)                                                                      \
@@ -815,9 +1016,7 @@ SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
   template void GenerateSurface<T, std::int64_t>(const Volume<T>&, const BlockRanges&,            \
     TriangleCaseTable, const ExtractionPlan&, const SurfaceBuffers<std::int64_t>&,                 \
     const ParallelFor&);                                                                           \
-  template SampledCounts CountSampled<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable,  \
-    double, int, int, const ParallelFor&);                                                         \
-  template SampledCounts CountSampled<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable,  \
+  template BlockSums CountBlocks<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable,       \
     const std::vector<std::int32_t>&, double, int, int, const ParallelFor&)
 
 MEDISO_FOR_EACH_SCALAR_TYPE(MEDISO_INSTANTIATE);

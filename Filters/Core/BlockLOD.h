@@ -23,11 +23,14 @@
  * - Points live on the cut edges of the sample grid. Each edge belongs to
  *   exactly one block (the one holding its lower end, faces going to the
  *   block above them, except on the volume's last face), and that block is
- *   always visited, because it holds both ends of the edge. Pass 1 marks each
- *   block's cut edges in a bit mask and counts triangles; a prefix sum over
+ *   always visited, because it holds both ends of the edge. Pass 1 classifies
+ *   a block's samples into one bit mask per row of samples, from which the
+ *   cut edges of a row are a few bit operations and the cases of a row's
+ *   cubes one 8 x 8 bit transpose; it marks each block's cut edges and cut
+ *   cubes in bit masks and counts triangles; a prefix sum over
  *   the visited blocks gives every block its first point and first triangle;
  *   the output is allocated once; pass 2 writes the points of owned edges in
- *   bit order and the triangles of every cube, finding a point's id as
+ *   bit order and the triangles of every cut cube, finding a point's id as
  *   "first point of the owner block + rank of the edge's bit". Points on
  *   shared edges are therefore merged within and across blocks, at every
  *   level: the surface is watertight (no duplicate points, no cracks).
@@ -204,9 +207,11 @@ struct ExtractionPlan
   std::vector<std::int64_t> TriangleOffset; ///< Per active block (+1): first triangle.
   std::vector<std::uint64_t> EdgeBits;      ///< Per active block: owned cut edges.
   std::vector<std::uint32_t> EdgeRank;      ///< Per active block and word: bits before it.
-  std::vector<std::uint8_t> CubeCases;      ///< Per active block: case of each cube.
+  std::vector<std::uint64_t> CutCubes;      ///< Per active block: cubes that make triangles.
+  std::vector<std::uint8_t> CubeCases;      ///< Per active block: case of each cut cube.
   int WordsPerBlock = 0;
-  int CubesPerBlock = 0; ///< (8 / stride)^3: stride of CubeCases.
+  int CubeWordsPerBlock = 0; ///< Stride of CutCubes.
+  int CubesPerBlock = 0;     ///< (8 / stride)^3: stride of CubeCases.
 
   std::int64_t GetNumberOfPoints() const
   {
@@ -226,6 +231,48 @@ bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, Triangle
   double isovalue, int level, ExtractionPlan& plan, const ParallelFor& parallel,
   const std::function<bool()>& abort = {});
 
+/// The value range of 3-component vectors (points, normals): per component,
+/// and of their length. A host can hand these to its arrays (VTK caches array
+/// ranges), so that nothing downstream reads the arrays again to find them.
+struct VectorRange
+{
+  double Min[3] = { 1e300, 1e300, 1e300 };
+  double Max[3] = { -1e300, -1e300, -1e300 };
+  double MinLength2 = 1e300; ///< Squared lengths.
+  double MaxLength2 = -1e300;
+  bool IsEmpty() const { return this->Min[0] > this->Max[0]; }
+  void Add(const float v[3])
+  {
+    double length2 = 0;
+    for (int c = 0; c < 3; ++c)
+    {
+      const double x = v[c];
+      this->Min[c] = x < this->Min[c] ? x : this->Min[c];
+      this->Max[c] = x > this->Max[c] ? x : this->Max[c];
+      length2 += x * x;
+    }
+    this->MinLength2 = length2 < this->MinLength2 ? length2 : this->MinLength2;
+    this->MaxLength2 = length2 > this->MaxLength2 ? length2 : this->MaxLength2;
+  }
+  void Merge(const VectorRange& o)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      this->Min[c] = o.Min[c] < this->Min[c] ? o.Min[c] : this->Min[c];
+      this->Max[c] = o.Max[c] > this->Max[c] ? o.Max[c] : this->Max[c];
+    }
+    this->MinLength2 = o.MinLength2 < this->MinLength2 ? o.MinLength2 : this->MinLength2;
+    this->MaxLength2 = o.MaxLength2 > this->MaxLength2 ? o.MaxLength2 : this->MaxLength2;
+  }
+};
+
+/// Ranges of what pass 2 wrote.
+struct SurfaceRanges
+{
+  VectorRange Points;
+  VectorRange Normals; ///< Empty without normals.
+};
+
 /// Where pass 2 writes. Arrays are sized from the plan; optional ones may be null.
 template <typename IdType>
 struct SurfaceBuffers
@@ -237,6 +284,7 @@ struct SurfaceBuffers
   std::int32_t* BlockIds = nullptr; ///< 1 per triangle (linear block index, on the whole
                                     ///< volume's grid for a piece), or null.
   IdType FirstPointId = 0;         ///< Added to every point id (several isovalues in one output).
+  SurfaceRanges* Ranges = nullptr; ///< Receives the written points' and normals' ranges, or null.
 };
 
 /// Pass 2: writes the surface of a completed plan.
@@ -244,29 +292,29 @@ template <typename T, typename IdType>
 void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
   const ExtractionPlan& plan, const SurfaceBuffers<IdType>& out, const ParallelFor& parallel);
 
-/// Counts for an estimate: exact when every active block is counted, else
-/// scaled from every `sampleStep`-th active block (spread over the volume).
-struct SampledCounts
+/// Sums of point and triangle counts over a list of blocks, for exact counts
+/// and for the estimator's samples (BlockLODEstimator.h). With an auxiliary
+/// (coarser) level, the level's counts are split by whether the block's
+/// auxiliary count is positive: Points and Triangles over blocks with a
+/// positive auxiliary count (every block without an auxiliary level), Rest*
+/// over the others, Aux* the auxiliary level's counts over all of them.
+struct BlockSums
 {
-  std::int64_t ActiveBlocks = 0;
-  std::int64_t SampledBlocks = 0;
+  std::int64_t Blocks = 0;
   double Points = 0;
   double Triangles = 0;
+  double RestPoints = 0;
+  double RestTriangles = 0;
+  double AuxPoints = 0;
+  double AuxTriangles = 0;
 };
 
-/// Counts cut cubes' triangles and cut edges at a level over a sample of the
-/// active blocks (no allocation proportional to the output).
+/// Counts cut edges (points) and triangles of a level, and of `auxLevel`
+/// (-1: none), on the given blocks (no allocation proportional to the output).
 template <typename T>
-SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
-  TriangleCaseTable cases, double isovalue, int level, int sampleStep,
+BlockSums CountBlocks(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
+  const std::vector<std::int32_t>& blocks, double isovalue, int level, int auxLevel,
   const ParallelFor& parallel);
-
-/// The same, with the isovalue's active blocks already listed (linear indices
-/// in increasing order, as ListActiveBlocks gives them).
-template <typename T>
-SampledCounts CountSampled(const Volume<T>& volume, const BlockRanges& ranges,
-  TriangleCaseTable cases, const std::vector<std::int32_t>& active, double isovalue, int level,
-  int sampleStep, const ParallelFor& parallel);
 
 /// Linear indices of the blocks active for an isovalue, in increasing order.
 std::vector<std::int32_t> ListActiveBlocks(const BlockRanges& ranges, double isovalue);

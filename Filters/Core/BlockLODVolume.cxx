@@ -32,22 +32,33 @@ struct BlockLODVolume::Typed
     const std::function<bool()>& abort) = 0;
   virtual void Generate(const ExtractionPlan& plan, const SurfaceBuffers<std::int32_t>& out) = 0;
   virtual void Generate(const ExtractionPlan& plan, const SurfaceBuffers<std::int64_t>& out) = 0;
-  virtual SurfaceCounts CountSampled(double isovalue, int level,
-    const std::vector<std::int32_t>& fullActive, std::int64_t sampleBlocks, bool& exact) = 0;
+  // Active blocks of a level's coarse copy (building it when `build`), or
+  // null when it has none.
+  virtual const BlockRanges* CoarseRanges(int level, bool build) = 0;
+  // Exact counts on a level's coarse copy (which must exist).
+  virtual SurfaceCounts CountCoarse(double isovalue, int level) = 0;
+  // Counts on full-volume blocks.
+  virtual BlockSums CountFull(const std::vector<std::int32_t>& blocks, double isovalue, int level,
+    int auxLevel) = 0;
+  int CoarseCopies = 0; // made so far
 };
 
 namespace
 {
-// Every `step`-th active block is counted; step 1 counts them all (exact).
-int SampleStep(std::int64_t activeBlocks, std::int64_t sampleBlocks)
-{
-  return static_cast<int>(std::max<std::int64_t>(1, activeBlocks / std::max<std::int64_t>(1, sampleBlocks)));
-}
-
 double CubesPerBlock(int stride)
 {
   const double perAxis = BlockCells / stride;
   return perAxis * perAxis * perAxis;
+}
+
+// A well-mixed 32-bit hash (for the estimator's deterministic sample).
+std::uint32_t Mix(std::uint32_t x)
+{
+  x ^= x >> 16;
+  x *= 0x7feb352du;
+  x ^= x >> 15;
+  x *= 0x846ca68bu;
+  return x ^ (x >> 16);
 }
 } // namespace
 
@@ -109,6 +120,7 @@ struct BlockLODVolume::TypedImpl : BlockLODVolume::Typed
       c.Samples = MakeCoarseCopy(this->Full, level, c.Values, this->Parallel);
       ComputeBlockRanges(c.Samples, c.Ranges, this->Parallel);
       c.Built = true;
+      ++this->CoarseCopies;
     }
     f(c.Samples, c.Ranges);
   }
@@ -141,34 +153,34 @@ struct BlockLODVolume::TypedImpl : BlockLODVolume::Typed
     this->GenerateAny(plan, out);
   }
 
-  SurfaceCounts CountSampled(double isovalue, int level,
-    const std::vector<std::int32_t>& fullActive, std::int64_t sampleBlocks, bool& exact) override
+  const BlockRanges* CoarseRanges(int level, bool build) override
   {
+    if (level >= NumberOfLevels - 1 || (!this->Levels[level].Built && !build))
+    {
+      return nullptr;
+    }
+    this->WithLevel(level, [](const Volume<T>&, const BlockRanges&) {});
+    return &this->Levels[level].Ranges;
+  }
+
+  SurfaceCounts CountCoarse(double isovalue, int level) override
+  {
+    const Coarse& coarse = this->Levels[level];
+    const std::vector<std::int32_t> active = ListActiveBlocks(coarse.Ranges, isovalue);
+    const BlockSums sums = CountBlocks(coarse.Samples, coarse.Ranges, this->Cases, active, isovalue,
+      NumberOfLevels - 1, -1, this->Parallel);
     SurfaceCounts c;
-    int step = 1;
-    if (level < NumberOfLevels - 1 && this->Levels[level].Built)
-    {
-      // The level's coarse copy exists: count on it (contiguous, cheap).
-      const Coarse& coarse = this->Levels[level];
-      const std::vector<std::int32_t> active = ListActiveBlocks(coarse.Ranges, isovalue);
-      step = SampleStep(static_cast<std::int64_t>(active.size()), sampleBlocks);
-      const SampledCounts s = mediso::CountSampled(coarse.Samples, coarse.Ranges, this->Cases,
-        active, isovalue, NumberOfLevels - 1, step, this->Parallel);
-      c.Points = s.Points;
-      c.Triangles = s.Triangles;
-      c.Cubes = static_cast<double>(s.ActiveBlocks) * CubesPerBlock(1);
-    }
-    else
-    {
-      step = SampleStep(static_cast<std::int64_t>(fullActive.size()), sampleBlocks);
-      const SampledCounts s = mediso::CountSampled(this->Full, this->FullRanges, this->Cases,
-        fullActive, isovalue, level, step, this->Parallel);
-      c.Points = s.Points;
-      c.Triangles = s.Triangles;
-      c.Cubes = static_cast<double>(s.ActiveBlocks) * CubesPerBlock(LevelStride(level));
-    }
-    exact = step == 1;
+    c.Points = sums.Points;
+    c.Triangles = sums.Triangles;
+    c.Cubes = static_cast<double>(active.size()) * CubesPerBlock(1);
     return c;
+  }
+
+  BlockSums CountFull(const std::vector<std::int32_t>& blocks, double isovalue, int level,
+    int auxLevel) override
+  {
+    return CountBlocks(
+      this->Full, this->FullRanges, this->Cases, blocks, isovalue, level, auxLevel, this->Parallel);
   }
 };
 
@@ -192,6 +204,11 @@ void BlockLODVolume::Reset()
 bool BlockLODVolume::IsValid() const
 {
   return this->Valid;
+}
+
+int BlockLODVolume::GetNumberOfCoarseCopies() const
+{
+  return this->Impl ? this->Impl->CoarseCopies : 0;
 }
 
 bool BlockLODVolume::SetVolume(const VolumeDescription& description)
@@ -240,11 +257,61 @@ SurfaceCounts BlockLODVolume::CountsOf(const ExtractionPlan& plan)
   return c;
 }
 
-SurfaceCounts BlockLODVolume::CountSampled(
-  double isovalue, int level, std::int64_t sampleBlocks, bool& exact)
+double BlockLODVolume::BlockCost(int level)
+{
+  // Measured on the project's machine: 0.12, 0.16, 0.49 and 1.5 microseconds.
+  constexpr double cost[NumberOfLevels] = { 1.0, 1.4, 4.2, 13.0 };
+  return cost[std::min(std::max(level, 0), NumberOfLevels - 1)];
+}
+
+double BlockLODVolume::ExactCountCost(double isovalue, int level)
+{
+  const bool small = level < NumberOfLevels - 2; // levels 0 and 1: copies of 1/512, 1/64
+  if (const BlockRanges* coarse = this->Impl->CoarseRanges(level, small))
+  {
+    return static_cast<double>(ListActiveBlocks(*coarse, isovalue).size()) *
+      BlockCost(NumberOfLevels - 1);
+  }
+  return static_cast<double>(this->ActiveBlocks(isovalue).size()) * BlockCost(level);
+}
+
+SurfaceCounts BlockLODVolume::CountExact(double isovalue, int level)
+{
+  const bool small = level < NumberOfLevels - 2;
+  if (this->Impl->CoarseRanges(level, small))
+  {
+    return this->Impl->CountCoarse(isovalue, level);
+  }
+  const std::vector<std::int32_t>& active = this->ActiveBlocks(isovalue);
+  const BlockSums sums = this->Impl->CountFull(active, isovalue, level, -1);
+  SurfaceCounts c;
+  c.Points = sums.Points;
+  c.Triangles = sums.Triangles;
+  c.Cubes = static_cast<double>(active.size()) * CubesPerBlock(LevelStride(level));
+  return c;
+}
+
+BlockSums BlockLODVolume::CountSample(
+  double isovalue, int level, int auxLevel, std::int64_t samples)
 {
   const std::vector<std::int32_t>& active = this->ActiveBlocks(isovalue);
-  return this->Impl->CountSampled(isovalue, level, active, sampleBlocks, exact);
+  const std::int64_t n = static_cast<std::int64_t>(active.size());
+  if (samples >= n)
+  {
+    return this->Impl->CountFull(active, isovalue, level, auxLevel);
+  }
+  // Jittered systematic sample: one block at a pseudo-random place in each of
+  // `samples` equal runs of the active list (which is in volume order), so
+  // the sample spreads over the volume without following its period.
+  std::vector<std::int32_t> chosen(static_cast<std::size_t>(samples));
+  for (std::int64_t s = 0; s < samples; ++s)
+  {
+    const std::int64_t lo = s * n / samples;
+    const std::int64_t hi = (s + 1) * n / samples;
+    const std::uint32_t r = Mix(static_cast<std::uint32_t>(s) * 2654435761u + static_cast<std::uint32_t>(level));
+    chosen[s] = active[lo + static_cast<std::int64_t>(r % static_cast<std::uint32_t>(hi - lo))];
+  }
+  return this->Impl->CountFull(chosen, isovalue, level, auxLevel);
 }
 
 const std::vector<std::int32_t>& BlockLODVolume::ActiveBlocks(double isovalue)

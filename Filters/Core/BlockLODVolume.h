@@ -12,15 +12,16 @@
  *
  * - the block ranges of the full volume (BlockLOD.h), computed by SetVolume();
  * - per coarse level 0-2, a contiguous copy of the level's samples and its own
- *   block ranges (MakeCoarseCopy), made the first time the level is planned;
+ *   block ranges (MakeCoarseCopy), made the first time the level is planned
+ *   (levels 0 and 1, 1/512 and 1/64 of the input, also when first counted);
  * - the active-block lists of the last few isovalues (estimates of every level
  *   use the same list).
  *
  * Plan() and Generate() run the two passes of BlockLOD.h for an (isovalue,
  * level): at level 3 on the full volume, below it at stride 1 on the level's
- * coarse copy, which gives exactly the level's surface. CountSampled() counts
- * a level on a spread sample of active blocks for the estimator
- * (BlockLODEstimator.h) without building a coarse copy.
+ * coarse copy, which gives exactly the level's surface. CountExact() and
+ * CountSample() count a level exactly, or on a spread sample of active
+ * blocks, for the estimator (BlockLODEstimator.h).
  *
  * The marching-cubes case table is data the host passes (BlockLOD.h,
  * TriangleCaseTable), and every pass runs through the host's ParallelFor.
@@ -89,6 +90,8 @@ public:
   void Reset();
   bool IsValid() const;
   const VolumeDescription& GetDescription() const { return this->Description; }
+  /// Coarse copies made since SetVolume() (a host can tell one-time work).
+  int GetNumberOfCoarseCopies() const;
   /// Block ranges of the full volume (value range, NaN count, per-block min/max).
   const BlockRanges& GetRanges() const { return this->Ranges; }
 
@@ -104,11 +107,21 @@ public:
   /// Exact counts of a plan made by Plan().
   static SurfaceCounts CountsOf(const ExtractionPlan& plan);
 
-  /// Counts of an (isovalue, level) on about `sampleBlocks` active blocks
-  /// spread over the volume, scaled to all of them (exact, and `exact` set,
-  /// when there are no more than that). Reads the level's coarse copy when it
-  /// exists, else the level's samples in the full volume (no copy is made).
-  SurfaceCounts CountSampled(double isovalue, int level, std::int64_t sampleBlocks, bool& exact);
+  /// The cost of counting one block of a level on the full volume, relative
+  /// to level 0 (a block of level 3 classifies 729 samples, of level 0 eight).
+  static double BlockCost(int level);
+  /// What CountExact() costs, in BlockCost() units: the active blocks of the
+  /// level's coarse copy where it exists (levels 0 and 1 build theirs, which
+  /// are small), else the active blocks of the full volume.
+  double ExactCountCost(double isovalue, int level);
+  /// Exact counts of an (isovalue, level), by the route ExactCountCost() prices.
+  SurfaceCounts CountExact(double isovalue, int level);
+  /// Counts of `level` and `auxLevel` (-1: none) on `samples` active blocks
+  /// of the full volume, one at a pseudo-random place in each of `samples`
+  /// equal runs of the active list (jittered systematic sampling: the sample
+  /// spreads over the volume without following its period). Every active
+  /// block when `samples` is not smaller than their number.
+  BlockSums CountSample(double isovalue, int level, int auxLevel, std::int64_t samples);
 
   /// Active blocks of the full volume for an isovalue (kept for the last few
   /// isovalues).

@@ -8,8 +8,9 @@
 //   cube of each level's sample grid (with NaN voxels and a size that is no
 //   multiple of 8);
 // - estimates per level: exact (every active block counted) on a small volume;
-//   sampled on a large one, within 10% of the exact count; scaled from two
-//   exact levels by the isovalue's own growth; recorded exact counts returned;
+//   on a large one, exact, or by ratio to an exact coarser level, or sampled,
+//   as the budget allows, each within its tolerance of a brute-force count;
+//   recorded exact counts returned and used as the ratio's level;
 // - the cost model reproduces a linear law from its samples, rescales its
 //   defaults from one sample and stays non-negative on collinear samples;
 // - the byte layout and the AutoLOD level choice;
@@ -192,7 +193,7 @@ void TestPlanCounts()
 
 void TestEstimates()
 {
-  // Small volume: few active blocks, every one counted: the estimate is exact.
+  // Small volume: every level counted on every active block: exact.
   {
     const Field f = MakeField(40, 37, 35, 11.0, 0.5, false);
     mediso::BlockLODVolume volume(Table.Cases, mediso::SerialFor);
@@ -203,101 +204,172 @@ void TestEstimates()
       double points, triangles;
       BruteForce(f, 0.0, level, points, triangles);
       const mediso::SurfaceEstimate e = estimator.Estimate(0.0, level);
-      Check(e.Counts.Triangles == triangles && e.Counts.Points == points,
-        "small volume: the estimate counts every active block, level " + std::to_string(level));
-      Check(estimator.HasExact(0.0, level), "a complete count is remembered as exact");
-      Check(estimator.Estimate(0.0, level).Method == mediso::EstimateMethod::Exact,
-        "asked again, the pair is exact");
-      const double active = static_cast<double>(volume.ActiveBlocks(0.0).size());
-      const double perAxis = 8.0 / mediso::LevelStride(level);
-      Check(e.Counts.Cubes == active * perAxis * perAxis * perAxis,
-        "cubes visited = active blocks x cubes per block");
+      Check(e.Method == mediso::EstimateMethod::Exact && e.Counts.Triangles == triangles &&
+          e.Counts.Points == points,
+        "small volume: exact counts at level " + std::to_string(level));
+      Check(estimator.HasExact(0.0, level), "an exact count is remembered");
+      // Cubes visited: what the plan of the pair visits (levels 0 and 1 are
+      // counted on the coarse copies the plans read).
+      mediso::ExtractionPlan plan;
+      volume.Plan(0.0, level, plan);
+      const double planned = mediso::BlockLODVolume::CountsOf(plan).Cubes;
+      const double fullBlocks = static_cast<double>(volume.ActiveBlocks(0.0).size()) * 512;
+      Check(level == 2 || e.Counts.Cubes == (level == 3 ? fullBlocks : planned),
+        "estimated cubes are the cubes the plan visits, level " + std::to_string(level));
     }
   }
 
-  // Large noisy volume: more than 2 x 256 active blocks, so counts are sampled.
+  // Large noisy volume (more active blocks than the budget counts at level 3).
   const Field f = MakeField(161, 150, 140, 62.0, 3.0, false);
   mediso::BlockLODVolume volume(Table.Cases, mediso::SerialFor);
   volume.SetVolume(Describe(f));
-  mediso::BlockLODEstimator estimator(volume);
   const double iso = 0.25;
   const std::int64_t active = static_cast<std::int64_t>(volume.ActiveBlocks(iso).size());
   std::printf("large volume: %lld active blocks of %lld\n", static_cast<long long>(active),
     static_cast<long long>(volume.GetRanges().GetNumberOfBlocks()));
-  Check(active > 2 * mediso::BlockLODEstimator::SampleBlocks, "enough active blocks to sample");
   double exact[4];
   for (int level = 0; level < mediso::NumberOfLevels; ++level)
   {
     double points;
     BruteForce(f, iso, level, points, exact[level]);
-    const mediso::SurfaceEstimate e = estimator.Estimate(iso, level);
-    const double error = (e.Counts.Triangles - exact[level]) / exact[level];
-    std::printf("sampled estimate level %d: %.0f triangles, exact %.0f (%+.2f%%)\n", level,
-      e.Counts.Triangles, exact[level], 100 * error);
-    Check(e.Method == mediso::EstimateMethod::Sampled, "a large count is sampled");
-    Check(std::fabs(error) < 0.10, "sampled estimate within 10% at level " + std::to_string(level));
-    Check(estimator.Estimate(iso, level).Counts.Triangles == e.Counts.Triangles,
-      "a sampled estimate is kept, not recounted");
+  }
+  const char* methods[] = { "exact", "ratio to an exact coarser level", "sampled" };
+  // Budgets: the default (levels 0-2 exact, level 3 by ratio to level 2), a
+  // small one (level 1 exact, levels 2-3 by ratio to it), none (sampled).
+  const double budgets[] = { mediso::BlockLODEstimator::DefaultSampleBudget, 3000.0, 0.0 };
+  const mediso::EstimateMethod expected[3][4] = {
+    { mediso::EstimateMethod::Exact, mediso::EstimateMethod::Exact, mediso::EstimateMethod::Exact,
+      mediso::EstimateMethod::Scaled },
+    { mediso::EstimateMethod::Exact, mediso::EstimateMethod::Exact, mediso::EstimateMethod::Scaled,
+      mediso::EstimateMethod::Scaled },
+    { mediso::EstimateMethod::Sampled, mediso::EstimateMethod::Sampled,
+      mediso::EstimateMethod::Sampled, mediso::EstimateMethod::Sampled }
+  };
+  const double tolerance[3] = { 0.03, 0.06, 0.10 };
+  for (int b = 0; b < 3; ++b)
+  {
+    mediso::BlockLODEstimator estimator(volume);
+    estimator.SetSampleBudget(budgets[b]);
+    for (int level = 0; level < mediso::NumberOfLevels; ++level)
+    {
+      const mediso::SurfaceEstimate e = estimator.Estimate(iso, level);
+      const double error = (e.Counts.Triangles - exact[level]) / exact[level];
+      std::printf("budget %g, level %d: %.0f triangles (%s), exact %.0f (%+.2f%%)\n", budgets[b],
+        level, e.Counts.Triangles, methods[static_cast<int>(e.Method)], exact[level], 100 * error);
+      Check(e.Method == expected[b][level],
+        "budget " + std::to_string(budgets[b]) + ", level " + std::to_string(level) + ": method");
+      Check(std::fabs(error) <= tolerance[b],
+        "budget " + std::to_string(budgets[b]) + ", level " + std::to_string(level) + ": error");
+      Check(estimator.Estimate(iso, level).Counts.Triangles == e.Counts.Triangles,
+        "an estimate is kept, not recounted");
+    }
   }
 
-  // A second isovalue with two exact levels: the others are scaled by its growth.
+  // A recorded exact count of a coarser level is the auxiliary even when the
+  // budget pays for nothing.
   const double iso2 = -0.75;
-  mediso::SurfaceCounts c1, c3;
   mediso::ExtractionPlan plan;
   volume.Plan(iso2, 1, plan);
-  c1 = mediso::BlockLODVolume::CountsOf(plan);
-  volume.Plan(iso2, 3, plan);
-  c3 = mediso::BlockLODVolume::CountsOf(plan);
+  const mediso::SurfaceCounts c1 = mediso::BlockLODVolume::CountsOf(plan);
+  mediso::BlockLODEstimator estimator(volume);
+  estimator.SetSampleBudget(0.0);
   estimator.RecordExact(iso2, 1, c1);
-  estimator.RecordExact(iso2, 3, c3);
-  const mediso::SurfaceEstimate e3 = estimator.Estimate(iso2, 3);
-  Check(e3.Method == mediso::EstimateMethod::Exact && e3.Counts.Triangles == c3.Triangles,
+  Check(estimator.Estimate(iso2, 1).Method == mediso::EstimateMethod::Exact &&
+      estimator.Estimate(iso2, 1).Counts.Triangles == c1.Triangles,
     "a recorded pair is exact");
-  const mediso::SurfaceEstimate e2 = estimator.Estimate(iso2, 2);
-  const double growth = std::sqrt(c3.Triangles / c1.Triangles);
-  Check(e2.Method == mediso::EstimateMethod::Scaled, "two exact levels: the others are scaled");
-  Check(std::fabs(e2.Counts.Triangles - c3.Triangles / growth) < 1e-6 * c3.Triangles,
-    "level 2 scaled from level 3 by the isovalue's own growth per level");
-  Check(std::fabs(e2.Counts.Cubes - c3.Cubes / 8) < 1e-6 * c3.Cubes,
-    "cubes scale by 8 per level, from the finer of two equally near levels");
-  const mediso::SurfaceEstimate e0 = estimator.Estimate(iso2, 0);
-  Check(std::fabs(e0.Counts.Triangles - c1.Triangles / growth) < 1e-6 * c1.Triangles,
-    "level 0 scaled from level 1, its nearest known level");
+  Check(estimator.Estimate(iso2, 3).Method == mediso::EstimateMethod::Scaled,
+    "a recorded coarser level scales the sample");
+  Check(estimator.Estimate(iso2, 0).Method == mediso::EstimateMethod::Sampled,
+    "no coarser level below level 0: plain sample");
 
   // Reset forgets every count.
   estimator.Reset();
-  Check(!estimator.HasExact(iso2, 3), "Reset forgets exact counts");
+  Check(!estimator.HasExact(iso2, 1), "Reset forgets exact counts");
 }
 
 void TestCostModel()
 {
-  mediso::CostModel model;
-  Check(model.Predict(1e6, 1e5) ==
-      1e6 * mediso::CostModel::DefaultSecondsPerCube + 1e5 * mediso::CostModel::DefaultSecondsPerTriangle,
+  using mediso::CostModel;
+  CostModel model;
+  Check(model.Predict(3, 1e6, 1e5) == 1e6 * CostModel::DefaultSecondsPerCube +
+        1e5 * CostModel::DefaultSecondsPerTriangle + CostModel::DefaultSecondsPerUpdate,
     "defaults before any record");
-  model.Record(2e6, 1e5, 2e6 * 1e-9 + 1e5 * 2e-8);
-  Check(std::fabs(model.Predict(2e6, 1e5) - (2e6 * 1e-9 + 1e5 * 2e-8)) < 1e-12,
-    "one record: the prediction at that record is its time");
-  const double a = 3e-9, b = 7e-8;
-  mediso::CostModel fit;
-  const double samples[][2] = { { 1e6, 2e4 }, { 4e6, 1e5 }, { 2.5e5, 9e4 }, { 8e6, 3e5 } };
+  const double first = 2.0 * model.Predict(3, 2e6, 1e5);
+  model.Record(3, 2e6, 1e5, first);
+  Check(std::fabs(model.Predict(3, 2e6, 1e5) - first) < 1e-12,
+    "one record: the defaults scaled to its time");
+
+  // A law with a fixed part is recovered from records of it, the oldest
+  // weighing least (they fade) but still consistent.
+  const double a = 3e-9, b = 7e-8, c = 2e-3;
+  CostModel fit;
+  const double samples[][2] = { { 1e6, 2e4 }, { 4e6, 1e5 }, { 2.5e5, 9e4 }, { 8e6, 3e5 },
+    { 3e6, 5e5 } };
   for (const auto& s : samples)
   {
-    fit.Record(s[0], s[1], a * s[0] + b * s[1]);
+    fit.Record(3, s[0], s[1], a * s[0] + b * s[1] + c);
   }
-  const double predicted = fit.Predict(3e6, 2e5);
-  Check(std::fabs(predicted - (a * 3e6 + b * 2e5)) < 1e-9 * predicted,
-    "a linear law is recovered from its samples");
-  mediso::CostModel collinear;
-  collinear.Record(1e6, 1e5, 0.01);
-  collinear.Record(2e6, 2e5, 0.03);
-  Check(collinear.Predict(1e6, 1e5) >= 0, "collinear samples never predict a negative time");
+  const double predicted = fit.Predict(3, 3e6, 2e5);
+  Check(std::fabs(predicted - (a * 3e6 + b * 2e5 + c)) < 1e-9 * predicted,
+    "a linear law with a fixed part is recovered from its records");
+
+  // The fit follows a change of the machine's speed: after enough records at
+  // twice the time, predictions are near twice the law.
+  for (int k = 0; k < 200; ++k)
+  {
+    const auto& s = samples[k % 5];
+    fit.Record(3, s[0], s[1], 2 * (a * s[0] + b * s[1] + c));
+  }
+  const double slower = fit.Predict(3, 3e6, 2e5);
+  Check(std::fabs(slower / (2 * (a * 3e6 + b * 2e5 + c)) - 1) < 0.01,
+    "older records fade: the fit follows a slower machine");
+
+  // Records far off the fit (a disturbed update, or a clock glitch) count a
+  // tenth: the fit stays near the law.
+  CostModel steady;
+  for (int k = 0; k < 20; ++k)
+  {
+    const auto& s = samples[k % 5];
+    steady.Record(3, s[0], s[1], a * s[0] + b * s[1] + c);
+  }
+  for (int k = 0; k < 3; ++k)
+  {
+    steady.Record(3, 3e6, 2e5, 0.2 * (a * 3e6 + b * 2e5 + c));
+  }
+  const double kept = steady.Predict(3, 3e6, 2e5) / (a * 3e6 + b * 2e5 + c);
+  std::printf("after three records at 0.2x the law: prediction %.2fx the law\n", kept);
+  Check(std::fabs(kept - 1) < 0.2, "records far off the fit count little");
+
+  // Before a level has records, the defaults scaled to all records; then to
+  // its own; then its own fit.
+  CostModel levels;
+  for (const auto& s : samples)
+  {
+    levels.Record(1, s[0], s[1], 3 * (a * s[0] + b * s[1] + c));
+  }
+  Check(std::fabs(levels.Predict(1, 3e6, 2e5) / (3 * (a * 3e6 + b * 2e5 + c)) - 1) < 1e-6,
+    "a level with enough records: its own fit");
+  const double unseen = levels.Predict(2, 3e6, 2e5);
+  levels.Record(2, 1e6, 1e5, 0.5 * levels.Predict(2, 1e6, 1e5));
+  Check(std::fabs(levels.Predict(2, 3e6, 2e5) / unseen - 0.5) < 1e-6,
+    "a level's first record rescales the defaults for that level");
+
+  // Records that cannot separate the terms (one size only) still predict that size.
+  CostModel collinear;
+  for (int k = 0; k < 5; ++k)
+  {
+    collinear.Record(3, 1e6, 1e5, 0.01);
+  }
+  Check(std::fabs(collinear.Predict(3, 1e6, 1e5) - 0.01) < 1e-6, "collinear records: their time");
+  Check(collinear.Predict(3, 2e6, 2e5) > 0, "never a negative time");
 }
 
 void TestLayoutAndLevel()
 {
-  mediso::SurfaceLayout layout; // normals, offsets
-  Check(layout.Bytes(10, 20) == 10 * 24 + 20 * 16 + 4, "points, normals, 32-bit ids and offsets");
+  mediso::SurfaceLayout layout; // normals, offsets, 64-bit ids
+  Check(layout.Bytes(10, 20) == 10 * 24 + 20 * 32 + 8, "points, normals, 64-bit ids and offsets");
+  layout.IdBytes = 4;
+  Check(layout.Bytes(10, 20) == 10 * 24 + 20 * 16 + 4, "32-bit ids and offsets while they fit");
   layout.Scalars = layout.BlockIds = true;
   Check(layout.Bytes(10, 20) == 10 * 28 + 20 * 20 + 4, "scalars and block ids add 4 bytes each");
   layout.Offsets = false;
@@ -306,8 +378,10 @@ void TestLayoutAndLevel()
   Check(!mediso::SurfaceLayout::NeedsWideIds(1e6, 7e8) &&
       mediso::SurfaceLayout::NeedsWideIds(1e6, 7.2e8),
     "64-bit ids once 3 x triangles passes INT32_MAX");
-  Check(mediso::SurfaceLayout().Bytes(1e6, 7.2e8) == 1e6 * 24 + 7.2e8 * 32 + 8,
-    "64-bit ids double the connectivity");
+  mediso::SurfaceLayout compact;
+  compact.IdBytes = 4;
+  Check(compact.Bytes(1e6, 7.2e8) == 1e6 * 24 + 7.2e8 * 32 + 8,
+    "compact ids widen to 64 bits past INT32_MAX");
 
   const Field f = MakeField(40, 37, 35, 11.0, 0.5, false);
   mediso::BlockLODVolume volume(Table.Cases, mediso::SerialFor);

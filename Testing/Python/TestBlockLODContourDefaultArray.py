@@ -18,13 +18,10 @@ import sys
 
 from paraview.simple import *  # noqa: F401,F403 (pvpython idiom, as the README)
 
-failures = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from clientserver import Checks  # noqa: E402
 
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED: " + what)
+check = Checks()
 
 
 def readme_example(head, label, isovalue):
@@ -68,7 +65,4 @@ if ct.is_file():
 else:
     print("real CT not cached (%s): OpenDataFile part not run" % ct)
 
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("BlockLODContour default array: all checks passed")
+check.finish("BlockLODContour default array: all checks passed")

@@ -258,7 +258,7 @@ public:
         const SurfaceEstimate e = this->Estimator.Estimate(s.Value, level);
         triangles += e.Counts.Triangles;
         bytes += this->Layout.Bytes(e.Counts);
-        seconds += this->Estimator.EstimateSeconds(s.Value, level);
+        seconds += this->Estimator.EstimateSeconds(s.Value, level, this->Costs);
       }
       val row = val::object();
       row.set("level", level);
@@ -624,8 +624,8 @@ private:
         out.Connectivity = reinterpret_cast<std::int32_t*>(made.Triangles.data());
         this->CPUVolume.Generate(plan, out);
         this->Estimator.RecordExact(key.Isovalue, key.Level, counts);
-        this->Estimator.GetCostModel().Record(
-          counts.Cubes, counts.Triangles, (emscripten_get_now() - start) / 1000.0);
+        this->Costs.Record(
+          key.Level, counts.Cubes, counts.Triangles, (emscripten_get_now() - start) / 1000.0);
         const double bytes = made.Bytes();
         this->Cache.Insert(key, std::move(made), bytes);
         this->Cache.Evict(std::max(this->Budget / 4.0, 0.0), keep);
@@ -672,6 +672,7 @@ private:
   BlockLODVolume CPUVolume{ mediso_web::MarchingCubesCases, SerialFor };
 #endif
   BlockLODEstimator Estimator{ CPUVolume };
+  CostModel Costs; // this page's updates: the estimator's seconds
   SurfaceCache<CPUSurface> Cache;
   SurfaceLayout Layout{ true, false, false, false }; // normals, no scalars, ids, or offsets
   std::vector<SurfaceKey> ShownKeys = std::vector<SurfaceKey>(MaximumIsovalues, SurfaceKey{ NAN, -1 });
