@@ -21,9 +21,11 @@ import argparse
 import json
 import os
 import shutil
+import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -106,9 +108,23 @@ def start_server():
             break
         print("server: " + line.rstrip(), flush=True)
         if "open http" in line:
+            # the server's later output, read so that a full pipe never blocks it
+            threading.Thread(target=lambda: [print("server: " + l.rstrip(), flush=True)
+                                             for l in server.stdout], daemon=True).start()
             return server, "http://127.0.0.1:%d/?token=%s&size=%dx%d" % (port, token, SIZE[0], SIZE[1])
-    server.kill()
+    stop_server(server)
     raise SystemExit("FAILED: the server did not start")
+
+
+def stop_server(server):
+    """Stops the server as Ctrl-C would (it stops its operations worker), killing it only if it
+    does not stop in 20 s."""
+    server.send_signal(signal.SIGINT)
+    try:
+        server.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        server.kill()
+        server.wait()
 
 
 def run_page(url, actions, name, extra=()):
@@ -191,7 +207,7 @@ if args.case == "budget":
         results = {path: run_page(url + "&budget=0.5&path=" + path, [], "budget-" + path)
                    for path in ("gpu", "cpu")}
     finally:
-        server.kill()
+        stop_server(server)
     for path, result in results.items():
         stats = result["stats"]
         print("%s: level %d, %s" % (path, stats["level"], stats["levelNote"]))
@@ -206,7 +222,7 @@ elif args.case == "nowebgl":
     try:
         result = run_page(url, [], "nowebgl", ["--no-webgl"])
     finally:
-        server.kill()
+        stop_server(server)
     print("page says: " + result["unsupported"])
     check(result["state"] != "ready", "the page does not claim to be ready without WebGL")
     check("WebGL2" in result["unsupported"], "the page says that WebGL2 is missing")
@@ -219,7 +235,7 @@ elif args.case == "gpu":
             {"call": "cpuCount", "args": [[BONE["value"]]]},
             {"call": "shot", "args": [shot]}], "gpu")
     finally:
-        server.kill()
+        stop_server(server)
     check(result["state"] == "ready", "the page is ready (%s)" % result["state"])
     stats = result["stats"]
     print("page stats: " + json.dumps({k: stats[k] for k in ("path", "reason", "primitives", "lastChangeMs")}))
@@ -250,7 +266,7 @@ else:
             {"call": "setCPULevel", "args": [1]},
             {"call": "shot", "args": [shots[1]]}], "cpu")
     finally:
-        server.kill()
+        stop_server(server)
     check(result["state"] == "ready", "the page is ready (%s)" % result["state"])
     levels = {3: result["results"][3], 1: result["results"][5]}
     view = paraview_view()
