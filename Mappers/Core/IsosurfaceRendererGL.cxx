@@ -99,6 +99,23 @@ void ProjectedRectangle(const Matrix& indexToClip, const int cells[3], const int
   }
 }
 
+// Whether the index box [0, cells] lies wholly inside the clip volume (all 8
+// corners): then no cell is off screen and the vertex stage skips its test.
+bool BoxInsideClipVolume(const Matrix& indexToClip, const int cells[3])
+{
+  for (int i = 0; i < 8; ++i)
+  {
+    const double p[4] = { (i & 1) ? double(cells[0]) : 0.0, (i & 2) ? double(cells[1]) : 0.0,
+      (i & 4) ? double(cells[2]) : 0.0, 1.0 };
+    const auto c = matrix4::Transform(indexToClip, p);
+    if (!(c[3] > 0.0) || std::fabs(c[0]) > c[3] || std::fabs(c[1]) > c[3] || std::fabs(c[2]) > c[3])
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
 // The transpose of the inverse of m's upper 3x3 (normals to view space).
 void NormalMatrix(const Matrix& m, double out[9])
 {
@@ -444,6 +461,7 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
   program->Set("oneRankPerCell", translucent || nearest ? 1 : 0);
   program->Set("parallelProjection", frame.Parallel ? 1 : 0);
   program->SetMatrix4("indexToClip", indexToClip.data());
+  program->Set("cullCells", BoxInsideClipVolume(indexToClip, cells) ? 0 : 1);
   program->SetMatrix4("indexToView", indexToView.data());
   program->SetMatrix4("clipToIndex", clipToIndex.data());
   program->SetMatrix3("gradientToView", gradientToView);
