@@ -73,7 +73,6 @@ uniform float isovalues[8];  // the fragment stage's isovalues and looks
 uniform vec4 isoColors[8];
 
 uniform mat4 indexToClip;    // cell-index space to clip coordinates
-uniform int cullCells;       // 1: part of the volume is off screen (see cellOffScreen())
 uniform vec2 viewportSize;   // pixels
 uniform float pointMargin;   // pixels added around each footprint
 #ifdef MEDISO_POINT_FOOTPRINT
@@ -433,12 +432,13 @@ void footprint(ivec3 c, vec3 boxLo, vec3 boxHi)
 #endif
 }
 
+#ifdef MEDISO_CULL_CELLS
 // Whether the whole cell [c, c + 1] lies outside the view: all its corners
 // beyond one of the clip volume's planes (the near plane included). The
 // surface box lies in the cell, so its footprint would be off screen too;
 // testing here skips the corner gradients' fetches for such cells, most of
-// the cells in a close zoom. (The renderer sets cullCells only when part of
-// the volume is off screen: in a whole-volume view the test is skipped.)
+// the cells in a close zoom. (Compiled in only when part of the volume is off
+// screen.)
 bool cellOffScreen(ivec3 c)
 {
   vec4 origin = indexToClip * vec4(vec3(c), 1.0);
@@ -454,6 +454,7 @@ bool cellOffScreen(ivec3 c)
   }
   return any(allPlus) || any(allMinus);
 }
+#endif
 
 void main()
 {
@@ -531,10 +532,16 @@ void main()
     vIsovalue = bit == 1 && rank == 0 && vIsovalue < 0 ? t : vIsovalue;
     rank -= bit;
   }
-  if ((oneRankPerCell == 1 && index != 0u) || (cullCells == 1 && vIsovalue >= 0 && cellOffScreen(cell)))
+  if (oneRankPerCell == 1 && index != 0u)
   {
     vIsovalue = -1;
   }
+#ifdef MEDISO_CULL_CELLS
+  if (vIsovalue >= 0 && cellOffScreen(cell))
+  {
+    vIsovalue = -1;
+  }
+#endif
   if (vIsovalue >= 0)
   {
     vLook = vec4(isoColors[vIsovalue].rgb, isovalues[vIsovalue]);

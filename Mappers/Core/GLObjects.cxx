@@ -466,6 +466,34 @@ void SetNearest(const GLApi& gl, GLenum target)
   f.TexParameteri(target, GL_TEXTURE_MAX_LEVEL, 0);
 }
 
+void SetCountingPassState(const GLApi& gl)
+{
+  const GLApi::Functions& f = gl.F();
+  for (GLenum cap :
+    { GL_DEPTH_TEST, GL_BLEND, GL_SCISSOR_TEST, GL_STENCIL_TEST, GL_CULL_FACE, GL_RASTERIZER_DISCARD })
+  {
+    f.Disable(cap);
+  }
+  f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+}
+
+void SetSurfacePassBlending(const GLApi& gl, bool translucent)
+{
+  const GLApi::Functions& f = gl.F();
+  if (translucent)
+  {
+    f.Enable(GL_BLEND);
+    f.BlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
+    f.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    f.DepthMask(GL_FALSE);
+  }
+  else
+  {
+    f.Disable(GL_BLEND);
+    f.DepthMask(GL_TRUE);
+  }
+}
+
 std::string FramebufferProblem(const GLApi& gl)
 {
   const GLenum status = gl.F().CheckFramebufferStatus(GL_DRAW_FRAMEBUFFER);

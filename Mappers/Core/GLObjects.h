@@ -180,6 +180,16 @@ inline void BindTextureUnit(const GLApi& gl, int unit, GLenum target, GLuint tex
 /// Nearest filtering, clamped: the only sampling the core uses (texelFetch).
 void SetNearest(const GLApi& gl, GLenum target);
 
+/// The state of the core's counting passes (the probe, the pyramid's levels): every fragment
+/// drawn is written as it is: no depth, stencil or scissor test, no blending or culling, the
+/// rasteriser on, every colour channel. Call it inside a ScopedGLState.
+void SetCountingPassState(const GLApi& gl);
+
+/// Blending and depth writes of one of the two surface passes: opaque (no blending, depth
+/// written) or translucent (premultiplied colours composited "over", depth tested only, so
+/// that translucent surfaces never hide what lies behind them). Call it inside a ScopedGLState.
+void SetSurfacePassBlending(const GLApi& gl, bool translucent);
+
 /// "" when the bound draw framebuffer is complete, else why not.
 std::string FramebufferProblem(const GLApi& gl);
 

@@ -79,13 +79,7 @@ ProbeResult ProbeGL(const GLApi& gl, std::string& reason)
   const GLApi::Functions& f = gl.F();
   ScopedGLState saved(gl, 1);
   gl.TakeErrors();
-  f.Disable(GL_DEPTH_TEST);
-  f.Disable(GL_BLEND);
-  f.Disable(GL_SCISSOR_TEST);
-  f.Disable(GL_STENCIL_TEST);
-  f.Disable(GL_CULL_FACE);
-  f.Disable(GL_RASTERIZER_DISCARD);
-  f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  SetCountingPassState(gl);
 
   Name volume(gl, NameKind::Texture), counts(gl, NameKind::Texture);
   Name fbo(gl, NameKind::Framebuffer), vertexArray(gl, NameKind::VertexArray);

@@ -599,13 +599,7 @@ bool HistoPyramidGL::Build(const std::vector<double>& isovalues, std::string& er
 
   ScopedGLState saved(gl, 2);
   gl.TakeErrors();
-  f.Disable(GL_DEPTH_TEST);
-  f.Disable(GL_BLEND);
-  f.Disable(GL_SCISSOR_TEST);
-  f.Disable(GL_STENCIL_TEST);
-  f.Disable(GL_CULL_FACE);
-  f.Disable(GL_RASTERIZER_DISCARD);
-  f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  SetCountingPassState(gl);
   f.PixelStorei(GL_PACK_ALIGNMENT, 4);
 
   // 1. The level atlases, allocated once per volume size.
@@ -757,12 +751,7 @@ bool HistoPyramidGL::ReadLevel(
 
   ScopedGLState saved(gl, 1);
   gl.TakeErrors();
-  f.Disable(GL_DEPTH_TEST);
-  f.Disable(GL_BLEND);
-  f.Disable(GL_SCISSOR_TEST);
-  f.Disable(GL_STENCIL_TEST);
-  f.Disable(GL_RASTERIZER_DISCARD);
-  f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  SetCountingPassState(gl);
   f.PixelStorei(GL_PACK_ALIGNMENT, 4);
 
   if (level == 0)

@@ -164,18 +164,7 @@ bool MeshRenderer::Render(const IsosurfaceFrame& frame, const matrix4::Matrix& w
   f.Disable(GL_CULL_FACE);
   for (int translucent = 0; translucent < 2; ++translucent)
   {
-    if (translucent)
-    {
-      f.Enable(GL_BLEND);
-      f.BlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
-      f.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-      f.DepthMask(GL_FALSE);
-    }
-    else
-    {
-      f.Disable(GL_BLEND);
-      f.DepthMask(GL_TRUE);
-    }
+    SetSurfacePassBlending(gl, translucent != 0);
     for (const auto& mesh : impl.Meshes)
     {
       if (!mesh || !mesh->Visible || (mesh->Color[3] < 1.0f) != (translucent == 1))
