@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -359,6 +360,37 @@ bool ReadMetaImage(const std::string& path, MetaImage& image, std::string& error
     {
       std::reverse(image.Bytes.begin() + i * valueBytes, image.Bytes.begin() + (i + 1) * valueBytes);
     }
+  }
+  return true;
+}
+
+bool WriteMetaImage(const std::string& path, const MetaImage& image, std::string& error)
+{
+  std::ofstream out(path, std::ios::binary);
+  if (!out)
+  {
+    error = path + ": cannot be written";
+    return false;
+  }
+  const double* s = image.Spacing;
+  const double* o = image.Origin;
+  const double* m = image.Direction;
+  char header[1024];
+  std::snprintf(header, sizeof(header),
+    "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = %s\n"
+    "CompressedData = False\nTransformMatrix = %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g "
+    "%.17g\nOffset = %.17g %.17g %.17g\nElementSpacing = %.17g %.17g %.17g\nDimSize = %d %d %d\n"
+    "ElementType = %s\nElementDataFile = LOCAL\n",
+    LittleEndianMachine() ? "False" : "True", m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8],
+    o[0], o[1], o[2], s[0], s[1], s[2], image.Dimensions[0], image.Dimensions[1],
+    image.Dimensions[2], MetaElementType(image.Type));
+  out << header;
+  out.write(reinterpret_cast<const char*>(image.Bytes.data()),
+    static_cast<std::streamsize>(image.Bytes.size()));
+  if (!out)
+  {
+    error = path + ": writing failed";
+    return false;
   }
   return true;
 }

@@ -49,6 +49,9 @@ struct MetaImage
 /// Reads `path` into `image`; false with the reason in @a error.
 bool ReadMetaImage(const std::string& path, MetaImage& image, std::string& error);
 
+/// Writes `image` to `path` as an uncompressed .mha (data LOCAL, in the machine's byte order).
+bool WriteMetaImage(const std::string& path, const MetaImage& image, std::string& error);
+
 /// The type's MetaImage name ("MET_SHORT").
 const char* MetaElementType(ScalarType type);
 

@@ -25,6 +25,7 @@
 #include "PngWriter.h"
 #include "SceneView.h"
 #include "ThreadedFor.h"
+#include "VolumeSources.h"
 
 #include <algorithm>
 #include <chrono>
@@ -43,10 +44,17 @@ namespace
 using namespace mediso;
 using Clock = std::chrono::steady_clock;
 
-const char* const Usage = R"(usage: mediso-render VOLUME.mha|VOLUME.mhd [options]
+const char* const Usage = R"(usage: mediso-render VOLUME.mha|VOLUME.mhd|phantom:N [options]
 
 Renders the isosurfaces of an uncompressed MetaImage volume on the GPU (cell
 rasterisation over a HistoPyramid), with no window and no X display (EGL).
+
+Volume:
+  phantom:N             in place of a file: the MedicalPhantom head on N^3
+                        points (int16 HU, spacing 240/(N-1) mm, no noise)
+  --resample WxHxD      resample the volume (trilinear) to WxHxD points over
+                        the same bounds, e.g. the head CT to 512x512x216
+  --write-volume F.mha  write the volume used (after --resample)
 
 Scene:
   --iso V[:R,G,B[,A]]   an isosurface: value, colour (0..1) and opacity
@@ -91,6 +99,8 @@ struct Options
   double Material[4] = { 0.15, 0.8, 0.25, 30.0 };
   bool Points = true, FirstHit = true;
   std::string Output;
+  int Resample[3] = { 0, 0, 0 };
+  std::string WriteVolume;
   bool Stats = false;
   int Frames = 1;
   int Rotate = 0;
@@ -248,6 +258,27 @@ Options Parse(int argc, char* argv[])
     {
       opt.Output = value("--output");
     }
+    else if (arg == "--resample")
+    {
+      const std::string text = value("--resample");
+      const std::vector<double> d = Numbers(text, 'x', "--resample");
+      if (d.size() != 3)
+      {
+        throw UsageError{ "--resample takes WxHxD, not " + text };
+      }
+      for (int a = 0; a < 3; ++a)
+      {
+        if (d[a] != std::floor(d[a]) || d[a] < 2 || d[a] > 16384)
+        {
+          throw UsageError{ "--resample: each size must be a whole number from 2 to 16384, not " + text };
+        }
+        opt.Resample[a] = static_cast<int>(d[a]);
+      }
+    }
+    else if (arg == "--write-volume")
+    {
+      opt.WriteVolume = value("--write-volume");
+    }
     else if (arg == "--stats")
     {
       opt.Stats = true;
@@ -302,9 +333,9 @@ Options Parse(int argc, char* argv[])
   {
     throw UsageError{ "no volume given" };
   }
-  if (opt.Surfaces.empty() && opt.Sweep == 0)
+  if (opt.Surfaces.empty() && opt.Sweep == 0 && opt.WriteVolume.empty())
   {
-    throw UsageError{ "give at least one --iso (or --sweep)" };
+    throw UsageError{ "give at least one --iso (or --sweep, or --write-volume)" };
   }
   if (opt.Surfaces.size() > static_cast<std::size_t>(MaximumIsovalues))
   {
@@ -537,9 +568,37 @@ int Run(int argc, char* argv[])
   }
   headless::MetaImage image;
   std::string error;
-  if (!headless::ReadMetaImage(opt.Input, image, error))
+  int phantomSize = 0;
+  if (headless::ParsePhantomSpec(opt.Input, phantomSize, error))
+  {
+    if (!error.empty() || !headless::MakePhantom(phantomSize, image, error))
+    {
+      return Fail(3, error);
+    }
+  }
+  else if (!headless::ReadMetaImage(opt.Input, image, error))
   {
     return Fail(3, error);
+  }
+  if (opt.Resample[0] > 0)
+  {
+    headless::MetaImage resampled;
+    if (!headless::Resample(image, opt.Resample, resampled, error))
+    {
+      return Fail(3, opt.Input + ": " + error);
+    }
+    image = std::move(resampled);
+  }
+  if (!opt.WriteVolume.empty())
+  {
+    if (!headless::WriteMetaImage(opt.WriteVolume, image, error))
+    {
+      return Fail(1, error);
+    }
+    if (opt.Surfaces.empty() && opt.Sweep == 0)
+    {
+      return 0;
+    }
   }
   for (int a = 0; a < 3; ++a)
   {

@@ -60,26 +60,32 @@ def data_dir():
 
 
 def volume_for(args, name):
+    """mediso-render's arguments for the input: a file, or on a machine with no mapper
+    (a GPU machine with only a driver) the volume mediso-render makes itself."""
     if name == "ct":
-        return os.path.join(data_dir(), "ct_head.mha")
+        return [os.path.join(data_dir(), "ct_head.mha")]
     folder = args.volumes or os.path.join(ROOT, "build", "bench-volumes")
     path = os.path.join(folder, name + ".mha")
     if not os.path.isfile(path):
         if not args.mapper:
+            if name == "ct512":
+                return volume_for(args, "ct") + ["--resample", "512x512x216"]
+            if name.startswith("phantom") and name[len("phantom"):].isdigit():
+                return ["phantom:" + name[len("phantom"):]]
             raise SystemExit("no %s: give --volumes with %s.mha" % (path, name))
         os.makedirs(folder, exist_ok=True)
         progress("writing %s" % path)
-        subprocess.run([args.mapper, "--input", name, "--ct", volume_for(args, "ct"),
+        subprocess.run([args.mapper, "--input", name, "--ct", volume_for(args, "ct")[0],
                         "--write-input", path], check=True, stdout=subprocess.DEVNULL)
-    return path
+    return [path]
 
 
 def run_render(args, volume, window, isovalue, rotate, sweep):
     """{protocol: (median ms, build ms, primitives)} of one mediso-render run."""
     # The mapper's benchmark views the volume from the front (-y), head up (+z): from VTK's
     # default camera (+z, up +y) that is an elevation of -90 degrees.
-    command = [args.render, volume, "--iso", "%g" % isovalue, "--size", window, "--api", args.api,
-               "--elevation", "-90"]
+    command = [args.render] + volume + ["--iso", "%g" % isovalue, "--size", window,
+                                        "--api", args.api, "--elevation", "-90"]
     if rotate:
         command += ["--rotate", str(rotate)]
     if sweep:
@@ -99,7 +105,7 @@ def run_render(args, volume, window, isovalue, rotate, sweep):
 
 def run_mapper(args, name, window):
     command = [os.path.join(ROOT, "Testing", "Scripts", "with-xvfb.sh"), args.mapper, "--input", name,
-               "--ct", volume_for(args, "ct"), "--frames", str(args.frames), "--sweep",
+               "--ct", volume_for(args, "ct")[0], "--frames", str(args.frames), "--sweep",
                str(args.sweep), "--windows", window, "--isovalues=" + args.isovalues,
                "--methods", "hp"]
     env = dict(os.environ, VTK_SMP_BACKEND_IN_USE="STDThread")

@@ -122,6 +122,20 @@ def main():
            [write_mha(os.path.join(temp, "nan.mha"), (6, 5, 4), "MET_FLOAT",
                       values=[nan] * 120, fmt="<f"), "--iso", "0"], 3, ["NaN"])
 
+    # Volumes it makes itself (phantom:N, --resample, --write-volume).
+    expect(binary, "phantom too small", ["phantom:1", "--iso", "0"], 3, ["whole number from 2"])
+    expect(binary, "phantom not a size", ["phantom:abc", "--iso", "0"], 3, ["whole number from 2"])
+    expect(binary, "phantom too large", ["phantom:99999", "--iso", "0"], 3, ["whole number from 2"])
+    expect(binary, "resample to 1 point", [good, "--iso", "0", "--resample", "1x4x4"], 2,
+           ["--resample"])
+    expect(binary, "resample with 2 sizes", [good, "--iso", "0", "--resample", "4x4"], 2,
+           ["WxHxD"])
+    expect(binary, "resample not whole", [good, "--iso", "0", "--resample", "4.5x4x4"], 2,
+           ["whole number"])
+    expect(binary, "volume written nowhere",
+           [good, "--write-volume", os.path.join(temp, "no-such-dir", "v.mha")], 1,
+           ["cannot be written"])
+
     # The context's limits, and no usable context.
     expect(binary, "over GL_MAX_3D_TEXTURE_SIZE",
            [write_mha(os.path.join(temp, "long.mha"), (2, 2, 20000), "MET_UCHAR",
