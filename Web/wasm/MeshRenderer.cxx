@@ -133,7 +133,9 @@ bool MeshRenderer::Render(const IsosurfaceFrame& frame, const matrix4::Matrix& w
   Internals& impl = *this->Impl;
   const GLApi& gl = *impl.GL;
   const GLApi::Functions& f = gl.F();
-  Program* program = impl.Programs.Get(gl, "", shaders::Mesh_vs, shaders::Mesh_fs, error);
+  const int numLights = std::max(0, std::min(frame.NumberOfLights, MaximumLights));
+  const std::string defines = "#define MEDISO_LIGHTS " + std::to_string(numLights) + "\n";
+  Program* program = impl.Programs.Get(gl, defines, shaders::Mesh_vs, shaders::Mesh_fs, error);
   if (!program)
   {
     error = "the mesh shaders do not build: " + error;
@@ -157,7 +159,6 @@ bool MeshRenderer::Render(const IsosurfaceFrame& frame, const matrix4::Matrix& w
   program->Set("diffuse", frame.Diffuse);
   program->Set("specular", frame.Specular);
   program->Set("specularPower", frame.SpecularPower);
-  program->Set("numberOfLights", frame.NumberOfLights);
   program->Set3fv("lightDirections", MaximumLights, &frame.LightDirections[0][0]);
   program->Set3fv("lightColors", MaximumLights, &frame.LightColors[0][0]);
   f.Enable(GL_DEPTH_TEST);
