@@ -134,6 +134,21 @@ void NormalMatrix(const Matrix& m, double out[9])
 }
 } // namespace
 
+int IsosurfaceFrame::LightsUsed() const
+{
+  return std::max(0, std::min(this->NumberOfLights, MaximumLights));
+}
+
+void SetLightingUniforms(Program& program, const IsosurfaceFrame& frame)
+{
+  program.Set("ambient", frame.Ambient);
+  program.Set("diffuse", frame.Diffuse);
+  program.Set("specular", frame.Specular);
+  program.Set("specularPower", frame.SpecularPower);
+  program.Set3fv("lightDirections", MaximumLights, &frame.LightDirections[0][0]);
+  program.Set3fv("lightColors", MaximumLights, &frame.LightColors[0][0]);
+}
+
 //------------------------------------------------------------------------------
 struct IsosurfaceRendererGL::Internals
 {
@@ -358,7 +373,6 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
   // whose fragments take the nearest hit of the cell's isovalues.
   const bool nearest = firstHit && counted.size() > 1;
   const bool childMasks = pyr.ChildMasks;
-  const int numLights = std::max(0, std::min(frame.NumberOfLights, MaximumLights));
 
   // 4. The program of this variant and pyramid layout.
   std::ostringstream defines, levels, descent;
@@ -389,7 +403,7 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
   {
     defines << "#define MEDISO_CULL_CELLS 1\n";
   }
-  defines << "#define MEDISO_LIGHTS " << numLights << "\n";
+  defines << "#define MEDISO_LIGHTS " << frame.LightsUsed() << "\n";
   defines << "#define MEDISO_ISOVALUES "
           << (translucent || nearest ? static_cast<int>(counted.size()) : MaximumIsovalues) << "\n";
   defines << pyr.Declarations();
@@ -462,12 +476,7 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
   program->SetMatrix3("gradientToView", gradientToView);
   program->Set1fv("isovalues", MaximumIsovalues, isoValues);
   program->Set4fv("isoColors", MaximumIsovalues, isoColors);
-  program->Set("ambient", frame.Ambient);
-  program->Set("diffuse", frame.Diffuse);
-  program->Set("specular", frame.Specular);
-  program->Set("specularPower", frame.SpecularPower);
-  program->Set3fv("lightDirections", MaximumLights, &frame.LightDirections[0][0]);
-  program->Set3fv("lightColors", MaximumLights, &frame.LightColors[0][0]);
+  SetLightingUniforms(*program, frame);
   // Where the cells are drawn: the viewport, or in the first-hit pass the
   // same viewport in buffers whose pixel (0, 0) is window pixel HitRect.xy.
   const int drawOrigin[2] = { firstHit ? viewport[0] - impl.HitRect[0] : viewport[0],

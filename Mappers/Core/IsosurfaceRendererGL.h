@@ -87,7 +87,22 @@ struct IsosurfaceFrame
   bool AllowPointFootprint = true;
   /// Draw opaque frames with point footprints through the first-hit pass.
   bool FirstHitPass = true;
+
+  /// The lights a program draws with (NumberOfLights within 0..MaximumLights): its
+  /// MEDISO_LIGHTS, a constant of the program, since a software rasteriser runs every
+  /// iteration of a loop with a uniform bound for every fragment.
+  int LightsUsed() const;
 };
+
+namespace glcore
+{
+class Program;
+}
+
+/// Sets a lit program's material and light uniforms (ambient, diffuse, specular,
+/// specularPower, lightDirections, lightColors) from the frame: the isosurface and the mesh
+/// programs shade alike.
+void SetLightingUniforms(glcore::Program& program, const IsosurfaceFrame& frame);
 
 /// What a frame did.
 struct IsosurfaceFrameStats

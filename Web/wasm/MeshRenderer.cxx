@@ -133,8 +133,7 @@ bool MeshRenderer::Render(const IsosurfaceFrame& frame, const matrix4::Matrix& w
   Internals& impl = *this->Impl;
   const GLApi& gl = *impl.GL;
   const GLApi::Functions& f = gl.F();
-  const int numLights = std::max(0, std::min(frame.NumberOfLights, MaximumLights));
-  const std::string defines = "#define MEDISO_LIGHTS " + std::to_string(numLights) + "\n";
+  const std::string defines = "#define MEDISO_LIGHTS " + std::to_string(frame.LightsUsed()) + "\n";
   Program* program = impl.Programs.Get(gl, defines, shaders::Mesh_vs, shaders::Mesh_fs, error);
   if (!program)
   {
@@ -155,12 +154,7 @@ bool MeshRenderer::Render(const IsosurfaceFrame& frame, const matrix4::Matrix& w
   }
   program->SetMatrix3("normalToView", normalToView);
   program->Set("parallelProjection", frame.Parallel ? 1 : 0);
-  program->Set("ambient", frame.Ambient);
-  program->Set("diffuse", frame.Diffuse);
-  program->Set("specular", frame.Specular);
-  program->Set("specularPower", frame.SpecularPower);
-  program->Set3fv("lightDirections", MaximumLights, &frame.LightDirections[0][0]);
-  program->Set3fv("lightColors", MaximumLights, &frame.LightColors[0][0]);
+  SetLightingUniforms(*program, frame);
   f.Enable(GL_DEPTH_TEST);
   f.Disable(GL_CULL_FACE);
   for (int translucent = 0; translucent < 2; ++translucent)
