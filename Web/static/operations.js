@@ -6,7 +6,8 @@
 // back, and the result itself only when asked for: downloads (STL, PLY, VTP), and the PLY for
 // window.mediso.showMesh when the page can draw a mesh. Every byte is counted into the readout.
 
-const $ = (id) => document.getElementById(id);
+import { $ } from "./state.js";
+
 const STAGES = {
   queued: "waiting for the server",
   surface: "extracting the surface",
@@ -29,12 +30,12 @@ function megabytes(n) {
 }
 
 /**
- * Drives the panel. `page` gives what it needs from app.js:
+ * Drives the panel. `page` gives what it needs of the rest of the page (app.js hands it over):
  *   dataset                  the dataset the page shows (docs/web.md's D)
  *   token                    the session's token
  *   surfaces()               the page's surfaces [{value, ...}]
  *   level()                  the level of the whole volume its surfaces are drawn at (0-3)
- *   request(url)             app.js's counted fetch: {response, body}
+ *   request(url)             the page's counted fetch (volume.js): {response, body}
  *   count(sent, received)    adds bytes the panel moved itself (WebSocket) to the readout
  */
 export function setupOperations(page) {
