@@ -60,6 +60,7 @@ async function start() {
     dataset: d,
     token: sessionToken(),
     surfaces: () => state.surfaces,
+    levels: state.facts.levels.count,
     // The page's surfaces as a level of the whole volume: the GPU path draws the fetched level
     // in full, the CPU path its own level of that.
     level: drawnLevel,

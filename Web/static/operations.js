@@ -34,7 +34,8 @@ function megabytes(n) {
  *   dataset                  the dataset the page shows (docs/web.md's D)
  *   token                    the session's token
  *   surfaces()               the page's surfaces [{value, ...}]
- *   level()                  the level of the whole volume its surfaces are drawn at (0-3)
+ *   levels                   the number of levels of detail (the module's; the last is the full volume)
+ *   level()                  the level of the whole volume its surfaces are drawn at
  *   request(url)             the page's counted fetch (volume.js): {response, body}
  *   count(sent, received)    adds bytes the panel moved itself (WebSocket) to the readout
  */
@@ -48,6 +49,13 @@ export function setupOperations(page) {
   let opening = null;
   let nextId = 1;
   let current = null; // {id, isovalue, level} of the operation in flight
+
+  // The levels to choose from, finest first, after "as on the page".
+  $("op-level").append(...Array.from({ length: page.levels }, (_, i) => {
+    const k = page.levels - 1 - i;
+    return Object.assign(document.createElement("option"),
+      { value: String(k), textContent: k === page.levels - 1 ? k + " (full)" : String(k) });
+  }));
 
   function setState(state, text) {
     section.dataset.state = state;
