@@ -15,12 +15,12 @@
 //   operations.js   the "On the server" panel
 //   ply.js          the server's surfaces, read
 
+import { interact } from "./interaction.js";
 import { setupOperations } from "./operations.js";
 import { applyPath, drawnLevel, requestPath } from "./path.js";
 import { fps, showDataset, unsupported, updateReadout } from "./readout.js";
 import { $, params, state } from "./state.js";
 import { replaceSurfaces, setupSurfaceList } from "./surfaces.js";
-import { interact } from "./interaction.js";
 import { change, clearMesh, renderNow, showMesh, startViewer } from "./viewer.js";
 import { countBytes, request, requestJSON, sessionToken } from "./volume.js";
 

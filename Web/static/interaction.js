@@ -2,8 +2,8 @@
 // Interaction on the canvas: dragging turns the camera about the focal point (azimuth,
 // elevation), the wheel dollies; each asks for one frame at the next animation frame.
 
-import { requestFrame } from "./viewer.js";
 import { state } from "./state.js";
+import { requestFrame } from "./viewer.js";
 
 export function interact(canvas) {
   let last = null;

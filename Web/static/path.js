@@ -3,9 +3,9 @@
 // BlockLOD core), and the level of the volume each can afford. The levels, their strides and
 // what the GPU path takes of a volume come from the module (state.facts), not from here.
 
-import { loadVolume } from "./volume.js";
 import { showPathNote } from "./readout.js";
 import { $, state } from "./state.js";
+import { loadVolume } from "./volume.js";
 
 // The CPU path keeps the volume within 1 / CPU_VOLUME_SHARE of the budget: its surfaces and
 // their cache take the rest.

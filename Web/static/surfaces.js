@@ -3,8 +3,8 @@
 // dataset's range), the "Add a surface" button, and the server panel's choice of surface. Every
 // change draws at once (viewer.js's change: change + frame, timed).
 
-import { change } from "./viewer.js";
 import { $, state } from "./state.js";
+import { change } from "./viewer.js";
 
 const SKIN = [0.93, 0.75, 0.62];
 const BONE = [0.97, 0.95, 0.88];
