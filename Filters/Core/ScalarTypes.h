@@ -91,6 +91,34 @@ bool VisitScalarType(ScalarType type, F&& f)
   return false;
 }
 
+/// The name of `type` as the hosts write it where their languages meet (the web
+/// server's X-Mediso-Type header, the page's volume loading): "int8", "uint8",
+/// "int16", "uint16", "int32", "uint32", "float32", "float64"; "" for an
+/// unknown value.
+inline const char* ScalarTypeName(ScalarType type)
+{
+  switch (type)
+  {
+    case ScalarType::Int8:
+      return "int8";
+    case ScalarType::UInt8:
+      return "uint8";
+    case ScalarType::Int16:
+      return "int16";
+    case ScalarType::UInt16:
+      return "uint16";
+    case ScalarType::Int32:
+      return "int32";
+    case ScalarType::UInt32:
+      return "uint32";
+    case ScalarType::Float32:
+      return "float32";
+    case ScalarType::Float64:
+      return "float64";
+  }
+  return "";
+}
+
 /// Bytes of one value of `type` (0 for an unknown value).
 inline int ScalarTypeSize(ScalarType type)
 {

@@ -314,20 +314,41 @@ std::uint64_t HistoPyramidGL::GetLastTilesDrawn() const
   return this->Impl->Built ? this->Impl->TilesDrawn : 0;
 }
 
+namespace
+{
+std::uint64_t VolumeTextureBytes(ScalarType type, const int points[3])
+{
+  const std::array<int, 3> texels = HistoPyramidGL::VolumeTextureSize(points);
+  return static_cast<std::uint64_t>(4 * texels[0]) * texels[1] * texels[2] *
+    VolumeFormatOf(type).BytesPerValue;
+}
+} // namespace
+
 std::uint64_t HistoPyramidGL::GetGPUMemoryBytes() const
 {
   const Internals& impl = *this->Impl;
   std::uint64_t bytes = 0;
   if (impl.Volume)
   {
-    bytes += static_cast<std::uint64_t>(4 * PackedVolumeWidth(impl.Points[0])) * impl.Points[1] *
-      impl.Points[2] * VolumeFormatOf(impl.Type).BytesPerValue;
+    bytes += VolumeTextureBytes(impl.Type, impl.Points);
   }
   if (!impl.Levels.empty())
   {
     bytes += impl.Layout.GetStoredBytes();
   }
   return bytes;
+}
+
+std::array<int, 3> HistoPyramidGL::VolumeTextureSize(const int points[3])
+{
+  return { { PackedVolumeWidth(points[0]), points[1], points[2] } };
+}
+
+std::uint64_t HistoPyramidGL::EstimateGPUMemoryBytes(ScalarType type, const int points[3])
+{
+  const int cells[3] = { std::max(1, points[0] - 1), std::max(1, points[1] - 1),
+    std::max(1, points[2] - 1) };
+  return VolumeTextureBytes(type, points) + PyramidLayout(cells).GetStoredBytes();
 }
 
 //------------------------------------------------------------------------------

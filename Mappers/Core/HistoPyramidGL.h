@@ -51,6 +51,7 @@
 #include "PyramidLayout.h"
 #include "ScalarTypes.h"
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -125,6 +126,19 @@ public:
 
   /// Bytes of GPU memory held now (volume texture and level atlases).
   std::uint64_t GetGPUMemoryBytes() const;
+
+  ///@{
+  /**
+   * What a volume of `points` per axis and of `type` takes before it is
+   * sent, for a host choosing what it can afford: the volume texture's size
+   * in texels (4 points to a texel along x; UploadVolume() refuses a volume
+   * whose texture exceeds GL_MAX_3D_TEXTURE_SIZE on an axis), and the GPU
+   * memory of that texture and of the built pyramid (what
+   * GetGPUMemoryBytes() says once the volume is uploaded and built).
+   */
+  static std::array<int, 3> VolumeTextureSize(const int points[3]);
+  static std::uint64_t EstimateGPUMemoryBytes(ScalarType type, const int points[3]);
+  ///@}
 
   /// Frees every GL object (the context must be current). UploadVolume() starts again.
   void Release();

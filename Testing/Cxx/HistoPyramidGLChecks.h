@@ -266,6 +266,13 @@ void RunType(mediso::HistoPyramidGL& gpu, const std::string& name, const std::ve
     }
     CompareBuild(gpu, name, values.data(), dims, isovalues);
   }
+  // What a host is told before it uploads (the web page chooses its level by it) is what the
+  // uploaded and built volume holds.
+  const std::uint64_t estimate =
+    mediso::HistoPyramidGL::EstimateGPUMemoryBytes(mediso::ScalarTypeOf<T>(), dims);
+  Check(gpu.IsBuilt() && gpu.GetGPUMemoryBytes() == estimate,
+    name + ": EstimateGPUMemoryBytes " + std::to_string(estimate) + " but GetGPUMemoryBytes " +
+      std::to_string(gpu.GetGPUMemoryBytes()));
 }
 
 template <typename T, typename F>

@@ -11,7 +11,8 @@
   BlockLODContour: exactly its triangles at levels 3 and 1, and images within the same threshold.
 - nowebgl: Chromium without WebGL: the page says so in words instead of staying blank.
 - budget: a client memory budget the full volume exceeds: the page fetches a coarser level of it
-  (each path its own), says so, and its bytes are that level's.
+  (each path its own), says so, and its bytes are that level's. The facts the page takes from
+  its WebAssembly module (scalar types, levels and their strides) describe the server's levels.
 
 The volume is the plugin's phantom at 72^3 written as a MetaImage; the page is served by
 Python/serve.py on a free local port. Exits 125 (skip) where Chromium, node or the module are
@@ -27,6 +28,7 @@ import subprocess
 import sys
 import threading
 import time
+import urllib.request
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -201,13 +203,35 @@ def compare(page_png, reference_png, what):
 common = [{"call": "setLook", "args": [MATERIAL]}, {"call": "setView", "args": [camera]}]
 if args.case == "budget":
     # The 72^3 int16 phantom is 0.75 MB: a 0.5 MB budget takes level 2 (36^3, 0.09 MB) for the GPU
-    # path (volume and pyramid: 1.1x) and for the CPU path (half the budget for the volume).
+    # path (the volume texture and the pyramid, as the module estimates them) and for the CPU path
+    # (half the budget for the volume).
     server, url = start_server()
     try:
-        results = {path: run_page(url + "&budget=0.5&path=" + path, [], "budget-" + path)
+        results = {path: run_page(url + "&budget=0.5&path=" + path,
+                                  [{"call": "facts"}, {"call": "estimates"}], "budget-" + path)
                    for path in ("gpu", "cpu")}
+        with urllib.request.urlopen(url.replace("/?", "/api/datasets?")) as answer:
+            described = json.load(answer)["datasets"][0]
     finally:
         stop_server(server)
+    facts = results["gpu"]["results"][0]
+    print("the module's facts: " + json.dumps(facts))
+    strides = facts["levels"]["strides"]
+    check(len(strides) == facts["levels"]["count"] == len(described["levels"])
+          and len(results["gpu"]["results"][1]) == len(strides),
+          "the module's levels (%d), the server's (%d) and the estimator's table (%d) agree in number"
+          % (facts["levels"]["count"], len(described["levels"]), len(results["gpu"]["results"][1])))
+    types = {t["name"]: t for t in facts["scalarTypes"]}
+    check(described["type"] in types, "the server's type %s is one of the module's %s"
+          % (described["type"], sorted(types)))
+    size = types.get(described["type"], {}).get("bytes", 0)
+    for k, (stride, level) in enumerate(zip(strides, described["levels"])):
+        d = level["dims"]
+        check(all(abs(level["spacing"][a] - stride * described["spacing"][a]) < 1e-9 for a in range(3))
+              and level["bytes"] == size * d[0] * d[1] * d[2],
+              "level %d: the server's spacing %s is the module's stride %d times %s, and its %d bytes "
+              "are %s values of %d bytes" % (k, level["spacing"], stride, described["spacing"],
+                                             level["bytes"], d, size))
     for path, result in results.items():
         stats = result["stats"]
         print("%s: level %d, %s" % (path, stats["level"], stats["levelNote"]))

@@ -25,6 +25,14 @@ for (const v of volumes) {
     "the volume crossed in " + v.encodedDataLength + " bytes with its headers, " +
     (v.encodedDataLength / raw).toFixed(3) + "x its " + raw + " raw bytes (at most 0.6x)");
 }
+// The page is ES modules (app.js imports the others): a browser runs a module script only when
+// it comes with a JavaScript MIME type.
+const scripts = [...wire.responses.values()].filter((r) => /\/static\/[^/?]+\.js(\?|$)/.test(r.url));
+const header = (r, name) => Object.entries(r.headers).find(([k]) => k.toLowerCase() === name)?.[1] || "";
+const notJS = scripts.filter((r) => !/^(text|application)\/javascript\b/.test(header(r, "content-type")));
+checks.check(scripts.length > 0 && notJS.length === 0,
+  scripts.length + " scripts of /static/ served as JavaScript" + (notJS.length ? " (not: " +
+    notJS.map((r) => r.url.replace(/\?.*/, "") + " " + header(r, "content-type")).join(", ") + ")" : ""));
 checks.check(wire.framesSent + wire.framesReceived === 0,
   "no WebSocket frame while the page loads and renders (" + wire.framesSent + " sent)");
 

@@ -6,7 +6,8 @@
 // back, and the result itself only when asked for: downloads (STL, PLY, VTP), and the PLY for
 // window.mediso.showMesh when the page can draw a mesh. Every byte is counted into the readout.
 
-const $ = (id) => document.getElementById(id);
+import { $ } from "./state.js";
+
 const STAGES = {
   queued: "waiting for the server",
   surface: "extracting the surface",
@@ -29,12 +30,13 @@ function megabytes(n) {
 }
 
 /**
- * Drives the panel. `page` gives what it needs from app.js:
+ * Drives the panel. `page` gives what it needs of the rest of the page (app.js hands it over):
  *   dataset                  the dataset the page shows (docs/web.md's D)
  *   token                    the session's token
  *   surfaces()               the page's surfaces [{value, ...}]
- *   level()                  the level of the whole volume its surfaces are drawn at (0-3)
- *   request(url)             app.js's counted fetch: {response, body}
+ *   levels                   the number of levels of detail (the module's; the last is the full volume)
+ *   level()                  the level of the whole volume its surfaces are drawn at
+ *   request(url)             the page's counted fetch (volume.js): {response, body}
  *   count(sent, received)    adds bytes the panel moved itself (WebSocket) to the readout
  */
 export function setupOperations(page) {
@@ -47,6 +49,13 @@ export function setupOperations(page) {
   let opening = null;
   let nextId = 1;
   let current = null; // {id, isovalue, level} of the operation in flight
+
+  // The levels to choose from, finest first, after "as on the page".
+  $("op-level").append(...Array.from({ length: page.levels }, (_, i) => {
+    const k = page.levels - 1 - i;
+    return Object.assign(document.createElement("option"),
+      { value: String(k), textContent: k === page.levels - 1 ? k + " (full)" : String(k) });
+  }));
 
   function setState(state, text) {
     section.dataset.state = state;

@@ -20,6 +20,7 @@
  * drawn as triangles (MeshRenderer). A surface the server made is drawn beside
  * either path.
  */
+#include "BlockLOD.h"
 #include "BlockLODCache.h"
 #include "BlockLODEstimator.h"
 #include "BlockLODVolume.h"
@@ -30,6 +31,8 @@
 #include "HistoPyramidGL.h"
 #include "IsosurfaceRendererGL.h"
 #include "MeshRenderer.h"
+#include "PyramidLayout.h"
+#include "ScalarTypes.h"
 #include "SceneView.h"
 #ifdef MEDISO_WEB_THREADS
 #include "ThreadedFor.h"
@@ -40,6 +43,7 @@
 #include <emscripten/html5.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -684,8 +688,72 @@ private:
   std::unique_ptr<web::MeshRenderer> Meshes;
 };
 
+namespace
+{
+// The facts the page takes from the cores rather than writing them again
+// (docs/web.md, The page's modules): each is stated once in C++.
+
+/// The scalar types the cores take: [{name, value, bytes}], `value` as
+/// WebViewer.setVolume takes it, `name` as the server's X-Mediso-Type says it.
+val ScalarTypes()
+{
+  val list = val::array();
+  for (int value = 0;; ++value)
+  {
+    const ScalarType type = static_cast<ScalarType>(value);
+    const int bytes = ScalarTypeSize(type);
+    if (bytes == 0)
+    {
+      break;
+    }
+    val entry = val::object();
+    entry.set("name", std::string(ScalarTypeName(type)));
+    entry.set("value", value);
+    entry.set("bytes", bytes);
+    list.call<void>("push", entry);
+  }
+  return list;
+}
+
+/// The sample stride of a level of detail (BlockLOD's levels; the server's
+/// volume levels sample the same points); 0 outside 0 .. NumberOfLevels - 1.
+int Stride(int level)
+{
+  return level >= 0 && level < NumberOfLevels ? LevelStride(level) : 0;
+}
+
+/// What the GPU path needs for a volume of `dims` points of scalar type
+/// `type` before it is fetched: {bytes: the volume texture and the built
+/// pyramid, texture: the volume texture's texels per axis}.
+val GPUVolume(int type, const val& dims)
+{
+  int points[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    points[a] = std::max(1, dims[a].as<int>());
+  }
+  const std::array<int, 3> texture = HistoPyramidGL::VolumeTextureSize(points);
+  val out = val::object();
+  out.set("bytes",
+    static_cast<double>(
+      HistoPyramidGL::EstimateGPUMemoryBytes(static_cast<ScalarType>(type), points)));
+  val size = val::array();
+  for (int t : texture)
+  {
+    size.call<void>("push", t);
+  }
+  out.set("texture", size);
+  return out;
+}
+} // namespace
+
 EMSCRIPTEN_BINDINGS(mediso_web)
 {
+  emscripten::function("scalarTypes", &ScalarTypes);
+  emscripten::constant("NumberOfLevels", NumberOfLevels);
+  emscripten::function("levelStride", &Stride);
+  emscripten::constant("MaximumIsovalues", MaximumIsovalues);
+  emscripten::function("gpuVolume", &GPUVolume);
   emscripten::class_<WebViewer>("WebViewer")
     .constructor<std::string>()
     .function("ready", &WebViewer::Ready)

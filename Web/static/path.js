@@ -1,0 +1,92 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Path choice (docs/web.md, Paths): the GPU path (the pyramid on WebGL2) or the CPU path (the
+// BlockLOD core), and the level of the volume each can afford. The levels, their strides and
+// what the GPU path takes of a volume come from the module (state.facts), not from here.
+
+import { showPathNote } from "./readout.js";
+import { $, state } from "./state.js";
+import { loadVolume } from "./volume.js";
+
+// The CPU path keeps the volume within 1 / CPU_VOLUME_SHARE of the budget: its surfaces and
+// their cache take the rest.
+const CPU_VOLUME_SHARE = 2;
+
+// The finest level of the volume a path can afford. GPU: its texture within the WebGL limits,
+// the volume texture and the pyramid within the budget. CPU: the volume within its share.
+function chooseLevel(dataset, info, budgetMB, path) {
+  const { count, strides } = state.facts.levels;
+  const full = count - 1;
+  const type = state.facts.scalarTypes.get(dataset.type);
+  for (let k = full; k >= 0; --k) {
+    const level = dataset.levels[k];
+    const d = level.dims;
+    const gpu = path === "cpu" ? null : state.facts.gpuVolume(type.value, d);
+    const fitsGL = !gpu || Math.max(...gpu.texture) <= info.max3DTextureSize;
+    const fitsBudget = (gpu ? gpu.bytes : CPU_VOLUME_SHARE * level.bytes) <= budgetMB * 1e6;
+    if (fitsGL && fitsBudget) {
+      const why = k === full ? "" :
+        "The volume is sent at level " + k + " (every " + strides[k] + "th point, " +
+        d.join("x") + "): the full " + dataset.dims.join("x") + " volume exceeds " +
+        (fitsGL ? "the memory budget." : "this WebGL's 3D texture limit.");
+      return { level: k, why };
+    }
+  }
+  return { level: 0, why: "Even level 0 of the volume exceeds the memory budget." };
+}
+
+// The path: what the user asked for, else from what the browser has. Both draw with WebGL2; the
+// GPU path ray-casts every covered pixel, which a software rasteriser does on the CPU, where the
+// CPU path's triangles are cheaper.
+function choosePath(requested, info, dataset, budgetMB) {
+  const gpu = chooseLevel(dataset, info, budgetMB, "gpu");
+  const cpu = chooseLevel(dataset, info, budgetMB, "cpu");
+  if (requested === "gpu" || requested === "cpu") {
+    return { path: requested, level: requested === "gpu" ? gpu : cpu, why: "chosen by the user" };
+  }
+  if (state.software) {
+    return { path: "cpu", level: cpu,
+      why: "auto: the WebGL2 renderer is software (" + state.unmaskedRenderer + "), where the " +
+        "triangles of the CPU path draw faster than per-pixel ray casting" };
+  }
+  if (gpu.level < cpu.level) {
+    return { path: "cpu", level: cpu,
+      why: "auto: the GPU path would need a coarser volume (" + gpu.why + ")" };
+  }
+  return { path: "gpu", level: gpu, why: "auto: WebGL2 on " + state.unmaskedRenderer };
+}
+
+/** Sets the path and fetches the volume again only if the path needs another level of it. */
+export async function applyPath() {
+  const budgetMB = Number($("budget").value) || 1024;
+  const choice = choosePath(state.requestedPath, state.viewer.info(), state.dataset, budgetMB);
+  state.path = choice.path;
+  state.reason = choice.why;
+  state.levelNote = choice.level.why;
+  showPathNote(choice.path, choice.why, choice.level.why);
+  $("path").value = state.requestedPath;
+  state.viewer.setPath(choice.path);
+  if (!state.volumePointer || state.level !== choice.level.level) {
+    await loadVolume(choice.level.level);
+  }
+  const volumeBytes = state.dataset.levels[state.level].bytes;
+  state.viewer.setBudget(Math.max(0, budgetMB * 1e6 - volumeBytes));
+}
+
+/** A new requested path ("auto", "gpu" or "cpu"), applied. */
+export async function requestPath(path) {
+  state.requestedPath = path;
+  await applyPath();
+}
+
+/**
+ * The level of the whole volume the page's surfaces are drawn at: the fetched level on the GPU
+ * path; on the CPU path its own level of the fetched volume (the strides multiply), level 0
+ * where that is coarser still.
+ */
+export function drawnLevel() {
+  if (state.path !== "cpu") {
+    return state.level;
+  }
+  const strides = state.facts.levels.strides;
+  return Math.max(0, strides.indexOf(strides[state.cpuLevel] * strides[state.level]));
+}

@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The page's state, declared once: every field, what it holds and the one module that changes
+// it (docs/web.md, The page's modules). Other modules read it. The object is sealed, so that
+// writing a field not declared here fails at once instead of adding a global by another name.
+
+/** The page's URL parameters (token, path, size, budget, threads). */
+export const params = new URLSearchParams(location.search);
+
+/** The page's element of that id. */
+export const $ = (id) => document.getElementById(id);
+
+export const state = Object.seal({
+  // viewer.js, once at the start: the WebAssembly module, its viewer on the canvas, and what
+  // the module states for the page (facts: scalar types, levels of detail, isovalue limit,
+  // the GPU path's memory of a volume), so that the page writes none of them itself.
+  module: null,
+  viewer: null,
+  facts: null,
+  threads: null, // threads of the CPU path (1 unless the page is cross-origin isolated)
+  software: false, // the WebGL2 renderer is a software one
+  unmaskedRenderer: "",
+
+  // app.js, once: the dataset shown (/api/datasets' first).
+  dataset: null,
+
+  // volume.js: the fetched volume in the module's memory, its level, and the bytes the page
+  // moved (its requests, and the server panel's WebSocket frames counted through volume.js).
+  volumePointer: 0,
+  level: null,
+  bytesSent: 0,
+  bytesReceived: 0,
+
+  // path.js: the path asked for ("auto", "gpu", "cpu"), the path drawn, and why.
+  requestedPath: params.get("path") || "auto",
+  path: "gpu",
+  reason: "",
+  levelNote: "",
+
+  // surfaces.js (and app.js's automation, through surfaces.js): the isosurfaces
+  // [{value, color: [r, g, b], opacity}].
+  surfaces: [],
+
+  // viewer.js, at each frame: its times and what it drew.
+  frameTimes: [], // [{at, ms}] of the last 120 frames
+  lastChangeMs: 0, // the last change + frame
+  lastFrameMs: 0,
+  buildMs: 0, // the part of the last frame that built the pyramid or the surfaces
+  primitives: 0,
+  triangles: 0,
+  cpuLevel: null, // the CPU path's level of detail of the fetched volume
+  pending: null, // the animation frame requested by interaction
+});

@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The surface list: one row per isosurface (value, colour, opacity, remove, a slider over the
+// dataset's range), the "Add a surface" button, and the server panel's choice of surface. Every
+// change draws at once (viewer.js's change: change + frame, timed).
+
+import { $, state } from "./state.js";
+import { change } from "./viewer.js";
+
+const SKIN = [0.93, 0.75, 0.62];
+const BONE = [0.97, 0.95, 0.88];
+
+/** The surfaces a dataset opens with: skin and bone for a CT in Hounsfield units. */
+export function defaultSurfaces(d) {
+  if (d.range[0] <= -900 && d.range[1] >= 400) { // a CT in Hounsfield units
+    return [{ value: -500, color: SKIN, opacity: 0.35 }, { value: 400, color: BONE, opacity: 1 }];
+  }
+  const v = d.range[0] + 0.3 * (d.range[1] - d.range[0]);
+  return [{ value: Number(v.toPrecision(4)), color: SKIN, opacity: 1 }];
+}
+
+function hex(color) {
+  return "#" + color.map((c) => Math.round(255 * c).toString(16).padStart(2, "0")).join("");
+}
+
+function fromHex(text) {
+  return [1, 3, 5].map((i) => parseInt(text.substr(i, 2), 16) / 255);
+}
+
+/** The rows of the list, made again from state.surfaces. */
+export function buildSurfaceList() {
+  const d = state.dataset;
+  const box = $("surfaces");
+  box.replaceChildren();
+  state.surfaces.forEach((s, i) => {
+    const row = document.createElement("div");
+    row.className = "surface";
+    const value = Object.assign(document.createElement("input"),
+      { type: "number", step: "any", value: s.value });
+    const color = Object.assign(document.createElement("input"), { type: "color", value: hex(s.color) });
+    const opacity = Object.assign(document.createElement("input"),
+      { type: "number", min: 0, max: 1, step: 0.05, value: s.opacity, title: "opacity" });
+    const remove = Object.assign(document.createElement("button"), { textContent: "x" });
+    const slider = Object.assign(document.createElement("input"),
+      { type: "range", min: d.range[0], max: d.range[1], step: "any", value: s.value });
+    value.oninput = () => change(() => { s.value = Number(value.value); slider.value = value.value; });
+    slider.oninput = () => change(() => { s.value = Number(slider.value); value.value = slider.value; });
+    color.oninput = () => change(() => { s.color = fromHex(color.value); });
+    opacity.oninput = () => change(() => { s.opacity = Math.min(1, Math.max(0, Number(opacity.value))); });
+    remove.onclick = () => change(() => { state.surfaces.splice(i, 1); buildSurfaceList(); });
+    row.append(value, color, opacity, remove, slider);
+    box.append(row);
+  });
+  const pick = $("op-surface");
+  pick.replaceChildren(...state.surfaces.map((s, i) =>
+    Object.assign(document.createElement("option"), { value: i, textContent: String(s.value) })));
+}
+
+/** The dataset's default surfaces in the list, and the "Add a surface" button. */
+export function setupSurfaceList() {
+  const d = state.dataset;
+  state.surfaces = defaultSurfaces(d);
+  buildSurfaceList();
+  $("add").onclick = () => change(() => {
+    state.surfaces.push({ value: d.range[0] + 0.5 * (d.range[1] - d.range[0]), color: BONE, opacity: 1 });
+    buildSurfaceList();
+  });
+}
+
+/**
+ * New surfaces, drawn (automation): [{value, color, opacity}], a missing colour or opacity
+ * taken from the surface at the same place in the list when `keepLooks`, else bone and opaque.
+ */
+export function replaceSurfaces(surfaces, keepLooks) {
+  change(() => {
+    state.surfaces = surfaces.map((s, i) => {
+      const old = keepLooks ? state.surfaces[i] || {} : {};
+      return { value: s.value, color: s.color || old.color || BONE, opacity: s.opacity ?? old.opacity ?? 1 };
+    });
+    buildSurfaceList();
+  });
+}

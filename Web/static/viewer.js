@@ -1,0 +1,123 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The renderer glue: the WebAssembly module (Web/wasm/WebViewer.cxx: the GPU core and the
+// BlockLOD core compiled for the browser), its viewer on the canvas, and the frames. The module
+// also states the facts the page needs of the cores (scalar types, levels of detail and their
+// strides, the isovalue limit, the GPU path's memory of a volume), read once into state.facts.
+
+import { parsePLY } from "./ply.js";
+import { updateReadout } from "./readout.js";
+import { params, state } from "./state.js";
+
+// The module: with threads where the page is cross-origin isolated (the server sends the
+// headers), else on one thread.
+async function loadModule() {
+  const threads = window.crossOriginIsolated && params.get("threads") !== "0";
+  const name = threads ? "mediso-mt" : "mediso";
+  await new Promise((resolve, reject) => {
+    const script = Object.assign(document.createElement("script"), { src: "static/" + name + ".js" });
+    script.onload = resolve;
+    script.onerror = () => reject(new Error("static/" + name + ".js cannot be loaded"));
+    document.head.append(script);
+  });
+  state.threads = threads ? navigator.hardwareConcurrency : 1;
+  const create = threads ? window.createMedisoThreads : window.createMediso;
+  return create({ locateFile: (f) => "static/" + f });
+}
+
+// What the module states for the page, as the page uses it.
+function readFacts(M) {
+  const count = M.NumberOfLevels;
+  return {
+    // name (the server's X-Mediso-Type) -> {name, value (for setVolume), bytes}
+    scalarTypes: new Map(M.scalarTypes().map((t) => [t.name, t])),
+    // level k samples every strides[k]-th point; count - 1 is the full volume
+    levels: { count, strides: Array.from({ length: count }, (_, k) => M.levelStride(k)) },
+    maximumIsovalues: M.MaximumIsovalues,
+    // {bytes, texture: [x, y, z] texels} of a volume of ScalarType value `type` on the GPU path
+    gpuVolume: (type, dims) => M.gpuVolume(type, dims),
+  };
+}
+
+/**
+ * Loads the module and makes its viewer on `canvas` (sized by the size=WIDTHxHEIGHT parameter
+ * when given). `probe` is a WebGL2 context of the page's, which names the renderer.
+ */
+export async function startViewer(canvas, probe) {
+  state.module = await loadModule();
+  state.facts = readFacts(state.module);
+  if (params.get("size")) { // WIDTHxHEIGHT (tests, benchmarks)
+    [canvas.width, canvas.height] = params.get("size").split("x").map(Number);
+  }
+  state.viewer = new state.module.WebViewer("#view");
+  state.viewer.resize(canvas.width, canvas.height);
+  if (!state.viewer.ready()) {
+    return false;
+  }
+  const debug = probe.getExtension("WEBGL_debug_renderer_info");
+  state.unmaskedRenderer = debug ? probe.getParameter(debug.UNMASKED_RENDERER_WEBGL)
+                                 : state.viewer.info().renderer;
+  state.software = /SwiftShader|llvmpipe|softpipe|Software/i.test(state.unmaskedRenderer);
+  return true;
+}
+
+/** Draws now and waits for the GPU: the time of a change + frame. */
+export function renderNow() {
+  const viewer = state.viewer;
+  viewer.setSurfaces(state.surfaces);
+  const start = performance.now();
+  if (!viewer.render()) {
+    throw new Error("render failed: " + viewer.stats().error);
+  }
+  viewer.finish();
+  const ms = performance.now() - start;
+  state.frameTimes.push({ at: performance.now(), ms });
+  if (state.frameTimes.length > 120) {
+    state.frameTimes.shift();
+  }
+  state.lastFrameMs = ms;
+  const stats = viewer.stats();
+  state.buildMs = stats.buildMs;
+  state.primitives = stats.primitives;
+  state.triangles = stats.triangles;
+  state.cpuLevel = stats.cpuLevel;
+  updateReadout();
+  return ms;
+}
+
+/** A change (`apply` changes what is drawn), then its frame, timed. */
+export function change(apply) {
+  apply();
+  state.lastChangeMs = renderNow();
+  updateReadout();
+}
+
+/** Frames on request (interaction), at most one per animation frame. */
+export function requestFrame() {
+  if (!state.pending) {
+    state.pending = requestAnimationFrame(() => {
+      state.pending = null;
+      renderNow();
+    });
+  }
+}
+
+/** Draws a surface the server made (a binary PLY) beside the isosurfaces. */
+export function showMesh(ply, color, opacity) {
+  const mesh = parsePLY(ply);
+  const M = state.module;
+  const points = M._malloc(mesh.points.byteLength);
+  const triangles = M._malloc(mesh.triangles.byteLength);
+  M.HEAPU8.set(new Uint8Array(mesh.points.buffer), points);
+  M.HEAPU8.set(new Uint8Array(mesh.triangles.buffer), triangles);
+  state.viewer.setResultMesh(points, mesh.points.length / 3, triangles, mesh.triangles.length / 3,
+    color, opacity);
+  M._free(points);
+  M._free(triangles);
+  renderNow();
+  return { points: mesh.points.length / 3, triangles: mesh.triangles.length / 3 };
+}
+
+export function clearMesh() {
+  state.viewer.clearResultMesh();
+  renderNow();
+}
