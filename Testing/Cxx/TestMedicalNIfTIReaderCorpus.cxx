@@ -422,6 +422,31 @@ std::map<std::string, std::function<void(const std::string&)>> Cases()
       "the stored int16 values");
   };
 
+  // A non-finite scale is no scale (as other readers take it), said once; a
+  // non-finite spacing is refused.
+  cases["NonFinite"] = [](const std::string& dir)
+  {
+    Fields f;
+    f.Slope = std::nan("");
+    const std::string path = dir + "/nan-slope.nii";
+    WritePlain(path, Int16File(f));
+    Messages messages;
+    auto reader = Read(path, messages);
+    const std::string expected = path + ": scl_slope is nan; the voxels are read unscaled.";
+    Check(
+      messages.Errors.empty() && messages.Warnings.size() == 1 && messages.Warnings[0] == expected,
+      "one warning: \"" + expected + "\"; got:" + Joined(messages.Errors) +
+        Joined(messages.Warnings));
+    vtkDataArray* scalars = reader->GetOutput()->GetPointData()->GetScalars();
+    Check(
+      scalars && scalars->GetDataType() == VTK_SHORT && scalars->GetComponent(7, 0) == Stored(7),
+      "the stored int16 values");
+    f.Slope = 1.0;
+    f.PixDim[1] = std::nan("");
+    WritePlain(dir + "/nan-pixdim.nii", Int16File(f));
+    ExpectRefused(dir + "/nan-pixdim.nii", "pixdim[1] (the spacing along x) is nan");
+  };
+
   // --- Refused files --------------------------------------------------------
   cases["ZeroDimension"] = [](const std::string& dir)
   {
