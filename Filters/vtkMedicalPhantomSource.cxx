@@ -223,7 +223,18 @@ int vtkMedicalPhantomSource::RequestData(
     }
     const vtkIdType k0 = extent[4] + static_cast<vtkIdType>(numSlices) * chunk / numChunks;
     const vtkIdType k1 = extent[4] + static_cast<vtkIdType>(numSlices) * (chunk + 1) / numChunks;
-    vtkSMPTools::For(k0, k1, 1, fill);
+    try
+    {
+      vtkSMPTools::For(k0, k1, 1, fill);
+    }
+    catch (const std::bad_alloc&)
+    {
+      // A thread's row of doubles, the last allocation left.
+      vtkErrorMacro("Cannot generate the phantom: memory ran out for the rows of "
+        << extent[1] - extent[0] + 1 << " doubles. The output is empty.");
+      output->Initialize();
+      return 1;
+    }
     this->UpdateProgress(static_cast<double>(chunk + 1) / numChunks);
   }
 
