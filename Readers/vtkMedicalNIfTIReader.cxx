@@ -506,8 +506,16 @@ std::string vtkMedicalNIfTIReader::CheckFile()
       msg << static_cast<std::uint64_t>(allBytes - h.VoxOffset) << " bytes from byte "
           << static_cast<std::uint64_t>(h.VoxOffset);
     }
-    msg << "), but the " << (gzipped ? "uncompressed gzip stream" : "file") << " holds only "
-        << held << " bytes";
+    msg << "), but ";
+    if (imagePath == headerPath)
+    {
+      msg << (gzipped ? "the uncompressed gzip stream" : "the file");
+    }
+    else
+    {
+      msg << (gzipped ? "the uncompressed gzip stream of " : "") << imagePath;
+    }
+    msg << " holds only " << held << " bytes";
     return msg.str();
   }
 

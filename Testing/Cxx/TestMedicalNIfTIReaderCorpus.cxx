@@ -422,6 +422,31 @@ std::map<std::string, std::function<void(const std::string&)>> Cases()
       "the stored int16 values");
   };
 
+  // A .hdr/.img pair ("ni1", voxels from byte 0 of the .img), opened by
+  // either name; a short .img is refused naming its own size.
+  cases["Pair"] = [](const std::string& dir)
+  {
+    Fields f;
+    f.Slope = 1.0;
+    f.Intercept = -1024.0;
+    f.VoxOffset = 0.0;
+    std::vector<unsigned char> header = Header(f);
+    header.resize(348);
+    std::memcpy(header.data() + 344, "ni1", 4);
+    WritePlain(dir + "/ct.hdr", header);
+    WritePlain(dir + "/ct.img", Int16Voxels(Voxels(f), false));
+    for (const char* name : { "/ct.hdr", "/ct.img" })
+    {
+      ExpectValues(
+        dir + name, VTK_INT, [](vtkIdType i) { return Stored(i) - 1024.0; }, Dims);
+    }
+    std::vector<unsigned char> half = Int16Voxels(Voxels(f) / 2, false);
+    WritePlain(dir + "/ct.img", half);
+    ExpectRefused(dir + "/ct.hdr",
+      "the header describes 4 x 3 x 2 INT16 voxels (48 bytes from byte 0), but " + dir +
+        "/ct.img holds only 24 bytes");
+  };
+
   // A non-finite scale is no scale (as other readers take it), said once; a
   // non-finite spacing is refused.
   cases["NonFinite"] = [](const std::string& dir)
