@@ -2,6 +2,7 @@
 #include "vtkMedicalPhantomSource.h"
 
 #include "HeadPhantom.h"
+#include "ProcessMemory.h"
 
 #include "vtkFieldData.h"
 #include "vtkIdTypeArray.h"
@@ -16,10 +17,10 @@
 #include "vtkShortArray.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
-#include <vtksys/SystemInformation.hxx>
-
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <new>
 #include <sstream>
 #include <vector>
 
@@ -95,16 +96,17 @@ std::string vtkMedicalPhantomSource::CheckParameters()
       return msg.str();
     }
   }
+  // The user's bound, where it is tighter than what the process may still
+  // allocate (physical memory, ulimit -v, cgroup: ProcessMemory.h).
   constexpr double BytesPerMB = 1.0e6;
-  double limitMB = this->MemoryLimit;
-  const char* limitSource = "the MemoryLimit property";
-  if (limitMB <= 0.0)
+  const mediso::MemoryAllowance allowance = mediso::ProcessMemoryAllowance();
+  double limitMB = allowance.Bounded() ? static_cast<double>(allowance.Bytes) / BytesPerMB
+                                       : std::numeric_limits<double>::infinity();
+  std::string limitSource = "what the process may still allocate: " + allowance.Limit;
+  if (this->MemoryLimit > 0.0 && this->MemoryLimit <= limitMB)
   {
-    vtksys::SystemInformation info;
-    info.RunMemoryCheck();
-    // vtksys reports MiB.
-    limitMB = static_cast<double>(info.GetAvailablePhysicalMemory()) * 1048576.0 / BytesPerMB;
-    limitSource = "the physical memory of this host";
+    limitMB = this->MemoryLimit;
+    limitSource = "the MemoryLimit property";
   }
   const int threads = std::max(1, vtkSMPTools::GetEstimatedNumberOfThreads());
   const double outputMB = OutputBytes(this->Dimensions) / BytesPerMB;
@@ -139,6 +141,7 @@ int vtkMedicalPhantomSource::RequestInformation(
   {
     vtkErrorMacro("Cannot generate the phantom: " << reason << ". The output is empty.");
   }
+  this->ReportedProblem = reason;
   outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), wholeExtent, 6);
   outInfo->Set(vtkDataObject::SPACING(), this->Spacing, 3);
   outInfo->Set(vtkDataObject::ORIGIN(), this->Origin, 3);
@@ -161,11 +164,16 @@ int vtkMedicalPhantomSource::RequestData(
 
   int extent[6];
   outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
-  if (!this->CheckParameters().empty() || extent[0] > extent[1] || extent[2] > extent[3] ||
-    extent[4] > extent[5])
+  const std::string reason = this->CheckParameters();
+  if (!reason.empty() || extent[0] > extent[1] || extent[2] > extent[3] || extent[4] > extent[5])
   {
-    // The error (if any) was reported in RequestInformation; an empty
+    // An error RequestInformation reported is not said twice; an empty
     // request is not an error.
+    if (!reason.empty() && this->ReportedProblem.empty())
+    {
+      vtkErrorMacro("Cannot generate the phantom: " << reason << ". The output is empty.");
+      this->ReportedProblem = reason;
+    }
     return 1;
   }
 
@@ -176,9 +184,23 @@ int vtkMedicalPhantomSource::RequestData(
   scalars->SetName("HU");
   const vtkIdType numPoints = static_cast<vtkIdType>(extent[1] - extent[0] + 1) *
     (extent[3] - extent[2] + 1) * (extent[5] - extent[4] + 1);
-  if (!scalars->Allocate(numPoints))
+  // RequestInformation's check was for the whole grid, a moment ago; the
+  // allocation can still fail (another allocation since, a limit lowered).
+  bool allocated = false;
+  try
   {
-    vtkErrorMacro("Cannot allocate " << numPoints << " points for the phantom.");
+    allocated = scalars->Allocate(numPoints) != 0;
+  }
+  catch (const std::bad_alloc&)
+  {
+    allocated = false;
+  }
+  if (!allocated)
+  {
+    vtkErrorMacro("Cannot generate the phantom: " << numPoints << " points ("
+                                                  << numPoints * sizeof(std::int16_t) / 1.0e6
+                                                  << " MB) could not be allocated. The output is "
+                                                     "empty.");
     output->Initialize();
     return 1;
   }
@@ -201,7 +223,18 @@ int vtkMedicalPhantomSource::RequestData(
     }
     const vtkIdType k0 = extent[4] + static_cast<vtkIdType>(numSlices) * chunk / numChunks;
     const vtkIdType k1 = extent[4] + static_cast<vtkIdType>(numSlices) * (chunk + 1) / numChunks;
-    vtkSMPTools::For(k0, k1, 1, fill);
+    try
+    {
+      vtkSMPTools::For(k0, k1, 1, fill);
+    }
+    catch (const std::bad_alloc&)
+    {
+      // A thread's row of doubles, the last allocation left.
+      vtkErrorMacro("Cannot generate the phantom: memory ran out for the rows of "
+        << extent[1] - extent[0] + 1 << " doubles. The output is empty.");
+      output->Initialize();
+      return 1;
+    }
     this->UpdateProgress(static_cast<double>(chunk + 1) / numChunks);
   }
 

@@ -92,9 +92,12 @@ public:
   ///@{
   /**
    * Upper bound, in MB (10^6 bytes), on the memory generation takes: the
-   * output and a row of doubles per thread. 0 (the default) means the
-   * physical memory of this machine. A request over the bound is refused
-   * with an error and an empty output.
+   * output and a row of doubles per thread. 0 (the default) means what the
+   * process may still allocate (mediso::ProcessMemoryAllowance(): the least
+   * of the host's available physical memory, the address-space limit set by
+   * `ulimit -v`, and the memory cgroup's limit); a positive bound applies
+   * where it is below that. A request over the bound is refused with an
+   * error and an empty output.
    */
   vtkSetClampMacro(MemoryLimit, double, 0.0, 1.0e12);
   vtkGetMacro(MemoryLimit, double);
@@ -120,6 +123,10 @@ private:
 
   // Empty string when the parameters are usable, else the reason.
   std::string CheckParameters();
+  // The reason RequestInformation reported (empty when none), so that
+  // RequestData reports a failure of its own (memory taken in between)
+  // instead of staying silent, and does not repeat one.
+  std::string ReportedProblem;
 };
 
 #endif

@@ -24,10 +24,12 @@
 #include "GLApi.h"
 #include "HistoPyramidGL.h"
 #include "IsosurfaceRendererGL.h"
+#include "ProcessMemory.h"
 
 #include <algorithm>
 #include <functional>
 #include <limits>
+#include <new>
 
 vtkStandardNewMacro(vtkOpenGLHistoPyramidIsosurfaces);
 
@@ -200,7 +202,34 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
   {
     impl.BuiltIsovalues.clear();
     impl.UploadedArray = nullptr;
-    if (!impl.Pyramid->UploadVolume(type, scalars->GetVoidPointer(0), dims, ParallelFor, reason))
+    // UploadVolume's CPU-side copies: doubles converted to float, and rows
+    // padded to a multiple of 4 points; past the allowance the CPU path
+    // (with its own check) draws instead.
+    const std::uint64_t points = static_cast<std::uint64_t>(dims[0]) * dims[1] * dims[2];
+    const std::uint64_t valueBytes = type == mediso::ScalarType::Float64
+      ? 4
+      : static_cast<std::uint64_t>(scalars->GetDataTypeSize());
+    std::uint64_t staging = type == mediso::ScalarType::Float64 ? 4 * points : 0;
+    if (dims[0] % 4 != 0)
+    {
+      staging += static_cast<std::uint64_t>(dims[0] + 3) / 4 * 4 * valueBytes * dims[1] * dims[2];
+    }
+    if (staging > 0 &&
+      !mediso::FitsInProcessMemory(staging, "the volume's copy for the GPU upload", reason))
+    {
+      return false;
+    }
+    bool uploaded = false;
+    try
+    {
+      uploaded =
+        impl.Pyramid->UploadVolume(type, scalars->GetVoidPointer(0), dims, ParallelFor, reason);
+    }
+    catch (const std::bad_alloc&)
+    {
+      reason = "memory ran out while copying the volume for the GPU upload";
+    }
+    if (!uploaded)
     {
       return false;
     }

@@ -1,18 +1,355 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMedicalNIfTIReader.h"
 
+#include "ProcessMemory.h"
+
+#include "vtkCallbackCommand.h"
+#include "vtkCommand.h"
 #include "vtkDataArray.h"
-#include "vtkFloatArray.h"
+#include "vtkErrorCode.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkMatrix4x4.h"
 #include "vtkNIFTIImageHeader.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkSMPTools.h"
+#include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkStringArray.h"
+#include "vtk_zlib.h"
+
+#include <vtksys/SystemTools.hxx>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <new>
+#include <sstream>
 
 vtkStandardNewMacro(vtkMedicalNIfTIReader);
+
+namespace
+{
+constexpr int NIfTI1HeaderBytes = 348;
+constexpr int NIfTI2HeaderBytes = 540;
+
+// NIfTI's datatype codes (nifti1.h), with the VTK type the superclass reads
+// them into; 0 where this reader refuses the type.
+struct DataTypeInfo
+{
+  int Code;
+  const char* Name;
+  int Bits;
+  int VTKType;
+};
+const DataTypeInfo DataTypes[] = { { 1, "BINARY", 1, 0 }, { 2, "UINT8", 8, VTK_TYPE_UINT8 },
+  { 4, "INT16", 16, VTK_TYPE_INT16 }, { 8, "INT32", 32, VTK_TYPE_INT32 },
+  { 16, "FLOAT32", 32, VTK_TYPE_FLOAT32 }, { 32, "COMPLEX64", 64, 0 },
+  { 64, "FLOAT64", 64, VTK_TYPE_FLOAT64 }, { 128, "RGB24", 24, 0 },
+  { 256, "INT8", 8, VTK_TYPE_INT8 }, { 512, "UINT16", 16, VTK_TYPE_UINT16 },
+  { 768, "UINT32", 32, VTK_TYPE_UINT32 }, { 1024, "INT64", 64, VTK_TYPE_INT64 },
+  { 1280, "UINT64", 64, VTK_TYPE_UINT64 }, { 1536, "FLOAT128", 128, 0 },
+  { 1792, "COMPLEX128", 128, 0 }, { 2048, "COMPLEX256", 256, 0 }, { 2304, "RGBA32", 32, 0 } };
+
+const DataTypeInfo* FindDataType(int code)
+{
+  for (const DataTypeInfo& t : DataTypes)
+  {
+    if (t.Code == code)
+    {
+      return &t;
+    }
+  }
+  return nullptr;
+}
+
+// The fields of a NIfTI-1, NIfTI-2 or Analyze 7.5 header this reader checks,
+// in native byte order and NIfTI-2's widths.
+struct Header
+{
+  int Version = 0;         // 0: Analyze 7.5
+  bool SingleFile = false; // magic "n+1"/"n+2": the voxels follow the header in the same file
+  std::int64_t Dim[8] = {};
+  double PixDim[8] = {};
+  int DataType = 0;
+  int BitPix = 0;
+  double VoxOffset = 0.0;
+  double Slope = 0.0;
+  double Intercept = 0.0;
+  double TOffset = 0.0;
+};
+
+template<typename T>
+T Field(const unsigned char* bytes, std::size_t offset, bool swap)
+{
+  unsigned char raw[sizeof(T)];
+  std::memcpy(raw, bytes + offset, sizeof(T));
+  if (swap)
+  {
+    std::reverse(raw, raw + sizeof(T));
+  }
+  T value;
+  std::memcpy(&value, raw, sizeof(T));
+  return value;
+}
+
+struct GzCloser
+{
+  void operator()(gzFile_s* f) const { gzclose(f); }
+};
+using GzFile = std::unique_ptr<gzFile_s, GzCloser>;
+
+// Reads the header of `path` (gzipped or not); empty string or the reason.
+std::string ReadHeader(const std::string& path, Header& h)
+{
+  GzFile file(gzopen(path.c_str(), "rb"));
+  if (!file)
+  {
+    return "the file cannot be opened";
+  }
+  unsigned char bytes[NIfTI2HeaderBytes] = {};
+  int got = gzread(file.get(), bytes, NIfTI1HeaderBytes);
+  if (got < 4)
+  {
+    return "the file is too short for a NIfTI header (" + std::to_string(std::max(got, 0)) +
+      " bytes)";
+  }
+  const std::int32_t size = Field<std::int32_t>(bytes, 0, false);
+  const std::int32_t swappedSize = Field<std::int32_t>(bytes, 0, true);
+  bool swap = false;
+  if (size == NIfTI1HeaderBytes || size == NIfTI2HeaderBytes)
+  {
+    swap = false;
+  }
+  else if (swappedSize == NIfTI1HeaderBytes || swappedSize == NIfTI2HeaderBytes)
+  {
+    swap = true;
+  }
+  else
+  {
+    return "this is not a NIfTI-1, NIfTI-2 or Analyze 7.5 header (its first field, sizeof_hdr, "
+           "is " +
+      std::to_string(size) + "; 348 or 540 expected)";
+  }
+  const int headerBytes = swap ? swappedSize : size;
+  if (headerBytes == NIfTI2HeaderBytes && got == NIfTI1HeaderBytes)
+  {
+    const int more =
+      gzread(file.get(), bytes + NIfTI1HeaderBytes, NIfTI2HeaderBytes - NIfTI1HeaderBytes);
+    if (more > 0)
+    {
+      got += more;
+    }
+  }
+  if (got < headerBytes)
+  {
+    return "the file ends inside its " + std::to_string(headerBytes) + "-byte header (" +
+      std::to_string(got) + " bytes)";
+  }
+  if (headerBytes == NIfTI2HeaderBytes)
+  {
+    if (std::memcmp(bytes + 4, "n+2", 4) != 0 && std::memcmp(bytes + 4, "ni2", 4) != 0)
+    {
+      return "the 540-byte header lacks NIfTI-2's magic (\"n+2\" or \"ni2\")";
+    }
+    h.Version = 2;
+    h.SingleFile = bytes[5] == '+';
+    h.DataType = Field<std::int16_t>(bytes, 12, swap);
+    h.BitPix = Field<std::int16_t>(bytes, 14, swap);
+    for (int i = 0; i < 8; ++i)
+    {
+      h.Dim[i] = Field<std::int64_t>(bytes, 16 + 8 * i, swap);
+      h.PixDim[i] = Field<double>(bytes, 104 + 8 * i, swap);
+    }
+    h.VoxOffset = static_cast<double>(Field<std::int64_t>(bytes, 168, swap));
+    h.Slope = Field<double>(bytes, 176, swap);
+    h.Intercept = Field<double>(bytes, 184, swap);
+    h.TOffset = Field<double>(bytes, 216, swap);
+    return std::string();
+  }
+  const bool nifti1 =
+    std::memcmp(bytes + 344, "n+1", 4) == 0 || std::memcmp(bytes + 344, "ni1", 4) == 0;
+  h.Version = nifti1 ? 1 : 0;
+  h.SingleFile = nifti1 && bytes[345] == '+';
+  h.DataType = Field<std::int16_t>(bytes, 70, swap);
+  h.BitPix = Field<std::int16_t>(bytes, 72, swap);
+  for (int i = 0; i < 8; ++i)
+  {
+    h.Dim[i] = Field<std::int16_t>(bytes, 40 + 2 * i, swap);
+    h.PixDim[i] = Field<float>(bytes, 76 + 4 * i, swap);
+  }
+  h.VoxOffset = Field<float>(bytes, 108, swap);
+  // Analyze 7.5 has no scale (the superclass ignores those bytes too).
+  h.Slope = nifti1 ? Field<float>(bytes, 112, swap) : 0.0;
+  h.Intercept = nifti1 ? Field<float>(bytes, 116, swap) : 0.0;
+  h.TOffset = nifti1 ? Field<float>(bytes, 136, swap) : 0.0;
+  return std::string();
+}
+
+// Whether `path` holds at least `needed` bytes, uncompressed; `held` is what it
+// holds when not. A gzip member ends with its uncompressed size modulo 2^32
+// (ISIZE); when that already covers `needed` the stream is not decompressed
+// here (a stream cut short is then caught by the read itself).
+bool HoldsBytes(const std::string& path, std::uint64_t needed, std::uint64_t& held, bool& gzipped)
+{
+  std::ifstream in(path, std::ios::binary);
+  unsigned char magic[2] = { 0, 0 };
+  in.read(reinterpret_cast<char*>(magic), 2);
+  gzipped = in.gcount() == 2 && magic[0] == 0x1f && magic[1] == 0x8b;
+  const std::uint64_t fileBytes = vtksys::SystemTools::FileLength(path);
+  if (!gzipped)
+  {
+    held = fileBytes;
+    return fileBytes >= needed;
+  }
+  if (fileBytes >= 18 && needed < (std::uint64_t(1) << 32))
+  {
+    unsigned char trailer[4];
+    in.clear();
+    in.seekg(-4, std::ios::end);
+    in.read(reinterpret_cast<char*>(trailer), 4);
+    const std::uint64_t isize = std::uint64_t(trailer[0]) | (std::uint64_t(trailer[1]) << 8) |
+      (std::uint64_t(trailer[2]) << 16) | (std::uint64_t(trailer[3]) << 24);
+    if (in.gcount() == 4 && isize >= needed)
+    {
+      held = isize;
+      return true;
+    }
+  }
+  // Several gzip members, more than 4 GiB, or a short stream: count.
+  GzFile file(gzopen(path.c_str(), "rb"));
+  held = 0;
+  if (!file)
+  {
+    return false;
+  }
+  std::vector<char> chunk(1 << 20);
+  while (held < needed)
+  {
+    const int got = gzread(file.get(), chunk.data(), static_cast<unsigned>(chunk.size()));
+    if (got <= 0)
+    {
+      break;
+    }
+    held += static_cast<std::uint64_t>(got);
+  }
+  return held >= needed;
+}
+
+const char* AxisName(int axis)
+{
+  static const char* const names[] = { "x", "y", "z" };
+  return names[axis];
+}
+
+// The calibrated type of the class comment's rule.
+int CalibratedType(int stored, double slope, double intercept)
+{
+  double lo = 0.0, hi = 0.0;
+  bool small = true;
+  switch (stored)
+  {
+    case VTK_TYPE_INT8:
+      lo = -128.0;
+      hi = 127.0;
+      break;
+    case VTK_TYPE_UINT8:
+      hi = 255.0;
+      break;
+    case VTK_TYPE_INT16:
+      lo = -32768.0;
+      hi = 32767.0;
+      break;
+    case VTK_TYPE_UINT16:
+      hi = 65535.0;
+      break;
+    default:
+      small = false;
+  }
+  if (small && slope == 1.0 && intercept == std::floor(intercept))
+  {
+    if (lo + intercept >= -32768.0 && hi + intercept <= 32767.0)
+    {
+      return VTK_SHORT;
+    }
+    if (lo + intercept >= -2147483648.0 && hi + intercept <= 2147483647.0)
+    {
+      return VTK_INT;
+    }
+  }
+  return (small || stored == VTK_TYPE_FLOAT32) ? VTK_FLOAT : VTK_DOUBLE;
+}
+
+template<typename In, typename Out>
+void Calibrate(const In* in, Out* out, vtkIdType n, double slope, double intercept)
+{
+  vtkSMPTools::For(0, n,
+    [&](vtkIdType begin, vtkIdType end)
+    {
+      for (vtkIdType i = begin; i < end; ++i)
+      {
+        out[i] = static_cast<Out>(static_cast<double>(in[i]) * slope + intercept);
+      }
+    });
+}
+
+template<typename In>
+void CalibrateTo(const In* in, vtkDataArray* out, vtkIdType n, double slope, double intercept)
+{
+  switch (out->GetDataType())
+  {
+    case VTK_SHORT:
+      Calibrate(in, static_cast<short*>(out->GetVoidPointer(0)), n, slope, intercept);
+      break;
+    case VTK_INT:
+      Calibrate(in, static_cast<int*>(out->GetVoidPointer(0)), n, slope, intercept);
+      break;
+    case VTK_FLOAT:
+      Calibrate(in, static_cast<float*>(out->GetVoidPointer(0)), n, slope, intercept);
+      break;
+    default:
+      Calibrate(in, static_cast<double*>(out->GetVoidPointer(0)), n, slope, intercept);
+  }
+}
+
+// Collects what the superclass reports as errors while it runs, so that the
+// reader says one thing, in its own words.
+struct ErrorCapture
+{
+  vtkObject* Object;
+  unsigned long Tag = 0;
+  std::string Text;
+  vtkNew<vtkCallbackCommand> Command;
+
+  explicit ErrorCapture(vtkObject* object)
+    : Object(object)
+  {
+    this->Command->SetClientData(this);
+    this->Command->SetCallback(
+      [](vtkObject*, unsigned long, void* clientData, void* callData)
+      {
+        auto* self = static_cast<ErrorCapture*>(clientData);
+        if (callData && self->Text.empty())
+        {
+          self->Text = static_cast<const char*>(callData);
+        }
+      });
+    // Before any observer of the user's, and the last to see the event.
+    this->Command->SetAbortFlagOnExecute(1);
+    this->Tag = object->AddObserver(vtkCommand::ErrorEvent, this->Command, 1000.0f);
+  }
+  ~ErrorCapture() { this->Object->RemoveObserver(this->Tag); }
+  ErrorCapture(const ErrorCapture&) = delete;
+  void operator=(const ErrorCapture&) = delete;
+};
+} // namespace
 
 //------------------------------------------------------------------------------
 vtkMedicalNIfTIReader::vtkMedicalNIfTIReader() = default;
@@ -21,13 +358,236 @@ vtkMedicalNIfTIReader::vtkMedicalNIfTIReader() = default;
 vtkMedicalNIfTIReader::~vtkMedicalNIfTIReader() = default;
 
 //------------------------------------------------------------------------------
+std::string vtkMedicalNIfTIReader::CheckFile()
+{
+  // The header's file and the voxels' file, found as the superclass finds them.
+  std::string headerPath, imagePath;
+  if (this->FileNames && this->FileNames->GetNumberOfValues() == 2)
+  {
+    for (vtkIdType i = 0; i < 2; ++i)
+    {
+      const std::string name = this->FileNames->GetValue(i);
+      (CheckExtension(name.c_str(), ".hdr") ? headerPath : imagePath) = name;
+    }
+    this->FileLabel = headerPath;
+    if (headerPath.empty() || imagePath.empty())
+    {
+      return "FileNames must hold one .hdr and one .img file";
+    }
+  }
+  else
+  {
+    const char* name = this->GetFileName();
+    if (!name || !*name)
+    {
+      this->FileLabel = "(no file)";
+      return "no FileName is set";
+    }
+    this->FileLabel = name;
+    char* found = ReplaceExtension(name, ".img", ".hdr");
+    headerPath = found ? found : "";
+    delete[] found;
+    found = ReplaceExtension(name, ".hdr", ".img");
+    imagePath = found ? found : "";
+    delete[] found;
+    if (headerPath.empty() || imagePath.empty())
+    {
+      return vtksys::SystemTools::FileExists(name)
+        ? "the other file of its .hdr/.img pair does not exist"
+        : "the file does not exist";
+    }
+  }
+
+  Header h;
+  std::string reason = ReadHeader(headerPath, h);
+  if (!reason.empty())
+  {
+    return reason;
+  }
+  std::ostringstream msg;
+  const std::int64_t ndim = h.Dim[0];
+  if (ndim < 1 || ndim > 7)
+  {
+    msg << "dim[0] (the number of dimensions) is " << ndim << "; NIfTI allows 1 to 7";
+    return msg.str();
+  }
+  std::int64_t dims[8] = { ndim, 1, 1, 1, 1, 1, 1, 1 };
+  for (int i = 1; i <= ndim; ++i)
+  {
+    if (h.Dim[i] < 1)
+    {
+      msg << "dim[" << i << "] is " << h.Dim[i] << "; every dimension must be at least 1";
+      return msg.str();
+    }
+    if (h.Dim[i] > std::numeric_limits<int>::max())
+    {
+      msg << "dim[" << i << "] is " << h.Dim[i] << ", more than a VTK extent holds ("
+          << std::numeric_limits<int>::max() << ")";
+      return msg.str();
+    }
+    dims[i] = h.Dim[i];
+  }
+  for (int i = 5; i <= 7; ++i)
+  {
+    if (dims[i] > 1)
+    {
+      msg << "dim[" << i << "] is " << dims[i]
+          << ": vectors and dimensions beyond time (dim[5..7] above 1) are not read";
+      return msg.str();
+    }
+  }
+  const DataTypeInfo* type = FindDataType(h.DataType);
+  if (!type)
+  {
+    msg << "datatype code " << h.DataType << " is not a NIfTI datatype";
+    return msg.str();
+  }
+  if (!type->VTKType)
+  {
+    msg << "datatype " << type->Name << " (" << type->Code
+        << ") is not read: one real number per voxel is needed";
+    return msg.str();
+  }
+  if (h.BitPix != type->Bits)
+  {
+    msg << "bitpix is " << h.BitPix << " but datatype " << type->Name << " has " << type->Bits
+        << " bits per voxel";
+    return msg.str();
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    if (!std::isfinite(h.PixDim[a + 1]))
+    {
+      msg << "pixdim[" << a + 1 << "] (the spacing along " << AxisName(a) << ") is "
+          << h.PixDim[a + 1];
+      return msg.str();
+    }
+  }
+  const double minOffset =
+    h.SingleFile ? (h.Version == 2 ? NIfTI2HeaderBytes : NIfTI1HeaderBytes) : 0;
+  if (!std::isfinite(h.VoxOffset) || h.VoxOffset < minOffset ||
+    h.VoxOffset != std::floor(h.VoxOffset) || h.VoxOffset > 9.0e18)
+  {
+    msg << "vox_offset is " << h.VoxOffset;
+    if (h.SingleFile)
+    {
+      msg << "; the voxels of a single-file NIfTI-" << h.Version << " image start after its "
+          << minOffset << "-byte header";
+    }
+    else
+    {
+      msg << ": not a byte offset";
+    }
+    return msg.str();
+  }
+
+  // The voxels of one volume and of all of them, in bytes, without overflow.
+  const std::uint64_t bytesPerVoxel = static_cast<std::uint64_t>(type->Bits / 8);
+  const long double volumeBytes =
+    static_cast<long double>(dims[1]) * dims[2] * dims[3] * bytesPerVoxel;
+  const long double allBytes = volumeBytes * dims[4] + h.VoxOffset;
+  std::uint64_t held = 0;
+  bool gzipped = false;
+  if (allBytes > 9.0e18L ||
+    !HoldsBytes(imagePath, static_cast<std::uint64_t>(allBytes), held, gzipped))
+  {
+    msg << "the header describes " << dims[1] << " x " << dims[2] << " x " << dims[3];
+    if (dims[4] > 1)
+    {
+      msg << " x " << dims[4];
+    }
+    msg << " " << type->Name << " voxels (";
+    if (allBytes > 9.0e18L)
+    {
+      msg << "more than 9e18 bytes";
+    }
+    else
+    {
+      msg << static_cast<std::uint64_t>(allBytes - h.VoxOffset) << " bytes from byte "
+          << static_cast<std::uint64_t>(h.VoxOffset);
+    }
+    msg << "), but ";
+    if (imagePath == headerPath)
+    {
+      msg << (gzipped ? "the uncompressed gzip stream" : "the file");
+    }
+    else
+    {
+      msg << (gzipped ? "the uncompressed gzip stream of " : "") << imagePath;
+    }
+    msg << " holds only " << held << " bytes";
+    return msg.str();
+  }
+
+  // The checks passed: what RequestInformation and RequestData need.
+  this->StoredScalarType = type->VTKType;
+  this->DataOffset = static_cast<unsigned long>(h.VoxOffset);
+  this->VolumeBytes = static_cast<unsigned long>(volumeBytes);
+  this->Slope = 1.0;
+  this->Intercept = 0.0;
+  double slope = h.Slope, intercept = h.Intercept;
+  if (!std::isfinite(slope))
+  {
+    vtkWarningMacro(<< this->FileLabel << ": scl_slope is " << slope
+                    << "; the voxels are read unscaled.");
+    slope = 0.0;
+  }
+  if (slope != 0.0 && !std::isfinite(intercept))
+  {
+    vtkWarningMacro(<< this->FileLabel << ": scl_inter is " << intercept << "; 0 is used.");
+    intercept = 0.0;
+  }
+  this->Calibrate = slope != 0.0 && (slope != 1.0 || intercept != 0.0);
+  if (this->Calibrate)
+  {
+    this->Slope = slope;
+    this->Intercept = intercept;
+  }
+  this->OutputScalarType = this->Calibrate
+    ? CalibratedType(this->StoredScalarType, this->Slope, this->Intercept)
+    : this->StoredScalarType;
+
+  this->TimeSteps.clear();
+  if (dims[4] > 1 && !this->TimeAsVector)
+  {
+    const double step = h.PixDim[4] > 0.0 && std::isfinite(h.PixDim[4]) ? h.PixDim[4] : 1.0;
+    const double start = std::isfinite(h.TOffset) && step == h.PixDim[4] ? h.TOffset : 0.0;
+    for (std::int64_t t = 0; t < dims[4]; ++t)
+    {
+      this->TimeSteps.push_back(start + step * static_cast<double>(t));
+    }
+  }
+  return std::string();
+}
+
+//------------------------------------------------------------------------------
 int vtkMedicalNIfTIReader::RequestInformation(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  this->Readable = false;
+  this->OutputScalarType = 0;
+  this->TimeSteps.clear();
+  outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+  outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  const int emptyExtent[6] = { 0, -1, 0, -1, 0, -1 };
+
+  const std::string reason = this->CheckFile();
+  if (!reason.empty())
+  {
+    vtkErrorMacro("Cannot read " << this->FileLabel << ": " << reason << ". The output is empty.");
+    this->OutputScalarType = 0;
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), emptyExtent, 6);
+    return 1;
+  }
   if (!this->Superclass::RequestInformation(request, inputVector, outputVector))
   {
-    return 0;
+    // Its one error is said; nothing is read.
+    this->OutputScalarType = 0;
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), emptyExtent, 6);
+    return 1;
   }
+
   // The superclass's matrices map its output's coordinates (index times
   // spacing, origin 0, slices already reordered for qfac) to the world:
   // their translation is the origin, their rotation the direction.
@@ -52,57 +612,170 @@ int vtkMedicalNIfTIReader::RequestInformation(
       this->Direction[3 * r + c] = matrix ? matrix->GetElement(r, c) : (r == c ? 1.0 : 0.0);
     }
   }
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  // A spacing of 0 the superclass reads as 1; a negative one becomes its
+  // magnitude along the reversed axis, so index times spacing along the
+  // direction lands where it did.
+  outInfo->Get(vtkDataObject::SPACING(), this->Spacing);
+  for (int a = 0; a < 3; ++a)
+  {
+    const double stored = header ? header->GetPixDim(a + 1) : 1.0;
+    if (stored == 0.0)
+    {
+      vtkWarningMacro(<< this->FileLabel << ": pixdim[" << a + 1 << "] (the spacing along "
+                      << AxisName(a) << ") is 0; a spacing of " << this->Spacing[a] << " is used.");
+    }
+    else if (this->Spacing[a] < 0.0)
+    {
+      this->Spacing[a] = -this->Spacing[a];
+      for (int r = 0; r < 3; ++r)
+      {
+        this->Direction[3 * r + a] = -this->Direction[3 * r + a];
+      }
+      vtkWarningMacro(<< this->FileLabel << ": pixdim[" << a + 1 << "] (the spacing along "
+                      << AxisName(a) << ") is " << stored << "; a spacing of " << this->Spacing[a]
+                      << " is used, along the reversed axis.");
+    }
+  }
+  outInfo->Set(vtkDataObject::SPACING(), this->Spacing, 3);
   outInfo->Set(vtkDataObject::ORIGIN(), this->Origin, 3);
   outInfo->Set(vtkDataObject::DIRECTION(), this->Direction, 9);
-  if (this->GetRescaleSlope() != 0.0 &&
-    (this->GetRescaleSlope() != 1.0 || this->GetRescaleIntercept() != 0.0))
+  vtkDataObject::SetPointDataActiveScalarInfo(
+    outInfo, this->OutputScalarType, this->GetNumberOfScalarComponents());
+  if (!this->TimeSteps.empty())
   {
-    vtkDataObject::SetPointDataActiveScalarInfo(
-      outInfo, VTK_FLOAT, this->GetNumberOfScalarComponents());
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), this->TimeSteps.data(),
+      static_cast<int>(this->TimeSteps.size()));
+    const double range[2] = { this->TimeSteps.front(), this->TimeSteps.back() };
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
   }
+  this->Readable = true;
   return 1;
+}
+
+//------------------------------------------------------------------------------
+bool vtkMedicalNIfTIReader::ReadVolume(vtkInformation* request, vtkInformationVector** inputVector,
+  vtkInformationVector* outputVector, std::string& reason)
+{
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  int extent[6];
+  outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
+  const std::uint64_t voxels = static_cast<std::uint64_t>(extent[1] - extent[0] + 1) *
+    static_cast<std::uint64_t>(extent[3] - extent[2] + 1) *
+    static_cast<std::uint64_t>(extent[5] - extent[4] + 1) *
+    static_cast<std::uint64_t>(this->GetNumberOfScalarComponents());
+  const int storedSize = vtkDataArray::GetDataTypeSize(this->StoredScalarType);
+  const int outputSize = vtkDataArray::GetDataTypeSize(this->OutputScalarType);
+  const std::uint64_t bytes = voxels * storedSize + (this->Calibrate ? voxels * outputSize : 0);
+  if (!mediso::FitsInProcessMemory(
+        bytes, this->Calibrate ? "the volume as stored and calibrated" : "the volume", reason))
+  {
+    return false;
+  }
+
+  // The time step asked for: the last one at or before the requested time.
+  std::size_t step = 0;
+  if (!this->TimeSteps.empty() &&
+    outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()))
+  {
+    const double time = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+    while (step + 1 < this->TimeSteps.size() && this->TimeSteps[step + 1] <= time)
+    {
+      ++step;
+    }
+  }
+
+  // The superclass allocates the type the pipeline information holds and
+  // reads from HeaderSize on: the stored type, from the chosen volume. The
+  // members are set directly, as Modified() here would re-execute the reader.
+  vtkDataObject::SetPointDataActiveScalarInfo(
+    outInfo, this->StoredScalarType, this->GetNumberOfScalarComponents());
+  this->HeaderSize = this->DataOffset + this->VolumeBytes * step;
+  int ok = 0;
+  std::string superclassError;
+  {
+    ErrorCapture capture(this);
+    ok = this->Superclass::RequestData(request, inputVector, outputVector);
+    superclassError = capture.Text;
+  }
+  this->HeaderSize = this->DataOffset;
+  vtkDataObject::SetPointDataActiveScalarInfo(
+    outInfo, this->OutputScalarType, this->GetNumberOfScalarComponents());
+  if (!ok)
+  {
+    if (this->GetErrorCode() == vtkErrorCode::PrematureEndOfFileError)
+    {
+      reason = "the file ends before the voxels the header describes do (it is truncated)";
+    }
+    else
+    {
+      const std::size_t colon = superclassError.rfind("): ");
+      reason = "the voxels cannot be read (" +
+        (colon == std::string::npos ? superclassError : superclassError.substr(colon + 3));
+      while (!reason.empty() && (reason.back() == '\n' || reason.back() == '.'))
+      {
+        reason.pop_back();
+      }
+      reason += ")";
+    }
+    return false;
+  }
+
+  vtkImageData* image = vtkImageData::GetData(outInfo);
+  vtkDataArray* stored = image->GetPointData()->GetScalars();
+  if (this->Calibrate && stored)
+  {
+    vtkSmartPointer<vtkDataArray> calibrated =
+      vtk::TakeSmartPointer(vtkDataArray::CreateDataArray(this->OutputScalarType));
+    calibrated->SetName(stored->GetName());
+    calibrated->SetNumberOfComponents(stored->GetNumberOfComponents());
+    calibrated->SetNumberOfTuples(stored->GetNumberOfTuples());
+    const vtkIdType n = stored->GetNumberOfValues();
+    switch (stored->GetDataType())
+    {
+      vtkTemplateMacro(CalibrateTo(static_cast<const VTK_TT*>(stored->GetVoidPointer(0)),
+        calibrated, n, this->Slope, this->Intercept));
+    }
+    image->GetPointData()->SetScalars(calibrated);
+  }
+  image->SetSpacing(this->Spacing);
+  image->SetOrigin(this->Origin);
+  image->SetDirectionMatrix(this->Direction);
+  if (!this->TimeSteps.empty())
+  {
+    image->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), this->TimeSteps[step]);
+  }
+  return true;
 }
 
 //------------------------------------------------------------------------------
 int vtkMedicalNIfTIReader::RequestData(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  if (!this->Superclass::RequestData(request, inputVector, outputVector))
-  {
-    return 0;
-  }
   vtkImageData* image = vtkImageData::GetData(outputVector, 0);
   if (!image)
   {
+    return 0;
+  }
+  if (!this->Readable)
+  {
+    // The reason was said in RequestInformation.
+    image->Initialize();
     return 1;
   }
-  image->SetOrigin(this->Origin);
-  image->SetDirectionMatrix(this->Direction);
-
-  const double slope = this->GetRescaleSlope();
-  const double intercept = this->GetRescaleIntercept();
-  vtkDataArray* stored = image->GetPointData()->GetScalars();
-  if (stored && slope != 0.0 && (slope != 1.0 || intercept != 0.0))
+  std::string reason;
+  bool ok = false;
+  try
   {
-    vtkNew<vtkFloatArray> calibrated;
-    calibrated->SetName(stored->GetName());
-    calibrated->SetNumberOfComponents(stored->GetNumberOfComponents());
-    calibrated->SetNumberOfTuples(stored->GetNumberOfTuples());
-    const int components = stored->GetNumberOfComponents();
-    vtkSMPTools::For(0, stored->GetNumberOfTuples(),
-      [&](vtkIdType begin, vtkIdType end)
-      {
-        for (vtkIdType t = begin; t < end; ++t)
-        {
-          for (int c = 0; c < components; ++c)
-          {
-            calibrated->SetTypedComponent(
-              t, c, static_cast<float>(stored->GetComponent(t, c) * slope + intercept));
-          }
-        }
-      });
-    image->GetPointData()->SetScalars(calibrated);
+    ok = this->ReadVolume(request, inputVector, outputVector, reason);
+  }
+  catch (const std::bad_alloc&)
+  {
+    reason = "memory ran out while reading the voxels";
+  }
+  if (!ok)
+  {
+    image->Initialize();
+    vtkErrorMacro("Cannot read " << this->FileLabel << ": " << reason << ". The output is empty.");
   }
   return 1;
 }
@@ -112,4 +785,6 @@ void vtkMedicalNIfTIReader::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "Placement: " << this->Placement << "\n";
+  os << indent << "OutputScalarType: " << this->OutputScalarType << "\n";
+  os << indent << "TimeSteps: " << this->TimeSteps.size() << "\n";
 }

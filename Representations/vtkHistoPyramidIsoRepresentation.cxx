@@ -13,8 +13,12 @@
 #include "vtkRectilinearGrid.h"
 #include "vtkResampleToImage.h"
 
+#include "ProcessMemory.h"
+
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <new>
 #include <sstream>
 
 namespace
@@ -265,10 +269,46 @@ int vtkHistoPyramidIsoRepresentation::RequestData(
       wanted = std::min({ wanted, 4.0 * static_cast<double>(n), 1024.0 });
       dimensions[a] = std::max(static_cast<int>(n), static_cast<int>(wanted));
     }
+    // The resampled copy of every point and cell array, and the mask
+    // vtkResampleToImage adds, must fit in what the process may allocate.
+    std::uint64_t bytesPerPoint = 1;
+    for (vtkDataSetAttributes* arrays : { static_cast<vtkDataSetAttributes*>(grid->GetPointData()),
+           static_cast<vtkDataSetAttributes*>(grid->GetCellData()) })
+    {
+      for (int i = 0; i < arrays->GetNumberOfArrays(); ++i)
+      {
+        vtkDataArray* array = arrays->GetArray(i);
+        bytesPerPoint += array
+          ? static_cast<std::uint64_t>(array->GetDataTypeSize()) * array->GetNumberOfComponents()
+          : 0;
+      }
+    }
+    std::string memoryProblem;
+    if (!mediso::FitsInProcessMemory(
+          static_cast<std::uint64_t>(dimensions[0]) * dimensions[1] * dimensions[2] * bytesPerPoint,
+          "the rectilinear grid resampled onto an even grid", memoryProblem))
+    {
+      vtkErrorMacro(<< "HistoPyramid Isosurface cannot draw this rectilinear grid: "
+                    << memoryProblem << ".");
+      this->Cache = nullptr;
+      this->IsoMapper->RemoveAllInputConnections(0);
+      return 1;
+    }
     vtkNew<vtkResampleToImage> resample;
     resample->SetInputDataObject(grid);
     resample->SetSamplingDimensions(dimensions);
-    resample->Update();
+    try
+    {
+      resample->Update();
+    }
+    catch (const std::bad_alloc&)
+    {
+      vtkErrorMacro(<< "HistoPyramid Isosurface cannot draw this rectilinear grid: memory ran "
+                       "out while resampling it onto an even grid.");
+      this->Cache = nullptr;
+      this->IsoMapper->RemoveAllInputConnections(0);
+      return 1;
+    }
     image->ShallowCopy(resample->GetOutput());
     // vtkResampleToImage marks the points it could not sample; every point
     // of a rectilinear grid's box can be, so the mask carries nothing.
