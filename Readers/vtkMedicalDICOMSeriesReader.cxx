@@ -46,65 +46,74 @@
 
 vtkStandardNewMacro(vtkMedicalDICOMSeriesReader);
 
-namespace {
+namespace
+{
 // DCMTK's decoders are process-wide registrations, made once whichever
 // thread reads first. DCMTK's own log goes quiet below fatal: every failure
 // it reports comes back as a condition that this reader turns into its one
 // message.
-void RegisterDecoders() {
+void RegisterDecoders()
+{
   static std::once_flag once;
-  std::call_once(once, [] {
-    OFLog::configure(OFLogger::FATAL_LOG_LEVEL);
-    DcmRLEDecoderRegistration::registerCodecs();
-    DJDecoderRegistration::registerCodecs();
-    DJLSDecoderRegistration::registerCodecs();
-  });
+  std::call_once(once,
+    []
+    {
+      OFLog::configure(OFLogger::FATAL_LOG_LEVEL);
+      DcmRLEDecoderRegistration::registerCodecs();
+      DJDecoderRegistration::registerCodecs();
+      DJLSDecoderRegistration::registerCodecs();
+    });
 }
 
 // The transfer syntaxes read: the uncompressed ones DCMTK parses itself and
 // the compressed ones the registered decoders handle.
-bool Decodable(E_TransferSyntax syntax) {
-  switch (syntax) {
-  case EXS_LittleEndianImplicit:
-  case EXS_LittleEndianExplicit:
-  case EXS_BigEndianExplicit:
-  case EXS_DeflatedLittleEndianExplicit:
-  case EXS_JPEGProcess1:
-  case EXS_JPEGProcess2_4:
-  case EXS_JPEGProcess6_8:
-  case EXS_JPEGProcess10_12:
-  case EXS_JPEGProcess14:
-  case EXS_JPEGProcess14SV1:
-  case EXS_JPEGLSLossless:
-  case EXS_JPEGLSLossy:
-  case EXS_RLELossless:
-    return true;
-  default:
-    return false;
+bool Decodable(E_TransferSyntax syntax)
+{
+  switch (syntax)
+  {
+    case EXS_LittleEndianImplicit:
+    case EXS_LittleEndianExplicit:
+    case EXS_BigEndianExplicit:
+    case EXS_DeflatedLittleEndianExplicit:
+    case EXS_JPEGProcess1:
+    case EXS_JPEGProcess2_4:
+    case EXS_JPEGProcess6_8:
+    case EXS_JPEGProcess10_12:
+    case EXS_JPEGProcess14:
+    case EXS_JPEGProcess14SV1:
+    case EXS_JPEGLSLossless:
+    case EXS_JPEGLSLossy:
+    case EXS_RLELossless:
+      return true;
+    default:
+      return false;
   }
 }
 
-std::string Number(double value) {
+std::string Number(double value)
+{
   std::ostringstream text;
   text.precision(6);
   text << value;
   return text.str();
 }
 
-std::string BaseName(const std::string &path) {
+std::string BaseName(const std::string& path)
+{
   return vtksys::SystemTools::GetFilenameName(path);
 }
 
 // One slice: a single-frame file, or one frame of a multi-frame file.
-struct Slice {
+struct Slice
+{
   std::size_t Instance = 0;
   unsigned long Frame = 0;
   bool HasPosition = false;
   bool HasOrientation = false;
   bool HasPixelSpacing = false;
-  double Position[3] = {0, 0, 0};
-  double Orientation[6] = {1, 0, 0, 0, 1, 0};
-  double PixelSpacing[2] = {1, 1}; // DICOM order: between rows, between columns
+  double Position[3] = { 0, 0, 0 };
+  double Orientation[6] = { 1, 0, 0, 0, 1, 0 };
+  double PixelSpacing[2] = { 1, 1 }; // DICOM order: between rows, between columns
   double Slope = 1.0;
   double Intercept = 0.0;
   double Distance = 0.0; // along the series' normal
@@ -112,7 +121,8 @@ struct Slice {
 };
 
 // What the scan keeps of one image file.
-struct Instance {
+struct Instance
+{
   std::string Path;
   std::string SeriesUID;
   std::string SeriesDescription;
@@ -127,34 +137,39 @@ struct Instance {
   std::vector<Slice> Slices;
 };
 
-std::string SliceName(const Instance &instance, const Slice &slice) {
+std::string SliceName(const Instance& instance, const Slice& slice)
+{
   std::string name = BaseName(instance.Path);
-  if (instance.Frames > 1) {
+  if (instance.Frames > 1)
+  {
     name += " frame " + std::to_string(slice.Frame + 1);
   }
   return name;
 }
 
-bool HasPart10Preamble(const std::string &path) {
+bool HasPart10Preamble(const std::string& path)
+{
   std::ifstream file(path, std::ios::binary);
   char head[132];
-  if (!file.read(head, sizeof(head))) {
+  if (!file.read(head, sizeof(head)))
+  {
     return false;
   }
-  return head[128] == 'D' && head[129] == 'I' && head[130] == 'C' &&
-         head[131] == 'M';
+  return head[128] == 'D' && head[129] == 'I' && head[130] == 'C' && head[131] == 'M';
 }
 
-bool ReadDoubles(DcmItem *item, const DcmTagKey &tag, double *values,
-                 int count) {
-  if (!item) {
+bool ReadDoubles(DcmItem* item, const DcmTagKey& tag, double* values, int count)
+{
+  if (!item)
+  {
     return false;
   }
-  for (int i = 0; i < count; ++i) {
+  for (int i = 0; i < count; ++i)
+  {
     Float64 value = 0.0;
-    if (item->findAndGetFloat64(tag, value, static_cast<unsigned long>(i))
-            .bad() ||
-        !std::isfinite(value)) {
+    if (item->findAndGetFloat64(tag, value, static_cast<unsigned long>(i)).bad() ||
+      !std::isfinite(value))
+    {
       return false;
     }
     values[i] = value;
@@ -164,160 +179,179 @@ bool ReadDoubles(DcmItem *item, const DcmTagKey &tag, double *values,
 
 // An attribute of a frame: in the frame's functional group macro, else in
 // the shared one, else at the top level of the dataset (a single-frame file).
-bool FrameDoubles(DcmItem *perFrame, DcmItem *shared, DcmItem *top,
-                  const DcmTagKey &macro, const DcmTagKey &tag, double *values,
-                  int count) {
-  for (DcmItem *group : {perFrame, shared}) {
-    DcmItem *item = nullptr;
+bool FrameDoubles(DcmItem* perFrame, DcmItem* shared, DcmItem* top, const DcmTagKey& macro,
+  const DcmTagKey& tag, double* values, int count)
+{
+  for (DcmItem* group : { perFrame, shared })
+  {
+    DcmItem* item = nullptr;
     if (group && group->findAndGetSequenceItem(macro, item, 0).good() &&
-        ReadDoubles(item, tag, values, count)) {
+      ReadDoubles(item, tag, values, count))
+    {
       return true;
     }
   }
   return ReadDoubles(top, tag, values, count);
 }
 
-enum class HeaderStatus { Image, NotImage, Unreadable };
+enum class HeaderStatus
+{
+  Image,
+  NotImage,
+  Unreadable
+};
 
 // The attributes of one file, read up to (not into) its pixel data.
-HeaderStatus ReadHeader(const std::string &path, Instance &instance,
-                        std::string &why) {
-  if (!HasPart10Preamble(path)) {
+HeaderStatus ReadHeader(const std::string& path, Instance& instance, std::string& why)
+{
+  if (!HasPart10Preamble(path))
+  {
     return HeaderStatus::NotImage;
   }
   DcmFileFormat file;
   // Values longer than 4 KB (the pixel data) stay on disk until asked for.
-  const OFCondition status = file.loadFile(path.c_str(), EXS_Unknown,
-                                           EGL_noChange, 4096, ERM_fileOnly);
-  if (status.bad()) {
+  const OFCondition status =
+    file.loadFile(path.c_str(), EXS_Unknown, EGL_noChange, 4096, ERM_fileOnly);
+  if (status.bad())
+  {
     why = status.text();
     return HeaderStatus::Unreadable;
   }
-  DcmDataset *data = file.getDataset();
+  DcmDataset* data = file.getDataset();
   if (!data || !data->tagExists(DCM_PixelData) ||
-      data->findAndGetUint16(DCM_Rows, instance.Rows).bad() ||
-      data->findAndGetUint16(DCM_Columns, instance.Columns).bad()) {
+    data->findAndGetUint16(DCM_Rows, instance.Rows).bad() ||
+    data->findAndGetUint16(DCM_Columns, instance.Columns).bad())
+  {
     return HeaderStatus::NotImage;
   }
   instance.Path = path;
   OFString text;
-  if (data->findAndGetOFString(DCM_SeriesInstanceUID, text).good()) {
+  if (data->findAndGetOFString(DCM_SeriesInstanceUID, text).good())
+  {
     instance.SeriesUID = text.c_str();
   }
-  if (data->findAndGetOFString(DCM_SeriesDescription, text).good()) {
+  if (data->findAndGetOFString(DCM_SeriesDescription, text).good())
+  {
     instance.SeriesDescription = text.c_str();
   }
   if (file.getMetaInfo() &&
-      file.getMetaInfo()
-          ->findAndGetOFString(DCM_TransferSyntaxUID, text)
-          .good()) {
+    file.getMetaInfo()->findAndGetOFString(DCM_TransferSyntaxUID, text).good())
+  {
     instance.TransferSyntaxUID = text.c_str();
     instance.Syntax = DcmXfer(text.c_str()).getXfer();
-  } else {
+  }
+  else
+  {
     instance.Syntax = data->getOriginalXfer();
     instance.TransferSyntaxUID = DcmXfer(instance.Syntax).getXferID();
   }
   data->findAndGetUint16(DCM_BitsAllocated, instance.BitsAllocated);
-  if (data->findAndGetUint16(DCM_BitsStored, instance.BitsStored).bad()) {
+  if (data->findAndGetUint16(DCM_BitsStored, instance.BitsStored).bad())
+  {
     instance.BitsStored = instance.BitsAllocated;
   }
-  if (data->findAndGetUint16(DCM_HighBit, instance.HighBit).bad()) {
+  if (data->findAndGetUint16(DCM_HighBit, instance.HighBit).bad())
+  {
     instance.HighBit = instance.BitsStored > 0 ? instance.BitsStored - 1 : 0;
   }
   data->findAndGetUint16(DCM_PixelRepresentation, instance.PixelRepresentation);
-  if (data->findAndGetUint16(DCM_SamplesPerPixel, instance.SamplesPerPixel)
-          .bad()) {
+  if (data->findAndGetUint16(DCM_SamplesPerPixel, instance.SamplesPerPixel).bad())
+  {
     instance.SamplesPerPixel = 1;
   }
-  if (data->findAndGetOFString(DCM_PhotometricInterpretation, text).good()) {
+  if (data->findAndGetOFString(DCM_PhotometricInterpretation, text).good())
+  {
     instance.Photometric = text.c_str();
   }
   Sint32 frames = 1;
-  if (data->findAndGetSint32(DCM_NumberOfFrames, frames).good() && frames > 1) {
+  if (data->findAndGetSint32(DCM_NumberOfFrames, frames).good() && frames > 1)
+  {
     instance.Frames = static_cast<unsigned long>(frames);
   }
   long number = 0;
   Sint32 value = 0;
-  if (data->findAndGetSint32(DCM_InstanceNumber, value).good()) {
+  if (data->findAndGetSint32(DCM_InstanceNumber, value).good())
+  {
     number = value;
   }
 
-  DcmItem *shared = nullptr;
+  DcmItem* shared = nullptr;
   data->findAndGetSequenceItem(DCM_SharedFunctionalGroupsSequence, shared, 0);
-  DcmSequenceOfItems *perFrame = nullptr;
+  DcmSequenceOfItems* perFrame = nullptr;
   data->findAndGetSequence(DCM_PerFrameFunctionalGroupsSequence, perFrame);
-  double thickness[1] = {0.0};
-  if (FrameDoubles(nullptr, shared, data, DCM_PixelMeasuresSequence,
-                   DCM_SliceThickness, thickness, 1)) {
+  double thickness[1] = { 0.0 };
+  if (FrameDoubles(
+        nullptr, shared, data, DCM_PixelMeasuresSequence, DCM_SliceThickness, thickness, 1))
+  {
     instance.SliceThickness = thickness[0];
   }
   instance.PerFramePositions =
-      instance.Frames == 1 || (perFrame && perFrame->card() >= instance.Frames);
+    instance.Frames == 1 || (perFrame && perFrame->card() >= instance.Frames);
   instance.Slices.resize(instance.Frames);
-  for (unsigned long f = 0; f < instance.Frames; ++f) {
-    Slice &slice = instance.Slices[f];
+  for (unsigned long f = 0; f < instance.Frames; ++f)
+  {
+    Slice& slice = instance.Slices[f];
     slice.Frame = f;
     slice.InstanceNumber = number;
-    DcmItem *group =
-        perFrame && f < perFrame->card() ? perFrame->getItem(f) : nullptr;
-    slice.HasPosition =
-        FrameDoubles(group, shared, data, DCM_PlanePositionSequence,
-                     DCM_ImagePositionPatient, slice.Position, 3);
-    slice.HasOrientation =
-        FrameDoubles(group, shared, data, DCM_PlaneOrientationSequence,
-                     DCM_ImageOrientationPatient, slice.Orientation, 6);
-    slice.HasPixelSpacing =
-        FrameDoubles(group, shared, data, DCM_PixelMeasuresSequence,
-                     DCM_PixelSpacing, slice.PixelSpacing, 2);
+    DcmItem* group = perFrame && f < perFrame->card() ? perFrame->getItem(f) : nullptr;
+    slice.HasPosition = FrameDoubles(
+      group, shared, data, DCM_PlanePositionSequence, DCM_ImagePositionPatient, slice.Position, 3);
+    slice.HasOrientation = FrameDoubles(group, shared, data, DCM_PlaneOrientationSequence,
+      DCM_ImageOrientationPatient, slice.Orientation, 6);
+    slice.HasPixelSpacing = FrameDoubles(
+      group, shared, data, DCM_PixelMeasuresSequence, DCM_PixelSpacing, slice.PixelSpacing, 2);
     double rescale[1];
-    if (FrameDoubles(group, shared, data, DCM_PixelValueTransformationSequence,
-                     DCM_RescaleSlope, rescale, 1)) {
+    if (FrameDoubles(
+          group, shared, data, DCM_PixelValueTransformationSequence, DCM_RescaleSlope, rescale, 1))
+    {
       slice.Slope = rescale[0];
     }
     if (FrameDoubles(group, shared, data, DCM_PixelValueTransformationSequence,
-                     DCM_RescaleIntercept, rescale, 1)) {
+          DCM_RescaleIntercept, rescale, 1))
+    {
       slice.Intercept = rescale[0];
     }
   }
   return HeaderStatus::Image;
 }
 
-struct Series {
+struct Series
+{
   std::string UID;
   std::string Description;
   std::vector<std::size_t> Instances; // indices into the scan
   std::size_t Slices = 0;
 };
 
-std::string Describe(const Series &series) {
-  std::string text =
-      series.UID.empty() ? std::string("(no Series Instance UID)") : series.UID;
+std::string Describe(const Series& series)
+{
+  std::string text = series.UID.empty() ? std::string("(no Series Instance UID)") : series.UID;
   text += " (";
-  if (!series.Description.empty()) {
+  if (!series.Description.empty())
+  {
     text += "\"" + series.Description + "\", ";
   }
-  text += std::to_string(series.Slices) +
-          (series.Slices == 1 ? " slice)" : " slices)");
+  text += std::to_string(series.Slices) + (series.Slices == 1 ? " slice)" : " slices)");
   return text;
 }
 
 // Stored values: masked to Bits Stored, sign-extended when signed, and the
 // least and greatest of each slice.
 template <typename Raw, typename Stored>
-void Unpack(const Raw *raw, Stored *out, std::size_t count,
-            const Instance &instance, std::int64_t &least,
-            std::int64_t &greatest) {
+void Unpack(const Raw* raw, Stored* out, std::size_t count, const Instance& instance,
+  std::int64_t& least, std::int64_t& greatest)
+{
   const unsigned shift = instance.HighBit + 1u - instance.BitsStored;
-  const std::uint32_t mask = instance.BitsStored >= 32
-                                 ? 0xffffffffu
-                                 : ((1u << instance.BitsStored) - 1u);
+  const std::uint32_t mask =
+    instance.BitsStored >= 32 ? 0xffffffffu : ((1u << instance.BitsStored) - 1u);
   const std::uint32_t sign = 1u << (instance.BitsStored - 1u);
   const bool isSigned = instance.PixelRepresentation == 1;
-  for (std::size_t p = 0; p < count; ++p) {
-    const std::uint32_t bits =
-        (static_cast<std::uint32_t>(raw[p]) >> shift) & mask;
+  for (std::size_t p = 0; p < count; ++p)
+  {
+    const std::uint32_t bits = (static_cast<std::uint32_t>(raw[p]) >> shift) & mask;
     std::int64_t value = bits;
-    if (isSigned && (bits & sign)) {
+    if (isSigned && (bits & sign))
+    {
       value -= static_cast<std::int64_t>(mask) + 1;
     }
     out[p] = static_cast<Stored>(value);
@@ -327,17 +361,18 @@ void Unpack(const Raw *raw, Stored *out, std::size_t count,
 }
 
 template <typename In, typename Out>
-void RescaleSlices(const In *in, Out *out, std::size_t sliceSize,
-                   const std::vector<double> &slopes,
-                   const std::vector<double> &intercepts) {
-  for (std::size_t k = 0; k < slopes.size(); ++k) {
-    const In *from = in + k * sliceSize;
-    Out *to = out + k * sliceSize;
+void RescaleSlices(const In* in, Out* out, std::size_t sliceSize, const std::vector<double>& slopes,
+  const std::vector<double>& intercepts)
+{
+  for (std::size_t k = 0; k < slopes.size(); ++k)
+  {
+    const In* from = in + k * sliceSize;
+    Out* to = out + k * sliceSize;
     const double slope = slopes[k];
     const double intercept = intercepts[k];
-    for (std::size_t p = 0; p < sliceSize; ++p) {
-      to[p] =
-          static_cast<Out>(slope * static_cast<double>(from[p]) + intercept);
+    for (std::size_t p = 0; p < sliceSize; ++p)
+    {
+      to[p] = static_cast<Out>(slope * static_cast<double>(from[p]) + intercept);
     }
   }
 }
@@ -345,34 +380,33 @@ void RescaleSlices(const In *in, Out *out, std::size_t sliceSize,
 // Linear interpolation along the normal from the sorted slices at
 // `distances` onto `count` slices from distances[0] with `step`.
 template <typename In, typename Out>
-void ResampleSlices(const In *in, Out *out, std::size_t sliceSize,
-                    const std::vector<double> &distances,
-                    const std::vector<double> &slopes,
-                    const std::vector<double> &intercepts, int count,
-                    double step) {
+void ResampleSlices(const In* in, Out* out, std::size_t sliceSize,
+  const std::vector<double>& distances, const std::vector<double>& slopes,
+  const std::vector<double>& intercepts, int count, double step)
+{
   std::size_t below = 0;
-  for (int z = 0; z < count; ++z) {
-    const double at =
-        z + 1 == count ? distances.back() : distances.front() + z * step;
-    while (below + 2 < distances.size() && distances[below + 1] <= at) {
+  for (int z = 0; z < count; ++z)
+  {
+    const double at = z + 1 == count ? distances.back() : distances.front() + z * step;
+    while (below + 2 < distances.size() && distances[below + 1] <= at)
+    {
       ++below;
     }
     const std::size_t above = std::min(below + 1, distances.size() - 1);
     double weight = 0.0;
-    if (above != below) {
+    if (above != below)
+    {
       weight = (at - distances[below]) / (distances[above] - distances[below]);
       weight = std::min(1.0, std::max(0.0, weight));
     }
-    const In *a = in + below * sliceSize;
-    const In *b = in + above * sliceSize;
-    Out *to = out + static_cast<std::size_t>(z) * sliceSize;
-    for (std::size_t p = 0; p < sliceSize; ++p) {
-      const double va =
-          slopes[below] * static_cast<double>(a[p]) + intercepts[below];
-      const double vb =
-          slopes[above] * static_cast<double>(b[p]) + intercepts[above];
-      to[p] = static_cast<Out>(
-          weight == 0.0 ? va : (1.0 - weight) * va + weight * vb);
+    const In* a = in + below * sliceSize;
+    const In* b = in + above * sliceSize;
+    Out* to = out + static_cast<std::size_t>(z) * sliceSize;
+    for (std::size_t p = 0; p < sliceSize; ++p)
+    {
+      const double va = slopes[below] * static_cast<double>(a[p]) + intercepts[below];
+      const double vb = slopes[above] * static_cast<double>(b[p]) + intercepts[above];
+      to[p] = static_cast<Out>(weight == 0.0 ? va : (1.0 - weight) * va + weight * vb);
     }
   }
 }
@@ -380,47 +414,57 @@ void ResampleSlices(const In *in, Out *out, std::size_t sliceSize,
 // The stored values into `out`: rescaled slice by slice, or (resample)
 // interpolated onto the even grid (float or double output).
 template <typename In>
-void Convert(const In *in, vtkDataArray *out, bool resample,
-             std::size_t sliceSize, const std::vector<double> &distances,
-             const std::vector<double> &slopes,
-             const std::vector<double> &intercepts, int count, double step) {
-  if (resample && out->GetDataType() == VTK_FLOAT) {
-    ResampleSlices(in, static_cast<float *>(out->GetVoidPointer(0)), sliceSize,
-                   distances, slopes, intercepts, count, step);
+void Convert(const In* in, vtkDataArray* out, bool resample, std::size_t sliceSize,
+  const std::vector<double>& distances, const std::vector<double>& slopes,
+  const std::vector<double>& intercepts, int count, double step)
+{
+  if (resample && out->GetDataType() == VTK_FLOAT)
+  {
+    ResampleSlices(in, static_cast<float*>(out->GetVoidPointer(0)), sliceSize, distances, slopes,
+      intercepts, count, step);
     return;
   }
-  if (resample) {
-    ResampleSlices(in, static_cast<double *>(out->GetVoidPointer(0)), sliceSize,
-                   distances, slopes, intercepts, count, step);
+  if (resample)
+  {
+    ResampleSlices(in, static_cast<double*>(out->GetVoidPointer(0)), sliceSize, distances, slopes,
+      intercepts, count, step);
     return;
   }
-  switch (out->GetDataType()) {
-    vtkTemplateMacro(
-        RescaleSlices(in, static_cast<VTK_TT *>(out->GetVoidPointer(0)),
-                      sliceSize, slopes, intercepts));
+  switch (out->GetDataType())
+  {
+    vtkTemplateMacro(RescaleSlices(
+      in, static_cast<VTK_TT*>(out->GetVoidPointer(0)), sliceSize, slopes, intercepts));
   }
 }
 
-int SmallestIntegerType(double least, double greatest) {
-  if (least >= 0.0) {
-    if (greatest <= 255.0) {
+int SmallestIntegerType(double least, double greatest)
+{
+  if (least >= 0.0)
+  {
+    if (greatest <= 255.0)
+    {
       return VTK_UNSIGNED_CHAR;
     }
-    if (greatest <= 65535.0) {
+    if (greatest <= 65535.0)
+    {
       return VTK_UNSIGNED_SHORT;
     }
-    if (greatest <= 4294967295.0) {
+    if (greatest <= 4294967295.0)
+    {
       return VTK_UNSIGNED_INT;
     }
     return VTK_DOUBLE;
   }
-  if (least >= -128.0 && greatest <= 127.0) {
+  if (least >= -128.0 && greatest <= 127.0)
+  {
     return VTK_SIGNED_CHAR;
   }
-  if (least >= -32768.0 && greatest <= 32767.0) {
+  if (least >= -32768.0 && greatest <= 32767.0)
+  {
     return VTK_SHORT;
   }
-  if (least >= -2147483648.0 && greatest <= 2147483647.0) {
+  if (least >= -2147483648.0 && greatest <= 2147483647.0)
+  {
     return VTK_INT;
   }
   return VTK_DOUBLE;
@@ -428,19 +472,20 @@ int SmallestIntegerType(double least, double greatest) {
 
 // An array of `tuples` values of `type`, or nullptr with the message when the
 // bytes do not fit or the allocation fails.
-vtkSmartPointer<vtkDataArray> NewVolume(int type, std::size_t tuples,
-                                        const char *what, std::string &error) {
+vtkSmartPointer<vtkDataArray> NewVolume(
+  int type, std::size_t tuples, const char* what, std::string& error)
+{
   vtkSmartPointer<vtkDataArray> array;
   array.TakeReference(vtkDataArray::CreateDataArray(type));
   const std::uint64_t bytes =
-      static_cast<std::uint64_t>(tuples) *
-      static_cast<std::uint64_t>(array->GetDataTypeSize());
-  if (!mediso::FitsInProcessMemory(bytes, what, error)) {
+    static_cast<std::uint64_t>(tuples) * static_cast<std::uint64_t>(array->GetDataTypeSize());
+  if (!mediso::FitsInProcessMemory(bytes, what, error))
+  {
     return nullptr;
   }
-  if (!array->Allocate(static_cast<vtkIdType>(tuples))) {
-    error = std::string("could not allocate ") + what + " (" +
-            Number(bytes / 1.0e6) + " MB)";
+  if (!array->Allocate(static_cast<vtkIdType>(tuples)))
+  {
+    error = std::string("could not allocate ") + what + " (" + Number(bytes / 1.0e6) + " MB)";
     return nullptr;
   }
   array->SetNumberOfTuples(static_cast<vtkIdType>(tuples));
@@ -449,32 +494,39 @@ vtkSmartPointer<vtkDataArray> NewVolume(int type, std::size_t tuples,
 } // namespace
 
 //------------------------------------------------------------------------------
-vtkMedicalDICOMSeriesReader::vtkMedicalDICOMSeriesReader() {
+vtkMedicalDICOMSeriesReader::vtkMedicalDICOMSeriesReader()
+{
   this->SetNumberOfInputPorts(0);
   this->SeriesList = vtkSmartPointer<vtkStringArray>::New();
 }
 
 //------------------------------------------------------------------------------
-vtkMedicalDICOMSeriesReader::~vtkMedicalDICOMSeriesReader() {
+vtkMedicalDICOMSeriesReader::~vtkMedicalDICOMSeriesReader()
+{
   this->SetFileName(nullptr);
   this->SetSeriesInstanceUID(nullptr);
 }
 
 //------------------------------------------------------------------------------
-vtkStringArray *vtkMedicalDICOMSeriesReader::GetSeriesInFolder() {
+vtkStringArray* vtkMedicalDICOMSeriesReader::GetSeriesInFolder()
+{
   return this->SeriesList;
 }
 
 //------------------------------------------------------------------------------
-std::string vtkMedicalDICOMSeriesReader::ReadSeries() {
-  if (!this->FileName || !this->FileName[0]) {
+std::string vtkMedicalDICOMSeriesReader::ReadSeries()
+{
+  if (!this->FileName || !this->FileName[0])
+  {
     return "no FileName: set a file of the series, or its folder";
   }
   const std::string path = this->FileName;
-  if (!vtksys::SystemTools::FileExists(path)) {
+  if (!vtksys::SystemTools::FileExists(path))
+  {
     return path + ": no such file or folder";
   }
-  if (!dcmDataDict.isDictionaryLoaded()) {
+  if (!dcmDataDict.isDictionaryLoaded())
+  {
     return "DCMTK's data dictionary is not loaded (see DCMDICTPATH): DICOM "
            "files cannot be read";
   }
@@ -482,16 +534,18 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries() {
 
   // 1. Scan the folder.
   const bool opened = !vtksys::SystemTools::FileIsDirectory(path);
-  const std::string folder =
-      opened ? vtksys::SystemTools::GetFilenamePath(path) : path;
+  const std::string folder = opened ? vtksys::SystemTools::GetFilenamePath(path) : path;
   vtksys::Directory directory;
-  if (!directory.Load(folder.empty() ? std::string(".") : folder)) {
+  if (!directory.Load(folder.empty() ? std::string(".") : folder))
+  {
     return folder + ": the folder cannot be listed";
   }
   std::vector<std::string> names;
-  for (unsigned long i = 0; i < directory.GetNumberOfFiles(); ++i) {
+  for (unsigned long i = 0; i < directory.GetNumberOfFiles(); ++i)
+  {
     const std::string name = directory.GetFile(i);
-    if (name != "." && name != "..") {
+    if (name != "." && name != "..")
+    {
       names.push_back(name);
     }
   }
@@ -500,44 +554,56 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries() {
   std::vector<std::string> unreadable;
   std::string openedSeries;
   bool openedFound = false;
-  for (const std::string &name : names) {
+  for (const std::string& name : names)
+  {
     const std::string file = folder.empty() ? name : folder + "/" + name;
-    if (vtksys::SystemTools::FileIsDirectory(file)) {
+    if (vtksys::SystemTools::FileIsDirectory(file))
+    {
       continue;
     }
     Instance instance;
     std::string why;
     const HeaderStatus status = ReadHeader(file, instance, why);
     const bool isOpened = opened && vtksys::SystemTools::SameFile(file, path);
-    if (status == HeaderStatus::Unreadable) {
-      if (isOpened) {
+    if (status == HeaderStatus::Unreadable)
+    {
+      if (isOpened)
+      {
         return path + ": DCMTK cannot read it (" + why + ")";
       }
       unreadable.push_back(name + " (" + why + ")");
       continue;
     }
-    if (status == HeaderStatus::NotImage) {
-      if (isOpened) {
-        return path + ": not a DICOM image (no Part 10 preamble \"DICM\", or "
-                      "no Rows, Columns and Pixel Data)";
+    if (status == HeaderStatus::NotImage)
+    {
+      if (isOpened)
+      {
+        return path +
+          ": not a DICOM image (no Part 10 preamble \"DICM\", or "
+          "no Rows, Columns and Pixel Data)";
       }
       continue;
     }
-    if (isOpened) {
+    if (isOpened)
+    {
       openedFound = true;
       openedSeries = instance.SeriesUID;
     }
     scan.push_back(std::move(instance));
   }
-  if (opened && !openedFound) {
+  if (opened && !openedFound)
+  {
     return path + ": not found in the listing of its folder";
   }
-  if (scan.empty()) {
+  if (scan.empty())
+  {
     return folder + ": no DICOM image files in the folder";
   }
-  if (!unreadable.empty()) {
+  if (!unreadable.empty())
+  {
     std::string list;
-    for (const std::string &entry : unreadable) {
+    for (const std::string& entry : unreadable)
+    {
       list += (list.empty() ? "" : "; ") + entry;
     }
     vtkWarningMacro(<< folder << ": skipped " << unreadable.size()
@@ -548,9 +614,11 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries() {
   std::vector<Series> series;
   {
     std::map<std::string, std::size_t> index;
-    for (std::size_t i = 0; i < scan.size(); ++i) {
+    for (std::size_t i = 0; i < scan.size(); ++i)
+    {
       auto found = index.find(scan[i].SeriesUID);
-      if (found == index.end()) {
+      if (found == index.end())
+      {
         found = index.emplace(scan[i].SeriesUID, series.size()).first;
         series.emplace_back();
         series.back().UID = scan[i].SeriesUID;
@@ -562,31 +630,40 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries() {
   }
   std::size_t chosen = series.size();
   std::string reason;
-  const std::string wanted =
-      this->SeriesInstanceUID ? this->SeriesInstanceUID : "";
-  for (std::size_t s = 0; s < series.size(); ++s) {
-    if (!wanted.empty() ? series[s].UID == wanted
-                        : (opened && series[s].UID == openedSeries)) {
+  const std::string wanted = this->SeriesInstanceUID ? this->SeriesInstanceUID : "";
+  for (std::size_t s = 0; s < series.size(); ++s)
+  {
+    if (!wanted.empty() ? series[s].UID == wanted : (opened && series[s].UID == openedSeries))
+    {
       chosen = s;
     }
   }
-  if (!wanted.empty()) {
+  if (!wanted.empty())
+  {
     reason = "the one SeriesInstanceUID names";
-    if (chosen == series.size()) {
+    if (chosen == series.size())
+    {
       std::string list;
-      for (const Series &s : series) {
+      for (const Series& s : series)
+      {
         list += (list.empty() ? "" : "; ") + Describe(s);
       }
-      return folder + ": no series with Series Instance UID " + wanted +
-             "; the folder holds " + list;
+      return folder + ": no series with Series Instance UID " + wanted + "; the folder holds " +
+        list;
     }
-  } else if (opened) {
+  }
+  else if (opened)
+  {
     reason = "the series of the file opened";
-  } else {
+  }
+  else
+  {
     reason = "the series with the most slices";
     chosen = 0;
-    for (std::size_t s = 1; s < series.size(); ++s) {
-      if (series[s].Slices > series[chosen].Slices) {
+    for (std::size_t s = 1; s < series.size(); ++s)
+    {
+      if (series[s].Slices > series[chosen].Slices)
+      {
         chosen = s;
       }
     }
@@ -594,343 +671,376 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries() {
   this->SeriesList->SetNumberOfValues(static_cast<vtkIdType>(series.size()));
   {
     vtkIdType row = 0;
-    auto line = [](const Series &s) {
-      return s.UID + " | " + s.Description + " | " + std::to_string(s.Slices) +
-             " slices";
-    };
+    auto line = [](const Series& s)
+    { return s.UID + " | " + s.Description + " | " + std::to_string(s.Slices) + " slices"; };
     this->SeriesList->SetValue(row++, line(series[chosen]));
-    for (std::size_t s = 0; s < series.size(); ++s) {
-      if (s != chosen) {
+    for (std::size_t s = 0; s < series.size(); ++s)
+    {
+      if (s != chosen)
+      {
         this->SeriesList->SetValue(row++, line(series[s]));
       }
     }
   }
-  if (series.size() > 1) {
+  if (series.size() > 1)
+  {
     std::string others;
-    for (std::size_t s = 0; s < series.size(); ++s) {
-      if (s != chosen) {
+    for (std::size_t s = 0; s < series.size(); ++s)
+    {
+      if (s != chosen)
+      {
         others += (others.empty() ? "" : "; ") + Describe(series[s]);
       }
     }
-    vtkWarningMacro(<< folder << ": the folder holds " << series.size()
-                    << " series; read " << Describe(series[chosen]) << ", "
-                    << reason << "; not read: " << others
+    vtkWarningMacro(<< folder << ": the folder holds " << series.size() << " series; read "
+                    << Describe(series[chosen]) << ", " << reason << "; not read: " << others
                     << ". SeriesInstanceUID chooses another.");
   }
-  const Series &read = series[chosen];
+  const Series& read = series[chosen];
 
   // 3-4. The slices, checked against the first one.
-  std::vector<Instance *> instances;
-  for (std::size_t i : read.Instances) {
+  std::vector<Instance*> instances;
+  for (std::size_t i : read.Instances)
+  {
     instances.push_back(&scan[i]);
   }
-  const Instance &first = *instances.front();
-  for (std::size_t i = 0; i < instances.size(); ++i) {
-    Instance &instance = *instances[i];
+  const Instance& first = *instances.front();
+  for (std::size_t i = 0; i < instances.size(); ++i)
+  {
+    Instance& instance = *instances[i];
     const std::string name = BaseName(instance.Path);
-    if (!Decodable(instance.Syntax)) {
-      return name + ": transfer syntax \"" +
-             DcmXfer(instance.Syntax).getXferName() + "\" (" +
-             instance.TransferSyntaxUID +
-             ") is not read (this reader decodes uncompressed, deflated, JPEG "
-             "baseline, extended and "
-             "lossless, JPEG-LS and RLE pixel data)";
+    if (!Decodable(instance.Syntax))
+    {
+      return name + ": transfer syntax \"" + DcmXfer(instance.Syntax).getXferName() + "\" (" +
+        instance.TransferSyntaxUID +
+        ") is not read (this reader decodes uncompressed, deflated, JPEG "
+        "baseline, extended and "
+        "lossless, JPEG-LS and RLE pixel data)";
     }
     if (instance.SamplesPerPixel != 1 ||
-        (instance.Photometric != "MONOCHROME1" &&
-         instance.Photometric != "MONOCHROME2")) {
-      return name + ": " + std::to_string(instance.SamplesPerPixel) +
-             " sample(s) per pixel, " + "Photometric Interpretation \"" +
-             instance.Photometric +
-             "\": only greyscale (MONOCHROME1/2) images are read";
+      (instance.Photometric != "MONOCHROME1" && instance.Photometric != "MONOCHROME2"))
+    {
+      return name + ": " + std::to_string(instance.SamplesPerPixel) + " sample(s) per pixel, " +
+        "Photometric Interpretation \"" + instance.Photometric +
+        "\": only greyscale (MONOCHROME1/2) images are read";
     }
-    if (instance.BitsAllocated != 8 && instance.BitsAllocated != 16) {
-      return name + ": Bits Allocated " +
-             std::to_string(instance.BitsAllocated) + " is not read (8 or 16)";
+    if (instance.BitsAllocated != 8 && instance.BitsAllocated != 16)
+    {
+      return name + ": Bits Allocated " + std::to_string(instance.BitsAllocated) +
+        " is not read (8 or 16)";
     }
-    if (instance.BitsStored == 0 ||
-        instance.BitsStored > instance.BitsAllocated ||
-        instance.HighBit + 1 < instance.BitsStored ||
-        instance.HighBit >= instance.BitsAllocated) {
-      return name + ": Bits Stored " + std::to_string(instance.BitsStored) +
-             " and High Bit " + std::to_string(instance.HighBit) +
-             " do not fit Bits Allocated " +
-             std::to_string(instance.BitsAllocated);
+    if (instance.BitsStored == 0 || instance.BitsStored > instance.BitsAllocated ||
+      instance.HighBit + 1 < instance.BitsStored || instance.HighBit >= instance.BitsAllocated)
+    {
+      return name + ": Bits Stored " + std::to_string(instance.BitsStored) + " and High Bit " +
+        std::to_string(instance.HighBit) + " do not fit Bits Allocated " +
+        std::to_string(instance.BitsAllocated);
     }
-    if (instance.Rows == 0 || instance.Columns == 0) {
-      return name + ": an image of " + std::to_string(instance.Columns) +
-             " x " + std::to_string(instance.Rows) + " pixels";
+    if (instance.Rows == 0 || instance.Columns == 0)
+    {
+      return name + ": an image of " + std::to_string(instance.Columns) + " x " +
+        std::to_string(instance.Rows) + " pixels";
     }
-    if (!instance.PerFramePositions) {
+    if (!instance.PerFramePositions)
+    {
       return name + ": " + std::to_string(instance.Frames) +
-             " frames without per-frame positions (Per-frame Functional "
-             "Groups, Plane Position "
-             "Sequence): their placement is unknown";
+        " frames without per-frame positions (Per-frame Functional "
+        "Groups, Plane Position "
+        "Sequence): their placement is unknown";
     }
-    if (instance.Rows != first.Rows || instance.Columns != first.Columns) {
+    if (instance.Rows != first.Rows || instance.Columns != first.Columns)
+    {
       return name + ": " + std::to_string(instance.Columns) + " x " +
-             std::to_string(instance.Rows) + " pixels, but " +
-             BaseName(first.Path) + " has " + std::to_string(first.Columns) +
-             " x " + std::to_string(first.Rows) +
-             ": slices of different sizes are not read";
+        std::to_string(instance.Rows) + " pixels, but " + BaseName(first.Path) + " has " +
+        std::to_string(first.Columns) + " x " + std::to_string(first.Rows) +
+        ": slices of different sizes are not read";
     }
     if (instance.BitsAllocated != first.BitsAllocated ||
-        instance.PixelRepresentation != first.PixelRepresentation) {
-      return name + ": pixel format " + std::to_string(instance.BitsAllocated) +
-             " bits " + (instance.PixelRepresentation ? "signed" : "unsigned") +
-             ", but " + BaseName(first.Path) + " has " +
-             std::to_string(first.BitsAllocated) + " bits " +
-             (first.PixelRepresentation ? "signed" : "unsigned") +
-             ": slices of different pixel formats are not read";
+      instance.PixelRepresentation != first.PixelRepresentation)
+    {
+      return name + ": pixel format " + std::to_string(instance.BitsAllocated) + " bits " +
+        (instance.PixelRepresentation ? "signed" : "unsigned") + ", but " + BaseName(first.Path) +
+        " has " + std::to_string(first.BitsAllocated) + " bits " +
+        (first.PixelRepresentation ? "signed" : "unsigned") +
+        ": slices of different pixel formats are not read";
     }
   }
 
-  std::vector<std::pair<Instance *, Slice *>> slices;
-  for (Instance *instance : instances) {
-    for (Slice &slice : instance->Slices) {
+  std::vector<std::pair<Instance*, Slice*>> slices;
+  for (Instance* instance : instances)
+  {
+    for (Slice& slice : instance->Slices)
+    {
       slices.emplace_back(instance, &slice);
     }
   }
-  const Slice &reference = *slices.front().second;
+  const Slice& reference = *slices.front().second;
   const bool single = slices.size() == 1;
-  double row[3] = {1, 0, 0};
-  double column[3] = {0, 1, 0};
-  if (reference.HasOrientation) {
+  double row[3] = { 1, 0, 0 };
+  double column[3] = { 0, 1, 0 };
+  if (reference.HasOrientation)
+  {
     std::copy(reference.Orientation, reference.Orientation + 3, row);
     std::copy(reference.Orientation + 3, reference.Orientation + 6, column);
     const double rowLength = vtkMath::Normalize(row);
     const double columnLength = vtkMath::Normalize(column);
-    if (std::abs(rowLength - 1.0) > 1e-3 ||
-        std::abs(columnLength - 1.0) > 1e-3 ||
-        std::abs(vtkMath::Dot(row, column)) > 1e-3) {
+    if (std::abs(rowLength - 1.0) > 1e-3 || std::abs(columnLength - 1.0) > 1e-3 ||
+      std::abs(vtkMath::Dot(row, column)) > 1e-3)
+    {
       return SliceName(*slices.front().first, reference) +
-             ": Image Orientation (Patient) is not two orthogonal unit vectors";
+        ": Image Orientation (Patient) is not two orthogonal unit vectors";
     }
-  } else if (!single) {
+  }
+  else if (!single)
+  {
     return SliceName(*slices.front().first, reference) +
-           ": no Image Orientation (Patient): the slices' order and spacing "
-           "are unknown";
+      ": no Image Orientation (Patient): the slices' order and spacing "
+      "are unknown";
   }
   double normal[3];
   vtkMath::Cross(row, column, normal);
-  for (auto &entry : slices) {
-    Slice &slice = *entry.second;
+  for (auto& entry : slices)
+  {
+    Slice& slice = *entry.second;
     const std::string name = SliceName(*entry.first, slice);
-    if (!single && !slice.HasPosition) {
-      return name + ": no Image Position (Patient): the slices' order and "
-                    "spacing are unknown";
+    if (!single && !slice.HasPosition)
+    {
+      return name +
+        ": no Image Position (Patient): the slices' order and "
+        "spacing are unknown";
     }
-    if (!single && !slice.HasOrientation) {
-      return name + ": no Image Orientation (Patient): the slices' order and "
-                    "spacing are unknown";
+    if (!single && !slice.HasOrientation)
+    {
+      return name +
+        ": no Image Orientation (Patient): the slices' order and "
+        "spacing are unknown";
     }
-    for (int c = 0; c < 6 && slice.HasOrientation; ++c) {
-      if (std::abs(slice.Orientation[c] - reference.Orientation[c]) > 1e-4) {
+    for (int c = 0; c < 6 && slice.HasOrientation; ++c)
+    {
+      if (std::abs(slice.Orientation[c] - reference.Orientation[c]) > 1e-4)
+      {
         std::string a, b;
-        for (int d = 0; d < 6; ++d) {
+        for (int d = 0; d < 6; ++d)
+        {
           a += (d ? "\\" : "") + Number(slice.Orientation[d]);
           b += (d ? "\\" : "") + Number(reference.Orientation[d]);
         }
         return name + ": Image Orientation (Patient) " + a + ", but " +
-               SliceName(*slices.front().first, reference) + " has " + b +
-               ": slices of different orientations are not read";
+          SliceName(*slices.front().first, reference) + " has " + b +
+          ": slices of different orientations are not read";
       }
     }
     if (slice.HasPixelSpacing != reference.HasPixelSpacing ||
-        std::abs(slice.PixelSpacing[0] - reference.PixelSpacing[0]) > 1e-4 ||
-        std::abs(slice.PixelSpacing[1] - reference.PixelSpacing[1]) > 1e-4) {
+      std::abs(slice.PixelSpacing[0] - reference.PixelSpacing[0]) > 1e-4 ||
+      std::abs(slice.PixelSpacing[1] - reference.PixelSpacing[1]) > 1e-4)
+    {
       return name + ": Pixel Spacing " + Number(slice.PixelSpacing[0]) + "\\" +
-             Number(slice.PixelSpacing[1]) + ", but " +
-             SliceName(*slices.front().first, reference) + " has " +
-             Number(reference.PixelSpacing[0]) + "\\" +
-             Number(reference.PixelSpacing[1]) +
-             ": slices of different pixel spacings are not read";
+        Number(slice.PixelSpacing[1]) + ", but " + SliceName(*slices.front().first, reference) +
+        " has " + Number(reference.PixelSpacing[0]) + "\\" + Number(reference.PixelSpacing[1]) +
+        ": slices of different pixel spacings are not read";
     }
-    if (slice.Slope == 0.0) {
+    if (slice.Slope == 0.0)
+    {
       return name + ": Rescale Slope 0";
     }
     slice.Distance = vtkMath::Dot(slice.Position, normal);
   }
   if (!reference.HasPixelSpacing || !(reference.PixelSpacing[0] > 0.0) ||
-      !(reference.PixelSpacing[1] > 0.0)) {
-    vtkWarningMacro(
-        << BaseName(first.Path)
-        << ": no valid Pixel Spacing; 1 mm between rows and columns assumed");
+    !(reference.PixelSpacing[1] > 0.0))
+  {
+    vtkWarningMacro(<< BaseName(first.Path)
+                    << ": no valid Pixel Spacing; 1 mm between rows and columns assumed");
   }
 
   // 5. Order along the normal, then check the steps.
   std::stable_sort(slices.begin(), slices.end(),
-                   [](const auto &a, const auto &b) {
-                     if (a.second->Distance != b.second->Distance) {
-                       return a.second->Distance < b.second->Distance;
-                     }
-                     return a.second->InstanceNumber < b.second->InstanceNumber;
-                   });
+    [](const auto& a, const auto& b)
+    {
+      if (a.second->Distance != b.second->Distance)
+      {
+        return a.second->Distance < b.second->Distance;
+      }
+      return a.second->InstanceNumber < b.second->InstanceNumber;
+    });
   const std::size_t count = slices.size();
   std::vector<double> distances(count);
-  for (std::size_t k = 0; k < count; ++k) {
+  for (std::size_t k = 0; k < count; ++k)
+  {
     distances[k] = slices[k].second->Distance;
   }
-  auto where = [&](std::size_t k) {
-    return Number(distances[k]) + " mm (" +
-           SliceName(*slices[k].first, *slices[k].second) + ")";
-  };
+  auto where = [&](std::size_t k)
+  { return Number(distances[k]) + " mm (" + SliceName(*slices[k].first, *slices[k].second) + ")"; };
   double median = 0.0;
   std::vector<std::string> uneven;
-  if (count > 1) {
+  if (count > 1)
+  {
     std::vector<double> steps(count - 1);
-    for (std::size_t k = 0; k + 1 < count; ++k) {
+    for (std::size_t k = 0; k + 1 < count; ++k)
+    {
       steps[k] = distances[k + 1] - distances[k];
     }
     std::vector<double> sorted = steps;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2,
-                     sorted.end());
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
     median = sorted[sorted.size() / 2];
     const double tolerance = 0.01 * median;
-    for (std::size_t k = 0; k + 1 < count; ++k) {
-      if (!(steps[k] > std::max(tolerance, 1e-6))) {
-        return "two slices at the same position along the normal, " + where(k) +
-               " and " + where(k + 1) + ": duplicate slices are not read";
+    for (std::size_t k = 0; k + 1 < count; ++k)
+    {
+      if (!(steps[k] > std::max(tolerance, 1e-6)))
+      {
+        return "two slices at the same position along the normal, " + where(k) + " and " +
+          where(k + 1) + ": duplicate slices are not read";
       }
     }
     // A stack that leaves the normal through the first slice (gantry tilt).
-    const double *origin = slices.front().second->Position;
-    const double lateral =
-        0.01 * std::min(reference.PixelSpacing[0], reference.PixelSpacing[1]);
-    for (std::size_t k = 1; k < count; ++k) {
+    const double* origin = slices.front().second->Position;
+    const double lateral = 0.01 * std::min(reference.PixelSpacing[0], reference.PixelSpacing[1]);
+    for (std::size_t k = 1; k < count; ++k)
+    {
       double offset[3];
       vtkMath::Subtract(slices[k].second->Position, origin, offset);
       const double along = vtkMath::Dot(offset, normal);
-      for (int c = 0; c < 3; ++c) {
+      for (int c = 0; c < 3; ++c)
+      {
         offset[c] -= along * normal[c];
       }
       const double off = vtkMath::Norm(offset);
-      if (off > std::max(lateral, 1e-3)) {
+      if (off > std::max(lateral, 1e-3))
+      {
         return SliceName(*slices[k].first, *slices[k].second) +
-               ": its Image Position (Patient) is " + Number(off) +
-               " mm off the line through " +
-               SliceName(*slices.front().first, *slices.front().second) +
-               " along the slice normal (a gantry tilt or a sheared stack): "
-               "not read";
+          ": its Image Position (Patient) is " + Number(off) + " mm off the line through " +
+          SliceName(*slices.front().first, *slices.front().second) +
+          " along the slice normal (a gantry tilt or a sheared stack): "
+          "not read";
       }
     }
-    for (std::size_t k = 0; k + 1 < count; ++k) {
-      if (std::abs(steps[k] - median) <= tolerance) {
+    for (std::size_t k = 0; k + 1 < count; ++k)
+    {
+      if (std::abs(steps[k] - median) <= tolerance)
+      {
         continue;
       }
       const double ratio = steps[k] / median;
       const double whole = std::round(ratio);
-      if (whole >= 2.0 && std::abs(steps[k] - whole * median) <= tolerance) {
+      if (whole >= 2.0 && std::abs(steps[k] - whole * median) <= tolerance)
+      {
         const int missing = static_cast<int>(whole) - 1;
+        uneven.push_back("a gap of " + Number(steps[k]) + " mm between " + where(k) + " and " +
+          where(k + 1) + " (" + std::to_string(missing) +
+          (missing == 1 ? " slice missing)" : " slices missing)"));
+      }
+      else
+      {
         uneven.push_back(
-            "a gap of " + Number(steps[k]) + " mm between " + where(k) +
-            " and " + where(k + 1) + " (" + std::to_string(missing) +
-            (missing == 1 ? " slice missing)" : " slices missing)"));
-      } else {
-        uneven.push_back("a step of " + Number(steps[k]) + " mm between " +
-                         where(k) + " and " + where(k + 1));
+          "a step of " + Number(steps[k]) + " mm between " + where(k) + " and " + where(k + 1));
       }
     }
   }
   std::string unevenList;
-  for (std::size_t u = 0; u < uneven.size() && u < 5; ++u) {
+  for (std::size_t u = 0; u < uneven.size() && u < 5; ++u)
+  {
     unevenList += (u ? "; " : "") + uneven[u];
   }
-  if (uneven.size() > 5) {
+  if (uneven.size() > 5)
+  {
     unevenList += "; and " + std::to_string(uneven.size() - 5) + " more";
   }
   const bool resample = !uneven.empty();
-  if (resample && !this->ResampleUnevenSlices) {
+  if (resample && !this->ResampleUnevenSlices)
+  {
     return "the slices are not evenly spaced (median step " + Number(median) +
-           " mm): " + unevenList +
-           ". Turn ResampleUnevenSlices on to resample them onto an even grid.";
+      " mm): " + unevenList + ". Turn ResampleUnevenSlices on to resample them onto an even grid.";
   }
 
   // 6. Decode every file into the stored values, slice by slice in order.
-  const std::size_t sliceSize =
-      static_cast<std::size_t>(first.Rows) * first.Columns;
+  const std::size_t sliceSize = static_cast<std::size_t>(first.Rows) * first.Columns;
   const bool isSigned = first.PixelRepresentation == 1;
-  const int storedType = first.BitsAllocated == 8
-                             ? (isSigned ? VTK_SIGNED_CHAR : VTK_UNSIGNED_CHAR)
-                             : (isSigned ? VTK_SHORT : VTK_UNSIGNED_SHORT);
+  const int storedType = first.BitsAllocated == 8 ? (isSigned ? VTK_SIGNED_CHAR : VTK_UNSIGNED_CHAR)
+                                                  : (isSigned ? VTK_SHORT : VTK_UNSIGNED_SHORT);
   std::string error;
   vtkSmartPointer<vtkDataArray> stored =
-      NewVolume(storedType, sliceSize * count, "the decoded series", error);
-  if (!stored) {
+    NewVolume(storedType, sliceSize * count, "the decoded series", error);
+  if (!stored)
+  {
     return error;
   }
-  std::map<const Slice *, std::size_t> order;
-  for (std::size_t k = 0; k < count; ++k) {
+  std::map<const Slice*, std::size_t> order;
+  for (std::size_t k = 0; k < count; ++k)
+  {
     order[slices[k].second] = k;
   }
   std::vector<std::int64_t> least(count, 0), greatest(count, 0);
-  for (Instance *instance : instances) {
+  for (Instance* instance : instances)
+  {
     const std::string name = BaseName(instance->Path);
     DcmFileFormat file;
-    OFCondition status =
-        file.loadFile(instance->Path.c_str(), EXS_Unknown, EGL_noChange,
-                      DCM_MaxReadLength, ERM_fileOnly);
-    DcmDataset *data = file.getDataset();
-    if (status.bad() || !data) {
-      return name + ": DCMTK cannot read it (" + std::string(status.text()) +
-             ")";
+    OFCondition status = file.loadFile(
+      instance->Path.c_str(), EXS_Unknown, EGL_noChange, DCM_MaxReadLength, ERM_fileOnly);
+    DcmDataset* data = file.getDataset();
+    if (status.bad() || !data)
+    {
+      return name + ": DCMTK cannot read it (" + std::string(status.text()) + ")";
     }
-    if (DcmXfer(instance->Syntax).isEncapsulated()) {
+    if (DcmXfer(instance->Syntax).isEncapsulated())
+    {
       status = data->chooseRepresentation(EXS_LittleEndianExplicit, nullptr);
-      if (status.bad() || !data->canWriteXfer(EXS_LittleEndianExplicit)) {
-        return name + ": DCMTK could not decode its \"" +
-               DcmXfer(instance->Syntax).getXferName() + "\" pixel data (" +
-               status.text() + ")";
+      if (status.bad() || !data->canWriteXfer(EXS_LittleEndianExplicit))
+      {
+        return name + ": DCMTK could not decode its \"" + DcmXfer(instance->Syntax).getXferName() +
+          "\" pixel data (" + status.text() + ")";
       }
     }
-    DcmElement *pixels = nullptr;
-    if (data->findAndGetElement(DCM_PixelData, pixels).bad() || !pixels) {
+    DcmElement* pixels = nullptr;
+    if (data->findAndGetElement(DCM_PixelData, pixels).bad() || !pixels)
+    {
       return name + ": no Pixel Data";
     }
     const std::size_t bytesPerSample = first.BitsAllocated / 8;
     const std::size_t expected = sliceSize * instance->Frames * bytesPerSample;
-    const void *raw = nullptr;
-    if (first.BitsAllocated == 8) {
-      Uint8 *values = nullptr;
+    const void* raw = nullptr;
+    if (first.BitsAllocated == 8)
+    {
+      Uint8* values = nullptr;
       status = pixels->getUint8Array(values);
       raw = values;
-    } else {
-      Uint16 *values = nullptr;
+    }
+    else
+    {
+      Uint16* values = nullptr;
       status = pixels->getUint16Array(values);
       raw = values;
     }
-    if (status.bad() || !raw || pixels->getLength() < expected) {
-      return name + ": Pixel Data holds " +
-             std::to_string(raw ? pixels->getLength() : 0) + " bytes, " +
-             std::to_string(expected) + " expected (" +
-             std::to_string(first.Columns) + " x " +
-             std::to_string(first.Rows) + " x " +
-             std::to_string(instance->Frames) + " frame(s) x " +
-             std::to_string(bytesPerSample) + " byte(s))";
+    if (status.bad() || !raw || pixels->getLength() < expected)
+    {
+      return name + ": Pixel Data holds " + std::to_string(raw ? pixels->getLength() : 0) +
+        " bytes, " + std::to_string(expected) + " expected (" + std::to_string(first.Columns) +
+        " x " + std::to_string(first.Rows) + " x " + std::to_string(instance->Frames) +
+        " frame(s) x " + std::to_string(bytesPerSample) + " byte(s))";
     }
-    for (const Slice &slice : instance->Slices) {
+    for (const Slice& slice : instance->Slices)
+    {
       const std::size_t k = order[&slice];
       std::int64_t lo = std::numeric_limits<std::int64_t>::max();
       std::int64_t hi = std::numeric_limits<std::int64_t>::min();
       const std::size_t at = slice.Frame * sliceSize;
-      void *to = stored->GetVoidPointer(static_cast<vtkIdType>(k * sliceSize));
-      switch (storedType) {
-      case VTK_UNSIGNED_CHAR:
-        Unpack(static_cast<const Uint8 *>(raw) + at,
-               static_cast<unsigned char *>(to), sliceSize, *instance, lo, hi);
-        break;
-      case VTK_SIGNED_CHAR:
-        Unpack(static_cast<const Uint8 *>(raw) + at,
-               static_cast<signed char *>(to), sliceSize, *instance, lo, hi);
-        break;
-      case VTK_UNSIGNED_SHORT:
-        Unpack(static_cast<const Uint16 *>(raw) + at,
-               static_cast<unsigned short *>(to), sliceSize, *instance, lo, hi);
-        break;
-      default:
-        Unpack(static_cast<const Uint16 *>(raw) + at, static_cast<short *>(to),
-               sliceSize, *instance, lo, hi);
-        break;
+      void* to = stored->GetVoidPointer(static_cast<vtkIdType>(k * sliceSize));
+      switch (storedType)
+      {
+        case VTK_UNSIGNED_CHAR:
+          Unpack(static_cast<const Uint8*>(raw) + at, static_cast<unsigned char*>(to), sliceSize,
+            *instance, lo, hi);
+          break;
+        case VTK_SIGNED_CHAR:
+          Unpack(static_cast<const Uint8*>(raw) + at, static_cast<signed char*>(to), sliceSize,
+            *instance, lo, hi);
+          break;
+        case VTK_UNSIGNED_SHORT:
+          Unpack(static_cast<const Uint16*>(raw) + at, static_cast<unsigned short*>(to), sliceSize,
+            *instance, lo, hi);
+          break;
+        default:
+          Unpack(static_cast<const Uint16*>(raw) + at, static_cast<short*>(to), sliceSize,
+            *instance, lo, hi);
+          break;
       }
       least[k] = lo;
       greatest[k] = hi;
@@ -941,73 +1051,70 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries() {
   std::vector<double> slopes(count), intercepts(count);
   bool uniform = true, integral = true;
   double low = 0.0, high = 0.0;
-  for (std::size_t k = 0; k < count; ++k) {
+  for (std::size_t k = 0; k < count; ++k)
+  {
     slopes[k] = slices[k].second->Slope;
     intercepts[k] = slices[k].second->Intercept;
-    uniform =
-        uniform && slopes[k] == slopes[0] && intercepts[k] == intercepts[0];
-    integral = integral && slopes[k] == std::round(slopes[k]) &&
-               intercepts[k] == std::round(intercepts[k]);
+    uniform = uniform && slopes[k] == slopes[0] && intercepts[k] == intercepts[0];
+    integral =
+      integral && slopes[k] == std::round(slopes[k]) && intercepts[k] == std::round(intercepts[k]);
     const double a = slopes[k] * static_cast<double>(least[k]) + intercepts[k];
-    const double b =
-        slopes[k] * static_cast<double>(greatest[k]) + intercepts[k];
+    const double b = slopes[k] * static_cast<double>(greatest[k]) + intercepts[k];
     low = k == 0 ? std::min(a, b) : std::min(low, std::min(a, b));
     high = k == 0 ? std::max(a, b) : std::max(high, std::max(a, b));
   }
   const int floatType = first.BitsStored > 16 ? VTK_DOUBLE : VTK_FLOAT;
-  const int outputType = (resample || !uniform || !integral)
-                             ? floatType
-                             : SmallestIntegerType(low, high);
+  const int outputType =
+    (resample || !uniform || !integral) ? floatType : SmallestIntegerType(low, high);
 
   int slicesOut = static_cast<int>(count);
-  double step =
-      count > 1 ? (distances.back() - distances.front()) / (count - 1) : 0.0;
-  if (resample) {
+  double step = count > 1 ? (distances.back() - distances.front()) / (count - 1) : 0.0;
+  if (resample)
+  {
     const double span = distances.back() - distances.front();
     slicesOut = static_cast<int>(std::round(span / median)) + 1;
     step = span / (slicesOut - 1);
   }
 
   vtkSmartPointer<vtkDataArray> volume;
-  if (!resample && outputType == storedType && slopes[0] == 1.0 &&
-      intercepts[0] == 0.0) {
+  if (!resample && outputType == storedType && slopes[0] == 1.0 && intercepts[0] == 0.0)
+  {
     volume = stored;
-  } else {
-    volume = NewVolume(outputType, sliceSize * slicesOut, "the rescaled series",
-                       error);
-    if (!volume) {
+  }
+  else
+  {
+    volume = NewVolume(outputType, sliceSize * slicesOut, "the rescaled series", error);
+    if (!volume)
+    {
       return error;
     }
-    switch (storedType) {
-    case VTK_UNSIGNED_CHAR:
-      Convert(static_cast<const unsigned char *>(stored->GetVoidPointer(0)),
-              volume, resample, sliceSize, distances, slopes, intercepts,
-              slicesOut, step);
-      break;
-    case VTK_SIGNED_CHAR:
-      Convert(static_cast<const signed char *>(stored->GetVoidPointer(0)),
-              volume, resample, sliceSize, distances, slopes, intercepts,
-              slicesOut, step);
-      break;
-    case VTK_UNSIGNED_SHORT:
-      Convert(static_cast<const unsigned short *>(stored->GetVoidPointer(0)),
-              volume, resample, sliceSize, distances, slopes, intercepts,
-              slicesOut, step);
-      break;
-    default:
-      Convert(static_cast<const short *>(stored->GetVoidPointer(0)), volume,
-              resample, sliceSize, distances, slopes, intercepts, slicesOut,
-              step);
-      break;
+    switch (storedType)
+    {
+      case VTK_UNSIGNED_CHAR:
+        Convert(static_cast<const unsigned char*>(stored->GetVoidPointer(0)), volume, resample,
+          sliceSize, distances, slopes, intercepts, slicesOut, step);
+        break;
+      case VTK_SIGNED_CHAR:
+        Convert(static_cast<const signed char*>(stored->GetVoidPointer(0)), volume, resample,
+          sliceSize, distances, slopes, intercepts, slicesOut, step);
+        break;
+      case VTK_UNSIGNED_SHORT:
+        Convert(static_cast<const unsigned short*>(stored->GetVoidPointer(0)), volume, resample,
+          sliceSize, distances, slopes, intercepts, slicesOut, step);
+        break;
+      default:
+        Convert(static_cast<const short*>(stored->GetVoidPointer(0)), volume, resample, sliceSize,
+          distances, slopes, intercepts, slicesOut, step);
+        break;
     }
   }
   volume->SetName("DICOMImage");
-  if (resample) {
-    vtkWarningMacro(
-        << "resampled " << count << " unevenly spaced slices (median step "
-        << Number(median) << " mm: " << unevenList << ") onto " << slicesOut
-        << " slices " << Number(step)
-        << " mm apart by linear interpolation (ResampleUnevenSlices)");
+  if (resample)
+  {
+    vtkWarningMacro(<< "resampled " << count << " unevenly spaced slices (median step "
+                    << Number(median) << " mm: " << unevenList << ") onto " << slicesOut
+                    << " slices " << Number(step)
+                    << " mm apart by linear interpolation (ResampleUnevenSlices)");
   }
 
   // Placement.
@@ -1016,73 +1123,78 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries() {
   this->Dimensions[0] = first.Columns;
   this->Dimensions[1] = first.Rows;
   this->Dimensions[2] = slicesOut;
-  const Slice &base = *slices.front().second;
-  for (int c = 0; c < 3; ++c) {
+  const Slice& base = *slices.front().second;
+  for (int c = 0; c < 3; ++c)
+  {
     this->Origin[c] = base.HasPosition ? base.Position[c] : 0.0;
     this->Direction[3 * c + 0] = row[c];
     this->Direction[3 * c + 1] = column[c];
     this->Direction[3 * c + 2] = normal[c];
   }
-  const bool spaced = reference.HasPixelSpacing &&
-                      reference.PixelSpacing[0] > 0.0 &&
-                      reference.PixelSpacing[1] > 0.0;
+  const bool spaced =
+    reference.HasPixelSpacing && reference.PixelSpacing[0] > 0.0 && reference.PixelSpacing[1] > 0.0;
   this->Spacing[0] = spaced ? reference.PixelSpacing[1] : 1.0;
   this->Spacing[1] = spaced ? reference.PixelSpacing[0] : 1.0;
-  this->Spacing[2] =
-      count > 1 ? step
-                : (first.SliceThickness > 0.0 ? first.SliceThickness : 1.0);
+  this->Spacing[2] = count > 1 ? step : (first.SliceThickness > 0.0 ? first.SliceThickness : 1.0);
   return std::string();
 }
 
 //------------------------------------------------------------------------------
 int vtkMedicalDICOMSeriesReader::RequestInformation(
-    vtkInformation *, vtkInformationVector **,
-    vtkInformationVector *outputVector) {
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
   this->Volume = nullptr;
   this->SeriesRead.clear();
   this->SeriesList->Initialize();
   std::string error;
-  try {
+  try
+  {
     error = this->ReadSeries();
-  } catch (const std::bad_alloc &) {
+  }
+  catch (const std::bad_alloc&)
+  {
     error = "out of memory while reading the series";
-  } catch (const std::exception &e) {
+  }
+  catch (const std::exception& e)
+  {
     error = std::string("failed while reading the series: ") + e.what();
   }
-  vtkInformation *outInfo = outputVector->GetInformationObject(0);
-  if (!error.empty()) {
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  if (!error.empty())
+  {
     this->Volume = nullptr;
     this->SeriesRead.clear();
     vtkErrorMacro(<< error);
-    const int empty[6] = {0, -1, 0, -1, 0, -1};
+    const int empty[6] = { 0, -1, 0, -1, 0, -1 };
     outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), empty, 6);
     return 1;
   }
-  const int whole[6] = {0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1,
-                        0, this->Dimensions[2] - 1};
+  const int whole[6] = { 0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0,
+    this->Dimensions[2] - 1 };
   outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole, 6);
   outInfo->Set(vtkDataObject::SPACING(), this->Spacing, 3);
   outInfo->Set(vtkDataObject::ORIGIN(), this->Origin, 3);
   outInfo->Set(vtkDataObject::DIRECTION(), this->Direction, 9);
-  vtkDataObject::SetPointDataActiveScalarInfo(outInfo,
-                                              this->Volume->GetDataType(), 1);
+  vtkDataObject::SetPointDataActiveScalarInfo(outInfo, this->Volume->GetDataType(), 1);
   return 1;
 }
 
 //------------------------------------------------------------------------------
 int vtkMedicalDICOMSeriesReader::RequestData(
-    vtkInformation *, vtkInformationVector **,
-    vtkInformationVector *outputVector) {
-  vtkImageData *output = vtkImageData::GetData(outputVector, 0);
-  if (!output) {
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkImageData* output = vtkImageData::GetData(outputVector, 0);
+  if (!output)
+  {
     return 0;
   }
   output->Initialize();
-  if (!this->Volume) {
+  if (!this->Volume)
+  {
     return 1; // the error was reported with the information
   }
-  output->SetExtent(0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0,
-                    this->Dimensions[2] - 1);
+  output->SetExtent(
+    0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0, this->Dimensions[2] - 1);
   output->SetSpacing(this->Spacing);
   output->SetOrigin(this->Origin);
   output->SetDirectionMatrix(this->Direction);
@@ -1091,17 +1203,17 @@ int vtkMedicalDICOMSeriesReader::RequestData(
 }
 
 //------------------------------------------------------------------------------
-void vtkMedicalDICOMSeriesReader::PrintSelf(ostream &os, vtkIndent indent) {
+void vtkMedicalDICOMSeriesReader::PrintSelf(ostream& os, vtkIndent indent)
+{
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)")
+  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
+  os << indent
+     << "SeriesInstanceUID: " << (this->SeriesInstanceUID ? this->SeriesInstanceUID : "(none)")
      << "\n";
-  os << indent << "SeriesInstanceUID: "
-     << (this->SeriesInstanceUID ? this->SeriesInstanceUID : "(none)") << "\n";
-  os << indent << "ResampleUnevenSlices: " << this->ResampleUnevenSlices
-     << "\n";
+  os << indent << "ResampleUnevenSlices: " << this->ResampleUnevenSlices << "\n";
   os << indent << "SeriesRead: " << this->SeriesRead << "\n";
-  os << indent << "Origin: " << this->Origin[0] << " " << this->Origin[1] << " "
-     << this->Origin[2] << "\n";
-  os << indent << "Spacing: " << this->Spacing[0] << " " << this->Spacing[1]
-     << " " << this->Spacing[2] << "\n";
+  os << indent << "Origin: " << this->Origin[0] << " " << this->Origin[1] << " " << this->Origin[2]
+     << "\n";
+  os << indent << "Spacing: " << this->Spacing[0] << " " << this->Spacing[1] << " "
+     << this->Spacing[2] << "\n";
 }

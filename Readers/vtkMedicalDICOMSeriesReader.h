@@ -106,12 +106,12 @@
 class vtkDataArray;
 class vtkStringArray;
 
-class MEDICALISOSURFACESREADERS_EXPORT vtkMedicalDICOMSeriesReader
-    : public vtkImageAlgorithm {
+class MEDICALISOSURFACESREADERS_EXPORT vtkMedicalDICOMSeriesReader : public vtkImageAlgorithm
+{
 public:
-  static vtkMedicalDICOMSeriesReader *New();
+  static vtkMedicalDICOMSeriesReader* New();
   vtkTypeMacro(vtkMedicalDICOMSeriesReader, vtkImageAlgorithm);
-  void PrintSelf(ostream &os, vtkIndent indent) override;
+  void PrintSelf(ostream& os, vtkIndent indent) override;
 
   ///@{
   /**
@@ -126,7 +126,7 @@ public:
    * The same as SetFileName (the name this reader had before it read with
    * DCMTK).
    */
-  void SetSeriesPath(const char *path) { this->SetFileName(path); }
+  void SetSeriesPath(const char* path) { this->SetFileName(path); }
 
   ///@{
   /**
@@ -155,28 +155,27 @@ public:
    * | N slices", the series read first. Empty before an update or after an
    * error in the scan.
    */
-  vtkStringArray *GetSeriesInFolder();
+  vtkStringArray* GetSeriesInFolder();
 
   /// After an update: the UID of the series read (empty after an error).
-  const char *GetSeriesRead() { return this->SeriesRead.c_str(); }
+  const char* GetSeriesRead() { return this->SeriesRead.c_str(); }
 
 protected:
   vtkMedicalDICOMSeriesReader();
   ~vtkMedicalDICOMSeriesReader() override;
 
-  int RequestInformation(vtkInformation *request,
-                         vtkInformationVector **inputVector,
-                         vtkInformationVector *outputVector) override;
-  int RequestData(vtkInformation *request, vtkInformationVector **inputVector,
-                  vtkInformationVector *outputVector) override;
+  int RequestInformation(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
+  int RequestData(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
 
-  char *FileName = nullptr;
-  char *SeriesInstanceUID = nullptr;
+  char* FileName = nullptr;
+  char* SeriesInstanceUID = nullptr;
   vtkTypeBool ResampleUnevenSlices = 0;
 
 private:
-  vtkMedicalDICOMSeriesReader(const vtkMedicalDICOMSeriesReader &) = delete;
-  void operator=(const vtkMedicalDICOMSeriesReader &) = delete;
+  vtkMedicalDICOMSeriesReader(const vtkMedicalDICOMSeriesReader&) = delete;
+  void operator=(const vtkMedicalDICOMSeriesReader&) = delete;
 
   // Scan, check, decode and rescale; an empty string or the error message.
   std::string ReadSeries();
@@ -184,10 +183,10 @@ private:
   vtkSmartPointer<vtkDataArray> Volume;
   vtkSmartPointer<vtkStringArray> SeriesList;
   std::string SeriesRead;
-  int Dimensions[3] = {0, 0, 0};
-  double Origin[3] = {0.0, 0.0, 0.0};
-  double Spacing[3] = {1.0, 1.0, 1.0};
-  double Direction[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  int Dimensions[3] = { 0, 0, 0 };
+  double Origin[3] = { 0.0, 0.0, 0.0 };
+  double Spacing[3] = { 1.0, 1.0, 1.0 };
+  double Direction[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
 };
 
 #endif
