@@ -628,6 +628,9 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
       series[found->second].Slices += scan[i].Frames;
     }
   }
+  // Largest first, so that every list of series reads the same way.
+  std::stable_sort(series.begin(), series.end(),
+    [](const Series& a, const Series& b) { return a.Slices > b.Slices; });
   std::size_t chosen = series.size();
   std::string reason;
   const std::string wanted = this->SeriesInstanceUID ? this->SeriesInstanceUID : "";
@@ -660,13 +663,6 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   {
     reason = "the series with the most slices";
     chosen = 0;
-    for (std::size_t s = 1; s < series.size(); ++s)
-    {
-      if (series[s].Slices > series[chosen].Slices)
-      {
-        chosen = s;
-      }
-    }
   }
   this->SeriesList->SetNumberOfValues(static_cast<vtkIdType>(series.size()));
   {
