@@ -6,8 +6,9 @@ The corpus (Testing/Python/dicom_corpus.py, run with Debian's /usr/bin/python3 a
 DCMTK's tools compress its copies) holds small series that each test one thing: plain CT
 with a rescale intercept, the same compressed as RLE, JPEG lossless and JPEG-LS, two series
 in a folder, a missing slice, uneven steps, a slope per slice, files that are not images, a
-transfer syntax that is not decoded, an enhanced multi-frame file, shuffled file order and an
-oblique plane. Every case asserts the exact values (interpolated ones to 1e-3) and geometry,
+transfer syntax that is not decoded, an enhanced multi-frame file, shuffled file order, an
+oblique plane, and damaged files (one cut short, pixel data shorter than the header says, a
+header claiming 34 TB). Every case asserts the exact values (interpolated ones to 1e-3) and geometry,
 or the exact message: the reader's errors and warnings are captured here, and any not
 expected fails the test. Skipped (exit 125) when /usr/bin/python3 lacks pydicom or DCMTK's
 tools are missing (Scripts/bootstrap.sh installs both).
@@ -200,6 +201,26 @@ expect_volume("multiframe")
 # File names and instance numbers shuffled; an oblique plane with signed pixels.
 expect_volume("shuffled")
 expect_volume("oblique")
+
+# Damaged files: each refused with its reason, nothing allocated for a header's claims.
+image, values, text = read(corpus / manifest["truncated"]["open"])
+check(messages(text) == [
+    ("warning", "%s: skipped 1 DICOM file(s) DCMTK cannot read: slice_002.dcm (Invalid stream)"
+     % (corpus / "truncated")),
+    ("error", "the slices are not evenly spaced (median step 2.5 mm): a gap of 5 mm between "
+     "12.5 mm (slice_001.dcm) and 17.5 mm (slice_003.dcm) (1 slice missing). Turn "
+     "ResampleUnevenSlices on to resample them onto an even grid.")],
+    "truncated: the cut file named, then the gap it leaves (got %s)" % messages(text))
+check(values is None or len(values) == 0, "truncated: an empty image")
+expect_error("short_pixels", corpus / manifest["short_pixels"]["open"],
+             "short.dcm: Pixel Data holds 100 bytes, 384 expected (16 x 12 x 1 frame(s) x 2 "
+             "byte(s))")
+image, values, text = read(corpus / manifest["huge"]["open"])
+got = messages(text)
+check(len(got) == 1 and got[0][0] == "error" and got[0][1].startswith(
+    "the decoded series (34358689.8 MB) does not fit in the "),
+    "huge: refused before allocating (got %s)" % got)
+check(values is None or len(values) == 0, "huge: an empty image")
 
 if check.failures:
     print("%d check(s) failed" % len(check.failures))

@@ -21,6 +21,9 @@ Cases (16 columns x 12 rows per slice, small on purpose):
 - multiframe: one Enhanced CT file of 5 frames in reverse position order, functional groups.
 - shuffled: the plain series with file names and instance numbers in a shuffled order.
 - oblique: signed 16-bit slices on a rotated plane, stacked along its normal, files shuffled.
+- truncated: the plain series with one slice's file cut short.
+- short_pixels: a slice whose Pixel Data is shorter than Rows x Columns.
+- huge: a multi-frame header claiming 34 TB of pixels over 64 bytes.
 """
 import json
 import os
@@ -312,6 +315,52 @@ def main(out):
          origin=list(origin), spacing=[0.6, 0.8, 1.75],
          direction=[row[0], col[0], normal[0], row[1], col[1], normal[1],
                     row[2], col[2], normal[2]])
+
+    # Damaged files. A slice cut short in its pixel data, in the middle of the series.
+    folder = os.path.join(out, "truncated")
+    plain_series(folder, uid("truncated"))
+    cut = os.path.join(folder, "slice_002.dcm")
+    with open(cut, "rb") as f:
+        data = f.read()
+    with open(cut, "wb") as f:
+        f.write(data[:len(data) - 100])
+    case("truncated", plain, open="truncated/slice_000.dcm", series=uid("truncated"))
+
+    # One slice whose pixel data is shorter than Rows x Columns says (its length
+    # consistent with the file, so that only the reader can tell).
+    folder = os.path.join(out, "short_pixels")
+    os.makedirs(folder)
+    image_slice(os.path.join(folder, "short.dcm"), uid("short"), 0, stored_slice(0),
+                (0.0, 0.0, 0.0))
+    ds = pydicom.dcmread(os.path.join(folder, "short.dcm"))
+    ds.PixelData = ds.PixelData[:100]
+    ds.save_as(os.path.join(folder, "short.dcm"), write_like_original=False)
+    case("short_pixels", plain[:1], open="short_pixels/short.dcm", series=uid("short"))
+
+    # A multi-frame header that claims 4000 frames of 65535 x 65535 (34 TB) over
+    # a few bytes of pixel data: refused before any allocation.
+    folder = os.path.join(out, "huge")
+    os.makedirs(folder)
+    series = uid("huge")
+    ds = base_dataset(ENHANCED_CT_IMAGE, series, uid(series, "file"), 1)
+    frames = 4000
+    ds.NumberOfFrames = frames
+    ds.Rows, ds.Columns = 65535, 65535
+    ds.SamplesPerPixel = 1
+    ds.PhotometricInterpretation = "MONOCHROME2"
+    ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 16, 16, 15, 0
+    ds.SharedFunctionalGroupsSequence = [shared]
+    per_frame = []
+    for f in range(frames):
+        position = Dataset()
+        position.ImagePositionPatient = [0.0, 0.0, float(f)]
+        group = Dataset()
+        group.PlanePositionSequence = [position]
+        per_frame.append(group)
+    ds.PerFrameFunctionalGroupsSequence = per_frame
+    ds.PixelData = bytes(64)
+    ds.save_as(os.path.join(folder, "huge.dcm"), write_like_original=False)
+    case("huge", plain[:1], open="huge/huge.dcm", series=series)
 
     with open(os.path.join(out, "manifest.json"), "w") as f:
         json.dump(manifest, f, indent=1)
