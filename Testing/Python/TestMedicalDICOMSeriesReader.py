@@ -7,7 +7,8 @@ DCMTK's tools compress its copies) holds small series that each test one thing: 
 with a rescale intercept, the same compressed as RLE, JPEG lossless and JPEG-LS, two series
 in a folder, a missing slice, uneven steps, a slope per slice, files that are not images, a
 transfer syntax that is not decoded, an enhanced multi-frame file, shuffled file order, an
-oblique plane, and damaged files (one cut short, pixel data shorter than the header says, a
+oblique plane, 8-bit implicit VR and big endian files, a duplicate position, a slice of
+another size, and damaged files (one cut short, pixel data shorter than the header says, a
 header claiming 34 TB). Every case asserts the exact values (interpolated ones to 1e-3) and geometry,
 or the exact message: the reader's errors and warnings are captured here, and any not
 expected fails the test. Skipped (exit 125) when /usr/bin/python3 lacks pydicom or DCMTK's
@@ -201,6 +202,16 @@ expect_volume("multiframe")
 # File names and instance numbers shuffled; an oblique plane with signed pixels.
 expect_volume("shuffled")
 expect_volume("oblique")
+
+# 8-bit implicit VR (uint8 as stored), signed big endian; a duplicate position, a mixed size.
+expect_volume("mr8")
+expect_volume("bigendian")
+expect_error("duplicate", corpus / manifest["duplicate"]["open"],
+             "two slices at the same position along the normal, 12.5 mm (slice_001.dcm) and "
+             "12.5 mm (slice_001_copy.dcm): duplicate slices are not read")
+expect_error("mixed_size", corpus / manifest["mixed_size"]["open"],
+             "slice_006.dcm: 8 x 8 pixels, but slice_000.dcm has 16 x 12: slices of different "
+             "sizes are not read")
 
 # Damaged files: each refused with its reason, nothing allocated for a header's claims.
 image, values, text = read(corpus / manifest["truncated"]["open"])

@@ -21,6 +21,10 @@ Cases (16 columns x 12 rows per slice, small on purpose):
 - multiframe: one Enhanced CT file of 5 frames in reverse position order, functional groups.
 - shuffled: the plain series with file names and instance numbers in a shuffled order.
 - oblique: signed 16-bit slices on a rotated plane, stacked along its normal, files shuffled.
+- mr8: 8-bit slices, implicit VR, no rescale (uint8 as stored).
+- bigendian: signed 16-bit slices in explicit VR big endian.
+- duplicate: the plain series with one slice copied under another UID.
+- mixed_size: the plain series with a 7th slice of 8 x 8 pixels.
 - truncated: the plain series with one slice's file cut short.
 - short_pixels: a slice whose Pixel Data is shorter than Rows x Columns.
 - huge: a multi-frame header claiming 34 TB of pixels over 64 bytes.
@@ -315,6 +319,63 @@ def main(out):
          origin=list(origin), spacing=[0.6, 0.8, 1.75],
          direction=[row[0], col[0], normal[0], row[1], col[1], normal[1],
                     row[2], col[2], normal[2]])
+
+    # 8-bit MR-like slices in implicit VR little endian, no rescale: uint8 as stored.
+    folder = os.path.join(out, "mr8")
+    os.makedirs(folder)
+    values = []
+    for k in range(3):
+        pixels = (stored_slice(k) % 256).astype(numpy.uint8)
+        path = os.path.join(folder, "mr_%d.dcm" % k)
+        image_slice(path, uid("mr8"), k, pixels, (0.0, 0.0, 4.0 * k), slope=1.0, intercept=0.0)
+        ds = pydicom.dcmread(path)
+        ds.file_meta.TransferSyntaxUID = pydicom.uid.ImplicitVRLittleEndian
+        ds.is_implicit_VR, ds.is_little_endian = True, True
+        ds.Modality = "MR"
+        ds.BitsAllocated, ds.BitsStored, ds.HighBit = 8, 8, 7
+        del ds.RescaleSlope, ds.RescaleIntercept
+        ds.PixelData = pixels.tobytes()
+        ds.save_as(path, write_like_original=False)
+        values.append(pixels.astype(float))
+    case("mr8", values, open="mr8/mr_0.dcm", series=uid("mr8"), dtype="uint8",
+         origin=[0.0, 0.0, 0.0], spacing=[0.6, 0.8, 4.0], direction=axial["direction"])
+
+    # Signed 16-bit in explicit VR big endian (retired, still met), intercept 0.
+    folder = os.path.join(out, "bigendian")
+    os.makedirs(folder)
+    values = []
+    for k in range(3):
+        pixels = stored_slice(k, seed=2).astype(numpy.int16) - 2000
+        path = os.path.join(folder, "be_%d.dcm" % k)
+        image_slice(path, uid("bigendian"), k, pixels, (0.0, 0.0, 4.0 * k), slope=1.0,
+                    intercept=0.0, signed=True, bits_stored=16)
+        ds = pydicom.dcmread(path)
+        ds.file_meta.TransferSyntaxUID = pydicom.uid.ExplicitVRBigEndian
+        ds.is_implicit_VR, ds.is_little_endian = False, False
+        ds.PixelData = pixels.astype(">i2").tobytes()
+        ds.save_as(path, write_like_original=False)
+        values.append(pixels.astype(float))
+    case("bigendian", values, open="bigendian/be_0.dcm", series=uid("bigendian"),
+         dtype="int16", origin=[0.0, 0.0, 0.0], spacing=[0.6, 0.8, 4.0],
+         direction=axial["direction"])
+
+    # The same position twice: a copy of a slice under another SOP Instance UID.
+    folder = os.path.join(out, "duplicate")
+    plain_series(folder, uid("duplicate"))
+    ds = pydicom.dcmread(os.path.join(folder, "slice_001.dcm"))
+    ds.SOPInstanceUID = ds.file_meta.MediaStorageSOPInstanceUID = uid("duplicate", "copy")
+    ds.save_as(os.path.join(folder, "slice_001_copy.dcm"), write_like_original=False)
+    case("duplicate", plain, open="duplicate/slice_000.dcm", series=uid("duplicate"))
+
+    # One slice of another size in the series.
+    folder = os.path.join(out, "mixed_size")
+    plain_series(folder, uid("mixed"))
+    image_slice(os.path.join(folder, "slice_006.dcm"), uid("mixed"), 6,
+                stored_slice(6)[:8, :8].copy(), (-20.0, -15.0, 25.0))
+    ds = pydicom.dcmread(os.path.join(folder, "slice_006.dcm"))
+    ds.Rows, ds.Columns = 8, 8
+    ds.save_as(os.path.join(folder, "slice_006.dcm"), write_like_original=False)
+    case("mixed_size", plain, open="mixed_size/slice_000.dcm", series=uid("mixed"))
 
     # Damaged files. A slice cut short in its pixel data, in the middle of the series.
     folder = os.path.join(out, "truncated")
