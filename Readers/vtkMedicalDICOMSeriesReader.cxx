@@ -116,7 +116,6 @@ struct Slice
   double PixelSpacing[2] = { 1, 1 }; // DICOM order: between rows, between columns
   double Slope = 1.0;
   double Intercept = 0.0;
-  double Distance = 0.0; // along the series' normal
   long InstanceNumber = 0;
 };
 
@@ -491,54 +490,35 @@ vtkSmartPointer<vtkDataArray> NewVolume(
   array->SetNumberOfTuples(static_cast<vtkIdType>(tuples));
   return array;
 }
-} // namespace
 
-//------------------------------------------------------------------------------
-vtkMedicalDICOMSeriesReader::vtkMedicalDICOMSeriesReader()
+std::string JoinList(const std::vector<std::string>& items, const char* separator)
 {
-  this->SetNumberOfInputPorts(0);
-  this->SeriesList = vtkSmartPointer<vtkStringArray>::New();
+  std::string text;
+  for (const std::string& item : items)
+  {
+    text += (text.empty() ? "" : separator) + item;
+  }
+  return text;
 }
 
-//------------------------------------------------------------------------------
-vtkMedicalDICOMSeriesReader::~vtkMedicalDICOMSeriesReader()
+// Step 1: the image files of the folder of `path` (or of the folder `path`).
+struct FolderScan
 {
-  this->SetFileName(nullptr);
-  this->SetSeriesInstanceUID(nullptr);
-}
+  std::string Folder;
+  bool FileOpened = false;
+  std::string OpenedSeries;
+  std::vector<Instance> Images;
+  std::vector<std::string> Unreadable; // "name (reason)"
+};
 
-//------------------------------------------------------------------------------
-vtkStringArray* vtkMedicalDICOMSeriesReader::GetSeriesInFolder()
+std::string ScanFolder(const std::string& path, FolderScan& scan)
 {
-  return this->SeriesList;
-}
-
-//------------------------------------------------------------------------------
-std::string vtkMedicalDICOMSeriesReader::ReadSeries()
-{
-  if (!this->FileName || !this->FileName[0])
-  {
-    return "no FileName: set a file of the series, or its folder";
-  }
-  const std::string path = this->FileName;
-  if (!vtksys::SystemTools::FileExists(path))
-  {
-    return path + ": no such file or folder";
-  }
-  if (!dcmDataDict.isDictionaryLoaded())
-  {
-    return "DCMTK's data dictionary is not loaded (see DCMDICTPATH): DICOM "
-           "files cannot be read";
-  }
-  RegisterDecoders();
-
-  // 1. Scan the folder.
-  const bool opened = !vtksys::SystemTools::FileIsDirectory(path);
-  const std::string folder = opened ? vtksys::SystemTools::GetFilenamePath(path) : path;
+  scan.FileOpened = !vtksys::SystemTools::FileIsDirectory(path);
+  scan.Folder = scan.FileOpened ? vtksys::SystemTools::GetFilenamePath(path) : path;
   vtksys::Directory directory;
-  if (!directory.Load(folder.empty() ? std::string(".") : folder))
+  if (!directory.Load(scan.Folder.empty() ? std::string(".") : scan.Folder))
   {
-    return folder + ": the folder cannot be listed";
+    return scan.Folder + ": the folder cannot be listed";
   }
   std::vector<std::string> names;
   for (unsigned long i = 0; i < directory.GetNumberOfFiles(); ++i)
@@ -550,13 +530,10 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
     }
   }
   std::sort(names.begin(), names.end());
-  std::vector<Instance> scan;
-  std::vector<std::string> unreadable;
-  std::string openedSeries;
   bool openedFound = false;
   for (const std::string& name : names)
   {
-    const std::string file = folder.empty() ? name : folder + "/" + name;
+    const std::string file = scan.Folder.empty() ? name : scan.Folder + "/" + name;
     if (vtksys::SystemTools::FileIsDirectory(file))
     {
       continue;
@@ -564,252 +541,218 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
     Instance instance;
     std::string why;
     const HeaderStatus status = ReadHeader(file, instance, why);
-    const bool isOpened = opened && vtksys::SystemTools::SameFile(file, path);
+    const bool isOpened = scan.FileOpened && vtksys::SystemTools::SameFile(file, path);
     if (status == HeaderStatus::Unreadable)
     {
       if (isOpened)
       {
         return path + ": DCMTK cannot read it (" + why + ")";
       }
-      unreadable.push_back(name + " (" + why + ")");
+      scan.Unreadable.push_back(name + " (" + why + ")");
       continue;
     }
     if (status == HeaderStatus::NotImage)
     {
       if (isOpened)
       {
-        return path +
-          ": not a DICOM image (no Part 10 preamble \"DICM\", or "
-          "no Rows, Columns and Pixel Data)";
+        return path + ": not a DICOM image (no Part 10 preamble \"DICM\", or no Rows, Columns " +
+          "and Pixel Data)";
       }
       continue;
     }
     if (isOpened)
     {
       openedFound = true;
-      openedSeries = instance.SeriesUID;
+      scan.OpenedSeries = instance.SeriesUID;
     }
-    scan.push_back(std::move(instance));
+    scan.Images.push_back(std::move(instance));
   }
-  if (opened && !openedFound)
+  if (scan.FileOpened && !openedFound)
   {
     return path + ": not found in the listing of its folder";
   }
-  if (scan.empty())
+  if (scan.Images.empty())
   {
-    return folder + ": no DICOM image files in the folder";
+    return scan.Folder + ": no DICOM image files in the folder";
   }
-  if (!unreadable.empty())
-  {
-    std::string list;
-    for (const std::string& entry : unreadable)
-    {
-      list += (list.empty() ? "" : "; ") + entry;
-    }
-    vtkWarningMacro(<< folder << ": skipped " << unreadable.size()
-                    << " DICOM file(s) DCMTK cannot read: " << list);
-  }
+  return std::string();
+}
 
-  // 2. Group by series and choose one.
-  std::vector<Series> series;
+// Step 2: the images grouped by Series Instance UID, largest series first
+// (so that every list of series reads the same way), and the one to read.
+struct SeriesChoice
+{
+  std::vector<Series> All;
+  std::size_t Chosen = 0;
+  std::string Reason;
+};
+
+std::string ChooseSeries(const FolderScan& scan, const std::string& wanted, SeriesChoice& choice)
+{
+  std::map<std::string, std::size_t> index;
+  for (std::size_t i = 0; i < scan.Images.size(); ++i)
   {
-    std::map<std::string, std::size_t> index;
-    for (std::size_t i = 0; i < scan.size(); ++i)
+    const Instance& image = scan.Images[i];
+    auto found = index.find(image.SeriesUID);
+    if (found == index.end())
     {
-      auto found = index.find(scan[i].SeriesUID);
-      if (found == index.end())
-      {
-        found = index.emplace(scan[i].SeriesUID, series.size()).first;
-        series.emplace_back();
-        series.back().UID = scan[i].SeriesUID;
-        series.back().Description = scan[i].SeriesDescription;
-      }
-      series[found->second].Instances.push_back(i);
-      series[found->second].Slices += scan[i].Frames;
+      found = index.emplace(image.SeriesUID, choice.All.size()).first;
+      choice.All.emplace_back();
+      choice.All.back().UID = image.SeriesUID;
+      choice.All.back().Description = image.SeriesDescription;
     }
+    choice.All[found->second].Instances.push_back(i);
+    choice.All[found->second].Slices += image.Frames;
   }
-  // Largest first, so that every list of series reads the same way.
-  std::stable_sort(series.begin(), series.end(),
+  std::stable_sort(choice.All.begin(), choice.All.end(),
     [](const Series& a, const Series& b) { return a.Slices > b.Slices; });
-  std::size_t chosen = series.size();
-  std::string reason;
-  const std::string wanted = this->SeriesInstanceUID ? this->SeriesInstanceUID : "";
-  for (std::size_t s = 0; s < series.size(); ++s)
-  {
-    if (!wanted.empty() ? series[s].UID == wanted : (opened && series[s].UID == openedSeries))
-    {
-      chosen = s;
-    }
-  }
+  const std::string* uid = nullptr;
   if (!wanted.empty())
   {
-    reason = "the one SeriesInstanceUID names";
-    if (chosen == series.size())
-    {
-      std::string list;
-      for (const Series& s : series)
-      {
-        list += (list.empty() ? "" : "; ") + Describe(s);
-      }
-      return folder + ": no series with Series Instance UID " + wanted + "; the folder holds " +
-        list;
-    }
+    uid = &wanted;
+    choice.Reason = "the one SeriesInstanceUID names";
   }
-  else if (opened)
+  else if (scan.FileOpened)
   {
-    reason = "the series of the file opened";
+    uid = &scan.OpenedSeries;
+    choice.Reason = "the series of the file opened";
   }
   else
   {
-    reason = "the series with the most slices";
-    chosen = 0;
+    choice.Chosen = 0;
+    choice.Reason = "the series with the most slices";
+    return std::string();
   }
-  this->SeriesList->SetNumberOfValues(static_cast<vtkIdType>(series.size()));
+  for (std::size_t s = 0; s < choice.All.size(); ++s)
   {
-    vtkIdType row = 0;
-    auto line = [](const Series& s)
-    { return s.UID + " | " + s.Description + " | " + std::to_string(s.Slices) + " slices"; };
-    this->SeriesList->SetValue(row++, line(series[chosen]));
-    for (std::size_t s = 0; s < series.size(); ++s)
+    if (choice.All[s].UID == *uid)
     {
-      if (s != chosen)
-      {
-        this->SeriesList->SetValue(row++, line(series[s]));
-      }
+      choice.Chosen = s;
+      return std::string();
     }
   }
-  if (series.size() > 1)
+  std::vector<std::string> list;
+  for (const Series& s : choice.All)
   {
-    std::string others;
-    for (std::size_t s = 0; s < series.size(); ++s)
-    {
-      if (s != chosen)
-      {
-        others += (others.empty() ? "" : "; ") + Describe(series[s]);
-      }
-    }
-    vtkWarningMacro(<< folder << ": the folder holds " << series.size() << " series; read "
-                    << Describe(series[chosen]) << ", " << reason << "; not read: " << others
-                    << ". SeriesInstanceUID chooses another.");
+    list.push_back(Describe(s));
   }
-  const Series& read = series[chosen];
+  return scan.Folder + ": no series with Series Instance UID " + *uid + "; the folder holds " +
+    JoinList(list, "; ");
+}
 
-  // 3-4. The slices, checked against the first one.
-  std::vector<Instance*> instances;
-  for (std::size_t i : read.Instances)
-  {
-    instances.push_back(&scan[i]);
-  }
+// Step 4, file by file: what the reader decodes, and the same size and pixel
+// format as the series' first file.
+std::string CheckInstances(const std::vector<Instance*>& instances)
+{
   const Instance& first = *instances.front();
-  for (std::size_t i = 0; i < instances.size(); ++i)
+  for (const Instance* instance : instances)
   {
-    Instance& instance = *instances[i];
-    const std::string name = BaseName(instance.Path);
-    if (!Decodable(instance.Syntax))
+    const std::string name = BaseName(instance->Path);
+    if (!Decodable(instance->Syntax))
     {
-      return name + ": transfer syntax \"" + DcmXfer(instance.Syntax).getXferName() + "\" (" +
-        instance.TransferSyntaxUID +
-        ") is not read (this reader decodes uncompressed, deflated, JPEG "
-        "baseline, extended and "
-        "lossless, JPEG-LS and RLE pixel data)";
+      return name + ": transfer syntax \"" + DcmXfer(instance->Syntax).getXferName() + "\" (" +
+        instance->TransferSyntaxUID + ") is not read (this reader decodes uncompressed, " +
+        "deflated, JPEG baseline, extended and lossless, JPEG-LS and RLE pixel data)";
     }
-    if (instance.SamplesPerPixel != 1 ||
-      (instance.Photometric != "MONOCHROME1" && instance.Photometric != "MONOCHROME2"))
+    if (instance->SamplesPerPixel != 1 ||
+      (instance->Photometric != "MONOCHROME1" && instance->Photometric != "MONOCHROME2"))
     {
-      return name + ": " + std::to_string(instance.SamplesPerPixel) + " sample(s) per pixel, " +
-        "Photometric Interpretation \"" + instance.Photometric +
+      return name + ": " + std::to_string(instance->SamplesPerPixel) + " sample(s) per pixel, " +
+        "Photometric Interpretation \"" + instance->Photometric +
         "\": only greyscale (MONOCHROME1/2) images are read";
     }
-    if (instance.BitsAllocated != 8 && instance.BitsAllocated != 16)
+    if (instance->BitsAllocated != 8 && instance->BitsAllocated != 16)
     {
-      return name + ": Bits Allocated " + std::to_string(instance.BitsAllocated) +
+      return name + ": Bits Allocated " + std::to_string(instance->BitsAllocated) +
         " is not read (8 or 16)";
     }
-    if (instance.BitsStored == 0 || instance.BitsStored > instance.BitsAllocated ||
-      instance.HighBit + 1 < instance.BitsStored || instance.HighBit >= instance.BitsAllocated)
+    if (instance->BitsStored == 0 || instance->BitsStored > instance->BitsAllocated ||
+      instance->HighBit + 1 < instance->BitsStored || instance->HighBit >= instance->BitsAllocated)
     {
-      return name + ": Bits Stored " + std::to_string(instance.BitsStored) + " and High Bit " +
-        std::to_string(instance.HighBit) + " do not fit Bits Allocated " +
-        std::to_string(instance.BitsAllocated);
+      return name + ": Bits Stored " + std::to_string(instance->BitsStored) + " and High Bit " +
+        std::to_string(instance->HighBit) + " do not fit Bits Allocated " +
+        std::to_string(instance->BitsAllocated);
     }
-    if (instance.Rows == 0 || instance.Columns == 0)
+    if (instance->Rows == 0 || instance->Columns == 0)
     {
-      return name + ": an image of " + std::to_string(instance.Columns) + " x " +
-        std::to_string(instance.Rows) + " pixels";
+      return name + ": an image of " + std::to_string(instance->Columns) + " x " +
+        std::to_string(instance->Rows) + " pixels";
     }
-    if (!instance.PerFramePositions)
+    if (!instance->PerFramePositions)
     {
-      return name + ": " + std::to_string(instance.Frames) +
-        " frames without per-frame positions (Per-frame Functional "
-        "Groups, Plane Position "
+      return name + ": " + std::to_string(instance->Frames) +
+        " frames without per-frame positions (Per-frame Functional Groups, Plane Position " +
         "Sequence): their placement is unknown";
     }
-    if (instance.Rows != first.Rows || instance.Columns != first.Columns)
+    if (instance->Rows != first.Rows || instance->Columns != first.Columns)
     {
-      return name + ": " + std::to_string(instance.Columns) + " x " +
-        std::to_string(instance.Rows) + " pixels, but " + BaseName(first.Path) + " has " +
+      return name + ": " + std::to_string(instance->Columns) + " x " +
+        std::to_string(instance->Rows) + " pixels, but " + BaseName(first.Path) + " has " +
         std::to_string(first.Columns) + " x " + std::to_string(first.Rows) +
         ": slices of different sizes are not read";
     }
-    if (instance.BitsAllocated != first.BitsAllocated ||
-      instance.PixelRepresentation != first.PixelRepresentation)
+    if (instance->BitsAllocated != first.BitsAllocated ||
+      instance->PixelRepresentation != first.PixelRepresentation)
     {
-      return name + ": pixel format " + std::to_string(instance.BitsAllocated) + " bits " +
-        (instance.PixelRepresentation ? "signed" : "unsigned") + ", but " + BaseName(first.Path) +
+      return name + ": pixel format " + std::to_string(instance->BitsAllocated) + " bits " +
+        (instance->PixelRepresentation ? "signed" : "unsigned") + ", but " + BaseName(first.Path) +
         " has " + std::to_string(first.BitsAllocated) + " bits " +
         (first.PixelRepresentation ? "signed" : "unsigned") +
         ": slices of different pixel formats are not read";
     }
   }
+  return std::string();
+}
 
-  std::vector<std::pair<Instance*, Slice*>> slices;
-  for (Instance* instance : instances)
+// Steps 3 and 5: every slice of the series, checked against the first one
+// and sorted along the normal; its steps checked against the median step.
+struct Stack
+{
+  std::vector<std::pair<const Instance*, const Slice*>> Slices; // in increasing position
+  std::vector<double> Distances;                                // along the normal
+  double Row[3] = { 1, 0, 0 };
+  double Column[3] = { 0, 1, 0 };
+  double Normal[3] = { 0, 0, 1 };
+  double Median = 0.0;             // median step
+  std::vector<std::string> Uneven; // gaps and uneven steps, in words
+  bool ValidPixelSpacing = false;
+
+  std::string Name(std::size_t k) const { return SliceName(*Slices[k].first, *Slices[k].second); }
+  std::string Where(std::size_t k) const
   {
-    for (Slice& slice : instance->Slices)
-    {
-      slices.emplace_back(instance, &slice);
-    }
+    return Number(this->Distances[k]) + " mm (" + this->Name(k) + ")";
   }
-  const Slice& reference = *slices.front().second;
-  const bool single = slices.size() == 1;
-  double row[3] = { 1, 0, 0 };
-  double column[3] = { 0, 1, 0 };
+};
+
+std::string CheckSlices(Stack& stack)
+{
+  const Slice& reference = *stack.Slices.front().second;
+  const std::string referenceName = stack.Name(0);
+  const bool single = stack.Slices.size() == 1;
   if (reference.HasOrientation)
   {
-    std::copy(reference.Orientation, reference.Orientation + 3, row);
-    std::copy(reference.Orientation + 3, reference.Orientation + 6, column);
-    const double rowLength = vtkMath::Normalize(row);
-    const double columnLength = vtkMath::Normalize(column);
+    std::copy(reference.Orientation, reference.Orientation + 3, stack.Row);
+    std::copy(reference.Orientation + 3, reference.Orientation + 6, stack.Column);
+    const double rowLength = vtkMath::Normalize(stack.Row);
+    const double columnLength = vtkMath::Normalize(stack.Column);
     if (std::abs(rowLength - 1.0) > 1e-3 || std::abs(columnLength - 1.0) > 1e-3 ||
-      std::abs(vtkMath::Dot(row, column)) > 1e-3)
+      std::abs(vtkMath::Dot(stack.Row, stack.Column)) > 1e-3)
     {
-      return SliceName(*slices.front().first, reference) +
-        ": Image Orientation (Patient) is not two orthogonal unit vectors";
+      return referenceName + ": Image Orientation (Patient) is not two orthogonal unit vectors";
     }
   }
-  else if (!single)
+  vtkMath::Cross(stack.Row, stack.Column, stack.Normal);
+  for (std::size_t k = 0; k < stack.Slices.size(); ++k)
   {
-    return SliceName(*slices.front().first, reference) +
-      ": no Image Orientation (Patient): the slices' order and spacing "
-      "are unknown";
-  }
-  double normal[3];
-  vtkMath::Cross(row, column, normal);
-  for (auto& entry : slices)
-  {
-    Slice& slice = *entry.second;
-    const std::string name = SliceName(*entry.first, slice);
+    const Slice& slice = *stack.Slices[k].second;
+    const std::string name = stack.Name(k);
     if (!single && !slice.HasPosition)
     {
-      return name +
-        ": no Image Position (Patient): the slices' order and "
-        "spacing are unknown";
+      return name + ": no Image Position (Patient): the slices' order and spacing are unknown";
     }
     if (!single && !slice.HasOrientation)
     {
-      return name +
-        ": no Image Orientation (Patient): the slices' order and "
-        "spacing are unknown";
+      return name + ": no Image Orientation (Patient): the slices' order and spacing are unknown";
     }
     for (int c = 0; c < 6 && slice.HasOrientation; ++c)
     {
@@ -821,9 +764,8 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
           a += (d ? "\\" : "") + Number(slice.Orientation[d]);
           b += (d ? "\\" : "") + Number(reference.Orientation[d]);
         }
-        return name + ": Image Orientation (Patient) " + a + ", but " +
-          SliceName(*slices.front().first, reference) + " has " + b +
-          ": slices of different orientations are not read";
+        return name + ": Image Orientation (Patient) " + a + ", but " + referenceName + " has " +
+          b + ": slices of different orientations are not read";
       }
     }
     if (slice.HasPixelSpacing != reference.HasPixelSpacing ||
@@ -831,141 +773,129 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
       std::abs(slice.PixelSpacing[1] - reference.PixelSpacing[1]) > 1e-4)
     {
       return name + ": Pixel Spacing " + Number(slice.PixelSpacing[0]) + "\\" +
-        Number(slice.PixelSpacing[1]) + ", but " + SliceName(*slices.front().first, reference) +
-        " has " + Number(reference.PixelSpacing[0]) + "\\" + Number(reference.PixelSpacing[1]) +
+        Number(slice.PixelSpacing[1]) + ", but " + referenceName + " has " +
+        Number(reference.PixelSpacing[0]) + "\\" + Number(reference.PixelSpacing[1]) +
         ": slices of different pixel spacings are not read";
     }
     if (slice.Slope == 0.0)
     {
       return name + ": Rescale Slope 0";
     }
-    slice.Distance = vtkMath::Dot(slice.Position, normal);
   }
-  if (!reference.HasPixelSpacing || !(reference.PixelSpacing[0] > 0.0) ||
-    !(reference.PixelSpacing[1] > 0.0))
-  {
-    vtkWarningMacro(<< BaseName(first.Path)
-                    << ": no valid Pixel Spacing; 1 mm between rows and columns assumed");
-  }
+  stack.ValidPixelSpacing =
+    reference.HasPixelSpacing && reference.PixelSpacing[0] > 0.0 && reference.PixelSpacing[1] > 0.0;
+  return std::string();
+}
 
-  // 5. Order along the normal, then check the steps.
-  std::stable_sort(slices.begin(), slices.end(),
-    [](const auto& a, const auto& b)
-    {
-      if (a.second->Distance != b.second->Distance)
-      {
-        return a.second->Distance < b.second->Distance;
-      }
-      return a.second->InstanceNumber < b.second->InstanceNumber;
-    });
-  const std::size_t count = slices.size();
-  std::vector<double> distances(count);
-  for (std::size_t k = 0; k < count; ++k)
+std::string StackSlices(const std::vector<Instance*>& instances, Stack& stack)
+{
+  for (const Instance* instance : instances)
   {
-    distances[k] = slices[k].second->Distance;
-  }
-  auto where = [&](std::size_t k)
-  { return Number(distances[k]) + " mm (" + SliceName(*slices[k].first, *slices[k].second) + ")"; };
-  double median = 0.0;
-  std::vector<std::string> uneven;
-  if (count > 1)
-  {
-    std::vector<double> steps(count - 1);
-    for (std::size_t k = 0; k + 1 < count; ++k)
+    for (const Slice& slice : instance->Slices)
     {
-      steps[k] = distances[k + 1] - distances[k];
-    }
-    std::vector<double> sorted = steps;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    median = sorted[sorted.size() / 2];
-    const double tolerance = 0.01 * median;
-    for (std::size_t k = 0; k + 1 < count; ++k)
-    {
-      if (!(steps[k] > std::max(tolerance, 1e-6)))
-      {
-        return "two slices at the same position along the normal, " + where(k) + " and " +
-          where(k + 1) + ": duplicate slices are not read";
-      }
-    }
-    // A stack that leaves the normal through the first slice (gantry tilt).
-    const double* origin = slices.front().second->Position;
-    const double lateral = 0.01 * std::min(reference.PixelSpacing[0], reference.PixelSpacing[1]);
-    for (std::size_t k = 1; k < count; ++k)
-    {
-      double offset[3];
-      vtkMath::Subtract(slices[k].second->Position, origin, offset);
-      const double along = vtkMath::Dot(offset, normal);
-      for (int c = 0; c < 3; ++c)
-      {
-        offset[c] -= along * normal[c];
-      }
-      const double off = vtkMath::Norm(offset);
-      if (off > std::max(lateral, 1e-3))
-      {
-        return SliceName(*slices[k].first, *slices[k].second) +
-          ": its Image Position (Patient) is " + Number(off) + " mm off the line through " +
-          SliceName(*slices.front().first, *slices.front().second) +
-          " along the slice normal (a gantry tilt or a sheared stack): "
-          "not read";
-      }
-    }
-    for (std::size_t k = 0; k + 1 < count; ++k)
-    {
-      if (std::abs(steps[k] - median) <= tolerance)
-      {
-        continue;
-      }
-      const double ratio = steps[k] / median;
-      const double whole = std::round(ratio);
-      if (whole >= 2.0 && std::abs(steps[k] - whole * median) <= tolerance)
-      {
-        const int missing = static_cast<int>(whole) - 1;
-        uneven.push_back("a gap of " + Number(steps[k]) + " mm between " + where(k) + " and " +
-          where(k + 1) + " (" + std::to_string(missing) +
-          (missing == 1 ? " slice missing)" : " slices missing)"));
-      }
-      else
-      {
-        uneven.push_back(
-          "a step of " + Number(steps[k]) + " mm between " + where(k) + " and " + where(k + 1));
-      }
+      stack.Slices.emplace_back(instance, &slice);
     }
   }
-  std::string unevenList;
-  for (std::size_t u = 0; u < uneven.size() && u < 5; ++u)
-  {
-    unevenList += (u ? "; " : "") + uneven[u];
-  }
-  if (uneven.size() > 5)
-  {
-    unevenList += "; and " + std::to_string(uneven.size() - 5) + " more";
-  }
-  const bool resample = !uneven.empty();
-  if (resample && !this->ResampleUnevenSlices)
-  {
-    return "the slices are not evenly spaced (median step " + Number(median) +
-      " mm): " + unevenList + ". Turn ResampleUnevenSlices on to resample them onto an even grid.";
-  }
-
-  // 6. Decode every file into the stored values, slice by slice in order.
-  const std::size_t sliceSize = static_cast<std::size_t>(first.Rows) * first.Columns;
-  const bool isSigned = first.PixelRepresentation == 1;
-  const int storedType = first.BitsAllocated == 8 ? (isSigned ? VTK_SIGNED_CHAR : VTK_UNSIGNED_CHAR)
-                                                  : (isSigned ? VTK_SHORT : VTK_UNSIGNED_SHORT);
-  std::string error;
-  vtkSmartPointer<vtkDataArray> stored =
-    NewVolume(storedType, sliceSize * count, "the decoded series", error);
-  if (!stored)
+  std::string error = CheckSlices(stack);
+  if (!error.empty())
   {
     return error;
   }
-  std::map<const Slice*, std::size_t> order;
-  for (std::size_t k = 0; k < count; ++k)
+  // Sorted by position along the normal; ties (refused below) by Instance Number.
+  const double* normal = stack.Normal;
+  std::stable_sort(stack.Slices.begin(), stack.Slices.end(),
+    [normal](const auto& a, const auto& b)
+    {
+      const double da = vtkMath::Dot(a.second->Position, normal);
+      const double db = vtkMath::Dot(b.second->Position, normal);
+      return da != db ? da < db : a.second->InstanceNumber < b.second->InstanceNumber;
+    });
+  const std::size_t count = stack.Slices.size();
+  for (const auto& entry : stack.Slices)
   {
-    order[slices[k].second] = k;
+    stack.Distances.push_back(vtkMath::Dot(entry.second->Position, normal));
   }
-  std::vector<std::int64_t> least(count, 0), greatest(count, 0);
-  for (Instance* instance : instances)
+  if (count < 2)
+  {
+    return std::string();
+  }
+  std::vector<double> steps(count - 1);
+  for (std::size_t k = 0; k + 1 < count; ++k)
+  {
+    steps[k] = stack.Distances[k + 1] - stack.Distances[k];
+  }
+  std::vector<double> sorted = steps;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  stack.Median = sorted[sorted.size() / 2];
+  const double tolerance = 0.01 * stack.Median;
+  for (std::size_t k = 0; k + 1 < count; ++k)
+  {
+    if (!(steps[k] > std::max(tolerance, 1e-6)))
+    {
+      return "two slices at the same position along the normal, " + stack.Where(k) + " and " +
+        stack.Where(k + 1) + ": duplicate slices are not read";
+    }
+  }
+  // A stack that leaves the line through the first slice along the normal
+  // (gantry tilt, shear) would need a sheared grid: refused.
+  const double* origin = stack.Slices.front().second->Position;
+  const double* pixel = stack.Slices.front().second->PixelSpacing;
+  const double lateral = std::max(1e-3, 0.01 * std::min(pixel[0], pixel[1]));
+  for (std::size_t k = 1; k < count; ++k)
+  {
+    double offset[3];
+    vtkMath::Subtract(stack.Slices[k].second->Position, origin, offset);
+    const double along = vtkMath::Dot(offset, normal);
+    for (int c = 0; c < 3; ++c)
+    {
+      offset[c] -= along * normal[c];
+    }
+    const double off = vtkMath::Norm(offset);
+    if (off > lateral)
+    {
+      return stack.Name(k) + ": its Image Position (Patient) is " + Number(off) +
+        " mm off the line through " + stack.Name(0) +
+        " along the slice normal (a gantry tilt or a sheared stack): not read";
+    }
+  }
+  for (std::size_t k = 0; k + 1 < count; ++k)
+  {
+    if (std::abs(steps[k] - stack.Median) <= tolerance)
+    {
+      continue;
+    }
+    const double whole = std::round(steps[k] / stack.Median);
+    const std::string between = " mm between " + stack.Where(k) + " and " + stack.Where(k + 1);
+    if (whole >= 2.0 && std::abs(steps[k] - whole * stack.Median) <= tolerance)
+    {
+      const int missing = static_cast<int>(whole) - 1;
+      stack.Uneven.push_back("a gap of " + Number(steps[k]) + between + " (" +
+        std::to_string(missing) + (missing == 1 ? " slice missing)" : " slices missing)"));
+    }
+    else
+    {
+      stack.Uneven.push_back("a step of " + Number(steps[k]) + between);
+    }
+  }
+  return std::string();
+}
+
+// Step 6: every file decoded (DCMTK's codecs for the compressed ones) and
+// its frames unpacked into `stored` at their place in the stack, with the
+// least and greatest stored value of each slice.
+std::string DecodeSlices(const std::vector<Instance*>& instances, const Stack& stack,
+  vtkDataArray* stored, std::vector<std::int64_t>& least, std::vector<std::int64_t>& greatest)
+{
+  const Instance& first = *instances.front();
+  const std::size_t sliceSize = static_cast<std::size_t>(first.Rows) * first.Columns;
+  std::map<const Slice*, std::size_t> order;
+  for (std::size_t k = 0; k < stack.Slices.size(); ++k)
+  {
+    order[stack.Slices[k].second] = k;
+  }
+  least.assign(stack.Slices.size(), 0);
+  greatest.assign(stack.Slices.size(), 0);
+  for (const Instance* instance : instances)
   {
     const std::string name = BaseName(instance->Path);
     DcmFileFormat file;
@@ -1019,7 +949,7 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
       std::int64_t hi = std::numeric_limits<std::int64_t>::min();
       const std::size_t at = slice.Frame * sliceSize;
       void* to = stored->GetVoidPointer(static_cast<vtkIdType>(k * sliceSize));
-      switch (storedType)
+      switch (stored->GetDataType())
       {
         case VTK_UNSIGNED_CHAR:
           Unpack(static_cast<const Uint8*>(raw) + at, static_cast<unsigned char*>(to), sliceSize,
@@ -1042,15 +972,150 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
       greatest[k] = hi;
     }
   }
+  return std::string();
+}
+} // namespace
 
-  // 7. Rescale into the output type.
+//------------------------------------------------------------------------------
+vtkMedicalDICOMSeriesReader::vtkMedicalDICOMSeriesReader()
+{
+  this->SetNumberOfInputPorts(0);
+  this->SeriesList = vtkSmartPointer<vtkStringArray>::New();
+}
+
+//------------------------------------------------------------------------------
+vtkMedicalDICOMSeriesReader::~vtkMedicalDICOMSeriesReader()
+{
+  this->SetFileName(nullptr);
+  this->SetSeriesInstanceUID(nullptr);
+}
+
+//------------------------------------------------------------------------------
+vtkStringArray* vtkMedicalDICOMSeriesReader::GetSeriesInFolder()
+{
+  return this->SeriesList;
+}
+
+//------------------------------------------------------------------------------
+std::string vtkMedicalDICOMSeriesReader::ReadSeries()
+{
+  if (!this->FileName || !this->FileName[0])
+  {
+    return "no FileName: set a file of the series, or its folder";
+  }
+  const std::string path = this->FileName;
+  if (!vtksys::SystemTools::FileExists(path))
+  {
+    return path + ": no such file or folder";
+  }
+  if (!dcmDataDict.isDictionaryLoaded())
+  {
+    return "DCMTK's data dictionary is not loaded (see DCMDICTPATH): no DICOM file can be read";
+  }
+  RegisterDecoders();
+
+  // 1-2. Scan the folder, choose a series, say which others it holds.
+  FolderScan scan;
+  std::string error = ScanFolder(path, scan);
+  if (!error.empty())
+  {
+    return error;
+  }
+  if (!scan.Unreadable.empty())
+  {
+    vtkWarningMacro(<< scan.Folder << ": skipped " << scan.Unreadable.size()
+                    << " DICOM file(s) DCMTK cannot read: " << JoinList(scan.Unreadable, "; "));
+  }
+  SeriesChoice choice;
+  error = ChooseSeries(scan, this->SeriesInstanceUID ? this->SeriesInstanceUID : "", choice);
+  if (!error.empty())
+  {
+    return error;
+  }
+  const Series& read = choice.All[choice.Chosen];
+  std::vector<std::string> others;
+  this->SeriesList->InsertNextValue(
+    read.UID + " | " + read.Description + " | " + std::to_string(read.Slices) + " slices");
+  for (std::size_t s = 0; s < choice.All.size(); ++s)
+  {
+    if (s != choice.Chosen)
+    {
+      const Series& other = choice.All[s];
+      others.push_back(Describe(other));
+      this->SeriesList->InsertNextValue(
+        other.UID + " | " + other.Description + " | " + std::to_string(other.Slices) + " slices");
+    }
+  }
+  if (!others.empty())
+  {
+    vtkWarningMacro(<< scan.Folder << ": the folder holds " << choice.All.size() << " series; read "
+                    << Describe(read) << ", " << choice.Reason << "; not read: "
+                    << JoinList(others, "; ") << ". SeriesInstanceUID chooses another.");
+  }
+
+  // 3-5. Check the files and the slices; order them along the normal.
+  std::vector<Instance*> instances;
+  for (std::size_t i : read.Instances)
+  {
+    instances.push_back(&scan.Images[i]);
+  }
+  Stack stack;
+  error = CheckInstances(instances);
+  if (error.empty())
+  {
+    error = StackSlices(instances, stack);
+  }
+  if (!error.empty())
+  {
+    return error;
+  }
+  const Instance& first = *instances.front();
+  if (!stack.ValidPixelSpacing)
+  {
+    vtkWarningMacro(<< BaseName(first.Path)
+                    << ": no valid Pixel Spacing; 1 mm between rows and columns assumed");
+  }
+  std::vector<std::string> listed(
+    stack.Uneven.begin(), stack.Uneven.begin() + std::min<std::size_t>(stack.Uneven.size(), 5));
+  if (stack.Uneven.size() > 5)
+  {
+    listed.push_back("and " + std::to_string(stack.Uneven.size() - 5) + " more");
+  }
+  const std::string unevenList = JoinList(listed, "; ");
+  const bool resample = !stack.Uneven.empty();
+  if (resample && !this->ResampleUnevenSlices)
+  {
+    return "the slices are not evenly spaced (median step " + Number(stack.Median) +
+      " mm): " + unevenList + ". Turn ResampleUnevenSlices on to resample them onto an even grid.";
+  }
+
+  // 6. Decode every file into the stored values.
+  const std::size_t count = stack.Slices.size();
+  const std::size_t sliceSize = static_cast<std::size_t>(first.Rows) * first.Columns;
+  const bool isSigned = first.PixelRepresentation == 1;
+  const int storedType = first.BitsAllocated == 8 ? (isSigned ? VTK_SIGNED_CHAR : VTK_UNSIGNED_CHAR)
+                                                  : (isSigned ? VTK_SHORT : VTK_UNSIGNED_SHORT);
+  vtkSmartPointer<vtkDataArray> stored =
+    NewVolume(storedType, sliceSize * count, "the decoded series", error);
+  if (!stored)
+  {
+    return error;
+  }
+  std::vector<std::int64_t> least, greatest;
+  error = DecodeSlices(instances, stack, stored, least, greatest);
+  if (!error.empty())
+  {
+    return error;
+  }
+
+  // 7. Rescale (or resample) into the output type.
   std::vector<double> slopes(count), intercepts(count);
   bool uniform = true, integral = true;
   double low = 0.0, high = 0.0;
   for (std::size_t k = 0; k < count; ++k)
   {
-    slopes[k] = slices[k].second->Slope;
-    intercepts[k] = slices[k].second->Intercept;
+    slopes[k] = stack.Slices[k].second->Slope;
+    intercepts[k] = stack.Slices[k].second->Intercept;
     uniform = uniform && slopes[k] == slopes[0] && intercepts[k] == intercepts[0];
     integral =
       integral && slopes[k] == std::round(slopes[k]) && intercepts[k] == std::round(intercepts[k]);
@@ -1062,22 +1127,17 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   const int floatType = first.BitsStored > 16 ? VTK_DOUBLE : VTK_FLOAT;
   const int outputType =
     (resample || !uniform || !integral) ? floatType : SmallestIntegerType(low, high);
-
+  const std::vector<double>& distances = stack.Distances;
   int slicesOut = static_cast<int>(count);
   double step = count > 1 ? (distances.back() - distances.front()) / (count - 1) : 0.0;
   if (resample)
   {
     const double span = distances.back() - distances.front();
-    slicesOut = static_cast<int>(std::round(span / median)) + 1;
+    slicesOut = static_cast<int>(std::round(span / stack.Median)) + 1;
     step = span / (slicesOut - 1);
   }
-
-  vtkSmartPointer<vtkDataArray> volume;
-  if (!resample && outputType == storedType && slopes[0] == 1.0 && intercepts[0] == 0.0)
-  {
-    volume = stored;
-  }
-  else
+  vtkSmartPointer<vtkDataArray> volume = stored;
+  if (resample || outputType != storedType || slopes[0] != 1.0 || intercepts[0] != 0.0)
   {
     volume = NewVolume(outputType, sliceSize * slicesOut, "the rescaled series", error);
     if (!volume)
@@ -1108,7 +1168,7 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   if (resample)
   {
     vtkWarningMacro(<< "resampled " << count << " unevenly spaced slices (median step "
-                    << Number(median) << " mm: " << unevenList << ") onto " << slicesOut
+                    << Number(stack.Median) << " mm: " << unevenList << ") onto " << slicesOut
                     << " slices " << Number(step)
                     << " mm apart by linear interpolation (ResampleUnevenSlices)");
   }
@@ -1119,18 +1179,16 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   this->Dimensions[0] = first.Columns;
   this->Dimensions[1] = first.Rows;
   this->Dimensions[2] = slicesOut;
-  const Slice& base = *slices.front().second;
+  const Slice& base = *stack.Slices.front().second;
   for (int c = 0; c < 3; ++c)
   {
     this->Origin[c] = base.HasPosition ? base.Position[c] : 0.0;
-    this->Direction[3 * c + 0] = row[c];
-    this->Direction[3 * c + 1] = column[c];
-    this->Direction[3 * c + 2] = normal[c];
+    this->Direction[3 * c + 0] = stack.Row[c];
+    this->Direction[3 * c + 1] = stack.Column[c];
+    this->Direction[3 * c + 2] = stack.Normal[c];
   }
-  const bool spaced =
-    reference.HasPixelSpacing && reference.PixelSpacing[0] > 0.0 && reference.PixelSpacing[1] > 0.0;
-  this->Spacing[0] = spaced ? reference.PixelSpacing[1] : 1.0;
-  this->Spacing[1] = spaced ? reference.PixelSpacing[0] : 1.0;
+  this->Spacing[0] = stack.ValidPixelSpacing ? base.PixelSpacing[1] : 1.0;
+  this->Spacing[1] = stack.ValidPixelSpacing ? base.PixelSpacing[0] : 1.0;
   this->Spacing[2] = count > 1 ? step : (first.SliceThickness > 0.0 ? first.SliceThickness : 1.0);
   return std::string();
 }
