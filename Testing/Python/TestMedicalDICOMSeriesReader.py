@@ -155,6 +155,14 @@ expect_volume("two_series", path=folder, text_expected=[
     listing % (folder, plain_line, "the series with the most slices", other_line)])
 expect_volume("two_series_other", path=folder, SeriesInstanceUID=other_uid, text_expected=[
     listing % (folder, other_line, "the one SeriesInstanceUID names", plain_line)])
+# The read-back property lists the folder's series, the one read first.
+reader, text = hp.captured(lambda: MedicalDICOMSeriesReader(FileName=str(folder / "other_000.dcm")))
+reader.UpdatePropertyInformation()
+listed = list(reader.GetProperty("SeriesInFolder"))
+check(listed == ["%s | Other series | 3 slices" % other_uid,
+                 "%s | Corpus series | 6 slices" % plain_uid],
+      "two_series: SeriesInFolder lists both, the one read first (got %s)" % listed)
+Delete(reader)
 expect_error("two_series: an unknown UID", folder,
              "%s: no series with Series Instance UID 1.2.3.4; the folder holds %s; %s"
              % (folder, plain_line, other_line), SeriesInstanceUID="1.2.3.4")
