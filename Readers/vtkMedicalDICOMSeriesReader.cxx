@@ -286,6 +286,12 @@ HeaderStatus ReadHeader(const std::string& path, Instance& instance, std::string
   }
   instance.PerFramePositions =
     instance.Frames == 1 || (perFrame && perFrame->card() >= instance.Frames);
+  if (!instance.PerFramePositions)
+  {
+    // Refused when its series is read; no slice is made for a frame count
+    // that nothing in the file backs (a header may claim billions).
+    return HeaderStatus::Image;
+  }
   instance.Slices.resize(instance.Frames);
   for (unsigned long f = 0; f < instance.Frames; ++f)
   {
@@ -1133,7 +1139,14 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   if (resample)
   {
     const double span = distances.back() - distances.front();
-    slicesOut = static_cast<int>(std::round(span / stack.Median)) + 1;
+    const double steps = std::round(span / stack.Median);
+    if (!(steps < 65535.0))
+    {
+      return "the slices are not evenly spaced (median step " + Number(stack.Median) +
+        " mm) and an even grid over their " + Number(span) + " mm would take " + Number(steps + 1) +
+        " slices: not resampled";
+    }
+    slicesOut = static_cast<int>(steps) + 1;
     step = span / (slicesOut - 1);
   }
   vtkSmartPointer<vtkDataArray> volume = stored;

@@ -71,6 +71,9 @@ const Case Cases[] = {
     nullptr },
   { "huge/huge.dcm", false, { 0, 0, 0 }, 0, "the decoded series (34358689.8 MB) does not fit",
     nullptr },
+  { "frames_claimed/frames.dcm", false, { 0, 0, 0 }, 0, "2000000000 frames without per-frame",
+    nullptr },
+  { "far_slice/slice_000.dcm", true, { 0, 0, 0 }, 0, "would take 100001 slices", nullptr },
   { "no_such_folder/x.dcm", false, { 0, 0, 0 }, 0, "no such file or folder", nullptr },
 };
 

@@ -241,6 +241,13 @@ check(len(got) == 1 and got[0][0] == "error" and got[0][1].startswith(
     "huge: refused before allocating (got %s)" % got)
 check(values is None or len(values) == 0, "huge: an empty image")
 
+expect_error("frames_claimed", corpus / manifest["frames_claimed"]["open"],
+             "frames.dcm: 2000000000 frames without per-frame positions (Per-frame Functional "
+             "Groups, Plane Position Sequence): their placement is unknown")
+expect_error("far_slice", corpus / manifest["far_slice"]["open"],
+             "the slices are not evenly spaced (median step 1 mm) and an even grid over their "
+             "100000 mm would take 100001 slices: not resampled", ResampleUnevenSlices=1)
+
 if check.failures:
     print("%d check(s) failed" % len(check.failures))
     sys.exit(1)

@@ -28,6 +28,8 @@ Cases (16 columns x 12 rows per slice, small on purpose):
 - truncated: the plain series with one slice's file cut short.
 - short_pixels: a slice whose Pixel Data is shorter than Rows x Columns.
 - huge: a multi-frame header claiming 34 TB of pixels over 64 bytes.
+- frames_claimed: a header claiming two billion frames without per-frame groups.
+- far_slice: slices at 0, 1, 2 and 100000 mm (an even grid too large to resample onto).
 """
 import json
 import os
@@ -422,6 +424,20 @@ def main(out):
     ds.PixelData = bytes(64)
     ds.save_as(os.path.join(folder, "huge.dcm"), write_like_original=False)
     case("huge", plain[:1], open="huge/huge.dcm", series=series)
+
+    # A multi-frame header claiming two billion frames and no per-frame groups.
+    folder = os.path.join(out, "frames_claimed")
+    os.makedirs(folder)
+    image_slice(os.path.join(folder, "frames.dcm"), uid("frames"), 0, stored_slice(0),
+                (0.0, 0.0, 0.0))
+    ds = pydicom.dcmread(os.path.join(folder, "frames.dcm"))
+    ds.NumberOfFrames = 2000000000
+    ds.save_as(os.path.join(folder, "frames.dcm"), write_like_original=False)
+    case("frames_claimed", plain[:1], open="frames_claimed/frames.dcm", series=uid("frames"))
+
+    # Slices at 0, 1, 2 and 100000 mm: an even grid would take 100001 slices.
+    far = plain_series(os.path.join(out, "far_slice"), uid("far"), z=[0.0, 1.0, 2.0, 1.0e5])
+    case("far_slice", far, open="far_slice/slice_000.dcm", series=uid("far"))
 
     with open(os.path.join(out, "manifest.json"), "w") as f:
         json.dump(manifest, f, indent=1)
