@@ -133,6 +133,8 @@ struct Instance
   double SliceThickness = 0.0;
   unsigned long Frames = 1;
   bool PerFramePositions = true;
+  // The Pixel Data's length in the file when uncompressed, else -1.
+  long long NativePixelBytes = -1;
   std::vector<Slice> Slices;
 };
 
@@ -243,6 +245,12 @@ HeaderStatus ReadHeader(const std::string& path, Instance& instance, std::string
   {
     instance.Syntax = data->getOriginalXfer();
     instance.TransferSyntaxUID = DcmXfer(instance.Syntax).getXferID();
+  }
+  DcmElement* pixels = nullptr;
+  if (!DcmXfer(instance.Syntax).isEncapsulated() &&
+    data->findAndGetElement(DCM_PixelData, pixels).good() && pixels)
+  {
+    instance.NativePixelBytes = pixels->getLength();
   }
   data->findAndGetUint16(DCM_BitsAllocated, instance.BitsAllocated);
   if (data->findAndGetUint16(DCM_BitsStored, instance.BitsStored).bad())
@@ -507,6 +515,21 @@ std::string JoinList(const std::vector<std::string>& items, const char* separato
   return text;
 }
 
+// The bytes of pixel data an image needs, and the message when it has fewer.
+std::uint64_t PixelBytes(const Instance& instance)
+{
+  return static_cast<std::uint64_t>(instance.Rows) * instance.Columns * instance.Frames *
+    (instance.BitsAllocated / 8);
+}
+
+std::string ShortPixelData(const Instance& instance, std::uint64_t have)
+{
+  return BaseName(instance.Path) + ": Pixel Data holds " + std::to_string(have) + " bytes, " +
+    std::to_string(PixelBytes(instance)) + " expected (" + std::to_string(instance.Columns) +
+    " x " + std::to_string(instance.Rows) + " x " + std::to_string(instance.Frames) +
+    " frame(s) x " + std::to_string(instance.BitsAllocated / 8) + " byte(s))";
+}
+
 // Step 1: the image files of the folder of `path` (or of the folder `path`).
 struct FolderScan
 {
@@ -689,6 +712,13 @@ std::string CheckInstances(const std::vector<Instance*>& instances)
       return name + ": " + std::to_string(instance->Frames) +
         " frames without per-frame positions (Per-frame Functional Groups, Plane Position " +
         "Sequence): their placement is unknown";
+    }
+    // Uncompressed pixel data shorter than the header says, known before
+    // anything is allocated for it.
+    if (instance->NativePixelBytes >= 0 &&
+      static_cast<std::uint64_t>(instance->NativePixelBytes) < PixelBytes(*instance))
+    {
+      return ShortPixelData(*instance, static_cast<std::uint64_t>(instance->NativePixelBytes));
     }
     if (instance->Rows != first.Rows || instance->Columns != first.Columns)
     {
@@ -926,8 +956,6 @@ std::string DecodeSlices(const std::vector<Instance*>& instances, const Stack& s
     {
       return name + ": no Pixel Data";
     }
-    const std::size_t bytesPerSample = first.BitsAllocated / 8;
-    const std::size_t expected = sliceSize * instance->Frames * bytesPerSample;
     const void* raw = nullptr;
     if (first.BitsAllocated == 8)
     {
@@ -941,12 +969,9 @@ std::string DecodeSlices(const std::vector<Instance*>& instances, const Stack& s
       status = pixels->getUint16Array(values);
       raw = values;
     }
-    if (status.bad() || !raw || pixels->getLength() < expected)
+    if (status.bad() || !raw || pixels->getLength() < PixelBytes(*instance))
     {
-      return name + ": Pixel Data holds " + std::to_string(raw ? pixels->getLength() : 0) +
-        " bytes, " + std::to_string(expected) + " expected (" + std::to_string(first.Columns) +
-        " x " + std::to_string(first.Rows) + " x " + std::to_string(instance->Frames) +
-        " frame(s) x " + std::to_string(bytesPerSample) + " byte(s))";
+      return ShortPixelData(*instance, raw ? pixels->getLength() : 0);
     }
     for (const Slice& slice : instance->Slices)
     {

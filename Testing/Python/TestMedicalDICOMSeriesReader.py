@@ -234,12 +234,15 @@ check(values is None or len(values) == 0, "truncated: an empty image")
 expect_error("short_pixels", corpus / manifest["short_pixels"]["open"],
              "short.dcm: Pixel Data holds 100 bytes, 384 expected (16 x 12 x 1 frame(s) x 2 "
              "byte(s))")
-image, values, text = read(corpus / manifest["huge"]["open"])
+expect_error("huge", corpus / manifest["huge"]["open"],
+             "huge.dcm: Pixel Data holds 64 bytes, 34358689800000 expected (65535 x 65535 x "
+             "4000 frame(s) x 2 byte(s))")
+image, values, text = read(corpus / manifest["huge_rle"]["open"])
 got = messages(text)
 check(len(got) == 1 and got[0][0] == "error" and got[0][1].startswith(
     "the decoded series (34358689.8 MB) does not fit in the "),
-    "huge: refused before allocating (got %s)" % got)
-check(values is None or len(values) == 0, "huge: an empty image")
+    "huge_rle: refused before allocating or decoding (got %s)" % got)
+check(values is None or len(values) == 0, "huge_rle: an empty image")
 
 expect_error("frames_claimed", corpus / manifest["frames_claimed"]["open"],
              "frames.dcm: 2000000000 frames without per-frame positions (Per-frame Functional "

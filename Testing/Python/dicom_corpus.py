@@ -27,7 +27,7 @@ Cases (16 columns x 12 rows per slice, small on purpose):
 - mixed_size: the plain series with a 7th slice of 8 x 8 pixels.
 - truncated: the plain series with one slice's file cut short.
 - short_pixels: a slice whose Pixel Data is shorter than Rows x Columns.
-- huge: a multi-frame header claiming 34 TB of pixels over 64 bytes.
+- huge: a multi-frame header claiming 34 TB of pixels over 64 bytes; huge_rle: the same, RLE.
 - frames_claimed: a header claiming two billion frames without per-frame groups.
 - far_slice: slices at 0, 1, 2 and 100000 mm (an even grid too large to resample onto).
 """
@@ -424,6 +424,16 @@ def main(out):
     ds.PixelData = bytes(64)
     ds.save_as(os.path.join(folder, "huge.dcm"), write_like_original=False)
     case("huge", plain[:1], open="huge/huge.dcm", series=series)
+    # The same header over an RLE fragment: compressed, its size is unknown
+    # until decoded, so the memory check is what refuses it.
+    folder = os.path.join(out, "huge_rle")
+    os.makedirs(folder)
+    ds.file_meta.TransferSyntaxUID = "1.2.840.10008.1.2.5"
+    ds.PixelData = encapsulate([bytes(64)])
+    ds["PixelData"].VR = "OB"
+    ds["PixelData"].is_undefined_length = True
+    ds.save_as(os.path.join(folder, "huge.dcm"), write_like_original=False)
+    case("huge_rle", plain[:1], open="huge_rle/huge.dcm", series=series)
 
     # A multi-frame header claiming two billion frames and no per-frame groups.
     folder = os.path.join(out, "frames_claimed")
