@@ -34,6 +34,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <limits>
@@ -42,6 +43,7 @@
 #include <new>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 vtkStandardNewMacro(vtkMedicalDICOMSeriesReader);
@@ -483,16 +485,17 @@ int SmallestIntegerType(double least, double greatest)
   return VTK_DOUBLE;
 }
 
-// An array of `tuples` values of `type`, or nullptr with the message when the
-// bytes do not fit or the allocation fails.
+// An array of `tuples` values of `type`, or nullptr with the message when
+// its bytes (and `alongside` more, needed at the same time) do not fit or
+// the allocation fails.
 vtkSmartPointer<vtkDataArray> NewVolume(
-  int type, std::size_t tuples, const char* what, std::string& error)
+  int type, std::size_t tuples, std::uint64_t alongside, const char* what, std::string& error)
 {
   vtkSmartPointer<vtkDataArray> array;
   array.TakeReference(vtkDataArray::CreateDataArray(type));
   const std::uint64_t bytes =
     static_cast<std::uint64_t>(tuples) * static_cast<std::uint64_t>(array->GetDataTypeSize());
-  if (!mediso::FitsInProcessMemory(bytes, what, error))
+  if (!mediso::FitsInProcessMemory(bytes + alongside, what, error))
   {
     return nullptr;
   }
@@ -563,7 +566,9 @@ std::string ScanFolder(const std::string& path, FolderScan& scan)
   for (const std::string& name : names)
   {
     const std::string file = scan.Folder.empty() ? name : scan.Folder + "/" + name;
-    if (vtksys::SystemTools::FileIsDirectory(file))
+    // Folders, pipes and devices are skipped: opening a pipe would block.
+    std::error_code failed;
+    if (!std::filesystem::is_regular_file(file, failed))
     {
       continue;
     }
@@ -1126,8 +1131,17 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   const bool isSigned = first.PixelRepresentation == 1;
   const int storedType = first.BitsAllocated == 8 ? (isSigned ? VTK_SIGNED_CHAR : VTK_UNSIGNED_CHAR)
                                                   : (isSigned ? VTK_SHORT : VTK_UNSIGNED_SHORT);
-  vtkSmartPointer<vtkDataArray> stored =
-    NewVolume(storedType, sliceSize * count, "the decoded series", error);
+  // DCMTK decodes a compressed file whole beside the stored volume.
+  std::uint64_t decoding = 0;
+  for (const Instance* instance : instances)
+  {
+    if (DcmXfer(instance->Syntax).isEncapsulated())
+    {
+      decoding = std::max(decoding, PixelBytes(*instance));
+    }
+  }
+  vtkSmartPointer<vtkDataArray> stored = NewVolume(storedType, sliceSize * count, decoding,
+    decoding ? "the decoded series and a compressed file's decoding" : "the decoded series", error);
   if (!stored)
   {
     return error;
@@ -1177,7 +1191,7 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   vtkSmartPointer<vtkDataArray> volume = stored;
   if (resample || outputType != storedType || slopes[0] != 1.0 || intercepts[0] != 0.0)
   {
-    volume = NewVolume(outputType, sliceSize * slicesOut, "the rescaled series", error);
+    volume = NewVolume(outputType, sliceSize * slicesOut, 0, "the rescaled series", error);
     if (!volume)
     {
       return error;

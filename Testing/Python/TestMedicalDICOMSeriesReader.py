@@ -188,7 +188,7 @@ expect_volume("uneven", ResampleUnevenSlices=1, tolerance=1e-3, text_expected=[
 # A slope and an intercept per slice: float values, exact.
 expect_volume("slopes")
 
-# A text file, random bytes and a DICOM file without pixel data: ignored, quietly.
+# A text file, random bytes, a named pipe and a DICOM file without pixel data: ignored, quietly.
 junk = expect_volume("junk")
 check(junk is not None and plain is not None and numpy.array_equal(junk, plain),
       "junk: the same values as the plain series")
@@ -240,7 +240,8 @@ expect_error("huge", corpus / manifest["huge"]["open"],
 image, values, text = read(corpus / manifest["huge_rle"]["open"])
 got = messages(text)
 check(len(got) == 1 and got[0][0] == "error" and got[0][1].startswith(
-    "the decoded series (34358689.8 MB) does not fit in the "),
+    "the decoded series and a compressed file's decoding (68717379.6 MB) does not fit in "
+    "the "),
     "huge_rle: refused before allocating or decoding (got %s)" % got)
 check(values is None or len(values) == 0, "huge_rle: an empty image")
 

@@ -16,7 +16,8 @@ Cases (16 columns x 12 rows per slice, small on purpose):
 - gap: the plain series without its 4th slice.
 - uneven: steps of 2, 2, 3, 2, 2 mm.
 - slopes: a slope and an intercept per slice (non-integral: float output).
-- junk: the plain series with a text file, a binary file and a DICOM file without pixel data.
+- junk: the plain series with a text file, a binary file, a named pipe and a DICOM file without
+  pixel data.
 - jpeg2000: the plain series with one file's transfer syntax UID set to JPEG 2000.
 - multiframe: one Enhanced CT file of 5 frames in reverse position order, functional groups.
 - shuffled: the plain series with file names and instance numbers in a shuffled order.
@@ -222,6 +223,7 @@ def main(out):
         f.write("Not DICOM: a note left in the series folder.\n" * 20)
     with open(os.path.join(folder, "random.bin"), "wb") as f:
         f.write(bytes((i * 73 + 11) % 256 for i in range(4096)))
+    os.mkfifo(os.path.join(folder, "pipe"))  # opening it to read would block
     report = base_dataset(BASIC_TEXT_SR, plain_uid, uid("report"), 99)
     report.Modality = "SR"
     report.ValueType = "CONTAINER"
