@@ -210,6 +210,18 @@ expect_volume("multiframe")
 # File names and instance numbers shuffled; an oblique plane with signed pixels.
 expect_volume("shuffled")
 expect_volume("oblique")
+# Placed right: voxel (i, j, k) lies where DICOM puts column i, row j of the k-th slice,
+# IPP_k + i * column spacing * row direction + j * row spacing * column direction.
+oblique = manifest["oblique"]
+image, _, _ = read(corpus / oblique["open"])
+row_dir, column_dir = numpy.array(oblique["row"]), numpy.array(oblique["column"])
+ipp_2 = numpy.array(oblique["positions"][2])  # as written in the third slice's file
+dicom_point = ipp_2 + 3 * 0.6 * row_dir + 5 * 0.8 * column_dir
+vtk_point = [0.0, 0.0, 0.0]
+image.TransformIndexToPhysicalPoint(3, 5, 2, vtk_point)
+check(numpy.allclose(vtk_point, dicom_point, atol=1e-4),
+      "oblique: voxel (3, 5, 2) at %s, DICOM's column 3, row 5 of slice 2 at %s"
+      % (vtk_point, dicom_point.tolist()))
 
 # 8-bit implicit VR (uint8 as stored), signed big endian; a duplicate position, a mixed size.
 expect_volume("mr8")

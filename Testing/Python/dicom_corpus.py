@@ -308,11 +308,12 @@ def main(out):
     folder = os.path.join(out, "oblique")
     os.makedirs(folder)
     series = uid("oblique")
-    values = []
+    values, positions = [], []
     for k in range(4):
         pixels = stored_slice(k, seed=3).astype(numpy.int32) - 2048  # -2048..2047
         position = origin + 1.75 * k * normal
         position = [float("%.6f" % v) for v in position]
+        positions.append(position)
         if k == 0:
             origin = numpy.array(position)
         image_slice(os.path.join(folder, "o_%d.dcm" % ((k * 3) % 4)), series, k, pixels,
@@ -320,6 +321,7 @@ def main(out):
                     signed=True, bits_stored=16, number=4 - k)
         values.append(pixels.astype(float))
     case("oblique", values, open="oblique/o_0.dcm", series=series, dtype="int16",
+         positions=positions, row=list(row), column=list(col),
          origin=list(origin), spacing=[0.6, 0.8, 1.75],
          direction=[row[0], col[0], normal[0], row[1], col[1], normal[1],
                     row[2], col[2], normal[2]])
