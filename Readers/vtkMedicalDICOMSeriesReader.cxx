@@ -108,7 +108,6 @@ std::string BaseName(const std::string& path)
 // One slice: a single-frame file, or one frame of a multi-frame file.
 struct Slice
 {
-  std::size_t Instance = 0;
   unsigned long Frame = 0;
   bool HasPosition = false;
   bool HasOrientation = false;
@@ -303,12 +302,17 @@ HeaderStatus ReadHeader(const std::string& path, Instance& instance, std::string
     return HeaderStatus::Image;
   }
   instance.Slices.resize(instance.Frames);
+  DcmItem* group = nullptr;
   for (unsigned long f = 0; f < instance.Frames; ++f)
   {
     Slice& slice = instance.Slices[f];
     slice.Frame = f;
     slice.InstanceNumber = number;
-    DcmItem* group = perFrame && f < perFrame->card() ? perFrame->getItem(f) : nullptr;
+    // Walked item after item: getItem(f) seeks from the first item each time.
+    if (perFrame)
+    {
+      group = static_cast<DcmItem*>(perFrame->nextInContainer(group));
+    }
     slice.HasPosition = FrameDoubles(
       group, shared, data, DCM_PlanePositionSequence, DCM_ImagePositionPatient, slice.Position, 3);
     slice.HasOrientation = FrameDoubles(group, shared, data, DCM_PlaneOrientationSequence,
