@@ -431,21 +431,15 @@ void ResampleSlices(const In* in, Out* out, std::size_t sliceSize,
 }
 
 // The stored values into `out`: rescaled slice by slice, or (resample)
-// interpolated onto the even grid (float or double output).
+// interpolated onto the even grid (float output).
 template <typename In>
 void Convert(const In* in, vtkDataArray* out, bool resample, std::size_t sliceSize,
   const std::vector<double>& distances, const std::vector<double>& slopes,
   const std::vector<double>& intercepts, int count, double step)
 {
-  if (resample && out->GetDataType() == VTK_FLOAT)
-  {
-    ResampleSlices(in, static_cast<float*>(out->GetVoidPointer(0)), sliceSize, distances, slopes,
-      intercepts, count, step);
-    return;
-  }
   if (resample)
   {
-    ResampleSlices(in, static_cast<double*>(out->GetVoidPointer(0)), sliceSize, distances, slopes,
+    ResampleSlices(in, static_cast<float*>(out->GetVoidPointer(0)), sliceSize, distances, slopes,
       intercepts, count, step);
     return;
   }
@@ -1173,9 +1167,10 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
     low = k == 0 ? std::min(a, b) : std::min(low, std::min(a, b));
     high = k == 0 ? std::max(a, b) : std::max(high, std::max(a, b));
   }
-  const int floatType = first.BitsStored > 16 ? VTK_DOUBLE : VTK_FLOAT;
+  // Float holds every stored value (at most 16 bits) times a slope exactly
+  // when the slope has a short binary fraction, and to 24 bits otherwise.
   const int outputType =
-    (resample || !uniform || !integral) ? floatType : SmallestIntegerType(low, high);
+    (resample || !uniform || !integral) ? VTK_FLOAT : SmallestIntegerType(low, high);
   const std::vector<double>& distances = stack.Distances;
   int slicesOut = static_cast<int>(count);
   double step = count > 1 ? (distances.back() - distances.front()) / (count - 1) : 0.0;

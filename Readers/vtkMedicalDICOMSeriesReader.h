@@ -58,12 +58,11 @@
  *    1.
  * 7. **Rescale.** Each slice's Rescale Slope and Intercept (1 and 0 when
  *    absent) are applied to its own values. The output type is:
- *    - float (double when more than 16 bits are stored) when the slopes or
- *      intercepts differ between slices, are not integers, or the slices
- *      were resampled;
+ *    - float when the slopes or intercepts differ between slices, are not
+ *      integers, or the slices were resampled;
  *    - otherwise the smallest integer type that holds the rescaled values
  *      actually present: unsigned 8, 16, 32 bits when none is negative,
- *      else signed 8, 16, 32 bits (a CT stored unsigned with intercept
+ *      else signed 8, 16, 32 bits, double beyond (a CT stored unsigned with intercept
  *      -1024 reads as signed 16-bit Hounsfield units).
  *
  * The pixels are decoded when the pipeline asks for information (the
