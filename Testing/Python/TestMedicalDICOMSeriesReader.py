@@ -8,7 +8,7 @@ with a rescale intercept, the same compressed as RLE, JPEG lossless and JPEG-LS,
 in a folder, a missing slice, uneven steps, a slope per slice, files that are not images, a
 transfer syntax that is not decoded, an enhanced multi-frame file, shuffled file order, an
 oblique plane, 8-bit implicit VR and big endian files, a duplicate position, a slice of
-another size, and damaged files (one cut short, pixel data shorter than the header says, a
+another size, a gantry tilt, a slice on another plane, a colour image, and damaged files (one cut short, pixel data shorter than the header says, a
 header claiming 34 TB). Every case asserts the exact values (interpolated ones to 1e-3) and geometry,
 or the exact message: the reader's errors and warnings are captured here, and any not
 expected fails the test. Skipped (exit 125) when /usr/bin/python3 lacks pydicom or DCMTK's
@@ -232,6 +232,17 @@ expect_error("duplicate", corpus / manifest["duplicate"]["open"],
 expect_error("mixed_size", corpus / manifest["mixed_size"]["open"],
              "slice_006.dcm: 8 x 8 pixels, but slice_000.dcm has 16 x 12: slices of different "
              "sizes are not read")
+
+expect_error("tilted", corpus / manifest["tilted"]["open"],
+             "slice_001.dcm: its Image Position (Patient) is 0.5 mm off the line through "
+             "slice_000.dcm along the slice normal (a gantry tilt or a sheared stack): not read")
+expect_error("mixed_orientation", corpus / manifest["mixed_orientation"]["open"],
+             "slice_006.dcm: Image Orientation (Patient) 1\\0\\0\\0\\0\\-1, but "
+             "slice_000.dcm has 1\\0\\0\\0\\1\\0: slices of different orientations "
+             "are not read")
+expect_error("rgb", corpus / manifest["rgb"]["open"],
+             'colour.dcm: 3 sample(s) per pixel, Photometric Interpretation "RGB": only '
+             "greyscale (MONOCHROME1/2) images are read")
 
 # Damaged files: each refused with its reason, nothing allocated for a header's claims.
 image, values, text = read(corpus / manifest["truncated"]["open"])

@@ -26,6 +26,9 @@ Cases (16 columns x 12 rows per slice, small on purpose):
 - bigendian: signed 16-bit slices in explicit VR big endian.
 - duplicate: the plain series with one slice copied under another UID.
 - mixed_size: the plain series with a 7th slice of 8 x 8 pixels.
+- tilted: slices shifted along y as they go along z (a gantry tilt).
+- mixed_orientation: the plain series with a 7th slice on a coronal plane.
+- rgb: a colour image.
 - truncated: the plain series with one slice's file cut short.
 - short_pixels: a slice whose Pixel Data is shorter than Rows x Columns.
 - huge: a multi-frame header claiming 34 TB of pixels over 64 bytes; huge_rle: the same, RLE.
@@ -382,6 +385,34 @@ def main(out):
     ds.Rows, ds.Columns = 8, 8
     ds.save_as(os.path.join(folder, "slice_006.dcm"), write_like_original=False)
     case("mixed_size", plain, open="mixed_size/slice_000.dcm", series=uid("mixed"))
+
+    # A gantry tilt: each slice shifted 0.5 mm along y, so the stack leaves the normal.
+    folder = os.path.join(out, "tilted")
+    os.makedirs(folder)
+    for k, z in enumerate(PLAIN_Z):
+        image_slice(os.path.join(folder, "slice_%03d.dcm" % k), uid("tilted"), k, stored_slice(k),
+                    (-20.0, -15.0 + 0.5 * k, z))
+    case("tilted", plain, open="tilted/slice_000.dcm", series=uid("tilted"))
+
+    # One slice of the series on another plane.
+    folder = os.path.join(out, "mixed_orientation")
+    plain_series(folder, uid("orientation"))
+    image_slice(os.path.join(folder, "slice_006.dcm"), uid("orientation"), 6, stored_slice(6),
+                (-20.0, -15.0, 25.0), orientation=(1, 0, 0, 0, 0, -1))
+    case("mixed_orientation", plain, open="mixed_orientation/slice_000.dcm",
+         series=uid("orientation"))
+
+    # Colour: three samples per pixel.
+    folder = os.path.join(out, "rgb")
+    os.makedirs(folder)
+    path = os.path.join(folder, "colour.dcm")
+    image_slice(path, uid("rgb"), 0, stored_slice(0), (0.0, 0.0, 0.0))
+    ds = pydicom.dcmread(path)
+    ds.SamplesPerPixel, ds.PhotometricInterpretation, ds.PlanarConfiguration = 3, "RGB", 0
+    ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 8, 8, 7, 0
+    ds.PixelData = bytes(ROWS * COLUMNS * 3)
+    ds.save_as(path, write_like_original=False)
+    case("rgb", plain[:1], open="rgb/colour.dcm", series=uid("rgb"))
 
     # Damaged files. A slice cut short in its pixel data, in the middle of the series.
     folder = os.path.join(out, "truncated")
