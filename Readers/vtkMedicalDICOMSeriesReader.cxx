@@ -1,157 +1,1309 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMedicalDICOMSeriesReader.h"
 
+#include "ProcessMemory.h"
+
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkMath.h"
-#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkStringArray.h"
 
+#include <vtksys/Directory.hxx>
 #include <vtksys/SystemTools.hxx>
 
+// DCMTK's configuration header comes before its other headers.
+#include "dcmtk/config/osconfig.h"
+
+#include "dcmtk/dcmdata/dcdeftag.h"
+#include "dcmtk/dcmdata/dcdict.h"
+#include "dcmtk/dcmdata/dcfilefo.h"
+#include "dcmtk/dcmdata/dcitem.h"
+#include "dcmtk/dcmdata/dcmetinf.h"
+#include "dcmtk/dcmdata/dcrledrg.h"
+#include "dcmtk/dcmdata/dcsequen.h"
+#include "dcmtk/dcmdata/dcxfer.h"
+#include "dcmtk/dcmjpeg/djdecode.h"
+#include "dcmtk/dcmjpls/djdecode.h"
+#include "dcmtk/oflog/oflog.h"
+
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <new>
+#include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 vtkStandardNewMacro(vtkMedicalDICOMSeriesReader);
 
-//------------------------------------------------------------------------------
-vtkMedicalDICOMSeriesReader::vtkMedicalDICOMSeriesReader() = default;
-
-//------------------------------------------------------------------------------
-vtkMedicalDICOMSeriesReader::~vtkMedicalDICOMSeriesReader() = default;
-
-//------------------------------------------------------------------------------
-void vtkMedicalDICOMSeriesReader::SetSeriesPath(const char* path)
+namespace
 {
-  if (path && path[0] && !vtksys::SystemTools::FileIsDirectory(path))
+// DCMTK's decoders are process-wide registrations, made once whichever
+// thread reads first. DCMTK's own log goes quiet below fatal: every failure
+// it reports comes back as a condition that this reader turns into its one
+// message.
+void RegisterDecoders()
+{
+  static std::once_flag once;
+  std::call_once(once,
+    []
+    {
+      OFLog::configure(OFLogger::FATAL_LOG_LEVEL);
+      DcmRLEDecoderRegistration::registerCodecs();
+      DJDecoderRegistration::registerCodecs();
+      DJLSDecoderRegistration::registerCodecs();
+    });
+}
+
+// The transfer syntaxes read: the uncompressed ones DCMTK parses itself and
+// the compressed ones the registered decoders handle.
+bool Decodable(E_TransferSyntax syntax)
+{
+  switch (syntax)
   {
-    this->SetDirectoryName(vtksys::SystemTools::GetFilenamePath(path).c_str());
+    case EXS_LittleEndianImplicit:
+    case EXS_LittleEndianExplicit:
+    case EXS_BigEndianExplicit:
+    case EXS_DeflatedLittleEndianExplicit:
+    case EXS_JPEGProcess1:
+    case EXS_JPEGProcess2_4:
+    case EXS_JPEGProcess6_8:
+    case EXS_JPEGProcess10_12:
+    case EXS_JPEGProcess14:
+    case EXS_JPEGProcess14SV1:
+    case EXS_JPEGLSLossless:
+    case EXS_JPEGLSLossy:
+    case EXS_RLELossless:
+      return true;
+    default:
+      return false;
+  }
+}
+
+std::string Number(double value)
+{
+  std::ostringstream text;
+  text.precision(6);
+  text << value;
+  return text.str();
+}
+
+std::string BaseName(const std::string& path)
+{
+  return vtksys::SystemTools::GetFilenameName(path);
+}
+
+// One slice: a single-frame file, or one frame of a multi-frame file.
+struct Slice
+{
+  unsigned long Frame = 0;
+  bool HasPosition = false;
+  bool HasOrientation = false;
+  bool HasPixelSpacing = false;
+  double Position[3] = { 0, 0, 0 };
+  double Orientation[6] = { 1, 0, 0, 0, 1, 0 };
+  double PixelSpacing[2] = { 1, 1 }; // DICOM order: between rows, between columns
+  double Slope = 1.0;
+  double Intercept = 0.0;
+  long InstanceNumber = 0;
+};
+
+// What the scan keeps of one image file.
+struct Instance
+{
+  std::string Path;
+  std::string SeriesUID;
+  std::string SeriesDescription;
+  std::string TransferSyntaxUID;
+  E_TransferSyntax Syntax = EXS_Unknown;
+  Uint16 Rows = 0, Columns = 0, BitsAllocated = 0, BitsStored = 0, HighBit = 0;
+  Uint16 PixelRepresentation = 0, SamplesPerPixel = 1;
+  std::string Photometric;
+  double SliceThickness = 0.0;
+  unsigned long Frames = 1;
+  bool PerFramePositions = true;
+  // The Pixel Data's length in the file when uncompressed, else -1.
+  long long NativePixelBytes = -1;
+  std::vector<Slice> Slices;
+};
+
+std::string SliceName(const Instance& instance, const Slice& slice)
+{
+  std::string name = BaseName(instance.Path);
+  if (instance.Frames > 1)
+  {
+    name += " frame " + std::to_string(slice.Frame + 1);
+  }
+  return name;
+}
+
+bool HasPart10Preamble(const std::string& path)
+{
+  std::ifstream file(path, std::ios::binary);
+  char head[132];
+  if (!file.read(head, sizeof(head)))
+  {
+    return false;
+  }
+  return head[128] == 'D' && head[129] == 'I' && head[130] == 'C' && head[131] == 'M';
+}
+
+bool ReadDoubles(DcmItem* item, const DcmTagKey& tag, double* values, int count)
+{
+  if (!item)
+  {
+    return false;
+  }
+  for (int i = 0; i < count; ++i)
+  {
+    Float64 value = 0.0;
+    if (item->findAndGetFloat64(tag, value, static_cast<unsigned long>(i)).bad() ||
+      !std::isfinite(value))
+    {
+      return false;
+    }
+    values[i] = value;
+  }
+  return true;
+}
+
+// An attribute of a frame: in the frame's functional group macro, else in
+// the shared one, else at the top level of the dataset (a single-frame file).
+bool FrameDoubles(DcmItem* perFrame, DcmItem* shared, DcmItem* top, const DcmTagKey& macro,
+  const DcmTagKey& tag, double* values, int count)
+{
+  for (DcmItem* group : { perFrame, shared })
+  {
+    DcmItem* item = nullptr;
+    if (group && group->findAndGetSequenceItem(macro, item, 0).good() &&
+      ReadDoubles(item, tag, values, count))
+    {
+      return true;
+    }
+  }
+  return ReadDoubles(top, tag, values, count);
+}
+
+enum class HeaderStatus
+{
+  Image,
+  NotImage,
+  Unreadable
+};
+
+// The attributes of one file, read up to (not into) its pixel data.
+HeaderStatus ReadHeader(const std::string& path, Instance& instance, std::string& why)
+{
+  if (!HasPart10Preamble(path))
+  {
+    return HeaderStatus::NotImage;
+  }
+  DcmFileFormat file;
+  // Values longer than 4 KB (the pixel data) stay on disk until asked for.
+  const OFCondition status =
+    file.loadFile(path.c_str(), EXS_Unknown, EGL_noChange, 4096, ERM_fileOnly);
+  if (status.bad())
+  {
+    why = status.text();
+    return HeaderStatus::Unreadable;
+  }
+  DcmDataset* data = file.getDataset();
+  if (!data || !data->tagExists(DCM_PixelData) ||
+    data->findAndGetUint16(DCM_Rows, instance.Rows).bad() ||
+    data->findAndGetUint16(DCM_Columns, instance.Columns).bad())
+  {
+    return HeaderStatus::NotImage;
+  }
+  instance.Path = path;
+  OFString text;
+  if (data->findAndGetOFString(DCM_SeriesInstanceUID, text).good())
+  {
+    instance.SeriesUID = text.c_str();
+  }
+  if (data->findAndGetOFString(DCM_SeriesDescription, text).good())
+  {
+    instance.SeriesDescription = text.c_str();
+  }
+  if (file.getMetaInfo() &&
+    file.getMetaInfo()->findAndGetOFString(DCM_TransferSyntaxUID, text).good())
+  {
+    instance.TransferSyntaxUID = text.c_str();
+    instance.Syntax = DcmXfer(text.c_str()).getXfer();
   }
   else
   {
-    this->SetDirectoryName(path);
+    instance.Syntax = data->getOriginalXfer();
+    instance.TransferSyntaxUID = DcmXfer(instance.Syntax).getXferID();
   }
+  DcmElement* pixels = nullptr;
+  if (!DcmXfer(instance.Syntax).isEncapsulated() &&
+    data->findAndGetElement(DCM_PixelData, pixels).good() && pixels)
+  {
+    instance.NativePixelBytes = pixels->getLength();
+  }
+  data->findAndGetUint16(DCM_BitsAllocated, instance.BitsAllocated);
+  if (data->findAndGetUint16(DCM_BitsStored, instance.BitsStored).bad())
+  {
+    instance.BitsStored = instance.BitsAllocated;
+  }
+  if (data->findAndGetUint16(DCM_HighBit, instance.HighBit).bad())
+  {
+    instance.HighBit = instance.BitsStored > 0 ? instance.BitsStored - 1 : 0;
+  }
+  data->findAndGetUint16(DCM_PixelRepresentation, instance.PixelRepresentation);
+  if (data->findAndGetUint16(DCM_SamplesPerPixel, instance.SamplesPerPixel).bad())
+  {
+    instance.SamplesPerPixel = 1;
+  }
+  if (data->findAndGetOFString(DCM_PhotometricInterpretation, text).good())
+  {
+    instance.Photometric = text.c_str();
+  }
+  Sint32 frames = 1;
+  if (data->findAndGetSint32(DCM_NumberOfFrames, frames).good() && frames > 1)
+  {
+    instance.Frames = static_cast<unsigned long>(frames);
+  }
+  long number = 0;
+  Sint32 value = 0;
+  if (data->findAndGetSint32(DCM_InstanceNumber, value).good())
+  {
+    number = value;
+  }
+
+  DcmItem* shared = nullptr;
+  data->findAndGetSequenceItem(DCM_SharedFunctionalGroupsSequence, shared, 0);
+  DcmSequenceOfItems* perFrame = nullptr;
+  data->findAndGetSequence(DCM_PerFrameFunctionalGroupsSequence, perFrame);
+  double thickness[1] = { 0.0 };
+  if (FrameDoubles(
+        nullptr, shared, data, DCM_PixelMeasuresSequence, DCM_SliceThickness, thickness, 1))
+  {
+    instance.SliceThickness = thickness[0];
+  }
+  instance.PerFramePositions =
+    instance.Frames == 1 || (perFrame && perFrame->card() >= instance.Frames);
+  if (!instance.PerFramePositions)
+  {
+    // Refused when its series is read; no slice is made for a frame count
+    // that nothing in the file backs (a header may claim billions).
+    return HeaderStatus::Image;
+  }
+  instance.Slices.resize(instance.Frames);
+  DcmItem* group = nullptr;
+  for (unsigned long f = 0; f < instance.Frames; ++f)
+  {
+    Slice& slice = instance.Slices[f];
+    slice.Frame = f;
+    slice.InstanceNumber = number;
+    // Walked item after item: getItem(f) seeks from the first item each time.
+    if (perFrame)
+    {
+      group = static_cast<DcmItem*>(perFrame->nextInContainer(group));
+    }
+    slice.HasPosition = FrameDoubles(
+      group, shared, data, DCM_PlanePositionSequence, DCM_ImagePositionPatient, slice.Position, 3);
+    slice.HasOrientation = FrameDoubles(group, shared, data, DCM_PlaneOrientationSequence,
+      DCM_ImageOrientationPatient, slice.Orientation, 6);
+    slice.HasPixelSpacing = FrameDoubles(
+      group, shared, data, DCM_PixelMeasuresSequence, DCM_PixelSpacing, slice.PixelSpacing, 2);
+    double rescale[1];
+    if (FrameDoubles(
+          group, shared, data, DCM_PixelValueTransformationSequence, DCM_RescaleSlope, rescale, 1))
+    {
+      slice.Slope = rescale[0];
+    }
+    if (FrameDoubles(group, shared, data, DCM_PixelValueTransformationSequence,
+          DCM_RescaleIntercept, rescale, 1))
+    {
+      slice.Intercept = rescale[0];
+    }
+  }
+  return HeaderStatus::Image;
+}
+
+struct Series
+{
+  std::string UID;
+  std::string Description;
+  std::vector<std::size_t> Instances; // indices into the scan
+  std::size_t Slices = 0;
+};
+
+std::string Describe(const Series& series)
+{
+  std::string text = series.UID.empty() ? std::string("(no Series Instance UID)") : series.UID;
+  text += " (";
+  if (!series.Description.empty())
+  {
+    text += "\"" + series.Description + "\", ";
+  }
+  text += std::to_string(series.Slices) + (series.Slices == 1 ? " slice)" : " slices)");
+  return text;
+}
+
+// Stored values: masked to Bits Stored, sign-extended when signed, and the
+// least and greatest of each slice.
+template <typename Raw, typename Stored>
+void Unpack(const Raw* raw, Stored* out, std::size_t count, const Instance& instance,
+  std::int64_t& least, std::int64_t& greatest)
+{
+  const unsigned shift = instance.HighBit + 1u - instance.BitsStored;
+  const std::uint32_t mask =
+    instance.BitsStored >= 32 ? 0xffffffffu : ((1u << instance.BitsStored) - 1u);
+  const std::uint32_t sign = 1u << (instance.BitsStored - 1u);
+  const bool isSigned = instance.PixelRepresentation == 1;
+  for (std::size_t p = 0; p < count; ++p)
+  {
+    const std::uint32_t bits = (static_cast<std::uint32_t>(raw[p]) >> shift) & mask;
+    std::int64_t value = bits;
+    if (isSigned && (bits & sign))
+    {
+      value -= static_cast<std::int64_t>(mask) + 1;
+    }
+    out[p] = static_cast<Stored>(value);
+    least = std::min(least, value);
+    greatest = std::max(greatest, value);
+  }
+}
+
+template <typename In, typename Out>
+void RescaleSlices(const In* in, Out* out, std::size_t sliceSize, const std::vector<double>& slopes,
+  const std::vector<double>& intercepts)
+{
+  for (std::size_t k = 0; k < slopes.size(); ++k)
+  {
+    const In* from = in + k * sliceSize;
+    Out* to = out + k * sliceSize;
+    const double slope = slopes[k];
+    const double intercept = intercepts[k];
+    for (std::size_t p = 0; p < sliceSize; ++p)
+    {
+      to[p] = static_cast<Out>(slope * static_cast<double>(from[p]) + intercept);
+    }
+  }
+}
+
+// Linear interpolation along the normal from the sorted slices at
+// `distances` onto `count` slices from distances[0] with `step`.
+template <typename In, typename Out>
+void ResampleSlices(const In* in, Out* out, std::size_t sliceSize,
+  const std::vector<double>& distances, const std::vector<double>& slopes,
+  const std::vector<double>& intercepts, int count, double step)
+{
+  std::size_t below = 0;
+  for (int z = 0; z < count; ++z)
+  {
+    const double at = z + 1 == count ? distances.back() : distances.front() + z * step;
+    while (below + 2 < distances.size() && distances[below + 1] <= at)
+    {
+      ++below;
+    }
+    const std::size_t above = std::min(below + 1, distances.size() - 1);
+    double weight = 0.0;
+    if (above != below)
+    {
+      weight = (at - distances[below]) / (distances[above] - distances[below]);
+      weight = std::min(1.0, std::max(0.0, weight));
+    }
+    const In* a = in + below * sliceSize;
+    const In* b = in + above * sliceSize;
+    Out* to = out + static_cast<std::size_t>(z) * sliceSize;
+    for (std::size_t p = 0; p < sliceSize; ++p)
+    {
+      const double va = slopes[below] * static_cast<double>(a[p]) + intercepts[below];
+      const double vb = slopes[above] * static_cast<double>(b[p]) + intercepts[above];
+      to[p] = static_cast<Out>(weight == 0.0 ? va : (1.0 - weight) * va + weight * vb);
+    }
+  }
+}
+
+// The stored values into `out`: rescaled slice by slice, or (resample)
+// interpolated onto the even grid (float output).
+template <typename In>
+void Convert(const In* in, vtkDataArray* out, bool resample, std::size_t sliceSize,
+  const std::vector<double>& distances, const std::vector<double>& slopes,
+  const std::vector<double>& intercepts, int count, double step)
+{
+  if (resample)
+  {
+    ResampleSlices(in, static_cast<float*>(out->GetVoidPointer(0)), sliceSize, distances, slopes,
+      intercepts, count, step);
+    return;
+  }
+  switch (out->GetDataType())
+  {
+    vtkTemplateMacro(RescaleSlices(
+      in, static_cast<VTK_TT*>(out->GetVoidPointer(0)), sliceSize, slopes, intercepts));
+  }
+}
+
+int SmallestIntegerType(double least, double greatest)
+{
+  if (least >= 0.0)
+  {
+    if (greatest <= 255.0)
+    {
+      return VTK_UNSIGNED_CHAR;
+    }
+    if (greatest <= 65535.0)
+    {
+      return VTK_UNSIGNED_SHORT;
+    }
+    if (greatest <= 4294967295.0)
+    {
+      return VTK_UNSIGNED_INT;
+    }
+    return VTK_DOUBLE;
+  }
+  if (least >= -128.0 && greatest <= 127.0)
+  {
+    return VTK_SIGNED_CHAR;
+  }
+  if (least >= -32768.0 && greatest <= 32767.0)
+  {
+    return VTK_SHORT;
+  }
+  if (least >= -2147483648.0 && greatest <= 2147483647.0)
+  {
+    return VTK_INT;
+  }
+  return VTK_DOUBLE;
+}
+
+// An array of `tuples` values of `type`, or nullptr with the message when
+// its bytes (and `alongside` more, needed at the same time) do not fit or
+// the allocation fails.
+vtkSmartPointer<vtkDataArray> NewVolume(
+  int type, std::size_t tuples, std::uint64_t alongside, const char* what, std::string& error)
+{
+  vtkSmartPointer<vtkDataArray> array;
+  array.TakeReference(vtkDataArray::CreateDataArray(type));
+  const std::uint64_t bytes =
+    static_cast<std::uint64_t>(tuples) * static_cast<std::uint64_t>(array->GetDataTypeSize());
+  if (!mediso::FitsInProcessMemory(bytes + alongside, what, error))
+  {
+    return nullptr;
+  }
+  if (!array->Allocate(static_cast<vtkIdType>(tuples)))
+  {
+    error = std::string("could not allocate ") + what + " (" + Number(bytes / 1.0e6) + " MB)";
+    return nullptr;
+  }
+  array->SetNumberOfTuples(static_cast<vtkIdType>(tuples));
+  return array;
+}
+
+std::string JoinList(const std::vector<std::string>& items, const char* separator)
+{
+  std::string text;
+  for (const std::string& item : items)
+  {
+    text += (text.empty() ? "" : separator) + item;
+  }
+  return text;
+}
+
+// The bytes of pixel data an image needs, and the message when it has fewer.
+std::uint64_t PixelBytes(const Instance& instance)
+{
+  return static_cast<std::uint64_t>(instance.Rows) * instance.Columns * instance.Frames *
+    (instance.BitsAllocated / 8);
+}
+
+std::string ShortPixelData(const Instance& instance, std::uint64_t have)
+{
+  return BaseName(instance.Path) + ": Pixel Data holds " + std::to_string(have) + " bytes, " +
+    std::to_string(PixelBytes(instance)) + " expected (" + std::to_string(instance.Columns) +
+    " x " + std::to_string(instance.Rows) + " x " + std::to_string(instance.Frames) +
+    " frame(s) x " + std::to_string(instance.BitsAllocated / 8) + " byte(s))";
+}
+
+// Step 1: the image files of the folder of `path` (or of the folder `path`).
+struct FolderScan
+{
+  std::string Folder;
+  bool FileOpened = false;
+  std::string OpenedSeries;
+  std::vector<Instance> Images;
+  std::vector<std::string> Unreadable; // "name (reason)"
+};
+
+std::string ScanFolder(const std::string& path, FolderScan& scan)
+{
+  scan.FileOpened = !vtksys::SystemTools::FileIsDirectory(path);
+  scan.Folder = scan.FileOpened ? vtksys::SystemTools::GetFilenamePath(path) : path;
+  vtksys::Directory directory;
+  if (!directory.Load(scan.Folder.empty() ? std::string(".") : scan.Folder))
+  {
+    return scan.Folder + ": the folder cannot be listed";
+  }
+  std::vector<std::string> names;
+  for (unsigned long i = 0; i < directory.GetNumberOfFiles(); ++i)
+  {
+    const std::string name = directory.GetFile(i);
+    if (name != "." && name != "..")
+    {
+      names.push_back(name);
+    }
+  }
+  std::sort(names.begin(), names.end());
+  bool openedFound = false;
+  for (const std::string& name : names)
+  {
+    const std::string file = scan.Folder.empty() ? name : scan.Folder + "/" + name;
+    // Folders, pipes and devices are skipped: opening a pipe would block.
+    std::error_code failed;
+    if (!std::filesystem::is_regular_file(file, failed))
+    {
+      continue;
+    }
+    Instance instance;
+    std::string why;
+    const HeaderStatus status = ReadHeader(file, instance, why);
+    const bool isOpened = scan.FileOpened && vtksys::SystemTools::SameFile(file, path);
+    if (status == HeaderStatus::Unreadable)
+    {
+      if (isOpened)
+      {
+        return path + ": DCMTK cannot read it (" + why + ")";
+      }
+      scan.Unreadable.push_back(name + " (" + why + ")");
+      continue;
+    }
+    if (status == HeaderStatus::NotImage)
+    {
+      if (isOpened)
+      {
+        return path + ": not a DICOM image (no Part 10 preamble \"DICM\", or no Rows, Columns " +
+          "and Pixel Data)";
+      }
+      continue;
+    }
+    if (isOpened)
+    {
+      openedFound = true;
+      scan.OpenedSeries = instance.SeriesUID;
+    }
+    scan.Images.push_back(std::move(instance));
+  }
+  if (scan.FileOpened && !openedFound)
+  {
+    return path + ": not found in the listing of its folder";
+  }
+  if (scan.Images.empty())
+  {
+    return scan.Folder + ": no DICOM image files in the folder";
+  }
+  return std::string();
+}
+
+// Step 2: the images grouped by Series Instance UID, largest series first
+// (so that every list of series reads the same way), and the one to read.
+struct SeriesChoice
+{
+  std::vector<Series> All;
+  std::size_t Chosen = 0;
+  std::string Reason;
+};
+
+std::string ChooseSeries(const FolderScan& scan, const std::string& wanted, SeriesChoice& choice)
+{
+  std::map<std::string, std::size_t> index;
+  for (std::size_t i = 0; i < scan.Images.size(); ++i)
+  {
+    const Instance& image = scan.Images[i];
+    auto found = index.find(image.SeriesUID);
+    if (found == index.end())
+    {
+      found = index.emplace(image.SeriesUID, choice.All.size()).first;
+      choice.All.emplace_back();
+      choice.All.back().UID = image.SeriesUID;
+      choice.All.back().Description = image.SeriesDescription;
+    }
+    choice.All[found->second].Instances.push_back(i);
+    choice.All[found->second].Slices += image.Frames;
+  }
+  std::stable_sort(choice.All.begin(), choice.All.end(),
+    [](const Series& a, const Series& b) { return a.Slices > b.Slices; });
+  const std::string* uid = nullptr;
+  if (!wanted.empty())
+  {
+    uid = &wanted;
+    choice.Reason = "the one SeriesInstanceUID names";
+  }
+  else if (scan.FileOpened)
+  {
+    uid = &scan.OpenedSeries;
+    choice.Reason = "the series of the file opened";
+  }
+  else
+  {
+    choice.Chosen = 0;
+    choice.Reason = "the series with the most slices";
+    return std::string();
+  }
+  for (std::size_t s = 0; s < choice.All.size(); ++s)
+  {
+    if (choice.All[s].UID == *uid)
+    {
+      choice.Chosen = s;
+      return std::string();
+    }
+  }
+  std::vector<std::string> list;
+  for (const Series& s : choice.All)
+  {
+    list.push_back(Describe(s));
+  }
+  return scan.Folder + ": no series with Series Instance UID " + *uid + "; the folder holds " +
+    JoinList(list, "; ");
+}
+
+// Step 4, file by file: what the reader decodes, and the same size and pixel
+// format as the series' first file.
+std::string CheckInstances(const std::vector<Instance*>& instances)
+{
+  const Instance& first = *instances.front();
+  for (const Instance* instance : instances)
+  {
+    const std::string name = BaseName(instance->Path);
+    if (!Decodable(instance->Syntax))
+    {
+      return name + ": transfer syntax \"" + DcmXfer(instance->Syntax).getXferName() + "\" (" +
+        instance->TransferSyntaxUID + ") is not read (this reader decodes uncompressed, " +
+        "deflated, JPEG baseline, extended and lossless, JPEG-LS and RLE pixel data)";
+    }
+    if (instance->SamplesPerPixel != 1 ||
+      (instance->Photometric != "MONOCHROME1" && instance->Photometric != "MONOCHROME2"))
+    {
+      return name + ": " + std::to_string(instance->SamplesPerPixel) + " sample(s) per pixel, " +
+        "Photometric Interpretation \"" + instance->Photometric +
+        "\": only greyscale (MONOCHROME1/2) images are read";
+    }
+    if (instance->BitsAllocated != 8 && instance->BitsAllocated != 16)
+    {
+      return name + ": Bits Allocated " + std::to_string(instance->BitsAllocated) +
+        " is not read (8 or 16)";
+    }
+    if (instance->BitsStored == 0 || instance->BitsStored > instance->BitsAllocated ||
+      instance->HighBit + 1 < instance->BitsStored || instance->HighBit >= instance->BitsAllocated)
+    {
+      return name + ": Bits Stored " + std::to_string(instance->BitsStored) + " and High Bit " +
+        std::to_string(instance->HighBit) + " do not fit Bits Allocated " +
+        std::to_string(instance->BitsAllocated);
+    }
+    if (instance->Rows == 0 || instance->Columns == 0)
+    {
+      return name + ": an image of " + std::to_string(instance->Columns) + " x " +
+        std::to_string(instance->Rows) + " pixels";
+    }
+    if (!instance->PerFramePositions)
+    {
+      return name + ": " + std::to_string(instance->Frames) +
+        " frames without per-frame positions (Per-frame Functional Groups, Plane Position " +
+        "Sequence): their placement is unknown";
+    }
+    // Uncompressed pixel data shorter than the header says, known before
+    // anything is allocated for it.
+    if (instance->NativePixelBytes >= 0 &&
+      static_cast<std::uint64_t>(instance->NativePixelBytes) < PixelBytes(*instance))
+    {
+      return ShortPixelData(*instance, static_cast<std::uint64_t>(instance->NativePixelBytes));
+    }
+    if (instance->Rows != first.Rows || instance->Columns != first.Columns)
+    {
+      return name + ": " + std::to_string(instance->Columns) + " x " +
+        std::to_string(instance->Rows) + " pixels, but " + BaseName(first.Path) + " has " +
+        std::to_string(first.Columns) + " x " + std::to_string(first.Rows) +
+        ": slices of different sizes are not read";
+    }
+    if (instance->BitsAllocated != first.BitsAllocated ||
+      instance->PixelRepresentation != first.PixelRepresentation)
+    {
+      return name + ": pixel format " + std::to_string(instance->BitsAllocated) + " bits " +
+        (instance->PixelRepresentation ? "signed" : "unsigned") + ", but " + BaseName(first.Path) +
+        " has " + std::to_string(first.BitsAllocated) + " bits " +
+        (first.PixelRepresentation ? "signed" : "unsigned") +
+        ": slices of different pixel formats are not read";
+    }
+  }
+  return std::string();
+}
+
+// Steps 3 and 5: every slice of the series, checked against the first one
+// and sorted along the normal; its steps checked against the median step.
+struct Stack
+{
+  std::vector<std::pair<const Instance*, const Slice*>> Slices; // in increasing position
+  std::vector<double> Distances;                                // along the normal
+  double Row[3] = { 1, 0, 0 };
+  double Column[3] = { 0, 1, 0 };
+  double Normal[3] = { 0, 0, 1 };
+  double Median = 0.0;             // median step
+  std::vector<std::string> Uneven; // gaps and uneven steps, in words
+  bool ValidPixelSpacing = false;
+
+  std::string Name(std::size_t k) const { return SliceName(*Slices[k].first, *Slices[k].second); }
+  std::string Where(std::size_t k) const
+  {
+    return Number(this->Distances[k]) + " mm (" + this->Name(k) + ")";
+  }
+};
+
+std::string CheckSlices(Stack& stack)
+{
+  const Slice& reference = *stack.Slices.front().second;
+  const std::string referenceName = stack.Name(0);
+  const bool single = stack.Slices.size() == 1;
+  if (reference.HasOrientation)
+  {
+    std::copy(reference.Orientation, reference.Orientation + 3, stack.Row);
+    std::copy(reference.Orientation + 3, reference.Orientation + 6, stack.Column);
+    const double rowLength = vtkMath::Normalize(stack.Row);
+    const double columnLength = vtkMath::Normalize(stack.Column);
+    if (std::abs(rowLength - 1.0) > 1e-3 || std::abs(columnLength - 1.0) > 1e-3 ||
+      std::abs(vtkMath::Dot(stack.Row, stack.Column)) > 1e-3)
+    {
+      return referenceName + ": Image Orientation (Patient) is not two orthogonal unit vectors";
+    }
+  }
+  vtkMath::Cross(stack.Row, stack.Column, stack.Normal);
+  for (std::size_t k = 0; k < stack.Slices.size(); ++k)
+  {
+    const Slice& slice = *stack.Slices[k].second;
+    const std::string name = stack.Name(k);
+    if (!single && !slice.HasPosition)
+    {
+      return name + ": no Image Position (Patient): the slices' order and spacing are unknown";
+    }
+    if (!single && !slice.HasOrientation)
+    {
+      return name + ": no Image Orientation (Patient): the slices' order and spacing are unknown";
+    }
+    for (int c = 0; c < 6 && slice.HasOrientation; ++c)
+    {
+      if (std::abs(slice.Orientation[c] - reference.Orientation[c]) > 1e-4)
+      {
+        std::string a, b;
+        for (int d = 0; d < 6; ++d)
+        {
+          a += (d ? "\\" : "") + Number(slice.Orientation[d]);
+          b += (d ? "\\" : "") + Number(reference.Orientation[d]);
+        }
+        return name + ": Image Orientation (Patient) " + a + ", but " + referenceName + " has " +
+          b + ": slices of different orientations are not read";
+      }
+    }
+    if (slice.HasPixelSpacing != reference.HasPixelSpacing ||
+      std::abs(slice.PixelSpacing[0] - reference.PixelSpacing[0]) > 1e-4 ||
+      std::abs(slice.PixelSpacing[1] - reference.PixelSpacing[1]) > 1e-4)
+    {
+      return name + ": Pixel Spacing " + Number(slice.PixelSpacing[0]) + "\\" +
+        Number(slice.PixelSpacing[1]) + ", but " + referenceName + " has " +
+        Number(reference.PixelSpacing[0]) + "\\" + Number(reference.PixelSpacing[1]) +
+        ": slices of different pixel spacings are not read";
+    }
+    if (slice.Slope == 0.0)
+    {
+      return name + ": Rescale Slope 0";
+    }
+  }
+  stack.ValidPixelSpacing =
+    reference.HasPixelSpacing && reference.PixelSpacing[0] > 0.0 && reference.PixelSpacing[1] > 0.0;
+  return std::string();
+}
+
+std::string StackSlices(const std::vector<Instance*>& instances, Stack& stack)
+{
+  for (const Instance* instance : instances)
+  {
+    for (const Slice& slice : instance->Slices)
+    {
+      stack.Slices.emplace_back(instance, &slice);
+    }
+  }
+  std::string error = CheckSlices(stack);
+  if (!error.empty())
+  {
+    return error;
+  }
+  // Sorted by position along the normal; ties (refused below) by Instance Number.
+  const double* normal = stack.Normal;
+  std::stable_sort(stack.Slices.begin(), stack.Slices.end(),
+    [normal](const auto& a, const auto& b)
+    {
+      const double da = vtkMath::Dot(a.second->Position, normal);
+      const double db = vtkMath::Dot(b.second->Position, normal);
+      return da != db ? da < db : a.second->InstanceNumber < b.second->InstanceNumber;
+    });
+  const std::size_t count = stack.Slices.size();
+  for (const auto& entry : stack.Slices)
+  {
+    stack.Distances.push_back(vtkMath::Dot(entry.second->Position, normal));
+  }
+  if (count < 2)
+  {
+    return std::string();
+  }
+  std::vector<double> steps(count - 1);
+  for (std::size_t k = 0; k + 1 < count; ++k)
+  {
+    steps[k] = stack.Distances[k + 1] - stack.Distances[k];
+  }
+  std::vector<double> sorted = steps;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  stack.Median = sorted[sorted.size() / 2];
+  const double tolerance = 0.01 * stack.Median;
+  for (std::size_t k = 0; k + 1 < count; ++k)
+  {
+    if (!(steps[k] > std::max(tolerance, 1e-6)))
+    {
+      return "two slices at the same position along the normal, " + stack.Where(k) + " and " +
+        stack.Where(k + 1) + ": duplicate slices are not read";
+    }
+  }
+  // A stack that leaves the line through the first slice along the normal
+  // (gantry tilt, shear) would need a sheared grid: refused.
+  const double* origin = stack.Slices.front().second->Position;
+  const double* pixel = stack.Slices.front().second->PixelSpacing;
+  const double lateral = std::max(1e-3, 0.01 * std::min(pixel[0], pixel[1]));
+  for (std::size_t k = 1; k < count; ++k)
+  {
+    double offset[3];
+    vtkMath::Subtract(stack.Slices[k].second->Position, origin, offset);
+    const double along = vtkMath::Dot(offset, normal);
+    for (int c = 0; c < 3; ++c)
+    {
+      offset[c] -= along * normal[c];
+    }
+    const double off = vtkMath::Norm(offset);
+    if (off > lateral)
+    {
+      return stack.Name(k) + ": its Image Position (Patient) is " + Number(off) +
+        " mm off the line through " + stack.Name(0) +
+        " along the slice normal (a gantry tilt or a sheared stack): not read";
+    }
+  }
+  for (std::size_t k = 0; k + 1 < count; ++k)
+  {
+    if (std::abs(steps[k] - stack.Median) <= tolerance)
+    {
+      continue;
+    }
+    const double whole = std::round(steps[k] / stack.Median);
+    const std::string between = " mm between " + stack.Where(k) + " and " + stack.Where(k + 1);
+    if (whole >= 2.0 && std::abs(steps[k] - whole * stack.Median) <= tolerance)
+    {
+      const int missing = static_cast<int>(whole) - 1;
+      stack.Uneven.push_back("a gap of " + Number(steps[k]) + between + " (" +
+        std::to_string(missing) + (missing == 1 ? " slice missing)" : " slices missing)"));
+    }
+    else
+    {
+      stack.Uneven.push_back("a step of " + Number(steps[k]) + between);
+    }
+  }
+  return std::string();
+}
+
+// Step 6: every file decoded (DCMTK's codecs for the compressed ones) and
+// its frames unpacked into `stored` at their place in the stack, with the
+// least and greatest stored value of each slice.
+std::string DecodeSlices(const std::vector<Instance*>& instances, const Stack& stack,
+  vtkDataArray* stored, std::vector<std::int64_t>& least, std::vector<std::int64_t>& greatest)
+{
+  const Instance& first = *instances.front();
+  const std::size_t sliceSize = static_cast<std::size_t>(first.Rows) * first.Columns;
+  std::map<const Slice*, std::size_t> order;
+  for (std::size_t k = 0; k < stack.Slices.size(); ++k)
+  {
+    order[stack.Slices[k].second] = k;
+  }
+  least.assign(stack.Slices.size(), 0);
+  greatest.assign(stack.Slices.size(), 0);
+  for (const Instance* instance : instances)
+  {
+    const std::string name = BaseName(instance->Path);
+    DcmFileFormat file;
+    OFCondition status = file.loadFile(
+      instance->Path.c_str(), EXS_Unknown, EGL_noChange, DCM_MaxReadLength, ERM_fileOnly);
+    DcmDataset* data = file.getDataset();
+    if (status.bad() || !data)
+    {
+      return name + ": DCMTK cannot read it (" + std::string(status.text()) + ")";
+    }
+    if (DcmXfer(instance->Syntax).isEncapsulated())
+    {
+      status = data->chooseRepresentation(EXS_LittleEndianExplicit, nullptr);
+      if (status.bad() || !data->canWriteXfer(EXS_LittleEndianExplicit))
+      {
+        return name + ": DCMTK could not decode its \"" + DcmXfer(instance->Syntax).getXferName() +
+          "\" pixel data (" + status.text() + ")";
+      }
+    }
+    DcmElement* pixels = nullptr;
+    if (data->findAndGetElement(DCM_PixelData, pixels).bad() || !pixels)
+    {
+      return name + ": no Pixel Data";
+    }
+    const void* raw = nullptr;
+    if (first.BitsAllocated == 8)
+    {
+      Uint8* values = nullptr;
+      status = pixels->getUint8Array(values);
+      raw = values;
+    }
+    else
+    {
+      Uint16* values = nullptr;
+      status = pixels->getUint16Array(values);
+      raw = values;
+    }
+    if (status.bad() || !raw || pixels->getLength() < PixelBytes(*instance))
+    {
+      return ShortPixelData(*instance, raw ? pixels->getLength() : 0);
+    }
+    for (const Slice& slice : instance->Slices)
+    {
+      const std::size_t k = order[&slice];
+      std::int64_t lo = std::numeric_limits<std::int64_t>::max();
+      std::int64_t hi = std::numeric_limits<std::int64_t>::min();
+      const std::size_t at = slice.Frame * sliceSize;
+      void* to = stored->GetVoidPointer(static_cast<vtkIdType>(k * sliceSize));
+      switch (stored->GetDataType())
+      {
+        case VTK_UNSIGNED_CHAR:
+          Unpack(static_cast<const Uint8*>(raw) + at, static_cast<unsigned char*>(to), sliceSize,
+            *instance, lo, hi);
+          break;
+        case VTK_SIGNED_CHAR:
+          Unpack(static_cast<const Uint8*>(raw) + at, static_cast<signed char*>(to), sliceSize,
+            *instance, lo, hi);
+          break;
+        case VTK_UNSIGNED_SHORT:
+          Unpack(static_cast<const Uint16*>(raw) + at, static_cast<unsigned short*>(to), sliceSize,
+            *instance, lo, hi);
+          break;
+        default:
+          Unpack(static_cast<const Uint16*>(raw) + at, static_cast<short*>(to), sliceSize,
+            *instance, lo, hi);
+          break;
+      }
+      least[k] = lo;
+      greatest[k] = hi;
+    }
+  }
+  return std::string();
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+vtkMedicalDICOMSeriesReader::vtkMedicalDICOMSeriesReader()
+{
+  this->SetNumberOfInputPorts(0);
+  this->SeriesList = vtkSmartPointer<vtkStringArray>::New();
+}
+
+//------------------------------------------------------------------------------
+vtkMedicalDICOMSeriesReader::~vtkMedicalDICOMSeriesReader()
+{
+  this->SetFileName(nullptr);
+  this->SetSeriesInstanceUID(nullptr);
+}
+
+//------------------------------------------------------------------------------
+vtkStringArray* vtkMedicalDICOMSeriesReader::GetSeriesInFolder()
+{
+  return this->SeriesList;
+}
+
+//------------------------------------------------------------------------------
+std::string vtkMedicalDICOMSeriesReader::ReadSeries()
+{
+  if (!this->FileName || !this->FileName[0])
+  {
+    return "no FileName: set a file of the series, or its folder";
+  }
+  const std::string path = this->FileName;
+  if (!vtksys::SystemTools::FileExists(path))
+  {
+    return path + ": no such file or folder";
+  }
+  if (!dcmDataDict.isDictionaryLoaded())
+  {
+    return "DCMTK's data dictionary is not loaded (see DCMDICTPATH): no DICOM file can be read";
+  }
+  RegisterDecoders();
+
+  // 1-2. Scan the folder, choose a series, say which others it holds.
+  FolderScan scan;
+  std::string error = ScanFolder(path, scan);
+  if (!error.empty())
+  {
+    return error;
+  }
+  if (!scan.Unreadable.empty())
+  {
+    vtkWarningMacro(<< scan.Folder << ": skipped " << scan.Unreadable.size()
+                    << " DICOM file(s) DCMTK cannot read: " << JoinList(scan.Unreadable, "; "));
+  }
+  SeriesChoice choice;
+  error = ChooseSeries(scan, this->SeriesInstanceUID ? this->SeriesInstanceUID : "", choice);
+  if (!error.empty())
+  {
+    return error;
+  }
+  const Series& read = choice.All[choice.Chosen];
+  std::vector<std::string> others;
+  this->SeriesList->InsertNextValue(
+    read.UID + " | " + read.Description + " | " + std::to_string(read.Slices) + " slices");
+  for (std::size_t s = 0; s < choice.All.size(); ++s)
+  {
+    if (s != choice.Chosen)
+    {
+      const Series& other = choice.All[s];
+      others.push_back(Describe(other));
+      this->SeriesList->InsertNextValue(
+        other.UID + " | " + other.Description + " | " + std::to_string(other.Slices) + " slices");
+    }
+  }
+  if (!others.empty())
+  {
+    vtkWarningMacro(<< scan.Folder << ": the folder holds " << choice.All.size() << " series; read "
+                    << Describe(read) << ", " << choice.Reason << "; not read: "
+                    << JoinList(others, "; ") << ". SeriesInstanceUID chooses another.");
+  }
+
+  // 3-5. Check the files and the slices; order them along the normal.
+  std::vector<Instance*> instances;
+  for (std::size_t i : read.Instances)
+  {
+    instances.push_back(&scan.Images[i]);
+  }
+  Stack stack;
+  error = CheckInstances(instances);
+  if (error.empty())
+  {
+    error = StackSlices(instances, stack);
+  }
+  if (!error.empty())
+  {
+    return error;
+  }
+  const Instance& first = *instances.front();
+  if (!stack.ValidPixelSpacing)
+  {
+    vtkWarningMacro(<< BaseName(first.Path)
+                    << ": no valid Pixel Spacing; 1 mm between rows and columns assumed");
+  }
+  std::vector<std::string> listed(
+    stack.Uneven.begin(), stack.Uneven.begin() + std::min<std::size_t>(stack.Uneven.size(), 5));
+  if (stack.Uneven.size() > 5)
+  {
+    listed.push_back("and " + std::to_string(stack.Uneven.size() - 5) + " more");
+  }
+  const std::string unevenList = JoinList(listed, "; ");
+  const bool resample = !stack.Uneven.empty();
+  if (resample && !this->ResampleUnevenSlices)
+  {
+    return "the slices are not evenly spaced (median step " + Number(stack.Median) +
+      " mm): " + unevenList + ". Turn ResampleUnevenSlices on to resample them onto an even grid.";
+  }
+
+  // 6. Decode every file into the stored values.
+  const std::size_t count = stack.Slices.size();
+  const std::size_t sliceSize = static_cast<std::size_t>(first.Rows) * first.Columns;
+  const bool isSigned = first.PixelRepresentation == 1;
+  const int storedType = first.BitsAllocated == 8 ? (isSigned ? VTK_SIGNED_CHAR : VTK_UNSIGNED_CHAR)
+                                                  : (isSigned ? VTK_SHORT : VTK_UNSIGNED_SHORT);
+  // DCMTK decodes a compressed file whole beside the stored volume.
+  std::uint64_t decoding = 0;
+  for (const Instance* instance : instances)
+  {
+    if (DcmXfer(instance->Syntax).isEncapsulated())
+    {
+      decoding = std::max(decoding, PixelBytes(*instance));
+    }
+  }
+  vtkSmartPointer<vtkDataArray> stored = NewVolume(storedType, sliceSize * count, decoding,
+    decoding ? "the decoded series and a compressed file's decoding" : "the decoded series", error);
+  if (!stored)
+  {
+    return error;
+  }
+  std::vector<std::int64_t> least, greatest;
+  error = DecodeSlices(instances, stack, stored, least, greatest);
+  if (!error.empty())
+  {
+    return error;
+  }
+
+  // 7. Rescale (or resample) into the output type.
+  std::vector<double> slopes(count), intercepts(count);
+  bool uniform = true, integral = true;
+  double low = 0.0, high = 0.0;
+  for (std::size_t k = 0; k < count; ++k)
+  {
+    slopes[k] = stack.Slices[k].second->Slope;
+    intercepts[k] = stack.Slices[k].second->Intercept;
+    uniform = uniform && slopes[k] == slopes[0] && intercepts[k] == intercepts[0];
+    integral =
+      integral && slopes[k] == std::round(slopes[k]) && intercepts[k] == std::round(intercepts[k]);
+    const double a = slopes[k] * static_cast<double>(least[k]) + intercepts[k];
+    const double b = slopes[k] * static_cast<double>(greatest[k]) + intercepts[k];
+    low = k == 0 ? std::min(a, b) : std::min(low, std::min(a, b));
+    high = k == 0 ? std::max(a, b) : std::max(high, std::max(a, b));
+  }
+  // Float holds every stored value (at most 16 bits) times a slope exactly
+  // when the slope has a short binary fraction, and to 24 bits otherwise.
+  const int outputType =
+    (resample || !uniform || !integral) ? VTK_FLOAT : SmallestIntegerType(low, high);
+  const std::vector<double>& distances = stack.Distances;
+  int slicesOut = static_cast<int>(count);
+  double step = count > 1 ? (distances.back() - distances.front()) / (count - 1) : 0.0;
+  if (resample)
+  {
+    const double span = distances.back() - distances.front();
+    const double steps = std::round(span / stack.Median);
+    if (!(steps < 65535.0))
+    {
+      return "the slices are not evenly spaced (median step " + Number(stack.Median) +
+        " mm) and an even grid over their " + Number(span) + " mm would take " + Number(steps + 1) +
+        " slices: not resampled";
+    }
+    slicesOut = static_cast<int>(steps) + 1;
+    step = span / (slicesOut - 1);
+  }
+  vtkSmartPointer<vtkDataArray> volume = stored;
+  if (resample || outputType != storedType || slopes[0] != 1.0 || intercepts[0] != 0.0)
+  {
+    volume = NewVolume(outputType, sliceSize * slicesOut, 0, "the rescaled series", error);
+    if (!volume)
+    {
+      return error;
+    }
+    switch (storedType)
+    {
+      case VTK_UNSIGNED_CHAR:
+        Convert(static_cast<const unsigned char*>(stored->GetVoidPointer(0)), volume, resample,
+          sliceSize, distances, slopes, intercepts, slicesOut, step);
+        break;
+      case VTK_SIGNED_CHAR:
+        Convert(static_cast<const signed char*>(stored->GetVoidPointer(0)), volume, resample,
+          sliceSize, distances, slopes, intercepts, slicesOut, step);
+        break;
+      case VTK_UNSIGNED_SHORT:
+        Convert(static_cast<const unsigned short*>(stored->GetVoidPointer(0)), volume, resample,
+          sliceSize, distances, slopes, intercepts, slicesOut, step);
+        break;
+      default:
+        Convert(static_cast<const short*>(stored->GetVoidPointer(0)), volume, resample, sliceSize,
+          distances, slopes, intercepts, slicesOut, step);
+        break;
+    }
+  }
+  volume->SetName("DICOMImage");
+  if (resample)
+  {
+    vtkWarningMacro(<< "resampled " << count << " unevenly spaced slices (median step "
+                    << Number(stack.Median) << " mm: " << unevenList << ") onto " << slicesOut
+                    << " slices " << Number(step)
+                    << " mm apart by linear interpolation (ResampleUnevenSlices)");
+  }
+
+  // Placement.
+  this->Volume = volume;
+  this->SeriesRead = read.UID;
+  this->Dimensions[0] = first.Columns;
+  this->Dimensions[1] = first.Rows;
+  this->Dimensions[2] = slicesOut;
+  const Slice& base = *stack.Slices.front().second;
+  for (int c = 0; c < 3; ++c)
+  {
+    this->Origin[c] = base.HasPosition ? base.Position[c] : 0.0;
+    this->Direction[3 * c + 0] = stack.Row[c];
+    this->Direction[3 * c + 1] = stack.Column[c];
+    this->Direction[3 * c + 2] = stack.Normal[c];
+  }
+  this->Spacing[0] = stack.ValidPixelSpacing ? base.PixelSpacing[1] : 1.0;
+  this->Spacing[1] = stack.ValidPixelSpacing ? base.PixelSpacing[0] : 1.0;
+  this->Spacing[2] = count > 1 ? step : (first.SliceThickness > 0.0 ? first.SliceThickness : 1.0);
+  return std::string();
 }
 
 //------------------------------------------------------------------------------
 int vtkMedicalDICOMSeriesReader::RequestInformation(
-  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  if (!this->Superclass::RequestInformation(request, inputVector, outputVector))
+  this->Volume = nullptr;
+  this->SeriesRead.clear();
+  this->SeriesList->Initialize();
+  std::string error;
+  try
   {
-    return 0;
+    error = this->ReadSeries();
   }
-  // The superclass sorted the series by decreasing position: the last file
-  // is the first slice of the image this reader makes.
-  const int files = this->GetNumberOfDICOMFileNames();
-  std::string first;
-  if (files > 0)
+  catch (const std::bad_alloc&)
   {
-    first = this->GetDICOMFileName(files - 1);
+    error = "out of memory while reading the series";
   }
-  else if (this->FileName)
+  catch (const std::exception& e)
   {
-    first = this->FileName;
+    error = std::string("failed while reading the series: ") + e.what();
   }
-  if (first.empty())
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  if (!error.empty())
   {
+    this->Volume = nullptr;
+    this->SeriesRead.clear();
+    vtkErrorMacro(<< error);
+    const int empty[6] = { 0, -1, 0, -1, 0, -1 };
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), empty, 6);
     return 1;
   }
-  vtkNew<vtkDICOMImageReader> slice;
-  slice->SetFileName(first.c_str());
-  slice->UpdateInformation();
-  const float* position = slice->GetImagePositionPatient();
-  const float* orientation = slice->GetImageOrientationPatient();
-  const double* pixelSpacing = slice->GetPixelSpacing(); // DICOM order: rows, then columns
-
-  double row[3] = { orientation[0], orientation[1], orientation[2] };
-  double column[3] = { orientation[3], orientation[4], orientation[5] };
-  if (vtkMath::Normalize(row) == 0.0 || vtkMath::Normalize(column) == 0.0)
-  {
-    // No Image Orientation (Patient): an axial slice.
-    row[0] = 1.0;
-    row[1] = row[2] = 0.0;
-    column[1] = 1.0;
-    column[0] = column[2] = 0.0;
-  }
-  double normal[3];
-  vtkMath::Cross(row, column, normal);
-  for (int i = 0; i < 3; ++i)
-  {
-    this->PatientOrigin[i] = position[i];
-    this->PatientDirection[3 * i + 0] = row[i];
-    this->PatientDirection[3 * i + 1] = column[i];
-    this->PatientDirection[3 * i + 2] = normal[i];
-  }
-  this->PatientSpacing[0] = pixelSpacing[1] > 0.0 ? pixelSpacing[1] : 1.0;
-  this->PatientSpacing[1] = pixelSpacing[0] > 0.0 ? pixelSpacing[0] : 1.0;
-  // Between slice positions when there are several (the superclass's), else
-  // the slice thickness.
-  this->PatientSpacing[2] = files > 1 ? this->DataSpacing[2] : pixelSpacing[2];
-  if (!(this->PatientSpacing[2] > 0.0))
-  {
-    this->PatientSpacing[2] = 1.0;
-  }
-
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  outInfo->Set(vtkDataObject::SPACING(), this->PatientSpacing, 3);
-  outInfo->Set(vtkDataObject::ORIGIN(), this->PatientOrigin, 3);
-  outInfo->Set(vtkDataObject::DIRECTION(), this->PatientDirection, 9);
+  const int whole[6] = { 0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0,
+    this->Dimensions[2] - 1 };
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole, 6);
+  outInfo->Set(vtkDataObject::SPACING(), this->Spacing, 3);
+  outInfo->Set(vtkDataObject::ORIGIN(), this->Origin, 3);
+  outInfo->Set(vtkDataObject::DIRECTION(), this->Direction, 9);
+  vtkDataObject::SetPointDataActiveScalarInfo(outInfo, this->Volume->GetDataType(), 1);
   return 1;
 }
 
 //------------------------------------------------------------------------------
 int vtkMedicalDICOMSeriesReader::RequestData(
-  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
 {
-  if (!this->Superclass::RequestData(request, inputVector, outputVector))
+  vtkImageData* output = vtkImageData::GetData(outputVector, 0);
+  if (!output)
   {
     return 0;
   }
-  vtkImageData* image = vtkImageData::GetData(outputVector, 0);
-  vtkDataArray* scalars = image ? image->GetPointData()->GetScalars() : nullptr;
-  if (!scalars || scalars->GetNumberOfTuples() == 0)
+  output->Initialize();
+  if (!this->Volume)
   {
-    return 1;
+    return 1; // the error was reported with the information
   }
-  int extent[6];
-  image->GetExtent(extent);
-  int whole[6];
-  outputVector->GetInformationObject(0)->Get(
-    vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), whole);
-  if (!std::equal(extent, extent + 6, whole))
-  {
-    vtkErrorMacro("reads whole series only (requested extent differs from the whole extent).");
-    image->Initialize();
-    return 1;
-  }
-
-  // The superclass's voxel (i, j, k) is column i of row (rows - 1 - j) of the
-  // (slices - 1 - k)-th slice in increasing position: reversing the order of
-  // all the rows of the volume undoes both at once.
-  const vtkIdType rowBytes = static_cast<vtkIdType>(extent[1] - extent[0] + 1) *
-    scalars->GetNumberOfComponents() * scalars->GetDataTypeSize();
-  const vtkIdType rows =
-    static_cast<vtkIdType>(extent[3] - extent[2] + 1) * (extent[5] - extent[4] + 1);
-  auto* bytes = static_cast<unsigned char*>(scalars->GetVoidPointer(0));
-  std::vector<unsigned char> swap(static_cast<std::size_t>(rowBytes));
-  for (vtkIdType r = 0; r < rows / 2; ++r)
-  {
-    unsigned char* a = bytes + r * rowBytes;
-    unsigned char* b = bytes + (rows - 1 - r) * rowBytes;
-    std::copy(a, a + rowBytes, swap.data());
-    std::copy(b, b + rowBytes, a);
-    std::copy(swap.data(), swap.data() + rowBytes, b);
-  }
-  scalars->Modified();
-  image->SetSpacing(this->PatientSpacing);
-  image->SetOrigin(this->PatientOrigin);
-  image->SetDirectionMatrix(this->PatientDirection);
+  output->SetExtent(
+    0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0, this->Dimensions[2] - 1);
+  output->SetSpacing(this->Spacing);
+  output->SetOrigin(this->Origin);
+  output->SetDirectionMatrix(this->Direction);
+  output->GetPointData()->SetScalars(this->Volume);
   return 1;
 }
 
@@ -159,8 +1311,14 @@ int vtkMedicalDICOMSeriesReader::RequestData(
 void vtkMedicalDICOMSeriesReader::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "PatientOrigin: " << this->PatientOrigin[0] << " " << this->PatientOrigin[1]
-     << " " << this->PatientOrigin[2] << "\n";
-  os << indent << "PatientSpacing: " << this->PatientSpacing[0] << " " << this->PatientSpacing[1]
-     << " " << this->PatientSpacing[2] << "\n";
+  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
+  os << indent
+     << "SeriesInstanceUID: " << (this->SeriesInstanceUID ? this->SeriesInstanceUID : "(none)")
+     << "\n";
+  os << indent << "ResampleUnevenSlices: " << this->ResampleUnevenSlices << "\n";
+  os << indent << "SeriesRead: " << this->SeriesRead << "\n";
+  os << indent << "Origin: " << this->Origin[0] << " " << this->Origin[1] << " " << this->Origin[2]
+     << "\n";
+  os << indent << "Spacing: " << this->Spacing[0] << " " << this->Spacing[1] << " "
+     << this->Spacing[2] << "\n";
 }

@@ -25,8 +25,9 @@ packages=(
   libhdf5-dev libgdal-dev libnetcdf-dev libgl2ps-dev libglew-dev libtheora-dev libtiff-dev
   # the GUI panel widgets (pqComponents) and the plugin's documentation (Qt help)
   libxml2-dev libboost-dev qhelpgenerator-qt5
-  # DCMTK writes the DICOM series the reader test opens
-  dcmtk
+  # DCMTK: the DICOM reader's library (libdcmtk-dev), and its tools (dcmtk) and
+  # pydicom (for /usr/bin/python3), which write the DICOM series the tests open
+  libdcmtk-dev dcmtk python3-pydicom
   # toolchain (python3 runs the data script and the offline format test)
   cmake ninja-build g++ make python3
   # rendering without a display (Mesa llvmpipe), and tests' network namespaces
