@@ -114,7 +114,7 @@ def run_input(args, name):
     token = "bench-%d" % port
     server = subprocess.Popen([shutil.which("pvpython"), "--no-mpi", os.path.join(HERE, "serve.py"),
                                "--plugin", args.plugin, "--wasm", args.wasm, "--data", path,
-                               "--port", str(port), "--token", token],
+                               "--port", str(port), "--token=" + token],
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     static = subprocess.Popen([sys.executable, "-m", "http.server", str(static_port), "--bind",
                                "127.0.0.1", "--directory", work],

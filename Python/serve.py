@@ -60,19 +60,57 @@ def log(message):
     print("serve: " + message, flush=True)
 
 
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse that says a bad argument in one line ("serve: ...", exit 2), no usage block."""
+
+    def error(self, message):
+        if "expected one argument" in message:  # e.g. --token -abc: argparse reads -abc as an option
+            message += " (a value that begins with '-' is given as --name=VALUE)"
+        self.exit(2, "serve: %s\n" % message)
+
+
+def _port(text):
+    try:
+        port = int(text)
+    except ValueError:
+        port = -1
+    if not 1 <= port <= 65535:
+        raise argparse.ArgumentTypeError("%r is not a port number (1-65535)" % text)
+    return port
+
+
+def _seconds(text):
+    try:
+        seconds = float(text)
+    except ValueError:
+        seconds = math.nan
+    if not (math.isfinite(seconds) and seconds > 0):
+        raise argparse.ArgumentTypeError("%r is not a positive number of seconds" % text)
+    return seconds
+
+
+def _plugin(text):
+    path = os.path.abspath(text)
+    if not os.path.isfile(path):
+        raise argparse.ArgumentTypeError("no such file: %s" % text)
+    return path
+
+
 def parse_args(argv):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--data", action="append", default=[],
                    help="a volume file (MetaImage, VTK XML image, NIfTI .nii/.nii.gz), a DICOM "
                         "series folder, or phantom:N (repeat for several)")
-    p.add_argument("--port", type=int, default=8765)
+    p.add_argument("--port", type=_port, default=8765)
     p.add_argument("--host", default="127.0.0.1",
                    help="address to listen on (default 127.0.0.1: this machine only)")
-    p.add_argument("--token", default="", help="the session's token (default: a random one)")
-    p.add_argument("--plugin", required=True, type=os.path.abspath, help="MedicalIsosurfaces.so")
+    p.add_argument("--token", default="",
+                   help="the session's token (default: a random one; one that begins with '-' "
+                        "is given as --token=VALUE)")
+    p.add_argument("--plugin", required=True, type=_plugin, help="MedicalIsosurfaces.so")
     p.add_argument("--wasm", default=os.path.join(ROOT, "build-web", "bin"),
                    help="folder of mediso.js and mediso.wasm")
-    p.add_argument("--max-operation-seconds", type=float, default=900.0,
+    p.add_argument("--max-operation-seconds", type=_seconds, default=900.0,
                    help="an operation running longer is stopped with an error")
     return p.parse_args(argv)
 

@@ -7,7 +7,8 @@ paths, the data file's own path); a WebSocket from another origin is refused; ev
 (not JSON, not an object, a non-finite or out-of-range isovalue, unknown operations, steps and
 fields, wrong types and ranges, a binary frame, a 100 KB message, deep nesting) gets an error
 naming the fault on the same socket, which stays usable; a 2 MB frame closes that socket with
-1009; and after all of it the server still serves and runs an operation.
+1009; and after all of it the server still serves and runs an operation. The token begins with
+'-' (the harness gives it as --token=VALUE).
 """
 import asyncio
 import json
@@ -19,7 +20,10 @@ import webserver  # noqa: E402  (skips when aiohttp or the plugin is missing)
 import aiohttp  # noqa: E402
 
 checks = webserver.Checks()
-server = webserver.Server(["phantom:48"])
+# A token that begins with '-' (as one random token in 64 does) works: the harness passes it as
+# --token=VALUE.
+server = webserver.Server(["phantom:48"], token="-" + webserver.secrets.token_urlsafe(12))
+checks(server.token.startswith("-"), "the server runs with a token that begins with '-'")
 SECRET_FILE = os.path.abspath(webserver.SERVE)
 
 

@@ -83,7 +83,7 @@ class Server:
         self.base = "http://127.0.0.1:%d" % self.port
         self.lines = []
         self.exit_code = None
-        command = [PVPYTHON, "--no-mpi", SERVE, "--plugin", PLUGIN, "--token", self.token,
+        command = [PVPYTHON, "--no-mpi", SERVE, "--plugin", PLUGIN, "--token=" + self.token,
                    "--port", str(self.port)] + list(extra)
         for d in self.data:
             command += ["--data", d]

@@ -99,7 +99,7 @@ def start_server():
     command = [sys.executable if os.path.basename(sys.executable).startswith("pvpython")
                else shutil.which("pvpython"), "--no-mpi", os.path.join(ROOT, "Python", "serve.py"),
                "--plugin", args.plugin, "--wasm", args.wasm, "--data", volume,
-               "--port", str(port), "--token", token]
+               "--port", str(port), "--token=" + token]
     server = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     deadline = time.time() + 120
     while time.time() < deadline:
