@@ -20,13 +20,10 @@ spec = importlib.util.spec_from_file_location(
 fetch_data = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(fetch_data)
 
-failures = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
 
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED: " + what)
+check = Checks()
 
 
 def nifti_header(endian, dims, spacing, datatype, bitpix):
@@ -100,7 +97,4 @@ dims, spacing, dtype, matrix, _ = fetch_data.ct_geometry_from_plist(
 check(dims == (256, 256, 108) and spacing[2] == 1.5 and dtype == "int16"
       and matrix == "matrix.dat", "plist geometry: %s %s" % (dims, spacing))
 
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("fetch_data formats: all checks passed")
+check.finish("fetch_data formats: all checks passed")

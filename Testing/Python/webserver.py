@@ -19,6 +19,8 @@ import sys
 import threading
 import time
 
+import checks  # Testing/Python/checks.py
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SERVE = os.path.join(ROOT, "Python", "serve.py")
 PVPYTHON = os.path.realpath("/proc/self/exe") if os.path.exists("/proc/self/exe") else \
@@ -52,25 +54,20 @@ def free_port():
         return s.getsockname()[1]
 
 
-class Checks:
+class Checks(checks.Checks):
+    """Prints every check ("ok: ..." too); finish() stops the servers and prints their output."""
+
     def __init__(self):
-        self.failures = []
+        super().__init__(verbose=True)
 
-    def __call__(self, ok, what):
-        print(("ok: " if ok else "FAILED: ") + what, flush=True)
-        if not ok:
-            self.failures.append(what)
-        return ok
-
-    def finish(self, *servers):
+    def finish(self, *servers, passed="all checks passed"):
         for server in servers:
             server.stop()
             print("---- server output (%s)" % " ".join(server.data))
             print("".join(server.lines), end="", flush=True)
             self(server.exit_code in (0, -15), "the server ended cleanly (exit %s)"
                  % server.exit_code)
-        print("%d failure(s)" % len(self.failures))
-        sys.exit(1 if self.failures else 0)
+        super().finish(passed)
 
 
 class Server:

@@ -38,13 +38,11 @@ parser.add_argument("--wasm", required=True)
 parser.add_argument("--out", required=True)
 args = parser.parse_args()
 
-failures = []
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "Python"))
+from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
 
-
-def check(ok, what):
-    print(("ok: " if ok else "FAILED: ") + what, flush=True)
-    if not ok:
-        failures.append(what)
+check = Checks(verbose=True)
 
 
 def skip(why):
@@ -287,7 +285,4 @@ else:
         Hide(contour, view)
         compare(shot, reference, "level %d: the CPU path against ParaView's BlockLODContour" % k)
 
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("TestWebPage %s passed" % args.case)
+check.finish("TestWebPage %s passed" % args.case)
