@@ -36,9 +36,6 @@ STATIC = os.path.join(ROOT, "Web", "static")
 sys.path.insert(0, HERE)
 import serve_operations  # noqa: E402  (the volumes' readers, and the worker's program)
 
-TYPES = {"char": "int8", "signed char": "int8", "unsigned char": "uint8", "short": "int16",
-         "unsigned short": "uint16", "int": "int32", "unsigned int": "uint32", "float": "float32",
-         "double": "float64"}
 MAX_MESSAGE = 64 * 1024        # a request on the WebSocket (docs/web.md)
 MAX_FRAME = 1024 * 1024        # above this aiohttp closes the socket (1009, message too big)
 MAX_STEPS = 8
@@ -116,26 +113,19 @@ def parse_args(argv):
 
 
 class Dataset:
-    """A volume the server opened: its values and where they lie."""
+    """A volume the server serves: its values (the worker's export, memory-mapped) and geometry."""
 
-    def __init__(self, ident, name, image, array):
-        from vtkmodules.util.numpy_support import vtk_to_numpy
+    def __init__(self, ident, volume):
+        import numpy
         self.ident = ident
-        self.name = name
-        self.dims = list(image.GetDimensions())
-        self.spacing = list(image.GetSpacing())
-        self.origin = list(image.GetOrigin())
-        matrix = image.GetDirectionMatrix()
-        self.direction = [matrix.GetElement(r, c) for r in range(3) for c in range(3)]
-        self.type = TYPES.get(array.GetDataTypeAsString())
-        if self.type is None:
-            raise ValueError("%s: %s values are not supported" % (name, array.GetDataTypeAsString()))
-        values = vtk_to_numpy(array)
-        self.values = values.reshape(self.dims[2], self.dims[1], self.dims[0])
-        lo, hi = array.GetRange()
-        if not (math.isfinite(lo) and math.isfinite(hi)) or lo >= hi:
-            raise ValueError("%s: its values span no range (%g..%g)" % (name, lo, hi))
-        self.range = [float(lo), float(hi)]
+        self.name = volume["name"]
+        self.dims = volume["dims"]
+        self.spacing = volume["spacing"]
+        self.origin = volume["origin"]
+        self.direction = volume["direction"]
+        self.type = volume["type"]
+        self.range = volume["range"]
+        self.values = numpy.load(volume["values"], mmap_mode="r")
         self.encoded = {}  # level -> gzip'd shuffled bytes
 
     def level(self, k):
@@ -165,11 +155,9 @@ class Dataset:
         return self.encoded[k]
 
 
-def open_datasets(specs, ns):
-    """The datasets of the specs (default: the fetched CT, else the phantom), as Dataset."""
-    datasets = []
-    for source, name, image, array in serve_operations.open_sources(specs, ns, log):
-        datasets.append(Dataset("d%d" % len(datasets), name, image, array))
+def open_datasets(volumes):
+    """Dataset for each volume the worker read and exported."""
+    datasets = [Dataset("d%d" % i, v) for i, v in enumerate(volumes)]
     for d in datasets:
         log("%s: %s, %s %s, range %g..%g" % (d.ident, d.name, "x".join(map(str, d.dims)), d.type,
                                              d.range[0], d.range[1]))
@@ -347,13 +335,27 @@ class Result:
                 pass
 
 
+class StartFailed(Exception):
+    """The worker did not start; the text says why, in one line."""
+
+
+def _ended(code):
+    """How a process ended, from its exit status: "SIGSEGV", "exit 1"."""
+    if code is not None and code < 0:
+        try:
+            return signal.Signals(-code).name
+        except ValueError:
+            return "signal %d" % -code
+    return "exit %s" % code
+
+
 class Operations:
     """The queue of operations and the one worker process that runs them in turn."""
 
-    def __init__(self, args, specs, datasets):
+    def __init__(self, args, specs):
         self.args = args
         self.specs = specs
-        self.index = {d.ident: i for i, d in enumerate(datasets)}
+        self.index = {"d%d" % i: i for i in range(len(specs))}  # as open_datasets names them
         self.folder = tempfile.mkdtemp(prefix="mediso-results-")
         self.queue = collections.deque()
         self.wake = asyncio.Event()
@@ -367,24 +369,41 @@ class Operations:
         self.task = None
 
     # -- the worker process
-    async def start_worker(self):
+    async def start_worker(self, export=None):
+        """Starts the worker; it reads the volumes. export: the first start, which also writes
+        their values there for the server and returns their descriptions. Raises StartFailed
+        with one line (naming the volume whose reading ended the process, if one did)."""
         command = [PVPYTHON, "--no-mpi", os.path.join(HERE, "serve_operations.py"),
-                   "--plugin", self.args.plugin, "--results", self.folder] + self.specs
+                   "--plugin", self.args.plugin, "--results", self.folder] + \
+            (["--export", export] if export else []) + self.specs
         process = await asyncio.create_subprocess_exec(
             *command, stdin=asyncio.subprocess.PIPE, stdout=asyncio.subprocess.PIPE,
             limit=1 << 20, start_new_session=True)
+        reading = None  # the volume it reads (its "opening" message comes first)
         try:
-            line = await asyncio.wait_for(process.stdout.readline(), WORKER_START_S)
-            message = json.loads(line) if line else {"fatal": "it exited (%s)" %
-                                                     await process.wait()}
+            deadline = asyncio.get_running_loop().time() + WORKER_START_S
+            while True:
+                line = await asyncio.wait_for(process.stdout.readline(),
+                                              deadline - asyncio.get_running_loop().time())
+                if not line:  # the process ended: a crash, an abort, a memory kill
+                    ended = _ended(await process.wait())
+                    message = {"fatal": "it exited (%s)" % ended} if reading is None else {
+                        "fatal": "%s: cannot be read: the reader ended its process (%s)"
+                        % (self.specs[reading], ended)}
+                    break
+                message = json.loads(line)
+                if "opening" not in message:
+                    break
+                reading = message["opening"]
         except (asyncio.TimeoutError, ValueError) as e:
             message = {"fatal": "it did not start (%s)" % (type(e).__name__)}
         if not message.get("ready"):
             if process.returncode is None:
                 process.kill()
                 await process.wait()
-            raise RuntimeError(message.get("fatal", "no ready message"))
+            raise StartFailed(message.get("fatal", "no ready message"))
         self.process = process
+        return message
 
     async def stop_worker(self):
         process, self.process = self.process, None
@@ -404,7 +423,7 @@ class Operations:
                 await self.start_worker()
                 self.unavailable = None
                 return True
-            except (RuntimeError, OSError) as e:
+            except (StartFailed, OSError) as e:
                 self.unavailable = "the server's operation process cannot start: %s" % e
                 log(self.unavailable)
                 await asyncio.sleep(1 + attempt)
@@ -730,7 +749,6 @@ def make_app(args, datasets, operations):
 
     async def on_startup(app):
         operations.task = asyncio.get_running_loop().create_task(operations.run())
-        asyncio.get_running_loop().create_task(operations.ensure_worker())
 
     async def on_cleanup(app):
         await operations.close()
@@ -754,29 +772,44 @@ def main(argv):
         family = socket.getaddrinfo(args.host, args.port, type=socket.SOCK_STREAM)[0][0]
         listener = socket.create_server((args.host, args.port), family=family)
     except OSError as e:
-        raise SystemExit("serve: cannot listen on %s:%d: %s" % (args.host, args.port,
-                                                                 e.strerror or e))
-    import paraview.simple as simple
-    ns = {"__name__": "medical_isosurfaces_proxies"}  # LoadPlugin fills a non-empty dict only
-    simple.LoadPlugin(args.plugin, ns=ns)
-    if "BlockLODContour" not in ns:
-        raise SystemExit("serve: %s is not the MedicalIsosurfaces plugin" % args.plugin)
+        # create_server adds "(while attempting to bind ...)" to the system's reason.
+        reason = os.strerror(e.errno) if e.errno and not isinstance(e, socket.gaierror) else \
+            e.strerror or e
+        raise SystemExit("serve: cannot listen on %s:%d: %s" % (args.host, args.port, reason))
     args.token = args.token or secrets.token_urlsafe(18)
     specs = args.data or serve_operations.default_sources()
     if not args.data and specs[0].startswith(serve_operations.PHANTOM):
         log("the head CT is not fetched (python3 Python/fetch_data.py): serving the phantom")
     specs = [s if s.startswith(serve_operations.PHANTOM) else os.path.abspath(s) for s in specs]
+    return asyncio.run(serve(args, specs, listener))
+
+
+async def serve(args, specs, listener):
+    """Reads the volumes in the worker, then serves until SIGINT or SIGTERM."""
+    operations = Operations(args, specs)
     try:
-        datasets = open_datasets(specs, ns)
-    except ValueError as e:
+        # The worker reads the volumes, not this process: a reader that crashes or aborts on a
+        # bad file ends the worker, and the server says which file in one line.
+        ready = await operations.start_worker(export=operations.folder)
+    except (StartFailed, OSError) as e:
+        await operations.close()
         raise SystemExit("serve: %s" % e)
-    operations = Operations(args, specs, datasets)
+    for note in ready["notes"]:
+        log(note)
+    datasets = open_datasets(ready["volumes"])
     app = make_app(args, datasets, operations)
+    runner = web.AppRunner(app, access_log=None)
+    await runner.setup()
+    await web.SockSite(runner, listener).start()
     host = "[%s]" % args.host if ":" in args.host else args.host
     if args.host not in ("127.0.0.1", "localhost", "::1"):
         log("listening on %s: anyone who can reach it and has the URL can use it" % args.host)
     log("open http://%s:%d/?token=%s" % (host, args.port, args.token))
-    web.run_app(app, sock=listener, print=None, access_log=None)
+    stop = asyncio.Event()
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        asyncio.get_running_loop().add_signal_handler(signum, stop.set)
+    await stop.wait()
+    await runner.cleanup()
     return 0
 
 
