@@ -32,7 +32,7 @@ SKIN = (0.93, 0.75, 0.62)
 BONE = (0.97, 0.95, 0.88)
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from machine_info import cpu_model, load_average  # noqa: E402
+from benchmark_common import cpu_model, load_average  # noqa: E402
 import serve_operations  # noqa: E402
 
 
