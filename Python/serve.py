@@ -36,6 +36,13 @@ STATIC = os.path.join(ROOT, "Web", "static")
 sys.path.insert(0, HERE)
 import serve_operations  # noqa: E402  (the volumes' readers, and the worker's program)
 
+# Level k of a volume samples the points at multiples of LEVEL_STRIDES[k] along each axis: the
+# strides of the C++ BlockLOD core, mediso::LevelStride(k) = BlockCells >> k = 8 >> k
+# (Filters/Core/BlockLOD.h), which TestWebServerLevels checks against BlockLODContour at each
+# level. The one difference: the C++'s coarse copy (MakeCoarseCopy) also takes the last point of
+# an axis whose length minus one is not a multiple of the stride; the levels sent to the page
+# leave that partial layer out (docs/web.md, "The server").
+LEVEL_STRIDES = (8, 4, 2, 1)
 MAX_MESSAGE = 64 * 1024        # a request on the WebSocket (docs/web.md)
 MAX_FRAME = 1024 * 1024        # above this aiohttp closes the socket (1009, message too big)
 MAX_STEPS = 8
@@ -129,15 +136,15 @@ class Dataset:
         self.encoded = {}  # level -> gzip'd shuffled bytes
 
     def level(self, k):
-        """Level k's values: every 2^(3-k)-th point along each axis."""
-        step = 1 << (3 - k)
+        """Level k's values: the points at multiples of LEVEL_STRIDES[k] along each axis."""
+        step = LEVEL_STRIDES[k]
         return self.values[::step, ::step, ::step]
 
     def describe(self):
         levels = []
-        for k in range(4):
+        for k in range(len(LEVEL_STRIDES)):
             v = self.level(k)
-            step = 1 << (3 - k)
+            step = LEVEL_STRIDES[k]
             levels.append({"dims": [v.shape[2], v.shape[1], v.shape[0]],
                            "spacing": [s * step for s in self.spacing], "bytes": int(v.nbytes)})
         return {"id": self.ident, "name": self.name, "dims": self.dims, "spacing": self.spacing,
@@ -274,7 +281,7 @@ def parse_message(text, datasets):
         if not dataset.range[0] <= isovalue <= dataset.range[1]:
             raise BadRequest("isovalue: %g is outside the data range %g..%g"
                              % (isovalue, dataset.range[0], dataset.range[1]))
-        level = _integer(message["level"], "level", 0, 3)
+        level = _integer(message["level"], "level", 0, len(LEVEL_STRIDES) - 1)
         steps = message.get("steps", [])
         if not isinstance(steps, list) or len(steps) > MAX_STEPS:
             raise BadRequest("steps: a list of at most %d operations" % MAX_STEPS)
@@ -671,7 +678,7 @@ def make_app(args, datasets, operations):
             k = int(request.query.get("level", "3"))
         except ValueError:
             k = -1
-        if not 0 <= k <= 3:
+        if not 0 <= k < len(LEVEL_STRIDES):
             raise web.HTTPBadRequest(text="level is 0, 1, 2 or 3\n")
         key = (d.ident, k)
         if key not in encoding:

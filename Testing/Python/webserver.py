@@ -162,6 +162,16 @@ async def operation(ws, request, timeout=300):
         return progress, answer
 
 
+def decode(body, dtype, count):
+    """The values of a gzip'd, byte-shuffled /api/volume body."""
+    import gzip
+    import numpy
+    raw = gzip.decompress(body)
+    size = numpy.dtype(dtype).itemsize
+    planes = numpy.frombuffer(raw, numpy.uint8).reshape(size, count)
+    return numpy.ascontiguousarray(planes.T).view(dtype).ravel()
+
+
 def surface_request(ident, dataset, isovalue, level=3, steps=()):
     return {"op": "surface", "id": ident, "dataset": dataset, "isovalue": isovalue,
             "level": level, "steps": list(steps)}
