@@ -1,6 +1,6 @@
 """pvpython test: the web server's levels follow the C++ BlockLOD core's level rule.
 
-Python/serve.py states the levels' strides in one constant (LEVEL_STRIDES, the C++'s
+The server states the levels' strides in one constant (serve_messages.LEVEL_STRIDES, the C++'s
 mediso::LevelStride). On a phantom of 65^3 points (64 cells: every stride divides it, so the C++'s
 coarse copy has no extra last point, the one difference the server names) each level k that
 /api/volume sends, contoured here with vtkFlyingEdges3D at its spacing, must give exactly the

@@ -113,6 +113,20 @@ async def paths(http):
     checks(code == 400, "a result format the server does not write: %d" % code)
     code, _, _ = await status_of(http, "/static/index.html")
     checks(code == 200, "the page's own files are served: %d" % code)
+    # Every file of the page is cross-origin isolated (the page's threads need it), cacheable by
+    # date, and of its type: the scripts as JavaScript (ES modules run only then).
+    for path, kind in (("/", "text/html"), ("/static/index.html", "text/html"),
+                       ("/static/app.js", "text/javascript"), ("/static/style.css", "text/css"),
+                       ("/static/mediso.js", "text/javascript"),
+                       ("/static/mediso.wasm", "application/wasm")):
+        code, _, r = await status_of(http, path)
+        checks(code == 200 and r.content_type == kind and
+               r.headers.get("Cross-Origin-Opener-Policy") == "same-origin" and
+               r.headers.get("Cross-Origin-Embedder-Policy") == "require-corp" and
+               "Last-Modified" in r.headers,
+               "%s: %d %s, isolated (COOP %s, COEP %s), Last-Modified %s"
+               % (path, code, r.content_type, r.headers.get("Cross-Origin-Opener-Policy"),
+                  r.headers.get("Cross-Origin-Embedder-Policy"), r.headers.get("Last-Modified")))
 
 
 BAD = [
