@@ -1,16 +1,19 @@
 """The web server's volumes and its operations on a surface (docs/web.md, "The server").
 
     pvpython --no-mpi Python/serve_operations.py --plugin MedicalIsosurfaces.so --results DIR \\
-        SOURCE [SOURCE ...]
+        [--export DIR] SOURCE [SOURCE ...]
 
 SOURCE is a volume file (MetaImage, VTK XML image, NIfTI .nii/.nii.gz), a DICOM series folder,
-or phantom:N (the plugin's MedicalPhantom, N^3 points). Python/serve.py opens its volumes with
-open_sources() below and starts this program once as its worker: one JSON line per job on stdin,
-JSON lines back on stdout (progress, then done, error or cancelled); SIGUSR1 cancels the job
-that runs. A job extracts the page's surface with the plugin's BlockLODContour (same volume,
-isovalue and level), applies the steps (smooth, fillHoles, clip, decimate) with VTK's filters,
-and writes the result as binary STL, binary little-endian PLY and appended-binary VTP, named by
-the job's result id, into the results folder.
+or phantom:N (the plugin's MedicalPhantom, N^3 points). Python/serve.py starts this program as its
+worker (Python/serve_jobs.py). It opens the volumes (open_sources(), each announced first with an
+"opening" line, so that the server can name the file whose reader ended the process; the readers'
+errors are captured and said in one "fatal" line); at the server's start, --export also writes
+their values as DIR/dN.npy and describes them in the "ready" line, so that no reader ever runs in
+the server. Then one JSON line per job on stdin, JSON lines back on stdout (progress, then done,
+error or cancelled); SIGUSR1 cancels the job that runs. A job extracts the page's surface with
+the plugin's BlockLODContour (same volume, isovalue and level), applies the steps (smooth,
+fillHoles, clip, decimate) with VTK's filters, and writes the result as binary STL, binary
+little-endian PLY and appended-binary VTP, named by the job's result id, into the results folder.
 
 A process of its own, not a thread of the web server: VTK's Python wrappers keep the GIL while a
 filter runs, so a VTK thread would stop the server's event loop (every page, every other browser)
