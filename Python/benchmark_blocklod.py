@@ -54,7 +54,8 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from machine_info import cpu_model, load_average  # noqa: E402
+from benchmark_common import (cpu_model, data_dir, fmt_s, load_average,  # noqa: E402
+                              mem_total_gb, table as markdown_table)
 
 ALL_INPUTS = ("ct", "ct512", "phantom256", "phantom512", "mri", "ctnoise", "phantomnoise", "mri05")
 DEFAULT_INPUTS = ("ct", "ct512", "phantom256", "phantom512", "mri", "ctnoise", "phantomnoise")
@@ -89,10 +90,6 @@ RESULT_TAG = "bench-result: "
 
 def progress(message):
     print("bench: " + message, flush=True)
-
-
-def data_dir():
-    return os.environ.get("MEDISO_DATA_DIR") or os.path.expanduser("~/.cache/medical-isosurfaces")
 
 
 def ct_path():
@@ -680,13 +677,6 @@ def run_child(args):
 # ----------------------------------------------------------------------------------------------
 # Parent: runs one child per input, prints the tables
 # ----------------------------------------------------------------------------------------------
-def fmt_s(seconds):
-    if seconds is None or (isinstance(seconds, float) and math.isnan(seconds)):
-        return "-"
-    if seconds < 0.1:
-        return "%.4f" % seconds
-    return "%.3f" % seconds
-
 
 def fmt_ratio(value):
     if value is None or math.isnan(value):
@@ -707,11 +697,7 @@ def fmt_mb(value):
 
 
 def table(headers, rows):
-    lines = ["", "| " + " | ".join(headers) + " |",
-             "|" + "|".join("---" if i == 0 else "---:" for i in range(len(headers))) + "|"]
-    for row in rows:
-        lines.append("| " + " | ".join(str(c) for c in row) + " |")
-    return lines
+    return [""] + markdown_table(headers, rows)
 
 
 def input_title(r):
@@ -1167,17 +1153,6 @@ def build_text(plugin):
     except (OSError, subprocess.SubprocessError):
         rev = "unknown"
     return "%s (libraries built %s; source %s)" % (plugin, built, rev)
-
-
-def mem_total_gb():
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemTotal:"):
-                    return int(line.split()[1]) / 1024.0 / 1024.0
-    except OSError:
-        pass
-    return 0.0
 
 
 def run_parent(args, argv):

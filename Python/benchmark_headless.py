@@ -24,7 +24,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from machine_info import cpu_model, load_average  # noqa: E402
+from benchmark_common import cpu_model, data_dir, load_average  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -53,10 +53,6 @@ def parse_args(argv):
                    help="folder of ct512.mha, phantom256.mha (default: written to build/bench-volumes)")
     p.add_argument("--out", default="")
     return p.parse_args(argv)
-
-
-def data_dir():
-    return os.environ.get("MEDISO_DATA_DIR") or os.path.expanduser("~/.cache/medical-isosurfaces")
 
 
 def volume_for(args, name):

@@ -39,7 +39,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from machine_info import cpu_model, load_average  # noqa: E402
+from benchmark_common import cpu_model, data_file, fmt_s, load_average, table  # noqa: E402
 
 ALL_INPUTS = ("ct", "ct512", "phantom256")
 TARGET_ROTATION = 0.5
@@ -55,8 +55,7 @@ def progress(message):
 
 
 def ct_path():
-    folder = os.environ.get("MEDISO_DATA_DIR") or os.path.expanduser("~/.cache/medical-isosurfaces")
-    return os.path.join(folder, "ct_head.mha")
+    return data_file("ct_head.mha")
 
 
 def parse_args(argv):
@@ -106,10 +105,6 @@ def run_input(args, name):
     return child.returncode, records, wall
 
 
-def fmt_s(v):
-    return "%.3f" % v if v >= 0.1 else "%.4f" % v
-
-
 def fmt_ratio(v):
     return "%.2fx" % v
 
@@ -118,13 +113,6 @@ def margin(ratio, limit):
     if ratio <= limit:
         return "%.0f%% under the limit" % (100.0 * (1.0 - ratio / limit))
     return "%.2fx the limit" % (ratio / limit)
-
-
-def table(header, rows):
-    lines = ["| " + " | ".join(header) + " |",
-             "|" + "|".join(["---"] + ["---:"] * (len(header) - 1)) + "|"]
-    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
-    return lines
 
 
 def method_name(r):

@@ -22,7 +22,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from machine_info import cpu_model, load_average  # noqa: E402
+from benchmark_common import cpu_model, data_file, load_average  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -74,8 +74,7 @@ def build_baseline(commit):
 
 
 def ct_path():
-    folder = os.environ.get("MEDISO_DATA_DIR") or os.path.expanduser("~/.cache/medical-isosurfaces")
-    return os.path.join(folder, "ct_head.mha")
+    return data_file("ct_head.mha")
 
 
 def run(binary, name, args):

@@ -17,14 +17,13 @@ import argparse
 import json
 import os
 import shutil
-import socket
 import statistics
 import subprocess
 import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from machine_info import cpu_model, load_average  # noqa: E402
+from benchmark_common import cpu_model, data_dir, free_port, load_average  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -49,12 +48,6 @@ def parse_args(argv):
     p.add_argument("--work", default=os.path.join(ROOT, "build", "bench-web"))
     p.add_argument("--out", default="")
     return p.parse_args(argv)
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def read_mha(path):
@@ -86,7 +79,7 @@ def read_mha(path):
 
 
 def volume_path(name):
-    data = os.environ.get("MEDISO_DATA_DIR") or os.path.expanduser("~/.cache/medical-isosurfaces")
+    data = data_dir()
     if name == "ct":
         return os.path.join(data, "ct_head.mha")
     path = os.path.join(ROOT, "build", "bench-volumes", name + ".mha")
@@ -114,7 +107,7 @@ def run_input(args, name):
     token = "bench-%d" % port
     server = subprocess.Popen([shutil.which("pvpython"), "--no-mpi", os.path.join(HERE, "serve.py"),
                                "--plugin", args.plugin, "--wasm", args.wasm, "--data", path,
-                               "--port", str(port), "--token", token],
+                               "--port", str(port), "--token=" + token],
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     static = subprocess.Popen([sys.executable, "-m", "http.server", str(static_port), "--bind",
                                "127.0.0.1", "--directory", work],

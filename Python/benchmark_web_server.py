@@ -24,15 +24,17 @@ come from it.
 import argparse
 import os
 import platform
+import shutil
 import statistics
 import sys
+import tempfile
 import time
 
 SKIN = (0.93, 0.75, 0.62)
 BONE = (0.97, 0.95, 0.88)
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from machine_info import cpu_model, load_average  # noqa: E402
+from benchmark_common import cpu_model, load_average  # noqa: E402
 import serve_operations  # noqa: E402
 
 
@@ -129,8 +131,11 @@ def main(argv):
     simple.LoadPlugin(args.plugin, ns=ns)
     spec = args.data or serve_operations.default_sources()[0]
     source, name, image, array = serve_operations.open_sources([spec], ns, lambda m: None)[0]
-    dataset = serve.Dataset("d0", name, image, array)
+    export = tempfile.mkdtemp(prefix="mediso-bench-")  # the values as the worker hands them over
+    dataset = serve.Dataset.load("d0", serve_operations.export(0, spec, name, image, array, export))
     volume_bytes = len(dataset.encode(3))
+    raw_bytes = dataset.values.nbytes
+    shutil.rmtree(export)
     lo, hi = dataset.range
     isovalues = [lo + (hi - lo) * (0.15 + 0.6 * i / max(1, args.changes - 1))
                  for i in range(args.changes)]
@@ -202,8 +207,8 @@ def main(argv):
     out("- Machine: %s, nproc %d (%s); OpenGL renderer: %s"
         % (platform.platform(), os.cpu_count() or 0, cpu_model(), renderer))
     out("- Volume: %s, %s %s, %.1f MB raw; the page receives it once in %d bytes (%.3fx raw)"
-        % (name, "x".join(map(str, dataset.dims)), dataset.type, dataset.values.nbytes / 1e6,
-           volume_bytes, volume_bytes / dataset.values.nbytes))
+        % (name, "x".join(map(str, dataset.dims)), dataset.type, raw_bytes / 1e6,
+           volume_bytes, volume_bytes / raw_bytes))
     out("- %d isovalue changes (one surface, %g to %g); rotation: %d frames of 1 degree, "
         "scene %s" % (len(isovalues), isovalues[0], isovalues[-1], args.frames,
                       " and ".join("%g (opacity %g)" % (v, o) for v, _, o in scene)))

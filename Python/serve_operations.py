@@ -1,16 +1,19 @@
 """The web server's volumes and its operations on a surface (docs/web.md, "The server").
 
     pvpython --no-mpi Python/serve_operations.py --plugin MedicalIsosurfaces.so --results DIR \\
-        SOURCE [SOURCE ...]
+        [--export DIR] SOURCE [SOURCE ...]
 
 SOURCE is a volume file (MetaImage, VTK XML image, NIfTI .nii/.nii.gz), a DICOM series folder,
-or phantom:N (the plugin's MedicalPhantom, N^3 points). Python/serve.py opens its volumes with
-open_sources() below and starts this program once as its worker: one JSON line per job on stdin,
-JSON lines back on stdout (progress, then done, error or cancelled); SIGUSR1 cancels the job
-that runs. A job extracts the page's surface with the plugin's BlockLODContour (same volume,
-isovalue and level), applies the steps (smooth, fillHoles, clip, decimate) with VTK's filters,
-and writes the result as binary STL, binary little-endian PLY and appended-binary VTP, named by
-the job's result id, into the results folder.
+or phantom:N (the plugin's MedicalPhantom, N^3 points). Python/serve.py starts this program as its
+worker (Python/serve_jobs.py). It opens the volumes (open_sources(), each announced first with an
+"opening" line, so that the server can name the file whose reader ended the process; the readers'
+errors are captured and said in one "fatal" line); at the server's start, --export also writes
+their values as DIR/dN.npy and describes them in the "ready" line, so that no reader ever runs in
+the server. Then one JSON line per job on stdin, JSON lines back on stdout (progress, then done,
+error or cancelled); SIGUSR1 cancels the job that runs. A job extracts the page's surface with
+the plugin's BlockLODContour (same volume, isovalue and level), applies the steps (smooth,
+fillHoles, clip, decimate) with VTK's filters, and writes the result as binary STL, binary
+little-endian PLY and appended-binary VTP, named by the job's result id, into the results folder.
 
 A process of its own, not a thread of the web server: VTK's Python wrappers keep the GIL while a
 filter runs, so a VTK thread would stop the server's event loop (every page, every other browser)
@@ -136,15 +139,110 @@ def image_of(source, name):
     return image, array
 
 
-def open_sources(specs, ns, log):
-    """[(source proxy, name, vtkImageData, vtkDataArray)] for the specs, in their order."""
+# The scalar types the page reads (numpy's names, as /api/datasets states them).
+SCALAR_TYPES = ("int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64")
+
+
+def quietly(function):
+    """function() with VTK's messages and the process's stderr captured.
+
+    Returns (its value, [VTK errors], [warnings]); stdout and stderr are both captured. A reader's VTK errors, and what MetaImage's
+    library (metaio) writes to std::cerr when it cannot read a file's data (it returns a
+    zero-filled volume and raises no VTK error), are errors; any other text it writes is a
+    warning. Whatever the reader prints while it crashes goes to the capture as well, so the
+    server says one line instead of a stack trace.
+    """
+    from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow, vtkStringOutputWindow
+    import tempfile
+    capture = vtkStringOutputWindow()
+    previous = vtkOutputWindow.GetInstance()
+    verbosity = vtkLogger.GetCurrentVerbosityCutoff()
+    vtkOutputWindow.SetInstance(capture)
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    with tempfile.TemporaryFile() as stderr:
+        os.dup2(stderr.fileno(), 1)
+        os.dup2(stderr.fileno(), 2)
+        try:
+            value = function()
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            for fd, copy in zip((1, 2), saved):
+                os.dup2(copy, fd)
+                os.close(copy)
+            vtkOutputWindow.SetInstance(previous)
+            vtkLogger.SetStderrVerbosity(verbosity)
+        stderr.seek(0)
+        printed = stderr.read().decode("utf-8", "replace")
+    errors, warnings = [], []
+    lines = capture.GetOutput().splitlines()
+    for i, line in enumerate(lines):
+        kind = errors if line.startswith("ERROR") else warnings if line.startswith("Warning") \
+            else None
+        if kind is not None:
+            following = [n for n in lines[i + 1:i + 3] if n.strip()]
+            kind.append(_last_line(following[0] if following else line))
+    printed = [line.strip() for line in printed.splitlines() if line.strip()]
+    if any(line.startswith("Meta") for line in printed):
+        errors.append(" ".join(printed))
+    elif printed:
+        warnings.append(" ".join(printed))
+    return value, errors, warnings
+
+
+def open_sources(specs, ns, log, opening=None):
+    """[(source proxy, name, vtkImageData, vtkDataArray)] for the specs, in their order.
+
+    Raises ValueError with one line for the user when a spec cannot be read; the reader's own
+    errors are captured and said in that line. opening(i) is called before spec i is read.
+    """
     opened = []
-    for spec in specs:
-        source, name, note = open_reader(spec, ns)
-        image, array = image_of(source, name)
+    for i, spec in enumerate(specs):
+        if opening is not None:
+            opening(i)
+
+        def read():
+            source, name, note = open_reader(spec, ns)
+            return (source, name, note) + image_of(source, spec)
+
+        (source, name, note, image, array), errors, warnings = quietly(read)
+        if errors:
+            raise ValueError("%s: %s" % (spec, errors[0]))
+        for warning in warnings:
+            log("%s: the reader warns: %s" % (name, warning))
         log("%s: read with %s" % (name, note))
         opened.append((source, name, image, array))
     return opened
+
+
+def describe(spec, name, image, array):
+    """What the server needs of a volume, besides its values: its geometry, type and range."""
+    import math
+    lo, hi = array.GetRange()
+    if not (math.isfinite(lo) and math.isfinite(hi)) or lo >= hi:
+        raise ValueError("%s: its values span no range (%g..%g)" % (spec, lo, hi))
+    matrix = image.GetDirectionMatrix()
+    return {"name": name, "dims": list(image.GetDimensions()), "spacing": list(image.GetSpacing()),
+            "origin": list(image.GetOrigin()),
+            "direction": [matrix.GetElement(r, c) for r in range(3) for c in range(3)],
+            "range": [float(lo), float(hi)]}
+
+
+def export(index, spec, name, image, array, folder):
+    """The volume's values as FOLDER/dINDEX.npy (z, y, x) for the server, and its description."""
+    import numpy
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    values = vtk_to_numpy(array)
+    if values.dtype.name not in SCALAR_TYPES:
+        raise ValueError("%s: %s values are not supported" % (spec, array.GetDataTypeAsString()))
+    description = describe(spec, name, image, array)
+    dims = description["dims"]
+    path = os.path.join(folder, "d%d.npy" % index)
+    numpy.save(path, values.reshape(dims[2], dims[1], dims[0]))
+    return dict(description, type=values.dtype.name, values=path)
 
 
 # ---------------------------------------------------------------------------------- the worker
@@ -394,6 +492,14 @@ def _last_line(text):
     return message
 
 
+def load_plugin(path, ns):
+    import paraview.simple as simple
+    try:
+        simple.LoadPlugin(path, ns=ns)
+    except RuntimeError:  # ParaView's "Problem loading plugin", after its own error message
+        pass
+
+
 def server_gone(results):
     """The end of input, or of output: the server is gone (a worker it replaces it ends with
     SIGKILL instead). Its results go with it, even when it was killed before it could remove them
@@ -415,6 +521,8 @@ def main(argv):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--plugin", required=True)
     p.add_argument("--results", required=True, help="folder the results are written to")
+    p.add_argument("--export", help="first start: write the volumes' values into this folder "
+                   "(dN.npy) and describe them in the ready message")
     p.add_argument("sources", nargs="+")
     args = p.parse_args(argv)
 
@@ -432,16 +540,26 @@ def main(argv):
     signal.signal(signal.SIGUSR1, cancel)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the server ends this process itself
 
-    import paraview.simple as simple
-    ns = {"__name__": "medical_isosurfaces_proxies"}  # LoadPlugin fills a non-empty dict only
-    simple.LoadPlugin(args.plugin, ns=ns)
+    def opening(index):  # the server names this source if reading it ends the process
+        emit(out, {"opening": index}, args.results)
+
+    notes = []
     try:
-        sources = open_sources(args.sources, ns, lambda m: None)
+        ns = {"__name__": "medical_isosurfaces_proxies"}  # LoadPlugin fills a non-empty dict only
+        _, errors, _ = quietly(lambda: load_plugin(args.plugin, ns))
+        if "BlockLODContour" not in ns:
+            raise ValueError("%s is not the MedicalIsosurfaces plugin%s" % (
+                args.plugin, " (%s)" % errors[0] if errors else ""))
+        sources = open_sources(args.sources, ns, notes.append, opening)
+        volumes = [] if not args.export else [
+            export(i, spec, name, image, array, args.export)
+            for i, (spec, (_, name, image, array)) in enumerate(zip(args.sources, sources))]
     except ValueError as e:
         emit(out, {"fatal": str(e)}, args.results)
         return 1
     worker = Worker(sources, ns, args.results, out)
-    worker.send({"ready": True, "datasets": [s[1] for s in sources]})
+    worker.send({"ready": True, "datasets": [s[1] for s in sources], "volumes": volumes,
+                 "notes": notes})
     for line in os.fdopen(0, "r"):  # pvpython replaces sys.stdin
         if not line.strip():
             continue

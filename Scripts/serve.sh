@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The web client, from a bare Debian 12 machine to a URL to open:
 #
-#   Scripts/serve.sh [--data FILE_OR_DICOM_DIR ...] [--port N] [--host ADDR] [--token TOKEN]
+#   Scripts/serve.sh [--data FILE_OR_DICOM_DIR ...] [--port N] [--host ADDR] [--token=TOKEN]
 #
 # 1. bootstrap: install packages, configure, build the plugin (Scripts/bootstrap.sh);
 # 2. build the page's WebAssembly module with Debian's emscripten (Scripts/build-web.sh);
@@ -12,7 +12,9 @@
 # --data takes a MetaImage (.mha/.mhd), VTK XML image (.vti), NIfTI (.nii, .nii.gz) file, a DICOM
 # series folder, or phantom:N; repeat it for several volumes. The server listens on 127.0.0.1
 # (this machine only) unless --host is given, on port 8765 unless --port is given; every request
-# needs the token of the printed URL. Ctrl-C stops it.
+# needs the token of the printed URL (random unless --token=TOKEN is given; a token that begins
+# with '-' must be given so). A volume that cannot be read stops the server at start with one line
+# naming the file and why. Ctrl-C stops it.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 

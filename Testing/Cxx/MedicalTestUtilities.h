@@ -39,17 +39,29 @@ inline int Finish(const char* passed)
   return 0;
 }
 
-/// Path of a file in the real-data cache of Python/fetch_data.py:
-/// $MEDISO_DATA_DIR, else ~/.cache/medical-isosurfaces.
-inline std::string DataFile(const std::string& name)
+/// The real-data folder that Python/fetch_data.py fills: $MEDISO_DATA_DIR, else
+/// ${XDG_CACHE_HOME:-$HOME/.cache}/medical-isosurfaces. The same rule as the Python side's one
+/// function (fetch_data.resolve_cache_dir); change both together.
+inline std::string DataDirectory()
 {
   const char* dir = std::getenv("MEDISO_DATA_DIR");
   if (dir && *dir)
   {
-    return std::string(dir) + "/" + name;
+    return dir;
+  }
+  const char* cache = std::getenv("XDG_CACHE_HOME");
+  if (cache && *cache)
+  {
+    return std::string(cache) + "/medical-isosurfaces";
   }
   const char* home = std::getenv("HOME");
-  return std::string(home ? home : ".") + "/.cache/medical-isosurfaces/" + name;
+  return std::string(home ? home : ".") + "/.cache/medical-isosurfaces";
+}
+
+/// Path of a file in the real-data folder (DataDirectory()).
+inline std::string DataFile(const std::string& name)
+{
+  return DataDirectory() + "/" + name;
 }
 } // namespace medical_test
 

@@ -3,8 +3,8 @@
 // triangle count within 0.5%, total area within 0.5%, every vertex of each
 // surface within 1e-4 voxel of a vertex of the other. Checked on the phantom
 // (odd sizes, a non-zero extent, spacing and origin, several scalar types) and
-// on the real head CT when it is cached (MEDISO_DATA_DIR or
-// ~/.cache/medical-isosurfaces/ct_head.mha).
+// on the real head CT when it is cached (ct_head.mha in
+// medical_test::DataDirectory()).
 //
 // Degenerate-triangle policy: both filters create one point per cut edge and
 // keep every triangle of the case table, so the counts are expected to match

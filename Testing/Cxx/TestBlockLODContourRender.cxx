@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Baseline image: the real head CT's bone (400 HU) from vtkBlockLODContour at
 // levels 0, 1, 2, 3, side by side. Skipped (125) when the CT is not cached
-// (Python/fetch_data.py; MEDISO_DATA_DIR or ~/.cache/medical-isosurfaces).
+// (Python/fetch_data.py; the folder of medical_test::DataDirectory()).
 #include "MedicalTestUtilities.h"
 #include "vtkBlockLODContour.h"
 

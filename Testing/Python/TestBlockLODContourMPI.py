@@ -99,13 +99,10 @@ for level in range(4):
     surface = servermanager.Fetch(pids)
     result["levels"][str(level)] = figures(surface)
 
-failures = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
 
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED: " + what)
+check = Checks()
 
 
 print("%d rank(s), phantom %s, isovalue %g" % (ranks, "x".join(map(str, args.dims)), args.isovalue))
@@ -150,7 +147,4 @@ if args.out:
         json.dump(result, f, indent=1)
 if args.port:
     simple.Disconnect()
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("BlockLODContour MPI (%d ranks): all checks passed" % ranks)
+check.finish("BlockLODContour MPI (%d ranks): all checks passed" % ranks)

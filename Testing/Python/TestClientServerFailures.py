@@ -24,14 +24,11 @@ import time
 BOUND = 30.0
 pvserver, pvpython, plugin = sys.argv[1:4]
 work = tempfile.mkdtemp()
-failures = []
 port = 11111
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
 
-
-def check(ok, what):
-    print(("ok: " if ok else "FAILED: ") + what)
-    if not ok:
-        failures.append(what)
+check = Checks(verbose=True)
 
 
 def start_server():
@@ -172,7 +169,4 @@ check(bool(triangles) and triangles[0] > 1000, "case 3: the session goes on (lev
 show("client", client_log)
 stop(server)
 
-if failures:
-    print("%d check(s) did not pass" % len(failures))
-    sys.exit(1)
-print("client/server failures: all checks passed")
+check.finish("client/server failures: all checks passed")

@@ -19,13 +19,10 @@ parser.add_argument("--server-pid", type=int, required=True)
 parser.add_argument("--plugin", required=True)
 args, _ = parser.parse_known_args()  # client-server.sh also passes relay arguments
 
-failures = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
 
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED: " + what)
+check = Checks()
 
 
 def plugin_mapped_here():
@@ -60,7 +57,4 @@ print("client pid %d, server pid %d, producer pid %d, extent %s, HU range %s"
       % (os.getpid(), args.server_pid, producer_pid, info.GetExtent(), hu.GetRange()))
 
 Disconnect()
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("client/server smoke: all checks passed")
+check.finish("client/server smoke: all checks passed")

@@ -4,7 +4,8 @@ The real data cannot be fetched everywhere, so the converters are checked on
 small synthetic inputs: MetaImage write/parse round trips (int16 with negative
 values, uint8), byte order of the written voxels, rejection of truncated files,
 NIfTI-1 header parsing in both byte orders, and the InVesalius plist geometry
-(numpy z, y, x order to x, y, z).
+(numpy z, y, x order to x, y, z); and the data folder's one rule (MEDISO_DATA_DIR, else
+${XDG_CACHE_HOME:-$HOME/.cache}/medical-isosurfaces).
 """
 import array
 import importlib.util
@@ -20,13 +21,10 @@ spec = importlib.util.spec_from_file_location(
 fetch_data = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(fetch_data)
 
-failures = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
 
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED: " + what)
+check = Checks()
 
 
 def nifti_header(endian, dims, spacing, datatype, bitpix):
@@ -100,7 +98,25 @@ dims, spacing, dtype, matrix, _ = fetch_data.ct_geometry_from_plist(
 check(dims == (256, 256, 108) and spacing[2] == 1.5 and dtype == "int16"
       and matrix == "matrix.dat", "plist geometry: %s %s" % (dims, spacing))
 
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("fetch_data formats: all checks passed")
+# The data folder's rule (resolve_cache_dir; MedicalTestUtilities.h's DataDirectory states it
+# for C++).
+saved = {k: os.environ.get(k) for k in ("MEDISO_DATA_DIR", "XDG_CACHE_HOME", "HOME")}
+try:
+    for environment, expected in (
+            ({"MEDISO_DATA_DIR": "/data/m", "XDG_CACHE_HOME": "/x", "HOME": "/h"}, "/data/m"),
+            ({"MEDISO_DATA_DIR": "", "XDG_CACHE_HOME": "/x", "HOME": "/h"},
+             "/x/medical-isosurfaces"),
+            ({"MEDISO_DATA_DIR": "", "XDG_CACHE_HOME": "", "HOME": "/h"},
+             "/h/.cache/medical-isosurfaces")):
+        os.environ.update(environment)
+        folder = str(fetch_data.resolve_cache_dir(None))
+        check(folder == expected, "data folder with %s: %s (expected %s)"
+              % (environment, folder, expected))
+finally:
+    for key, value in saved.items():
+        if value is None:
+            os.environ.pop(key, None)
+        else:
+            os.environ[key] = value
+
+check.finish("fetch_data formats: all checks passed")

@@ -12,13 +12,13 @@ Usage: pvpython TestHistoPyramidRepresentationMemory.py --plugin PATH --out DIR
 """
 import argparse
 import resource
-import sys
 
 from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 from vtkmodules.vtkCommonCore import vtkDoubleArray
 from vtkmodules.vtkCommonDataModel import vtkRectilinearGrid
 
 from HistoPyramidRepresentationChecks import REPRESENTATION, captured, make_view, render_info
+from checks import Checks  # Testing/Python/checks.py
 
 parser = argparse.ArgumentParser()
 parser.add_argument("--plugin", required=True)
@@ -26,13 +26,7 @@ parser.add_argument("--out", required=True)
 args = parser.parse_args()
 LoadPlugin(args.plugin, ns=globals())
 
-failures = []
-
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED: " + what)
+check = Checks()
 
 
 def limit_address_space(headroom_mb):
@@ -109,7 +103,4 @@ check("resampled onto an even" not in text.split(expected_start)[-1],
       "no resampling warning after the error")
 print("rectilinear: %s" % (text.strip().splitlines()[-1] if text.strip() else "no message"))
 
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("HistoPyramid representation under a memory limit: all checks passed")
+check.finish("HistoPyramid representation under a memory limit: all checks passed")

@@ -64,14 +64,10 @@ scene = os.path.join(here, "MedicalIsosurfacesGUIScene.py")
 NAME = "TestMedicalIsosurfacesGUI"
 # The main window's area on the 1920x1080 screen, less the status bar.
 CROP = (0, 0, 1400, 1020)  # x, y, width, height
-failures = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
 
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED: " + what)
-    return ok
+check = Checks()
 
 
 def capture():
@@ -254,7 +250,4 @@ if representation_screen is not None and blocklod_screen is not None:
                 write_png(os.path.join(args.out, NAME + "-diff.png"), diff)
             print("%.3f%% of the pixels differ from the baseline" % (100 * fraction))
 
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("GUI: all checks passed")
+check.finish("GUI: all checks passed")

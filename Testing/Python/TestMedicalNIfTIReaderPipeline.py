@@ -20,14 +20,9 @@ from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 from paraview import servermanager
 from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow, vtkStringOutputWindow
 from vtkmodules.util.numpy_support import vtk_to_numpy
+from checks import Checks  # Testing/Python/checks.py
 
-failures = []
-
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED: " + what)
+check = Checks()
 
 
 def nifti1(dims, slope=0.0, intercept=0.0, pixdim4=1.0, toffset=0.0):
@@ -137,7 +132,4 @@ check(text.count("vtkMedicalNIfTIReader (") == 1 and expected in text,
 check(points == 0 and triangles == 0, "nothing downstream (%d points, %d cells)" % (points, triangles))
 print("truncated: %s" % expected)
 
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("NIfTI reader in ParaView: all checks passed")
+check.finish("NIfTI reader in ParaView: all checks passed")

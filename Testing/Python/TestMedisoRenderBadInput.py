@@ -13,13 +13,10 @@ import struct
 import subprocess
 import sys
 
-failures = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
 
-
-def check(ok, what):
-    if not ok:
-        print("FAILED: " + what)
-        failures.append(what)
+check = Checks()
 
 
 def write_mha(path, dims, element="MET_SHORT", values=None, extra="", fmt="<h", truncate=0,
@@ -149,10 +146,7 @@ def main():
     expect(binary, "a bad EGL platform", [good, "--iso", "0"], 4, ["MEDISO_EGL_PLATFORM"],
            env={"MEDISO_EGL_PLATFORM": "x11"})
 
-    if failures:
-        print("%d check(s) failed" % len(failures))
-        return 1
-    print("TestMedisoRenderBadInput passed")
+    check.finish("TestMedisoRenderBadInput passed")
     return 0
 
 

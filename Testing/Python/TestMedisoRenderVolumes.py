@@ -17,14 +17,11 @@ import struct
 import subprocess
 import sys
 
-failures = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
+
+check = Checks()
 FORMATS = {"MET_FLOAT": "f", "MET_SHORT": "h"}
-
-
-def check(ok, what):
-    if not ok:
-        print("FAILED: " + what)
-        failures.append(what)
 
 
 def write_mha(path, dims, spacing, origin, element, values):
@@ -191,10 +188,7 @@ def main():
     os.makedirs(temp, exist_ok=True)
     check_resample(binary, temp)
     check_phantom(binary, temp, benchmark)
-    if failures:
-        print("%d check(s) failed" % len(failures))
-        return 1
-    print("TestMedisoRenderVolumes passed")
+    check.finish("TestMedisoRenderVolumes passed")
     return 0
 
 

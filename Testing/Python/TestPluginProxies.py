@@ -14,13 +14,10 @@ from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 from paraview import servermanager
 from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow, vtkStringOutputWindow
 
-failures = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
 
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED: " + what)
+check = Checks()
 
 
 plugin = sys.argv[1] if len(sys.argv) > 1 else os.environ["MEDISO_PLUGIN"]
@@ -119,7 +116,4 @@ for label, props, needle in cases:
     check(points == 0, "%s: empty output" % label)
     print("%s: error reported: %s" % (label, text.strip().splitlines()[-1][:160] if text.strip() else "none"))
 
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("plugin proxies: all checks passed")
+check.finish("plugin proxies: all checks passed")

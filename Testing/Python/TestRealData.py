@@ -29,13 +29,10 @@ if missing:
 
 from paraview.simple import OpenDataFile  # noqa: E402
 
-failures = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
 
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED: " + what)
+check = Checks()
 
 
 for name, dims, spacing, vtk_type, vmin, vmax in expected:
@@ -57,7 +54,4 @@ for name, dims, spacing, vtk_type, vmin, vmax in expected:
                                                  tuple(round(s, 7) for s in got_spacing),
                                                  array.GetRange()))
 
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("real data: all checks passed")
+check.finish("real data: all checks passed")

@@ -10,7 +10,6 @@ bytes. Bad --data (no such file, a folder without DICOM files, a surface, a 2D i
 of size 1) and a port in use each stop the server with a message saying why.
 """
 import asyncio
-import gzip
 import os
 import subprocess
 import sys
@@ -102,14 +101,6 @@ def dicom_series(folder, mha):
     return out
 
 
-def decode(body, dtype, count):
-    """The values of a gzip'd, byte-shuffled body."""
-    raw = gzip.decompress(body)
-    size = numpy.dtype(dtype).itemsize
-    planes = numpy.frombuffer(raw, numpy.uint8).reshape(size, count)
-    return numpy.ascontiguousarray(planes.T).view(dtype).ravel()
-
-
 async def served(server, written):
     async with aiohttp.ClientSession(auto_decompress=False) as http:
         async with http.get(server.url("/api/datasets")) as r:
@@ -131,7 +122,7 @@ async def served(server, written):
                     dims = [int(n) for n in r.headers["X-Mediso-Dims"].split(",")]
                 step = 1 << (3 - level)
                 expected = values[::step, ::step, ::step]
-                got = decode(body, NUMPY[d["type"]], expected.size)
+                got = webserver.decode(body, NUMPY[d["type"]], expected.size)
                 checks(dims == list(expected.shape[::-1]) and
                        numpy.array_equal(got.astype(numpy.float64),
                                          expected.ravel().astype(numpy.float64)),

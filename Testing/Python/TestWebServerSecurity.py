@@ -7,7 +7,8 @@ paths, the data file's own path); a WebSocket from another origin is refused; ev
 (not JSON, not an object, a non-finite or out-of-range isovalue, unknown operations, steps and
 fields, wrong types and ranges, a binary frame, a 100 KB message, deep nesting) gets an error
 naming the fault on the same socket, which stays usable; a 2 MB frame closes that socket with
-1009; and after all of it the server still serves and runs an operation.
+1009; and after all of it the server still serves and runs an operation. The token begins with
+'-' (the harness gives it as --token=VALUE).
 """
 import asyncio
 import json
@@ -19,7 +20,10 @@ import webserver  # noqa: E402  (skips when aiohttp or the plugin is missing)
 import aiohttp  # noqa: E402
 
 checks = webserver.Checks()
-server = webserver.Server(["phantom:48"])
+# A token that begins with '-' (as one random token in 64 does) works: the harness passes it as
+# --token=VALUE.
+server = webserver.Server(["phantom:48"], token="-" + webserver.secrets.token_urlsafe(12))
+checks(server.token.startswith("-"), "the server runs with a token that begins with '-'")
 SECRET_FILE = os.path.abspath(webserver.SERVE)
 
 
@@ -109,6 +113,20 @@ async def paths(http):
     checks(code == 400, "a result format the server does not write: %d" % code)
     code, _, _ = await status_of(http, "/static/index.html")
     checks(code == 200, "the page's own files are served: %d" % code)
+    # Every file of the page is cross-origin isolated (the page's threads need it), cacheable by
+    # date, and of its type: the scripts as JavaScript (ES modules run only then).
+    for path, kind in (("/", "text/html"), ("/static/index.html", "text/html"),
+                       ("/static/app.js", "text/javascript"), ("/static/style.css", "text/css"),
+                       ("/static/mediso.js", "text/javascript"),
+                       ("/static/mediso.wasm", "application/wasm")):
+        code, _, r = await status_of(http, path)
+        checks(code == 200 and r.content_type == kind and
+               r.headers.get("Cross-Origin-Opener-Policy") == "same-origin" and
+               r.headers.get("Cross-Origin-Embedder-Policy") == "require-corp" and
+               "Last-Modified" in r.headers,
+               "%s: %d %s, isolated (COOP %s, COEP %s), Last-Modified %s"
+               % (path, code, r.content_type, r.headers.get("Cross-Origin-Opener-Policy"),
+                  r.headers.get("Cross-Origin-Embedder-Policy"), r.headers.get("Last-Modified")))
 
 
 BAD = [

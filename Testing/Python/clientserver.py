@@ -22,6 +22,8 @@ import socket
 import sys
 import time
 
+import checks  # Testing/Python/checks.py
+
 from paraview import servermanager
 import paraview.simple as simple
 
@@ -51,27 +53,13 @@ def parse_args(description, extra=None):
     return parser.parse_args()
 
 
-class Checks:
-    def __init__(self):
-        self.failures = []
-
-    def __call__(self, ok, what):
-        if not ok:
-            self.failures.append(what)
-            print("FAILED: " + what)
-        return ok
-
+class Checks(checks.Checks):
     def finish(self, passed_message):
         # Disconnect first: a client that just exits leaves pvserver logging a
         # socket error.
         if servermanager.ActiveConnection is not None:
             simple.Disconnect()
-        if self.failures:
-            print("%d check(s) failed" % len(self.failures))
-            sys.stdout.flush()
-            os._exit(1)
-        print(passed_message)
-        sys.stdout.flush()
+        super().finish(passed_message, exit=os._exit)
 
 
 class RelayCounter:

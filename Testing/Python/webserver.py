@@ -19,6 +19,8 @@ import sys
 import threading
 import time
 
+import checks  # Testing/Python/checks.py
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SERVE = os.path.join(ROOT, "Python", "serve.py")
 PVPYTHON = os.path.realpath("/proc/self/exe") if os.path.exists("/proc/self/exe") else \
@@ -52,25 +54,20 @@ def free_port():
         return s.getsockname()[1]
 
 
-class Checks:
+class Checks(checks.Checks):
+    """Prints every check ("ok: ..." too); finish() stops the servers and prints their output."""
+
     def __init__(self):
-        self.failures = []
+        super().__init__(verbose=True)
 
-    def __call__(self, ok, what):
-        print(("ok: " if ok else "FAILED: ") + what, flush=True)
-        if not ok:
-            self.failures.append(what)
-        return ok
-
-    def finish(self, *servers):
+    def finish(self, *servers, passed="all checks passed"):
         for server in servers:
             server.stop()
             print("---- server output (%s)" % " ".join(server.data))
             print("".join(server.lines), end="", flush=True)
             self(server.exit_code in (0, -15), "the server ended cleanly (exit %s)"
                  % server.exit_code)
-        print("%d failure(s)" % len(self.failures))
-        sys.exit(1 if self.failures else 0)
+        super().finish(passed)
 
 
 class Server:
@@ -83,7 +80,7 @@ class Server:
         self.base = "http://127.0.0.1:%d" % self.port
         self.lines = []
         self.exit_code = None
-        command = [PVPYTHON, "--no-mpi", SERVE, "--plugin", PLUGIN, "--token", self.token,
+        command = [PVPYTHON, "--no-mpi", SERVE, "--plugin", PLUGIN, "--token=" + self.token,
                    "--port", str(self.port)] + list(extra)
         for d in self.data:
             command += ["--data", d]
@@ -163,6 +160,16 @@ async def operation(ws, request, timeout=300):
             progress.append(answer)
             continue
         return progress, answer
+
+
+def decode(body, dtype, count):
+    """The values of a gzip'd, byte-shuffled /api/volume body."""
+    import gzip
+    import numpy
+    raw = gzip.decompress(body)
+    size = numpy.dtype(dtype).itemsize
+    planes = numpy.frombuffer(raw, numpy.uint8).reshape(size, count)
+    return numpy.ascontiguousarray(planes.T).view(dtype).ravel()
 
 
 def surface_request(ident, dataset, isovalue, level=3, steps=()):

@@ -40,13 +40,11 @@ parser.add_argument("--wasm", required=True)
 parser.add_argument("--out", required=True)
 args = parser.parse_args()
 
-failures = []
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "Python"))
+from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
 
-
-def check(ok, what):
-    print(("ok: " if ok else "FAILED: ") + what, flush=True)
-    if not ok:
-        failures.append(what)
+check = Checks(verbose=True)
 
 
 def skip(why):
@@ -101,7 +99,7 @@ def start_server():
     command = [sys.executable if os.path.basename(sys.executable).startswith("pvpython")
                else shutil.which("pvpython"), "--no-mpi", os.path.join(ROOT, "Python", "serve.py"),
                "--plugin", args.plugin, "--wasm", args.wasm, "--data", volume,
-               "--port", str(port), "--token", token]
+               "--port", str(port), "--token=" + token]
     server = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     deadline = time.time() + 120
     while time.time() < deadline:
@@ -311,7 +309,4 @@ else:
         Hide(contour, view)
         compare(shot, reference, "level %d: the CPU path against ParaView's BlockLODContour" % k)
 
-if failures:
-    print("%d check(s) failed" % len(failures))
-    sys.exit(1)
-print("TestWebPage %s passed" % args.case)
+check.finish("TestWebPage %s passed" % args.case)

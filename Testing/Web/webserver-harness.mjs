@@ -42,7 +42,7 @@ export async function startServer(data = []) {
   const port = await freePort();
   const token = "t" + Math.random().toString(36).slice(2, 12);
   const args = ["--no-mpi", path.join(ROOT, "Python", "serve.py"), "--plugin", plugin,
-    "--wasm", wasm, "--token", token, "--port", String(port),
+    "--wasm", wasm, `--token=${token}`, "--port", String(port),
     ...data.flatMap((d) => ["--data", d])];
   const child = spawn(process.env.MEDISO_PVPYTHON || "pvpython", args,
     { stdio: ["ignore", "pipe", "pipe"] });
