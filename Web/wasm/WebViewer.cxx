@@ -667,7 +667,7 @@ private:
   // The CPU path.
   bool CPUPath = false;
 #ifdef MEDISO_WEB_THREADS
-  BlockLODVolume CPUVolume{ mediso_web::MarchingCubesCases, headless::ThreadedFor };
+  BlockLODVolume CPUVolume{ mediso_web::MarchingCubesCases, ThreadedFor };
 #else
   BlockLODVolume CPUVolume{ mediso_web::MarchingCubesCases, SerialFor };
 #endif
