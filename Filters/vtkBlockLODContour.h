@@ -107,6 +107,10 @@
 
 class vtkDataArray;
 class vtkImageData;
+namespace mediso
+{
+struct SurfacesUpdate;
+}
 
 class MEDICALISOSURFACESFILTERS_EXPORT vtkBlockLODContour : public vtkPolyDataAlgorithm
 {
@@ -302,12 +306,15 @@ private:
   // The steps of RequestData, in order (ChooseArray is part of CheckInput).
   vtkDataArray* ChooseArray(vtkImageData* input, vtkInformationVector** inputVector);
   vtkDataArray* CheckInput(vtkImageData* input, vtkInformationVector** inputVector);
+  // Execute runs them; `step` names the one running (for a message when
+  // memory runs out). Choosing, planning and generating are the core's
+  // (BlockLODSurfaces); ReportUpdate says what they did.
+  void Execute(vtkInformationVector** inputVector, vtkImageData* input, vtkPolyData* output,
+    const char*& step);
   std::vector<double> IsovaluesWithSurface();
-  int ChooseLevel(const std::vector<double>& values);
-  bool PlanLevel(const std::vector<double>& values, int& level);
   void ReportEstimates(double isovalue);
-  bool GenerateLevel(const std::vector<double>& values, int level);
-  void AssembleOutput(vtkPolyData* output);
+  void ReportUpdate(const mediso::SurfacesUpdate& update);
+  bool AssembleOutput(vtkPolyData* output);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;
