@@ -34,11 +34,12 @@ int SharedCostModel::GetNumberOfSamples() const
 }
 
 //------------------------------------------------------------------------------
-BlockLODSurfacesBase::BlockLODSurfacesBase(
-  TriangleCaseTable cases, ParallelFor parallel, std::shared_ptr<SharedCostModel> costs)
+BlockLODSurfacesBase::BlockLODSurfacesBase(TriangleCaseTable cases, ParallelFor parallel,
+  std::shared_ptr<SharedCostModel> costs, const SurfaceLayout& layout)
   : Volume(cases, std::move(parallel))
   , Estimator(Volume)
   , Costs(costs ? std::move(costs) : std::make_shared<SharedCostModel>())
+  , Layout(layout)
 {
 }
 

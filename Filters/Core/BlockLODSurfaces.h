@@ -151,6 +151,9 @@ struct SurfaceMaker
   /// Optional: called after pass 2 with the ranges it wrote.
   std::function<void(const SurfaceKey& key, Surface& surface, const SurfaceRanges& written)>
     Finish;
+  /// Optional: the bytes the cache counts for a surface (default: the
+  /// layout's bytes of its counts).
+  std::function<double(const Surface& surface)> Bytes;
 };
 
 /// Checks an update's hosts may give.
@@ -172,8 +175,9 @@ public:
   /// failure there is caught as std::bad_alloc).
   static constexpr double LargeAllocationBytes = 1.0e6;
 
-  BlockLODSurfacesBase(
-    TriangleCaseTable cases, ParallelFor parallel, std::shared_ptr<SharedCostModel> costs);
+  /// `costs` null: a model of the unit's own. `layout`: see SetLayout().
+  BlockLODSurfacesBase(TriangleCaseTable cases, ParallelFor parallel,
+    std::shared_ptr<SharedCostModel> costs, const SurfaceLayout& layout = SurfaceLayout());
   virtual ~BlockLODSurfacesBase();
   BlockLODSurfacesBase(const BlockLODSurfacesBase&) = delete;
   BlockLODSurfacesBase& operator=(const BlockLODSurfacesBase&) = delete;
@@ -370,7 +374,7 @@ bool BlockLODSurfaces<Surface>::Generate(const std::vector<double>& values, int 
     this->Surfaces.push_back(surface);
     if (this->CacheLimit > 0)
     {
-      this->Cache.Insert(key, surface, bytes);
+      this->Cache.Insert(key, surface, maker.Bytes ? maker.Bytes(surface) : bytes);
     }
     if (this->Stopped(hooks, update))
     {
