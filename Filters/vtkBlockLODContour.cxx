@@ -435,12 +435,14 @@ struct vtkBlockLODContour::vtkInternals
   }
 
   // How the filter's output arrays are made from the core's plans.
-  static mediso::SurfaceMaker<vtkSmartPointer<vtkPolyData>> Maker(const mediso::SurfaceLayout& layout)
+  static mediso::SurfaceMaker<vtkSmartPointer<vtkPolyData>> Maker(
+    const mediso::SurfaceLayout& layout)
   {
     mediso::SurfaceMaker<vtkSmartPointer<vtkPolyData>> maker;
     maker.Allocate = [layout](const mediso::SurfaceKey&, std::int64_t points,
                        std::int64_t triangles, vtkSmartPointer<vtkPolyData>& surface,
-                       mediso::SurfaceTarget& target) {
+                       mediso::SurfaceTarget& target)
+    {
       SurfaceArrays arrays = AllocateSurface(points, triangles, layout);
       if (!Valid(arrays, points, triangles))
       {
@@ -457,7 +459,8 @@ struct vtkBlockLODContour::vtkInternals
       return true;
     };
     maker.Finish = [](const mediso::SurfaceKey& key, vtkSmartPointer<vtkPolyData>& surface,
-                     const mediso::SurfaceRanges& written) {
+                     const mediso::SurfaceRanges& written)
+    {
       CacheRanges(surface->GetPoints()->GetData(), written.Points);
       CacheRanges(surface->GetPointData()->GetNormals(), written.Normals);
       const double iso = static_cast<float>(key.Isovalue); // the scalars' value, as stored
@@ -632,7 +635,8 @@ void vtkBlockLODContour::Execute(
   mediso::UpdateHooks hooks;
   hooks.PollAbort = [this]() { return this->GetAbortExecute() != 0; };
   hooks.CheckAbort = [this]() { return this->CheckAbort(); };
-  hooks.Planned = [this, &values](int level) {
+  hooks.Planned = [this, &values](int level)
+  {
     this->ChosenLevel = level;
     this->ReportEstimates(values[0]);
     this->UpdateProgress(0.5);
@@ -922,10 +926,9 @@ void vtkBlockLODContour::ReportUpdate(const mediso::SurfacesUpdate& update)
     const char* needs = update.Level0Planned ? "level 0 needs " : "even level 0 needs ";
     if (processBound)
     {
-      vtkErrorMacro("MemoryBudget " << this->MemoryBudget << " MB is more than the "
-                                    << allowance.str() << ", and " << needs
-                                    << update.Level0Bytes / BytesPerMB
-                                    << " MB. The output is empty.");
+      vtkErrorMacro("MemoryBudget "
+        << this->MemoryBudget << " MB is more than the " << allowance.str() << ", and " << needs
+        << update.Level0Bytes / BytesPerMB << " MB. The output is empty.");
     }
     else
     {

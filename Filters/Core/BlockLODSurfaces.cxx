@@ -136,7 +136,8 @@ int BlockLODSurfacesBase::ChooseLevel(
   }
   update.ChoiceBytes = choice.BudgetBytes;
   double level0Bytes = 0;
-  const int level = this->Estimator.ChooseLevel(values, choice.BudgetBytes, this->Layout, level0Bytes);
+  const int level =
+    this->Estimator.ChooseLevel(values, choice.BudgetBytes, this->Layout, level0Bytes);
   // The budget is the host's wish; the process may hold less. Reading the
   // allowance costs a few file reads: only for a choice that allocates much.
   double chosenBytes = level0Bytes;

@@ -123,9 +123,9 @@ struct SurfacesUpdate
 
   std::string Message; ///< OutOfMemory: what did not fit, and what binds.
 
-  int Extractions = 0;     ///< Surfaces extracted.
-  int CacheHits = 0;       ///< Surfaces served from the cache.
-  SurfaceCounts Extracted; ///< Cubes and triangles of the extracted surfaces.
+  int Extractions = 0;      ///< Surfaces extracted.
+  int CacheHits = 0;        ///< Surfaces served from the cache.
+  SurfaceCounts Extracted;  ///< Cubes and triangles of the extracted surfaces.
   bool OneTimeWork = false; ///< Block ranges or a coarse copy were made for it.
 };
 
@@ -139,7 +139,7 @@ struct SurfaceTarget
 };
 
 /// How a host makes its surfaces.
-template <typename Surface>
+template<typename Surface>
 struct SurfaceMaker
 {
   /// A new surface of `points` and `triangles` for `key`, with the buffers
@@ -149,8 +149,7 @@ struct SurfaceMaker
     Surface& surface, SurfaceTarget& target)>
     Allocate;
   /// Optional: called after pass 2 with the ranges it wrote.
-  std::function<void(const SurfaceKey& key, Surface& surface, const SurfaceRanges& written)>
-    Finish;
+  std::function<void(const SurfaceKey& key, Surface& surface, const SurfaceRanges& written)> Finish;
   /// Optional: the bytes the cache counts for a surface (default: the
   /// layout's bytes of its counts).
   std::function<double(const Surface& surface)> Bytes;
@@ -215,8 +214,8 @@ protected:
 
   // Steps of an update. Each sets the update's outcome when it fails.
   void Begin(SurfacesUpdate& update);
-  int ChooseLevel(const std::vector<double>& values, const LevelChoice& choice,
-    SurfacesUpdate& update);
+  int ChooseLevel(
+    const std::vector<double>& values, const LevelChoice& choice, SurfacesUpdate& update);
   bool PlanLevel(const std::vector<double>& values, const LevelChoice& choice, int& level,
     const UpdateHooks& hooks, SurfacesUpdate& update);
   // Checks `bytes` against the process's allowance (see LargeAllocationBytes).
@@ -245,7 +244,7 @@ private:
  * The unit for a host's surface type (see the file's description). A host
  * holds one per input, and per update calls SetVolume() and Update().
  */
-template <typename Surface>
+template<typename Surface>
 class BlockLODSurfaces : public BlockLODSurfacesBase
 {
 public:
@@ -282,7 +281,7 @@ private:
 };
 
 //------------------------------------------------------------------------------
-template <typename Surface>
+template<typename Surface>
 SurfacesUpdate BlockLODSurfaces<Surface>::Update(const std::vector<double>& isovalues,
   const LevelChoice& choice, const SurfaceMaker<Surface>& maker, const UpdateHooks& hooks)
 {
@@ -313,7 +312,7 @@ SurfacesUpdate BlockLODSurfaces<Surface>::Update(const std::vector<double>& isov
 }
 
 //------------------------------------------------------------------------------
-template <typename Surface>
+template<typename Surface>
 bool BlockLODSurfaces<Surface>::Generate(const std::vector<double>& values, int level,
   const SurfaceMaker<Surface>& maker, const UpdateHooks& hooks, SurfacesUpdate& update)
 {
@@ -331,8 +330,8 @@ bool BlockLODSurfaces<Surface>::Generate(const std::vector<double>& values, int 
     const ExtractionPlan& plan = this->Plans[i];
     const SurfaceCounts counts = BlockLODVolume::CountsOf(plan);
     const double bytes = this->Layout.Bytes(counts);
-    const std::string what = "level " + std::to_string(level) + "'s surface of isovalue " +
-      FormatIsovalue(values[i]);
+    const std::string what =
+      "level " + std::to_string(level) + "'s surface of isovalue " + FormatIsovalue(values[i]);
     if (!this->Fits(bytes, what, update))
     {
       return false;
@@ -342,8 +341,8 @@ bool BlockLODSurfaces<Surface>::Generate(const std::vector<double>& values, int 
     {
       SurfaceTarget target;
       SurfaceRanges written;
-      if (!maker.Allocate(key, plan.GetNumberOfPoints(), plan.GetNumberOfTriangles(), surface,
-            target))
+      if (!maker.Allocate(
+            key, plan.GetNumberOfPoints(), plan.GetNumberOfTriangles(), surface, target))
       {
         this->RanOut(what, update);
         return false;

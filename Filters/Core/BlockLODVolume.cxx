@@ -268,7 +268,8 @@ double BlockLODVolume::PlanBytes(double isovalue, int level)
   }
   if (const BlockRanges* coarse = this->Impl->CoarseRanges(level, false))
   {
-    const std::int64_t active = static_cast<std::int64_t>(ListActiveBlocks(*coarse, isovalue).size());
+    const std::int64_t active =
+      static_cast<std::int64_t>(ListActiveBlocks(*coarse, isovalue).size());
     return ExtractionPlanBytes(coarse->GetNumberOfBlocks(), active, pass);
   }
   // The copy samples every stride-th point and the last one along each axis.
@@ -280,7 +281,8 @@ double BlockLODVolume::PlanBytes(double isovalue, int level)
     samples *= points;
     blocks *= (points - 1 + BlockCells - 1) / BlockCells;
   }
-  const double copy = samples * ScalarTypeSize(this->Description.Type) + blocks * 2 * sizeof(double);
+  const double copy =
+    samples * ScalarTypeSize(this->Description.Type) + blocks * 2 * sizeof(double);
   const auto copyBlocks = static_cast<std::int64_t>(blocks);
   return copy + ExtractionPlanBytes(copyBlocks, std::min(copyBlocks, fullActive), pass);
 }

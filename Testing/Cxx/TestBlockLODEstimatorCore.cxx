@@ -14,10 +14,10 @@
 //   defaults from one sample and stays non-negative on collinear samples;
 // - the byte layout and the AutoLOD level choice;
 // - SetVolume recomputes only for a changed description.
-#include "FanCaseTable.h"
-#include "MedicalTestUtilities.h"
 #include "BlockLODEstimator.h"
 #include "BlockLODVolume.h"
+#include "FanCaseTable.h"
+#include "MedicalTestUtilities.h"
 
 #include <cmath>
 #include <cstdint>

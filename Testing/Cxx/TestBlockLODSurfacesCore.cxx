@@ -46,8 +46,9 @@ struct Maker
   mediso::SurfaceMaker<MeshRef> Make()
   {
     mediso::SurfaceMaker<MeshRef> maker;
-    maker.Allocate = [this](const mediso::SurfaceKey&, std::int64_t points,
-                       std::int64_t triangles, MeshRef& mesh, mediso::SurfaceTarget& target) {
+    maker.Allocate = [this](const mediso::SurfaceKey&, std::int64_t points, std::int64_t triangles,
+                       MeshRef& mesh, mediso::SurfaceTarget& target)
+    {
       ++this->Allocations;
       if (this->Fail)
       {
@@ -157,8 +158,8 @@ void TestFixedLevelAndCache()
   // Again: a cache hit, no allocation, the same surface, no predicted seconds.
   Check(!unit.SetVolume(Describe(values, n, 1)), "the same description is not new");
   u = unit.Update({ 0.0 }, Fixed(3), maker.Make());
-  Check(u.Status == Outcome::Done && u.Extractions == 0 && u.CacheHits == 1 &&
-      maker.Allocations == 1,
+  Check(
+    u.Status == Outcome::Done && u.Extractions == 0 && u.CacheHits == 1 && maker.Allocations == 1,
     "a cached pair is not extracted again (" + Num(maker.Allocations) + " allocations)");
   Check(unit.GetSurfaces().at(0) == first, "the cache returns the same surface");
   Check(unit.EstimateSeconds(0.0, 3) == 0.0, "a cached pair costs 0 s");
@@ -229,11 +230,10 @@ void TestAutoLevel()
   u = unit.Update({ 0.0 }, Auto(0.5 * bytes[0]), maker.Make());
   Check(u.Status == Outcome::NothingFits && u.Level == -1 && unit.GetSurfaces().empty() &&
       maker.Allocations == allocations && std::abs(u.Level0Bytes - bytes[0]) < 1,
-    "a binding budget below level 0 makes nothing and says level 0's bytes (" +
-      Num(u.Level0Bytes) + ")");
+    "a binding budget below level 0 makes nothing and says level 0's bytes (" + Num(u.Level0Bytes) +
+      ")");
   u = unit.Update({ 0.0 }, Auto(0.5 * bytes[0], false), maker.Make());
-  Check(u.Status == Outcome::Done && u.Level == 0 && u.OverBudget &&
-      unit.GetSurfaces().size() == 1,
+  Check(u.Status == Outcome::Done && u.Level == 0 && u.OverBudget && unit.GetSurfaces().size() == 1,
     "a guiding budget below level 0 makes level 0 and says it is over");
 }
 
@@ -257,13 +257,13 @@ void TestRetryLower()
     const double level2 = probe.EstimateBytes(iso, 2);
     Maker maker;
     const mediso::SurfacesUpdate exact = probe.Update({ iso }, Fixed(3), maker.Make());
-    const double exactBytes = probe.GetLayout().Bytes(mediso::SurfaceCounts{
-      static_cast<double>(probe.GetSurfaces().at(0)->Points.size() / 3),
-      static_cast<double>(probe.GetSurfaces().at(0)->Triangles.size() / 3), 0 });
+    const double exactBytes = probe.GetLayout().Bytes(
+      mediso::SurfaceCounts{ static_cast<double>(probe.GetSurfaces().at(0)->Points.size() / 3),
+        static_cast<double>(probe.GetSurfaces().at(0)->Triangles.size() / 3), 0 });
     const mediso::SurfacesUpdate coarser = probe.Update({ iso }, Fixed(2), maker.Make());
-    const double exact2 = probe.GetLayout().Bytes(mediso::SurfaceCounts{
-      static_cast<double>(probe.GetSurfaces().at(0)->Points.size() / 3),
-      static_cast<double>(probe.GetSurfaces().at(0)->Triangles.size() / 3), 0 });
+    const double exact2 = probe.GetLayout().Bytes(
+      mediso::SurfaceCounts{ static_cast<double>(probe.GetSurfaces().at(0)->Points.size() / 3),
+        static_cast<double>(probe.GetSurfaces().at(0)->Triangles.size() / 3), 0 });
     if (e.Method == mediso::EstimateMethod::Exact || exact.Status != Outcome::Done ||
       coarser.Status != Outcome::Done || !(estimated < exactBytes) || !(level2 < estimated) ||
       !(exact2 < estimated))

@@ -75,7 +75,8 @@ SurfaceMaker<CPUSurfaceRef> CPUSurfaceMaker()
 {
   SurfaceMaker<CPUSurfaceRef> maker;
   maker.Allocate = [](const SurfaceKey&, std::int64_t points, std::int64_t triangles,
-                     CPUSurfaceRef& surface, SurfaceTarget& target) {
+                     CPUSurfaceRef& surface, SurfaceTarget& target)
+  {
     surface = std::make_shared<CPUSurface>();
     surface->Points.resize(3 * static_cast<std::size_t>(points));
     surface->Normals.resize(surface->Points.size());
