@@ -896,7 +896,7 @@ void vtkBlockLODContour::ReportUpdate(const mediso::SurfacesUpdate& update)
 {
   // With AutoLOD the choice fits the budget, or what the process may still
   // allocate when that is less: the messages name the one that bound.
-  const bool processBound = update.ChoiceBytes < this->MemoryBudget * BytesPerMB;
+  const bool processBound = this->AutoLOD && update.ChoiceBytes < this->MemoryBudget * BytesPerMB;
   std::ostringstream allowance;
   if (processBound)
   {
