@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkBlockLODContour.h"
 
-#include "BlockLODCache.h"
-#include "BlockLODEstimator.h"
-#include "BlockLODVolume.h"
+#include "BlockLODSurfaces.h"
+#include "ProcessMemory.h"
 
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
@@ -35,10 +34,11 @@
 #include "vtkUnsignedCharArray.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <mutex>
+#include <new>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -82,6 +82,8 @@ struct SurfaceArrays
   std::int64_t* Connectivity64 = nullptr;
 };
 
+// VTK's arrays report a failed allocation and stay empty (they do not throw):
+// Valid() is false then.
 SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const mediso::SurfaceLayout& layout)
 {
   SurfaceArrays out;
@@ -152,6 +154,17 @@ SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const
   return out;
 }
 
+bool Valid(const SurfaceArrays& a, std::int64_t points, std::int64_t triangles)
+{
+  vtkPolyData* s = a.Surface;
+  vtkCellArray* polys = s->GetPolys();
+  return s->GetNumberOfPoints() == points && polys->GetNumberOfCells() == triangles &&
+    polys->GetConnectivityArray()->GetNumberOfValues() == 3 * triangles &&
+    (!a.Normals || s->GetPointData()->GetNormals()->GetNumberOfTuples() == points) &&
+    (!a.Scalars || s->GetPointData()->GetScalars()->GetNumberOfTuples() == points) &&
+    (!a.BlockIds || s->GetCellData()->GetArray("BlockId")->GetNumberOfTuples() == triangles);
+}
+
 // "its point arrays: 'a' (1 component), 'b' (3 components)", or "it has no
 // point arrays", for messages about the array to contour.
 std::string DescribeArrays(vtkFieldData* data, const char* kind)
@@ -190,12 +203,30 @@ mediso::SurfaceLayout OutputLayout(vtkBlockLODContour* self)
 }
 
 // The cost model of EstimateSeconds(): it describes the machine, not an input,
-// so every filter of the process learns into and predicts from the same one.
-struct
+// so every filter of the process learns into and predicts from the same one
+// (made on first use, shared by the filters' surfaces units).
+std::shared_ptr<mediso::SharedCostModel> ProcessCostModel()
 {
-  std::mutex Mutex;
-  mediso::CostModel Model;
-} SharedCost;
+  static const std::shared_ptr<mediso::SharedCostModel> model =
+    std::make_shared<mediso::SharedCostModel>();
+  return model;
+}
+
+// "  (the process may still allocate 12.3 MB: the process's address-space
+// limit (ulimit -v))", for a message about memory that ran out.
+std::string DescribeAllowance()
+{
+  const mediso::MemoryAllowance allowance = mediso::ProcessMemoryAllowance();
+  std::ostringstream text;
+  text.setf(std::ios::fixed);
+  text.precision(1);
+  if (allowance.Bounded())
+  {
+    text << " (the process may still allocate " << static_cast<double>(allowance.Bytes) / BytesPerMB
+         << " MB: " << allowance.Limit << ")";
+  }
+  return text.str();
+}
 
 // Stores a vector array's ranges in VTK's range cache (per component and of
 // the length, finite or not: the array holds only finite values).
@@ -274,18 +305,10 @@ double Now()
 
 struct vtkBlockLODContour::vtkInternals
 {
-  mediso::BlockLODVolume Volume{ VTKCaseTable(), SMPFor };
-  mediso::BlockLODEstimator Estimator{ Volume };
-  mediso::SurfaceCache<vtkSmartPointer<vtkPolyData>> Cache;
-  mediso::SurfaceLayout CacheLayout;
+  // The core's volume, estimator, cache and planning (Filters/Core/BlockLODSurfaces.h).
+  mediso::BlockLODSurfaces<vtkSmartPointer<vtkPolyData>> Surfaces{ VTKCaseTable(), SMPFor,
+    ProcessCostModel() };
   bool WarnedMissing = false; // NaN or infinite values, once per input
-
-  // What the last RequestData planned (one plan per isovalue, kept between
-  // updates so that their buffers are reused, not faulted in again) and
-  // generated, and the counts of the pairs it extracted (for the cost model).
-  std::vector<mediso::ExtractionPlan> Plans;
-  std::vector<vtkSmartPointer<vtkPolyData>> Surfaces;
-  mediso::SurfaceCounts Extracted;
 
   // Cells that are not ghosts, as an inclusive cell index range per axis:
   // ghost layers of a structured piece are whole slabs at its faces. Without
@@ -403,15 +426,47 @@ struct vtkBlockLODContour::vtkInternals
   // counts and surfaces of the old one are forgotten).
   bool Refresh(const mediso::VolumeDescription& description)
   {
-    if (!this->Volume.SetVolume(description))
+    if (!this->Surfaces.SetVolume(description))
     {
       return false;
     }
-    this->Estimator.Reset();
-    this->Cache.Clear();
-    this->Plans.clear(); // sized for the old input
     this->WarnedMissing = false;
     return true;
+  }
+
+  // How the filter's output arrays are made from the core's plans.
+  static mediso::SurfaceMaker<vtkSmartPointer<vtkPolyData>> Maker(
+    const mediso::SurfaceLayout& layout)
+  {
+    mediso::SurfaceMaker<vtkSmartPointer<vtkPolyData>> maker;
+    maker.Allocate = [layout](const mediso::SurfaceKey&, std::int64_t points,
+                       std::int64_t triangles, vtkSmartPointer<vtkPolyData>& surface,
+                       mediso::SurfaceTarget& target)
+    {
+      SurfaceArrays arrays = AllocateSurface(points, triangles, layout);
+      if (!Valid(arrays, points, triangles))
+      {
+        return false;
+      }
+      surface = arrays.Surface;
+      target.UseWide = arrays.Connectivity64 != nullptr;
+      target.Narrow.Connectivity = arrays.Connectivity32;
+      target.Wide.Connectivity = arrays.Connectivity64;
+      target.Narrow.Points = target.Wide.Points = arrays.Points;
+      target.Narrow.Normals = target.Wide.Normals = arrays.Normals;
+      target.Narrow.Scalars = target.Wide.Scalars = arrays.Scalars;
+      target.Narrow.BlockIds = target.Wide.BlockIds = arrays.BlockIds;
+      return true;
+    };
+    maker.Finish = [](const mediso::SurfaceKey& key, vtkSmartPointer<vtkPolyData>& surface,
+                     const mediso::SurfaceRanges& written)
+    {
+      CacheRanges(surface->GetPoints()->GetData(), written.Points);
+      CacheRanges(surface->GetPointData()->GetNormals(), written.Normals);
+      const double iso = static_cast<float>(key.Isovalue); // the scalars' value, as stored
+      CacheRanges(surface->GetPointData()->GetScalars(), iso, iso);
+    };
+    return maker;
   }
 };
 
@@ -479,25 +534,25 @@ int vtkBlockLODContour::FillInputPortInformation(int, vtkInformation* info)
 
 void vtkBlockLODContour::ClearCache()
 {
-  this->Internals->Cache.Clear();
+  this->Internals->Surfaces.ClearCache();
 }
 
 double vtkBlockLODContour::GetCacheMegabytes()
 {
-  return this->Internals->Cache.GetBytes() / BytesPerMB;
+  return this->Internals->Surfaces.GetCacheBytes() / BytesPerMB;
 }
 
 //------------------------------------------------------------------------------
 double vtkBlockLODContour::EstimateTriangles(double isovalue, int level)
 {
-  const mediso::SurfaceEstimate e = this->Internals->Estimator.Estimate(isovalue, level);
+  const mediso::SurfaceEstimate e = this->Internals->Surfaces.Estimate(isovalue, level);
   this->LastEstimateMethod = static_cast<int>(e.Method);
   return e.Method == mediso::EstimateMethod::None ? -1.0 : e.Counts.Triangles;
 }
 
 double vtkBlockLODContour::EstimateMegabytes(double isovalue, int level)
 {
-  const mediso::SurfaceEstimate e = this->Internals->Estimator.Estimate(isovalue, level);
+  const mediso::SurfaceEstimate e = this->Internals->Surfaces.Estimate(isovalue, level);
   this->LastEstimateMethod = static_cast<int>(e.Method);
   return e.Method == mediso::EstimateMethod::None
     ? -1.0
@@ -506,20 +561,10 @@ double vtkBlockLODContour::EstimateMegabytes(double isovalue, int level)
 
 double vtkBlockLODContour::EstimateSeconds(double isovalue, int level)
 {
-  vtkInternals& in = *this->Internals;
-  if (in.Volume.IsValid() && in.Cache.Contains(mediso::SurfaceKey{ isovalue, level }))
-  {
-    this->LastEstimateMethod = static_cast<int>(mediso::EstimateMethod::Exact);
-    return 0.0; // served from the cache
-  }
-  const mediso::SurfaceEstimate e = in.Estimator.Estimate(isovalue, level);
-  this->LastEstimateMethod = static_cast<int>(e.Method);
-  if (e.Method == mediso::EstimateMethod::None)
-  {
-    return -1.0;
-  }
-  std::lock_guard<std::mutex> lock(SharedCost.Mutex);
-  return SharedCost.Model.Predict(level, e.Counts);
+  mediso::EstimateMethod method = mediso::EstimateMethod::None;
+  const double seconds = this->Internals->Surfaces.EstimateSeconds(isovalue, level, &method);
+  this->LastEstimateMethod = static_cast<int>(method);
+  return seconds;
 }
 
 //------------------------------------------------------------------------------
@@ -536,57 +581,92 @@ int vtkBlockLODContour::RequestData(
   {
     return 0;
   }
+  // A failed allocation is checked for before it is made (BlockLODSurfaces.h,
+  // and before the output is assembled); this is the last resort.
+  const char* step = "checking the input";
+  try
+  {
+    this->Execute(inputVector, input, output, step);
+  }
+  catch (const std::bad_alloc&)
+  {
+    output->Initialize();
+    this->ChosenLevel = -1;
+    vtkErrorMacro("The process ran out of memory while " << step << DescribeAllowance()
+                                                         << ". The output is empty.");
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODContour::Execute(
+  vtkInformationVector** inputVector, vtkImageData* input, vtkPolyData* output, const char*& step)
+{
   vtkInternals& in = *this->Internals;
-  in.Surfaces.clear();
-  in.Extracted = mediso::SurfaceCounts();
   const double start = Now();
 
   // Check: an array the core can read, on a grid it can contour.
   vtkDataArray* array = this->CheckInput(input, inputVector);
   if (!array || this->ContourValues->GetNumberOfContours() < 1)
   {
-    return 1;
+    return;
   }
   // Refresh block ranges (kept while the input stays the same).
-  const bool refreshed =
-    in.Refresh(vtkInternals::Describe(input, array, inputVector[0]->GetInformationObject(0)));
-  if (refreshed)
+  step = "computing the block ranges";
+  if (in.Refresh(vtkInternals::Describe(input, array, inputVector[0]->GetInformationObject(0))))
   {
     ++this->NumberOfBlockRangeComputations;
   }
-  const int coarseCopies = in.Volume.GetNumberOfCoarseCopies();
   this->UpdateProgress(0.1);
   const std::vector<double> values = this->IsovaluesWithSurface();
   if (values.empty())
   {
-    return 1;
+    return;
   }
-  // Choose the level, plan it (exact sizes before any allocation), generate, output.
-  int level = this->ChooseLevel(values);
-  if (level < 0 || !this->PlanLevel(values, level))
+  // Choose the level, plan it (exact sizes before any allocation), generate
+  // (BlockLODSurfaces), then assemble the output.
+  step = "making the surfaces";
+  const mediso::SurfaceLayout layout = OutputLayout(this);
+  in.Surfaces.SetLayout(layout);
+  in.Surfaces.SetCacheLimit(this->CacheMemoryLimit * BytesPerMB);
+  mediso::LevelChoice choice;
+  choice.Level = this->AutoLOD ? mediso::LevelChoice::Auto : this->LOD;
+  choice.BudgetBytes = this->MemoryBudget * BytesPerMB;
+  mediso::UpdateHooks hooks;
+  hooks.PollAbort = [this]() { return this->GetAbortExecute() != 0; };
+  hooks.CheckAbort = [this]() { return this->CheckAbort(); };
+  hooks.Planned = [this, &values](int level)
   {
-    output->Initialize();
-    return 1;
-  }
-  this->ChosenLevel = level;
-  this->ReportEstimates(values[0]);
-  this->UpdateProgress(0.5);
-  if (!this->GenerateLevel(values, level))
+    this->ChosenLevel = level;
+    this->ReportEstimates(values[0]);
+    this->UpdateProgress(0.5);
+  };
+  const mediso::SurfacesUpdate update =
+    in.Surfaces.Update(values, choice, vtkInternals::Maker(layout), hooks);
+  this->NumberOfExtractions += update.Extractions;
+  this->NumberOfCacheHits += update.CacheHits;
+  this->ReportUpdate(update);
+  if (update.Status != mediso::SurfacesUpdate::Outcome::Done)
   {
+    if (update.Status == mediso::SurfacesUpdate::Outcome::OutOfMemory)
+    {
+      this->ChosenLevel = -1; // nothing was made
+    }
     output->Initialize();
-    return 1;
+    return;
   }
   this->UpdateProgress(0.9);
-  this->AssembleOutput(output);
+  step = "assembling the output";
+  if (!this->AssembleOutput(output))
+  {
+    output->Initialize();
+    this->ChosenLevel = -1;
+    return;
+  }
   // The cost model learns from updates that extracted something and did no
   // one-time work (block ranges, coarse copies).
-  if (in.Extracted.Cubes > 0 && !refreshed && in.Volume.GetNumberOfCoarseCopies() == coarseCopies)
-  {
-    std::lock_guard<std::mutex> lock(SharedCost.Mutex);
-    SharedCost.Model.Record(level, in.Extracted.Cubes, in.Extracted.Triangles, Now() - start);
-  }
+  in.Surfaces.RecordCost(update, Now() - start);
   this->UpdateProgress(1.0);
-  return 1;
 }
 
 //------------------------------------------------------------------------------
@@ -749,11 +829,11 @@ vtkDataArray* vtkBlockLODContour::CheckInput(vtkImageData* input, vtkInformation
 std::vector<double> vtkBlockLODContour::IsovaluesWithSurface()
 {
   vtkInternals& in = *this->Internals;
-  const mediso::BlockRanges& ranges = in.Volume.GetRanges();
+  const mediso::BlockRanges& ranges = in.Surfaces.GetVolume().GetRanges();
   std::vector<double> values;
   // A parallel piece may well lie outside an isovalue (all air, say): only a
   // whole volume warns about its range.
-  const bool piece = in.Volume.GetDescription().IsPiece();
+  const bool piece = in.Surfaces.GetVolume().GetDescription().IsPiece();
   if (!ranges.HasFiniteValues())
   {
     if (piece)
@@ -812,71 +892,62 @@ std::vector<double> vtkBlockLODContour::IsovaluesWithSurface()
 }
 
 //------------------------------------------------------------------------------
-int vtkBlockLODContour::ChooseLevel(const std::vector<double>& values)
+void vtkBlockLODContour::ReportUpdate(const mediso::SurfacesUpdate& update)
 {
-  if (!this->AutoLOD)
+  // With AutoLOD the choice fits the budget, or what the process may still
+  // allocate when that is less: the messages name the one that bound.
+  const bool processBound = this->AutoLOD && update.ChoiceBytes < this->MemoryBudget * BytesPerMB;
+  std::ostringstream allowance;
+  if (processBound)
   {
-    return this->LOD;
+    allowance << update.ChoiceBytes / BytesPerMB << " MB the process may still allocate ("
+              << update.Allowance.Limit << ")";
   }
-  double level0Bytes = 0;
-  const int level = this->Internals->Estimator.ChooseLevel(
-    values, this->MemoryBudget * BytesPerMB, OutputLayout(this), level0Bytes);
-  if (level < 0)
+  for (const auto& dropped : update.Dropped)
   {
-    vtkErrorMacro("MemoryBudget " << this->MemoryBudget << " MB is too small: even level 0 needs "
-                                  << level0Bytes / BytesPerMB << " MB. The output is empty.");
+    if (processBound)
+    {
+      vtkWarningMacro("Level " << dropped.first << " needs " << dropped.second / BytesPerMB
+                               << " MB, over the " << allowance.str()
+                               << " (the estimate was low): using level " << dropped.first - 1
+                               << ".");
+    }
+    else
+    {
+      vtkWarningMacro("Level " << dropped.first << " needs " << dropped.second / BytesPerMB
+                               << " MB, over the MemoryBudget of " << this->MemoryBudget
+                               << " MB (the estimate was low): using level " << dropped.first - 1
+                               << ".");
+    }
   }
-  return level;
-}
-
-//------------------------------------------------------------------------------
-bool vtkBlockLODContour::PlanLevel(const std::vector<double>& values, int& level)
-{
-  vtkInternals& in = *this->Internals;
-  const mediso::SurfaceLayout layout = OutputLayout(this);
-  if (layout != in.CacheLayout)
+  using Outcome = mediso::SurfacesUpdate::Outcome;
+  if (update.Status == Outcome::NothingFits)
   {
-    in.Cache.Clear();
-    in.CacheLayout = layout;
+    const char* needs = update.Level0Planned ? "level 0 needs " : "even level 0 needs ";
+    if (processBound)
+    {
+      vtkErrorMacro("MemoryBudget "
+        << this->MemoryBudget << " MB is more than the " << allowance.str() << ", and " << needs
+        << update.Level0Bytes / BytesPerMB << " MB. The output is empty.");
+    }
+    else
+    {
+      vtkErrorMacro("MemoryBudget " << this->MemoryBudget << " MB is too small: " << needs
+                                    << update.Level0Bytes / BytesPerMB
+                                    << " MB. The output is empty.");
+    }
   }
-  const double budgetBytes = this->MemoryBudget * BytesPerMB;
-  auto abort = [this]() { return this->GetAbortExecute() != 0; };
-  for (;;)
+  else if (update.Status == Outcome::OutOfMemory)
   {
-    in.Plans.resize(values.size());
-    double bytes = 0;
-    for (std::size_t i = 0; i < values.size(); ++i)
-    {
-      const double v = values[i];
-      const mediso::SurfaceKey key{ v, level };
-      if (in.Cache.Contains(key))
-      {
-        bytes += in.Cache.EntryBytes(key);
-        continue;
-      }
-      mediso::ExtractionPlan& plan = in.Plans[i];
-      if (!in.Volume.Plan(v, level, plan, abort) || this->CheckAbort())
-      {
-        return false;
-      }
-      const mediso::SurfaceCounts exact = mediso::BlockLODVolume::CountsOf(plan);
-      in.Estimator.RecordExact(v, level, exact);
-      bytes += layout.Bytes(exact);
-    }
-    if (!this->AutoLOD || bytes <= budgetBytes)
-    {
-      return true;
-    }
-    if (level == 0)
-    {
-      vtkErrorMacro("MemoryBudget " << this->MemoryBudget << " MB is too small: level 0 needs "
-                                    << bytes / BytesPerMB << " MB. The output is empty.");
-      return false;
-    }
-    vtkWarningMacro("Level " << level << " needs " << bytes / BytesPerMB
-                             << " MB, over the MemoryBudget of " << this->MemoryBudget
-                             << " MB (the estimate was low): using level " << level - 1 << ".");
-    --level;
+    std::string message = update.Message;
+    message[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(message[0])));
+    vtkErrorMacro(<< message << ". The output is empty.");
+  }
+  else if (update.Status == Outcome::Done && update.LimitedByProcess)
+  {
+    vtkWarningMacro("Level " << update.BudgetLevel << " fits the MemoryBudget of "
+                             << this->MemoryBudget << " MB but not the " << allowance.str()
+                             << ": using level " << update.Level << ".");
   }
 }
 
@@ -894,70 +965,9 @@ void vtkBlockLODContour::ReportEstimates(double isovalue)
 }
 
 //------------------------------------------------------------------------------
-bool vtkBlockLODContour::GenerateLevel(const std::vector<double>& values, int level)
+bool vtkBlockLODContour::AssembleOutput(vtkPolyData* output)
 {
-  vtkInternals& in = *this->Internals;
-  const mediso::SurfaceLayout layout = OutputLayout(this);
-  std::vector<mediso::SurfaceKey> used;
-  for (std::size_t i = 0; i < values.size(); ++i)
-  {
-    const mediso::SurfaceKey key{ values[i], level };
-    used.push_back(key);
-    if (vtkSmartPointer<vtkPolyData>* cached = in.Cache.Find(key))
-    {
-      ++this->NumberOfCacheHits;
-      in.Surfaces.push_back(*cached);
-      continue;
-    }
-    const mediso::ExtractionPlan& plan = in.Plans[i];
-    SurfaceArrays arrays =
-      AllocateSurface(plan.GetNumberOfPoints(), plan.GetNumberOfTriangles(), layout);
-      mediso::SurfaceRanges written;
-    auto generate = [&](auto* connectivity) {
-      mediso::SurfaceBuffers<std::remove_pointer_t<decltype(connectivity)>> buffers;
-      buffers.Points = arrays.Points;
-      buffers.Normals = arrays.Normals;
-      buffers.Scalars = arrays.Scalars;
-      buffers.BlockIds = arrays.BlockIds;
-      buffers.Connectivity = connectivity;
-      buffers.Ranges = &written;
-      in.Volume.Generate(plan, buffers);
-    };
-    if (arrays.Connectivity32)
-    {
-      generate(arrays.Connectivity32);
-    }
-    else
-    {
-      generate(arrays.Connectivity64);
-    }
-    vtkPolyData* surface = arrays.Surface;
-    CacheRanges(surface->GetPoints()->GetData(), written.Points);
-    CacheRanges(surface->GetPointData()->GetNormals(), written.Normals);
-    const double iso = static_cast<float>(values[i]); // the scalars' value, as stored
-    CacheRanges(surface->GetPointData()->GetScalars(), iso, iso);
-    ++this->NumberOfExtractions;
-    const mediso::SurfaceCounts counts = mediso::BlockLODVolume::CountsOf(plan);
-    in.Extracted.Cubes += counts.Cubes;
-    in.Extracted.Triangles += counts.Triangles;
-    in.Surfaces.push_back(arrays.Surface);
-    if (this->CacheMemoryLimit > 0)
-    {
-      in.Cache.Insert(key, arrays.Surface, layout.Bytes(counts));
-    }
-    if (this->CheckAbort())
-    {
-      return false;
-    }
-  }
-  in.Cache.Evict(this->CacheMemoryLimit * BytesPerMB, used);
-  return true;
-}
-
-//------------------------------------------------------------------------------
-void vtkBlockLODContour::AssembleOutput(vtkPolyData* output)
-{
-  const std::vector<vtkSmartPointer<vtkPolyData>>& pieces = this->Internals->Surfaces;
+  const std::vector<vtkSmartPointer<vtkPolyData>>& pieces = this->Internals->Surfaces.GetSurfaces();
   if (pieces.size() == 1)
   {
     output->ShallowCopy(pieces[0]);
@@ -970,7 +980,23 @@ void vtkBlockLODContour::AssembleOutput(vtkPolyData* output)
       points += p->GetNumberOfPoints();
       triangles += p->GetNumberOfPolys();
     }
-    SurfaceArrays all = AllocateSurface(points, triangles, OutputLayout(this));
+    // One more copy of every surface: checked before it is made.
+    const mediso::SurfaceLayout layout = OutputLayout(this);
+    const double bytes = layout.Bytes(static_cast<double>(points), static_cast<double>(triangles));
+    std::string message;
+    if (bytes >= mediso::BlockLODSurfacesBase::LargeAllocationBytes &&
+      !mediso::FitsInProcessMemory(static_cast<std::uint64_t>(bytes), "The output", message))
+    {
+      vtkErrorMacro(<< message << ". The output is empty.");
+      return false;
+    }
+    SurfaceArrays all = AllocateSurface(points, triangles, layout);
+    if (!Valid(all, points, triangles))
+    {
+      vtkErrorMacro("The output (" << bytes / BytesPerMB
+                                   << " MB) could not be allocated. The output is empty.");
+      return false;
+    }
     mediso::SurfaceRanges merged;
     double scalars[2] = { 1e300, -1e300 };
     std::int64_t p0 = 0, t0 = 0;
@@ -1046,6 +1072,7 @@ void vtkBlockLODContour::AssembleOutput(vtkPolyData* output)
   addField("BlockLODEstimatedTriangles", this->EstimatedTriangles, 4);
   addField("BlockLODEstimatedMB", this->EstimatedMegabytes, 4);
   addField("BlockLODEstimatedSeconds", this->EstimatedSeconds, 4);
+  return true;
 }
 
 //------------------------------------------------------------------------------

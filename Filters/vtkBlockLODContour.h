@@ -11,10 +11,12 @@
  * budget. The method is the VTK-free core in Filters/Core, which documents
  * it: BlockLOD.h (blocks, levels, point merging, normals), BlockLODVolume.h
  * (one input with its block ranges and coarse copies), BlockLODEstimator.h
- * (the memory and time estimates, the level choice) and BlockLODCache.h (the
- * (isovalue, level) surface cache). This class converts the input and output
- * and runs, per update: check the input, refresh the block ranges, choose the
- * level, plan it, generate the surfaces, assemble the output. In short:
+ * (the memory and time estimates, the level choice), BlockLODCache.h (the
+ * (isovalue, level) surface cache) and BlockLODSurfaces.h (all of them behind
+ * one update, as the web page runs them too). This class converts the input
+ * and output and runs, per update: check the input, describe it to the core
+ * (block ranges refreshed when it changed), let the core choose the level,
+ * plan it and generate the surfaces, assemble the output. In short:
  *
  * -# Block ranges. The minimum and maximum of every block are computed once
  *    per input array (in parallel) and kept until the input data, the array or
@@ -51,7 +53,14 @@
  *    counts are known before any output is allocated, so an underestimate
  *    never pushes the process past the budget: the filter drops to a coarser
  *    level and warns. If even level 0 does not fit, it reports an error and
- *    produces nothing.
+ *    produces nothing. A budget larger than what the process may still
+ *    allocate (ProcessMemory.h: free memory, `ulimit -v`, a cgroup's limit)
+ *    is not trusted: the level fits the smaller of the two, with a warning
+ *    when the process's allowance lowered it.
+ * -# Memory. Every plan, surface and merged output is checked against what
+ *    the process may still allocate before it is allocated; one that does not
+ *    fit gives one error naming it and an empty output, and a failed
+ *    allocation (std::bad_alloc) never leaves RequestData.
  *
  * Output: triangles (64-bit connectivity, VTK's own; 32-bit while it fits
  * with CompactIds), point normals ("Normals", optional), the isovalue as
@@ -107,6 +116,10 @@
 
 class vtkDataArray;
 class vtkImageData;
+namespace mediso
+{
+struct SurfacesUpdate;
+}
 
 class MEDICALISOSURFACESFILTERS_EXPORT vtkBlockLODContour : public vtkPolyDataAlgorithm
 {
@@ -302,12 +315,15 @@ private:
   // The steps of RequestData, in order (ChooseArray is part of CheckInput).
   vtkDataArray* ChooseArray(vtkImageData* input, vtkInformationVector** inputVector);
   vtkDataArray* CheckInput(vtkImageData* input, vtkInformationVector** inputVector);
+  // Execute runs them; `step` names the one running (for a message when
+  // memory runs out). Choosing, planning and generating are the core's
+  // (BlockLODSurfaces); ReportUpdate says what they did.
+  void Execute(vtkInformationVector** inputVector, vtkImageData* input, vtkPolyData* output,
+    const char*& step);
   std::vector<double> IsovaluesWithSurface();
-  int ChooseLevel(const std::vector<double>& values);
-  bool PlanLevel(const std::vector<double>& values, int& level);
   void ReportEstimates(double isovalue);
-  bool GenerateLevel(const std::vector<double>& values, int level);
-  void AssembleOutput(vtkPolyData* output);
+  void ReportUpdate(const mediso::SurfacesUpdate& update);
+  bool AssembleOutput(vtkPolyData* output);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

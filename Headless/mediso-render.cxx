@@ -444,7 +444,7 @@ public:
     std::string error;
     const auto start = Clock::now();
     if (!this->Pyramid.UploadVolume(this->Image.Type, this->Image.Bytes.data(),
-          this->Image.Dimensions, headless::ThreadedFor, error))
+          this->Image.Dimensions, ThreadedFor, error))
     {
       return error;
     }

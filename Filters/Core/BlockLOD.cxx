@@ -624,6 +624,18 @@ void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const Para
   ranges.ValueRange[1] = *std::max_element(ranges.Max.begin(), ranges.Max.end());
 }
 
+double ExtractionPlanBytes(std::int64_t blocks, std::int64_t activeBlocks, int level)
+{
+  // The vectors PlanExtraction() sizes below, per block and per active block.
+  const int cubesPerAxis = BlockCells / LevelStride(level);
+  const double perActive = sizeof(std::int32_t) + 2 * sizeof(std::int64_t) +
+    cubesPerAxis * cubesPerAxis * cubesPerAxis * sizeof(std::uint8_t) +
+    CubeWordsPerBlock(level) * sizeof(std::uint64_t) +
+    WordsPerBlock(level) * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
+  return static_cast<double>(blocks) * sizeof(std::int32_t) +
+    static_cast<double>(activeBlocks) * perActive;
+}
+
 template <typename T>
 bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
   double isovalue, int level, ExtractionPlan& plan, const ParallelFor& parallel,

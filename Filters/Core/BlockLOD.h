@@ -223,6 +223,10 @@ struct ExtractionPlan
   }
 };
 
+/// Bytes a plan of `level` holds for a volume of `blocks` blocks, `activeBlocks`
+/// of them active (what PlanExtraction() allocates, for a check before it does).
+double ExtractionPlanBytes(std::int64_t blocks, std::int64_t activeBlocks, int level);
+
 /// Pass 1: active blocks, cut-edge masks and exact point and triangle counts.
 /// `abort` (may be empty) is polled between blocks; when it returns true the
 /// plan is left incomplete and false is returned.

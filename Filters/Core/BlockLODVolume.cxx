@@ -257,6 +257,36 @@ SurfaceCounts BlockLODVolume::CountsOf(const ExtractionPlan& plan)
   return c;
 }
 
+double BlockLODVolume::PlanBytes(double isovalue, int level)
+{
+  // Plan() runs the full-resolution pass on the level's volume.
+  const int pass = NumberOfLevels - 1;
+  const std::int64_t fullActive = static_cast<std::int64_t>(this->ActiveBlocks(isovalue).size());
+  if (level >= pass)
+  {
+    return ExtractionPlanBytes(this->Ranges.GetNumberOfBlocks(), fullActive, pass);
+  }
+  if (const BlockRanges* coarse = this->Impl->CoarseRanges(level, false))
+  {
+    const std::int64_t active =
+      static_cast<std::int64_t>(ListActiveBlocks(*coarse, isovalue).size());
+    return ExtractionPlanBytes(coarse->GetNumberOfBlocks(), active, pass);
+  }
+  // The copy samples every stride-th point and the last one along each axis.
+  const int stride = LevelStride(level);
+  double samples = 1, blocks = 1;
+  for (int a = 0; a < 3; ++a)
+  {
+    const int points = (this->Description.Dims[a] - 1 + stride - 1) / stride + 1;
+    samples *= points;
+    blocks *= (points - 1 + BlockCells - 1) / BlockCells;
+  }
+  const double copy =
+    samples * ScalarTypeSize(this->Description.Type) + blocks * 2 * sizeof(double);
+  const auto copyBlocks = static_cast<std::int64_t>(blocks);
+  return copy + ExtractionPlanBytes(copyBlocks, std::min(copyBlocks, fullActive), pass);
+}
+
 double BlockLODVolume::BlockCost(int level)
 {
   // Measured on the project's machine: 0.12, 0.16, 0.49 and 1.5 microseconds.

@@ -107,6 +107,11 @@ public:
   /// Exact counts of a plan made by Plan().
   static SurfaceCounts CountsOf(const ExtractionPlan& plan);
 
+  /// Bytes Plan() would allocate for an (isovalue, level): the plan, and the
+  /// level's coarse copy with its block ranges when it is not made yet (then
+  /// the copy's active blocks are bounded by the full volume's).
+  double PlanBytes(double isovalue, int level);
+
   /// The cost of counting one block of a level on the full volume, relative
   /// to level 0 (a block of level 3 classifies 729 samples, of level 0 eight).
   static double BlockCost(int level);

@@ -132,7 +132,12 @@ MemoryAllowance ProcessMemoryAllowance()
 //------------------------------------------------------------------------------
 bool FitsInProcessMemory(std::uint64_t bytes, const char* what, std::string& message)
 {
-  const MemoryAllowance allowance = ProcessMemoryAllowance();
+  return FitsInAllowance(ProcessMemoryAllowance(), bytes, what, message);
+}
+
+bool FitsInAllowance(
+  const MemoryAllowance& allowance, std::uint64_t bytes, const char* what, std::string& message)
+{
   if (bytes <= allowance.Bytes)
   {
     return true;

@@ -58,6 +58,11 @@ MemoryAllowance ProcessMemoryAllowance();
  */
 bool FitsInProcessMemory(std::uint64_t bytes, const char* what, std::string& message);
 
+/// The same against an allowance read earlier (a host that checks several
+/// allocations of one step reads the allowance once and counts them off it).
+bool FitsInAllowance(
+  const MemoryAllowance& allowance, std::uint64_t bytes, const char* what, std::string& message);
+
 } // namespace mediso
 
 #endif

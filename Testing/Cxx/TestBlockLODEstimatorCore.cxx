@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Unit test of the VTK-free block LOD volume and estimator
 // (Filters/Core/BlockLODVolume.h, BlockLODEstimator.h), without VTK. The
-// marching-cubes table is this test's own (the core takes the table as data):
-// each case fans triangles over its cut edges, min(5, cut edges - 2) of them,
-// so that exact counts can be recomputed here by brute force.
+// marching-cubes table is the tests' own (FanCaseTable.h; the core takes the
+// table as data), so that exact counts can be recomputed here by brute force.
 // - Plan's exact points and triangles equal a brute-force count over every
 //   cube of each level's sample grid (with NaN voxels and a size that is no
 //   multiple of 8);
@@ -15,9 +14,10 @@
 //   defaults from one sample and stays non-negative on collinear samples;
 // - the byte layout and the AutoLOD level choice;
 // - SetVolume recomputes only for a changed description.
-#include "MedicalTestUtilities.h"
 #include "BlockLODEstimator.h"
 #include "BlockLODVolume.h"
+#include "FanCaseTable.h"
+#include "MedicalTestUtilities.h"
 
 #include <cmath>
 #include <cstdint>
@@ -29,44 +29,8 @@ namespace
 {
 using medical_test::Check;
 
-// Corners and edges in vtkMarchingCubes' numbering (the layout the core expects).
-constexpr int Corner[8][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { 0, 0, 1 },
-  { 1, 0, 1 }, { 1, 1, 1 }, { 0, 1, 1 } };
-constexpr int Edge[12][2] = { { 0, 1 }, { 1, 2 }, { 3, 2 }, { 0, 3 }, { 4, 5 }, { 5, 6 }, { 7, 6 },
-  { 4, 7 }, { 0, 4 }, { 1, 5 }, { 3, 7 }, { 2, 6 } };
-
-struct FanTable
-{
-  int Cases[256][16];
-  int Count[256];
-  FanTable()
-  {
-    for (int c = 0; c < 256; ++c)
-    {
-      int cut[12], n = 0;
-      for (int e = 0; e < 12; ++e)
-      {
-        if (((c >> Edge[e][0]) & 1) != ((c >> Edge[e][1]) & 1))
-        {
-          cut[n++] = e;
-        }
-      }
-      this->Count[c] = n >= 3 ? std::min(5, n - 2) : 0;
-      int* out = this->Cases[c];
-      for (int i = 0; i < 16; ++i)
-      {
-        out[i] = -1;
-      }
-      for (int t = 0; t < this->Count[c]; ++t)
-      {
-        out[3 * t] = cut[0];
-        out[3 * t + 1] = cut[t + 1];
-        out[3 * t + 2] = cut[t + 2];
-      }
-    }
-  }
-};
-const FanTable Table;
+using medical_test::Corner;
+const medical_test::FanTable& Table = medical_test::FanCases;
 
 struct Field
 {

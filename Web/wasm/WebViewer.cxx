@@ -21,9 +21,7 @@
  * either path.
  */
 #include "BlockLOD.h"
-#include "BlockLODCache.h"
-#include "BlockLODEstimator.h"
-#include "BlockLODVolume.h"
+#include "BlockLODSurfaces.h"
 #include "Camera.h"
 #include "GLApiFunctions.h"
 #include "GLProbe.h"
@@ -70,6 +68,31 @@ struct CPUSurface
     return 4.0 * (this->Points.size() + this->Normals.size() + this->Triangles.size());
   }
 };
+/// What the CPU path's estimates count: normals, no scalars, block ids or offsets.
+const SurfaceLayout CPULayout{ true, false, false, false };
+
+/// As the surfaces unit holds it: shared by its cache and the update's list.
+using CPUSurfaceRef = std::shared_ptr<CPUSurface>;
+
+/// How the CPU path's surfaces are made: plain vectors, 32-bit indices.
+SurfaceMaker<CPUSurfaceRef> CPUSurfaceMaker()
+{
+  SurfaceMaker<CPUSurfaceRef> maker;
+  maker.Allocate = [](const SurfaceKey&, std::int64_t points, std::int64_t triangles,
+                     CPUSurfaceRef& surface, SurfaceTarget& target)
+  {
+    surface = std::make_shared<CPUSurface>();
+    surface->Points.resize(3 * static_cast<std::size_t>(points));
+    surface->Normals.resize(surface->Points.size());
+    surface->Triangles.resize(3 * static_cast<std::size_t>(triangles));
+    target.Narrow.Points = surface->Points.data();
+    target.Narrow.Normals = surface->Normals.data();
+    target.Narrow.Connectivity = reinterpret_cast<std::int32_t*>(surface->Triangles.data());
+    return true;
+  };
+  maker.Bytes = [](const CPUSurfaceRef& surface) { return surface->Bytes(); };
+  return maker;
+}
 
 /// Mesh slots: the CPU path's surfaces, then the server's result.
 constexpr int ResultSlot = MaximumIsovalues;
@@ -232,9 +255,7 @@ public:
     std::copy(this->Placement.Origin, this->Placement.Origin + 3, description.Origin);
     std::copy(this->Placement.Spacing, this->Placement.Spacing + 3, description.Spacing);
     description.Stamp = ++this->VolumeStamp;
-    this->CPUVolume.SetVolume(description);
-    this->Estimator.Reset();
-    this->Cache.Clear();
+    this->CPU.SetVolume(description);
     this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
     this->ResetCamera();
     return true;
@@ -259,10 +280,10 @@ public:
       double triangles = 0.0, bytes = 0.0, seconds = 0.0;
       for (const IsosurfaceLook& s : this->Frame.Surfaces)
       {
-        const SurfaceEstimate e = this->Estimator.Estimate(s.Value, level);
+        const SurfaceEstimate e = this->CPU.Estimate(s.Value, level);
         triangles += e.Counts.Triangles;
-        bytes += this->Layout.Bytes(e.Counts);
-        seconds += this->Estimator.EstimateSeconds(s.Value, level, this->Costs);
+        bytes += this->CPU.GetLayout().Bytes(e.Counts);
+        seconds += this->CPU.EstimateSeconds(s.Value, level);
       }
       val row = val::object();
       row.set("level", level);
@@ -514,7 +535,7 @@ public:
     stats.set("primitives", this->CPUPath ? 0.0 : static_cast<double>(this->Stats.Primitives));
     stats.set("triangles", this->CPUPath ? this->ShownTriangles : 0.0);
     stats.set("cpuLevel", this->CPULevel);
-    stats.set("cacheMB", this->Cache.GetBytes() / 1e6);
+    stats.set("cacheMB", this->CPU.GetCacheBytes() / 1e6);
     stats.set("footprint", std::string(this->Stats.PointFootprint ? "points" : "boxes"));
     stats.set("firstHit", this->Stats.FirstHit);
     stats.set("buildMs", this->LastBuildMs);
@@ -569,9 +590,9 @@ private:
     return m;
   }
 
-  // The CPU path: the level (requested, or the estimator's within the
-  // budget), each surface extracted or taken from the cache, uploaded when
-  // it changed.
+  // The CPU path: the surfaces unit makes or finds each surface at the
+  // level requested, or the estimator's within the budget (a guide here:
+  // level 0 when nothing fits, said in the error); uploaded when it changed.
   bool UpdateCPUSurfaces()
   {
     std::vector<double> values;
@@ -579,72 +600,52 @@ private:
     {
       values.push_back(s.Value);
     }
-    int level = this->RequestedLevel;
-    if (level < 0)
+    LevelChoice choice;
+    choice.Level = this->RequestedLevel < 0 ? LevelChoice::Auto : this->RequestedLevel;
+    choice.BudgetBytes = this->Budget;
+    choice.BudgetBinds = false;
+    this->CPU.SetCacheLimit(std::max(this->Budget / 4.0, 0.0));
+    const double start = emscripten_get_now();
+    const SurfacesUpdate update = this->CPU.Update(values, choice, CPUSurfaceMaker());
+    if (update.OverBudget)
     {
-      double level0Bytes = 0.0;
-      level = this->Estimator.ChooseLevel(values, this->Budget, this->Layout, level0Bytes);
-      if (level < 0)
-      {
-        this->LastError = "not even level 0 of these isosurfaces fits the memory budget (" +
-          std::to_string(level0Bytes / 1e6) + " MB needed)";
-        level = 0;
-      }
+      this->LastError = "not even level 0 of these isosurfaces fits the memory budget (" +
+        std::to_string(update.Level0Bytes / 1e6) + " MB needed)";
     }
-    this->CPULevel = level;
-    std::vector<SurfaceKey> keep;
-    for (double v : values)
+    if (update.Status != SurfacesUpdate::Outcome::Done)
     {
-      keep.push_back(SurfaceKey{ v, level });
+      this->LastError = update.Status == SurfacesUpdate::Outcome::OutOfMemory
+        ? update.Message
+        : "the extraction stopped";
+      return false;
     }
+    this->CPU.RecordCost(update, (emscripten_get_now() - start) / 1000.0);
+    // No isovalues: the level the choice would give for nothing, as before any surface.
+    this->CPULevel = !values.empty() ? update.Level
+      : this->RequestedLevel < 0     ? NumberOfLevels - 1
+                                     : this->RequestedLevel;
+    const std::vector<CPUSurfaceRef>& surfaces = this->CPU.GetSurfaces();
     this->ShownTriangles = 0.0;
     for (int slot = 0; slot < MaximumIsovalues; ++slot)
     {
-      if (slot >= static_cast<int>(values.size()))
+      if (slot >= static_cast<int>(surfaces.size()))
       {
         this->Meshes->Clear(slot);
         this->ShownKeys[slot] = SurfaceKey{ NAN, -1 };
         continue;
       }
-      const SurfaceKey key = keep[slot];
-      CPUSurface* surface = this->Cache.Find(key);
-      if (!surface)
-      {
-        CPUSurface made;
-        const double start = emscripten_get_now();
-        ExtractionPlan plan;
-        if (!this->CPUVolume.Plan(key.Isovalue, key.Level, plan))
-        {
-          this->LastError = "the extraction stopped";
-          return false;
-        }
-        const SurfaceCounts counts = BlockLODVolume::CountsOf(plan);
-        made.Points.resize(3 * static_cast<std::size_t>(plan.GetNumberOfPoints()));
-        made.Normals.resize(made.Points.size());
-        made.Triangles.resize(3 * static_cast<std::size_t>(plan.GetNumberOfTriangles()));
-        SurfaceBuffers<std::int32_t> out;
-        out.Points = made.Points.data();
-        out.Normals = made.Normals.data();
-        out.Connectivity = reinterpret_cast<std::int32_t*>(made.Triangles.data());
-        this->CPUVolume.Generate(plan, out);
-        this->Estimator.RecordExact(key.Isovalue, key.Level, counts);
-        this->Costs.Record(
-          key.Level, counts.Cubes, counts.Triangles, (emscripten_get_now() - start) / 1000.0);
-        const double bytes = made.Bytes();
-        this->Cache.Insert(key, std::move(made), bytes);
-        this->Cache.Evict(std::max(this->Budget / 4.0, 0.0), keep);
-        surface = this->Cache.Find(key);
-      }
+      const SurfaceKey key{ values[slot], update.Level };
+      const CPUSurface& surface = *surfaces[slot];
       if (!(this->ShownKeys[slot] == key))
       {
-        this->Meshes->SetMesh(slot, surface->Points.data(), surface->Normals.data(),
-          static_cast<std::int64_t>(surface->Points.size() / 3), surface->Triangles.data(),
-          static_cast<std::int64_t>(surface->Triangles.size() / 3));
+        this->Meshes->SetMesh(slot, surface.Points.data(), surface.Normals.data(),
+          static_cast<std::int64_t>(surface.Points.size() / 3), surface.Triangles.data(),
+          static_cast<std::int64_t>(surface.Triangles.size() / 3));
         this->ShownKeys[slot] = key;
       }
       const IsosurfaceLook& look = this->Frame.Surfaces[slot];
       this->Meshes->SetLook(slot, look.Color, look.Opacity, true);
-      this->ShownTriangles += static_cast<double>(surface->Triangles.size() / 3);
+      this->ShownTriangles += static_cast<double>(surface.Triangles.size() / 3);
     }
     return true;
   }
@@ -670,15 +671,14 @@ private:
 
   // The CPU path.
   bool CPUPath = false;
+  // Its own cost model: this page's updates give the estimator's seconds.
 #ifdef MEDISO_WEB_THREADS
-  BlockLODVolume CPUVolume{ mediso_web::MarchingCubesCases, headless::ThreadedFor };
+  BlockLODSurfaces<CPUSurfaceRef> CPU{ mediso_web::MarchingCubesCases, ThreadedFor,
+    std::make_shared<SharedCostModel>(), CPULayout };
 #else
-  BlockLODVolume CPUVolume{ mediso_web::MarchingCubesCases, SerialFor };
+  BlockLODSurfaces<CPUSurfaceRef> CPU{ mediso_web::MarchingCubesCases, SerialFor,
+    std::make_shared<SharedCostModel>(), CPULayout };
 #endif
-  BlockLODEstimator Estimator{ CPUVolume };
-  CostModel Costs; // this page's updates: the estimator's seconds
-  SurfaceCache<CPUSurface> Cache;
-  SurfaceLayout Layout{ true, false, false, false }; // normals, no scalars, ids, or offsets
   std::vector<SurfaceKey> ShownKeys = std::vector<SurfaceKey>(MaximumIsovalues, SurfaceKey{ NAN, -1 });
   std::uint64_t VolumeStamp = 0;
   int RequestedLevel = -1;

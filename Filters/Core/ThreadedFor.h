@@ -1,9 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 /**
  * @file ThreadedFor.h
- * @brief A parallel for over std::thread, for the headless hosts of the core
- * (the ParaView plugin uses vtkSMPTools instead; a browser without threads
- * runs serially).
+ * @brief A ParallelFor (BlockLOD.h) over std::thread (no VTK): the one the
+ * hosts without vtkSMPTools use, mediso-render and the web page's threaded
+ * module (the ParaView plugin passes vtkSMPTools instead; a browser without
+ * threads runs SerialFor).
+ *
+ * Header-only, so that linking the core adds no thread library: a host that
+ * includes it links its platform's threads (Threads::Threads, or Emscripten's
+ * -pthread).
  */
 #ifndef MedicalIsosurfaces_ThreadedFor_h
 #define MedicalIsosurfaces_ThreadedFor_h
@@ -15,8 +20,6 @@
 #include <vector>
 
 namespace mediso
-{
-namespace headless
 {
 /// Runs body over [begin, end) cut into one contiguous range per hardware thread.
 inline void ThreadedFor(std::int64_t begin, std::int64_t end,
@@ -46,7 +49,6 @@ inline void ThreadedFor(std::int64_t begin, std::int64_t end,
     w.join();
   }
 }
-} // namespace headless
 } // namespace mediso
 
 #endif
