@@ -168,7 +168,7 @@ const char* vtkHistoPyramidIsoRepresentation::GetFallbackReason()
 //------------------------------------------------------------------------------
 double vtkHistoPyramidIsoRepresentation::GetNumberOfPrimitives()
 {
-  return static_cast<double>(this->IsoMapper->GetNumberOfPrimitives());
+  return static_cast<double>(this->IsoMapper->GetGPUStats().Primitives);
 }
 
 //------------------------------------------------------------------------------
@@ -180,7 +180,7 @@ double vtkHistoPyramidIsoRepresentation::GetNumberOfFallbackTriangles()
 //------------------------------------------------------------------------------
 double vtkHistoPyramidIsoRepresentation::GetNumberOfPyramidBuilds()
 {
-  return static_cast<double>(this->IsoMapper->GetNumberOfPyramidBuilds());
+  return static_cast<double>(this->IsoMapper->GetGPUStats().PyramidBuilds);
 }
 
 //------------------------------------------------------------------------------

@@ -6,13 +6,16 @@
  * The hosts of the GPU core (the ParaView mapper's shell, mediso-render, the
  * web page) describe a frame with these plain structures: the surfaces'
  * looks, the volume's cell-index space seen by a camera, the lights and the
- * material. IsosurfaceRendererGL draws it; the web page's mesh renderer shades
- * its triangles with the same lights and material.
+ * material. IsosurfaceScene draws it; the web page's mesh renderer shades
+ * its triangles with the same lights and material. IsosurfaceSceneStats is
+ * what the scene says it did, which the hosts forward whole (the VTK mapper
+ * and the ParaView representation, the program's --stats, the page's stats()).
  */
 #ifndef MedicalIsosurfaces_IsosurfaceFrame_h
 #define MedicalIsosurfaces_IsosurfaceFrame_h
 
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
 namespace mediso
@@ -41,7 +44,8 @@ struct IsosurfaceFrame
   double NearPlane = 0.01;
   /// The viewport in the bound framebuffer's pixels (x, y, width, height).
   int Viewport[4] = { 0, 0, 1, 1 };
-  /// The isosurfaces, exactly those the pyramid was last built for, in the same order.
+  /// The isosurfaces, exactly those the pyramid was last built for, in the same order
+  /// (IsosurfaceScene fills them in from its own list).
   std::vector<IsosurfaceLook> Surfaces;
   /// Lights: directions towards the light in view space, and colours (times intensity).
   int NumberOfLights = 0;
@@ -60,6 +64,36 @@ struct IsosurfaceFrame
   /// MEDISO_LIGHTS, a constant of the program, since a software rasteriser runs every
   /// iteration of a loop with a uniform bound for every fragment.
   int LightsUsed() const { return std::max(0, std::min(this->NumberOfLights, MaximumLights)); }
+};
+
+/// What IsosurfaceScene did: its last frame, its last pyramid build and volume upload, and its work
+/// so far.
+struct IsosurfaceSceneStats
+{
+  ///@{
+  /// The last frame: the primitives (active cell-isovalue pairs) it drew, whether as point
+  /// sprites (else quads over each cell's box) and through the first-hit pass.
+  std::uint64_t Primitives = 0;
+  bool PointFootprint = false;
+  bool FirstHit = false;
+  ///@}
+
+  ///@{
+  /// The last pyramid build: seconds (its passes and the read-back of the total), the level-1
+  /// tiles it drew (those whose value range holds an isovalue) and the volume's tiles.
+  double BuildSeconds = 0.0;
+  std::uint64_t BuildTilesDrawn = 0;
+  std::uint64_t BuildTiles = 0;
+  ///@}
+
+  /// Seconds the last volume upload took (packing, tile ranges, the 3D texture).
+  double UploadSeconds = 0.0;
+
+  ///@{
+  /// Pyramid builds and volume uploads so far (camera moves do neither).
+  std::uint64_t PyramidBuilds = 0;
+  std::uint64_t VolumeUploads = 0;
+  ///@}
 };
 
 } // namespace mediso

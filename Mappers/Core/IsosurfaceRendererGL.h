@@ -42,6 +42,8 @@
  * HistoPyramidGL::BindWalk()), draw the cells (through the first-hit pass
  * or in one).
  *
+ * Hosts do not call the renderer: IsosurfaceScene does.
+ *
  * The renderer draws into the framebuffer bound when Render() is called,
  * with the depth function the host has set, and restores every piece of
  * state it changes.
