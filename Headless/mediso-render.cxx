@@ -3,8 +3,8 @@
  * @file mediso-render.cxx
  * @brief mediso-render: exact GPU isosurfaces of a MetaImage volume, headless (EGL, no X, no VTK).
  *
- * The GPU core (mediso::HistoPyramidGL and IsosurfaceRendererGL, the same
- * code the ParaView mapper runs) on a context of its own: it renders one
+ * The GPU core (mediso::IsosurfaceScene, the same code the ParaView mapper
+ * and the web page run) on a context of its own: it renders one
  * image, or runs the paper's protocol (360 one-degree rotations; the sweep of
  * 95 equidistant isovalues) and prints a table. The scene follows the
  * ParaView mapper's conventions (VTK's camera, a headlight, the volume's
@@ -19,8 +19,7 @@
 #include "GLApiFunctions.h"
 #include "GLProbe.h"
 #include "HeadlessContext.h"
-#include "HistoPyramidGL.h"
-#include "IsosurfaceRendererGL.h"
+#include "IsosurfaceScene.h"
 #include "MetaImage.h"
 #include "PngWriter.h"
 #include "SceneView.h"
@@ -341,15 +340,13 @@ Options Parse(int argc, char* argv[])
   {
     throw UsageError{ "at most " + std::to_string(MaximumIsovalues) + " isosurfaces" };
   }
-  std::sort(opt.Surfaces.begin(), opt.Surfaces.end(),
-    [](const IsosurfaceLook& a, const IsosurfaceLook& b) { return a.Value < b.Value; });
-  for (std::size_t i = 1; i < opt.Surfaces.size(); ++i)
+  // The scene's order (increasing values); a repeated value is a mistake here.
+  const SurfaceSelection selection = IsosurfaceScene::Normalize(opt.Surfaces);
+  if (!selection.Repeated.empty())
   {
-    if (opt.Surfaces[i].Value == opt.Surfaces[i - 1].Value)
-    {
-      throw UsageError{ "isovalue " + std::to_string(opt.Surfaces[i].Value) + " given twice" };
-    }
+    throw UsageError{ "isovalue " + std::to_string(selection.Repeated.front()) + " given twice" };
   }
+  opt.Surfaces = selection.Surfaces;
   return opt;
 }
 
@@ -391,31 +388,30 @@ std::string JsonString(const std::string& s)
   return out + "\"";
 }
 
-// The scene: the volume on the GPU, the camera, the target framebuffer.
-class Scene
+// The core's scene with the volume, the camera and the target framebuffer.
+class HeadlessView
 {
 public:
-  Scene(const Options& options, const headless::MetaImage& image,
-    std::shared_ptr<const GLApi> gl)
+  HeadlessView(
+    const Options& options, const headless::MetaImage& image, std::shared_ptr<const GLApi> gl)
     : Opt(options)
     , Image(image)
     , GL(std::move(gl))
-    , Pyramid(this->GL)
-    , Renderer(this->GL)
+    , Scene(ThreadedFor)
   {
+    this->Scene.SetContext(this->GL);
   }
 
-  ~Scene()
+  ~HeadlessView()
   {
-    this->Pyramid.Release();
-    this->Renderer.Release();
+    this->Scene.Release();
     const GLApi::Functions& f = this->GL->F();
     f.DeleteFramebuffers(1, &this->FBO);
     f.DeleteRenderbuffers(2, this->Buffers);
   }
 
-  // Returns "" or why the target or the volume cannot be made.
-  std::string Prepare()
+  // The target framebuffer and the volume on the GPU: "" or why they cannot be made.
+  std::string MakeTargetAndVolume()
   {
     const GLApi::Functions& f = this->GL->F();
     GLint maxRenderbuffer = 0, maxViewport[2] = { 0, 0 };
@@ -441,14 +437,15 @@ public:
       return "the " + std::to_string(this->Opt.Width) + "x" + std::to_string(this->Opt.Height) +
         " framebuffer cannot be made (" + this->GL->TakeErrors() + ")";
     }
+    VolumeDescription volume;
+    volume.Type = this->Image.Type;
+    volume.Data = this->Image.Bytes.data();
+    std::copy(this->Image.Dimensions, this->Image.Dimensions + 3, volume.Dims);
     std::string error;
-    const auto start = Clock::now();
-    if (!this->Pyramid.UploadVolume(this->Image.Type, this->Image.Bytes.data(),
-          this->Image.Dimensions, ThreadedFor, error))
+    if (!this->Scene.SetVolume(volume, error))
     {
       return error;
     }
-    this->UploadMs = Milliseconds(Clock::now() - start);
     this->SetCamera(0.0);
     return "";
   }
@@ -480,23 +477,12 @@ public:
     this->Frame.FirstHitPass = this->Opt.FirstHit;
   }
 
-  // Builds the pyramid for `surfaces`; "" or why not.
+  // Builds the pyramid for `surfaces` (ahead of the frame, to time it apart); "" or why not.
   std::string Build(const std::vector<IsosurfaceLook>& surfaces)
   {
-    std::vector<double> values;
-    for (const IsosurfaceLook& s : surfaces)
-    {
-      values.push_back(s.Value);
-    }
+    this->Scene.SetSurfaces(surfaces);
     std::string error;
-    const auto start = Clock::now();
-    if (!this->Pyramid.Build(values, error))
-    {
-      return error;
-    }
-    this->BuildMs = Milliseconds(Clock::now() - start);
-    this->Frame.Surfaces = surfaces;
-    return "";
+    return this->Scene.Update(error) ? "" : error;
   }
 
   // One frame, finished: "" or why not.
@@ -515,7 +501,7 @@ public:
     f.ClearBufferfv(GL_COLOR, 0, background);
     f.ClearBufferfv(GL_DEPTH, 0, &one);
     std::string error;
-    if (!this->Renderer.Render(this->Pyramid, this->Frame, this->Stats, error))
+    if (!this->Scene.Render(this->Frame, error))
     {
       return error;
     }
@@ -538,14 +524,16 @@ public:
 
   const Options& Opt;
   const headless::MetaImage& Image;
+  // Milliseconds the scene's last upload and build took.
+  double UploadMs() const { return 1000.0 * this->Scene.GetStats().UploadSeconds; }
+  double BuildMs() const { return 1000.0 * this->Scene.GetStats().BuildSeconds; }
+
   std::shared_ptr<const GLApi> GL;
-  HistoPyramidGL Pyramid;
-  IsosurfaceRendererGL Renderer;
+  IsosurfaceScene Scene;
   IsosurfaceFrame Frame;
-  IsosurfaceFrameStats Stats;
   GLuint FBO = 0;
   GLuint Buffers[2] = { 0, 0 };
-  double UploadMs = 0.0, BuildMs = 0.0, FrameMs = 0.0;
+  double FrameMs = 0.0;
 };
 
 int Fail(int code, const std::string& text)
@@ -626,8 +614,8 @@ int Run(int argc, char* argv[])
   {
     return Fail(4, gl.Describe() + " cannot run the GPU path: " + error);
   }
-  Scene scene(opt, image, context->GetGLApi());
-  error = scene.Prepare();
+  HeadlessView scene(opt, image, context->GetGLApi());
+  error = scene.MakeTargetAndVolume();
   if (!error.empty())
   {
     return Fail(4, opt.Input + ": " + error);
@@ -672,14 +660,16 @@ int Run(int argc, char* argv[])
       {
         json << (i ? ", " : "") << opt.Surfaces[i].Value;
       }
-      json << "], \"primitives\": " << scene.Stats.Primitives << ", \"upload_ms\": " << scene.UploadMs
-           << ", \"build_ms\": " << scene.BuildMs << ", \"draw_ms\": " << Median(frames)
-           << ", \"frame_ms\": " << scene.BuildMs + Median(frames) << ", \"frames\": " << frames.size()
-           << ", \"gpu_bytes\": " << scene.Pyramid.GetGPUMemoryBytes()
-           << ", \"framebuffer_bytes\": " << scene.Renderer.GetFrameBufferBytes()
+      const IsosurfaceSceneStats& stats = scene.Scene.GetStats();
+      json << "], \"primitives\": " << stats.Primitives << ", \"upload_ms\": " << scene.UploadMs()
+           << ", \"build_ms\": " << scene.BuildMs() << ", \"draw_ms\": " << Median(frames)
+           << ", \"frame_ms\": " << scene.BuildMs() + Median(frames)
+           << ", \"frames\": " << frames.size()
+           << ", \"gpu_bytes\": " << scene.Scene.GetGPUMemoryBytes()
+           << ", \"framebuffer_bytes\": " << scene.Scene.GetFrameBufferBytes()
            << ", \"volume_bytes\": " << image.Bytes.size()
-           << ", \"footprint\": " << JsonString(scene.Stats.PointFootprint ? "points" : "boxes")
-           << ", \"first_hit\": " << (scene.Stats.FirstHit ? "true" : "false") << "}";
+           << ", \"footprint\": " << JsonString(stats.PointFootprint ? "points" : "boxes")
+           << ", \"first_hit\": " << (stats.FirstHit ? "true" : "false") << "}";
       std::printf("%s\n", json.str().c_str());
     }
   }
@@ -707,7 +697,7 @@ int Run(int argc, char* argv[])
     std::printf("%-9s %7d %10.3f %9.2f %10.3f %10.3f %10s %12llu\n", "rotation", opt.Rotate,
       total / 1000.0, 1000.0 * opt.Rotate / total, Median(frames),
       *std::min_element(frames.begin(), frames.end()), "-",
-      static_cast<unsigned long long>(scene.Stats.Primitives));
+      static_cast<unsigned long long>(scene.Scene.GetStats().Primitives));
     scene.SetCamera(0.0);
   }
   if (opt.Sweep > 0)
@@ -742,9 +732,9 @@ int Run(int argc, char* argv[])
       }
       const double ms = Milliseconds(Clock::now() - start);
       steps.push_back(ms);
-      builds.push_back(scene.BuildMs);
+      builds.push_back(scene.BuildMs());
       total += ms;
-      primitives = std::max(primitives, scene.Stats.Primitives);
+      primitives = std::max(primitives, scene.Scene.GetStats().Primitives);
     }
     std::printf("%-9s %7d %10.3f %9.2f %10.3f %10.3f %10.3f %12llu\n", "sweep", opt.Sweep,
       total / 1000.0, 1000.0 * opt.Sweep / total, Median(steps),

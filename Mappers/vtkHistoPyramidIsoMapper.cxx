@@ -16,7 +16,7 @@
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 
-#include "PyramidLayout.h"
+#include "IsosurfaceScene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -117,7 +117,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
   Internals& impl = *this->Impl;
   this->LastRenderPath = NoPath;
-  this->NumberOfPrimitives = 0;
+  this->GPUStats.Primitives = 0;
   this->NumberOfFallbackTriangles = 0;
 
   // Say a message once (per distinct text), as an error or a warning.
@@ -186,43 +186,26 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
 
-  // 2. The isovalues and their looks, in increasing order; invisible ones
-  //    (opacity 0) and NaN ones left out. A value's index in the property's
-  //    list picks its surface colour and opacity.
+  // 2. The isovalues and their looks, normalised as every host of the core
+  //    does (mediso::IsosurfaceScene::Normalize(): increasing values, each
+  //    once, at most MaximumIsovalues, NaN ones left out, each said once);
+  //    invisible ones (opacity 0) left out after. A value's index in the
+  //    property's list picks its surface colour and opacity.
   vtkVolumeProperty* property = vol->GetProperty();
   vtkContourValues* values = property->GetIsoSurfaceValues();
-  std::vector<std::pair<double, int>> requested; // value, index in the property's list
-  int notANumber = 0;
-  for (int i = 0; values && i < values->GetNumberOfContours(); ++i)
+  std::vector<mediso::IsosurfaceLook> given(values ? values->GetNumberOfContours() : 0);
+  for (std::size_t i = 0; i < given.size(); ++i)
   {
-    const double v = values->GetValue(i);
-    if (std::isnan(v))
-    {
-      ++notANumber;
-    }
-    else
-    {
-      requested.emplace_back(v, i);
-    }
+    given[i].Value = values->GetValue(static_cast<int>(i));
   }
-  if (notANumber > 0)
+  const mediso::SurfaceSelection requested = mediso::IsosurfaceScene::Normalize(given);
+  for (const std::string& note : requested.Notes)
   {
-    std::ostringstream msg;
-    msg << notANumber << " of the " << values->GetNumberOfContours()
-        << " isovalues " << (notANumber == 1 ? "is" : "are")
-        << " not a number (NaN): an isosurface needs a numeric value; "
-        << (requested.empty() ? "nothing is drawn." : "the others are drawn.");
-    sayOnce(false, msg.str());
+    sayOnce(false, note);
   }
-  std::stable_sort(requested.begin(), requested.end(),
-    [](const std::pair<double, int>& a, const std::pair<double, int>& b) { return a.first < b.first; });
-  requested.erase(std::unique(requested.begin(), requested.end(),
-                    [](const std::pair<double, int>& a, const std::pair<double, int>& b)
-                    { return a.first == b.first; }),
-    requested.end());
-  if (requested.empty())
+  if (requested.Surfaces.empty())
   {
-    if (notANumber == 0)
+    if (requested.NotANumber == 0)
     {
       sayOnce(false,
         "no isovalues: set them with vtkVolumeProperty::GetIsoSurfaceValues() "
@@ -230,20 +213,12 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     }
     return;
   }
-  if (requested.size() > static_cast<std::size_t>(mediso::MaximumIsovalues))
-  {
-    std::ostringstream msg;
-    msg << requested.size() << " isovalues requested; only the lowest "
-        << mediso::MaximumIsovalues << " are drawn.";
-    sayOnce(false, msg.str());
-    requested.resize(mediso::MaximumIsovalues);
-  }
   std::vector<Surface> surfaces;
   vtkPiecewiseFunction* opacity = property->GetScalarOpacity(0);
-  for (const auto& entry : requested)
+  for (std::size_t k = 0; k < requested.Surfaces.size(); ++k)
   {
-    const double v = entry.first;
-    const std::size_t index = static_cast<std::size_t>(entry.second);
+    const double v = requested.Surfaces[k].Value;
+    const std::size_t index = static_cast<std::size_t>(requested.Sources[k]);
     Surface s;
     s.Value = v;
     s.Opacity = 1.0;
@@ -296,14 +271,8 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   {
     this->LastRenderPath = GPUPath;
     this->FallbackReason.clear();
-    this->NumberOfPrimitives = gpu->GetNumberOfPrimitives();
-    this->LastFootprint = gpu->GetLastPointFootprint() ? PointFootprint : BoxFootprint;
-    this->LastFirstHitPass = gpu->GetLastFirstHitPass();
-    this->LastBuildSeconds = gpu->GetLastBuildSeconds();
-    this->LastBuildTilesDrawn = gpu->GetLastBuildTilesDrawn();
-    this->LastBuildTiles = gpu->GetLastBuildTiles();
-    this->NumberOfPyramidBuilds = gpu->GetNumberOfPyramidBuilds();
-    this->NumberOfVolumeUploads = gpu->GetNumberOfVolumeUploads();
+    this->GPUStats = gpu->GetStats();
+    this->LastFootprint = this->GPUStats.PointFootprint ? PointFootprint : BoxFootprint;
     return;
   }
   if (!this->ForceCPUFallback)
@@ -325,8 +294,8 @@ void vtkHistoPyramidIsoMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LastRenderPath: " << this->GetLastRenderPathAsString() << "\n";
   os << indent << "FallbackReason: " << this->FallbackReason << "\n";
   os << indent << "ForceCPUFallback: " << this->ForceCPUFallback << "\n";
-  os << indent << "NumberOfPrimitives: " << this->NumberOfPrimitives << "\n";
-  os << indent << "NumberOfPyramidBuilds: " << this->NumberOfPyramidBuilds << "\n";
-  os << indent << "NumberOfVolumeUploads: " << this->NumberOfVolumeUploads << "\n";
+  os << indent << "NumberOfPrimitives: " << this->GPUStats.Primitives << "\n";
+  os << indent << "NumberOfPyramidBuilds: " << this->GPUStats.PyramidBuilds << "\n";
+  os << indent << "NumberOfVolumeUploads: " << this->GPUStats.VolumeUploads << "\n";
   os << indent << "GPUMemoryBytes: " << this->GetGPUMemoryBytes() << "\n";
 }

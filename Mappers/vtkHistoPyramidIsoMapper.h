@@ -14,7 +14,7 @@
  * and chooses; the work is done by:
  *
  * - vtkOpenGLHistoPyramidIsosurfaces, the GPU path: a thin VTK shell over
- *   the portable core (mediso::HistoPyramidGL, mediso::IsosurfaceRendererGL;
+ *   the portable core's scene (mediso::IsosurfaceScene;
  *   OpenGL 3.2 core / OpenGL ES 3.0, the same code as mediso-render and the
  *   web page). The volume is uploaded once as a 3D texture of its own type
  *   (int16 stays 16-bit); the core counts the active cells of the current
@@ -68,8 +68,9 @@
 #ifndef vtkHistoPyramidIsoMapper_h
 #define vtkHistoPyramidIsoMapper_h
 
+#include "IsosurfaceFrame.h"                 // For mediso::IsosurfaceSceneStats
 #include "MedicalIsosurfacesMappersModule.h" // For export macro
-#include "vtkOpenGLHistoPyramidIsosurfaces.h"  // For Surface
+#include "vtkOpenGLHistoPyramidIsosurfaces.h" // For Surface
 #include "vtkVolumeMapper.h"
 
 #include <cmath>   // For std::isfinite
@@ -169,28 +170,39 @@ public:
   vtkBooleanMacro(FirstHitPass, bool);
   ///@}
 
+#if !defined(__VTK_WRAP__)
+  /**
+   * What the GPU path did, as the core's scene says it (the last GPU frame,
+   * the last pyramid build and volume upload, the builds and uploads so far):
+   * one structure, which vtkHistoPyramidIsoRepresentation forwards whole.
+   * The getters below read it. Primitives is 0 after a frame the GPU path
+   * did not draw.
+   */
+  const mediso::IsosurfaceSceneStats& GetGPUStats() const { return this->GPUStats; }
+#endif
+
   /// Whether the last GPU frame drew through the first-hit pass.
-  vtkGetMacro(LastFirstHitPass, bool);
+  bool GetLastFirstHitPass() const { return this->GPUStats.FirstHit; }
 
   /// Primitives (active cell-isovalue pairs) of the last GPU frame.
-  vtkGetMacro(NumberOfPrimitives, std::uint64_t);
+  std::uint64_t GetNumberOfPrimitives() const { return this->GPUStats.Primitives; }
 
   /// Seconds the last pyramid build took (its passes and the read-back of the total).
-  vtkGetMacro(LastBuildSeconds, double);
+  double GetLastBuildSeconds() const { return this->GPUStats.BuildSeconds; }
 
   ///@{
   /**
    * The last pyramid build's level-1 pass: how many of its tiles it drew
-   * (those whose value range holds an isovalue; see vtkOpenGLHistoPyramid)
+   * (those whose value range holds an isovalue; see mediso::VolumeTiles)
    * and how many there are.
    */
-  vtkGetMacro(LastBuildTilesDrawn, std::uint64_t);
-  vtkGetMacro(LastBuildTiles, std::uint64_t);
+  std::uint64_t GetLastBuildTilesDrawn() const { return this->GPUStats.BuildTilesDrawn; }
+  std::uint64_t GetLastBuildTiles() const { return this->GPUStats.BuildTiles; }
   ///@}
 
   /// Pyramid builds and volume uploads so far (camera moves do neither).
-  vtkGetMacro(NumberOfPyramidBuilds, std::uint64_t);
-  vtkGetMacro(NumberOfVolumeUploads, std::uint64_t);
+  std::uint64_t GetNumberOfPyramidBuilds() const { return this->GPUStats.PyramidBuilds; }
+  std::uint64_t GetNumberOfVolumeUploads() const { return this->GPUStats.VolumeUploads; }
 
   /// Bytes of GPU memory the mapper holds now for the volume (volume and pyramid).
   std::uint64_t GetGPUMemoryBytes() const;
@@ -262,13 +274,7 @@ private:
   bool AllowPointFootprint = true;
   int LastFootprint = BoxFootprint;
   bool FirstHitPass = true;
-  bool LastFirstHitPass = false;
-  std::uint64_t NumberOfPrimitives = 0;
-  std::uint64_t NumberOfPyramidBuilds = 0;
-  double LastBuildSeconds = 0.0;
-  std::uint64_t LastBuildTilesDrawn = 0;
-  std::uint64_t LastBuildTiles = 0;
-  std::uint64_t NumberOfVolumeUploads = 0;
+  mediso::IsosurfaceSceneStats GPUStats;
   std::uint64_t NumberOfFallbackTriangles = 0;
   int ColorSource = TransferFunctionColors;
   double SolidColor[3] = { 1.0, 1.0, 1.0 };

@@ -16,27 +16,20 @@
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkSMPTools.h"
-#include "vtkTimerLog.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 #include "vtkWeakPointer.h"
 
-#include "GLApi.h"
-#include "HistoPyramidGL.h"
-#include "IsosurfaceRendererGL.h"
-#include "ProcessMemory.h"
+#include "IsosurfaceScene.h"
 
 #include <algorithm>
 #include <functional>
-#include <limits>
-#include <new>
 
 vtkStandardNewMacro(vtkOpenGLHistoPyramidIsosurfaces);
 
 namespace
 {
 using namespace medical_gl;
-
 
 void ParallelFor(std::int64_t begin, std::int64_t end,
   const std::function<void(std::int64_t, std::int64_t)>& body)
@@ -47,46 +40,24 @@ void ParallelFor(std::int64_t begin, std::int64_t end,
 } // anonymous namespace
 
 //------------------------------------------------------------------------------
-// The core's objects, in the context of Window (the window of the last render).
+// The core's scene, in the context of Window (the window of the last render).
 struct vtkOpenGLHistoPyramidIsosurfaces::Internals
 {
   vtkWeakPointer<vtkOpenGLRenderWindow> Window;
   bool Probed = false;
   bool Usable = false;
   std::string Reason;
-  std::shared_ptr<const mediso::GLApi> GL;
-  std::unique_ptr<mediso::HistoPyramidGL> Pyramid;
-  std::unique_ptr<mediso::IsosurfaceRendererGL> Renderer;
+  mediso::IsosurfaceScene Scene{ ParallelFor };
 
-  // What the uploaded volume and the built pyramid were made from.
-  vtkDataArray* UploadedArray = nullptr;
-  vtkMTimeType UploadedArrayTime = 0;
-  int UploadedDims[3] = { 0, 0, 0 };
-  std::vector<double> BuiltIsovalues;
-
-  // Frees the core's objects (the window's context must be current).
+  // Frees the scene's objects (the window's context must be current).
   void Release()
   {
-    if (this->Pyramid)
-    {
-      this->Pyramid->Release();
-    }
-    if (this->Renderer)
-    {
-      this->Renderer->Release();
-    }
-    this->Pyramid.reset();
-    this->Renderer.reset();
-    this->GL.reset();
-    this->UploadedArray = nullptr;
-    this->UploadedArrayTime = 0;
-    this->UploadedDims[0] = this->UploadedDims[1] = this->UploadedDims[2] = 0;
-    this->BuiltIsovalues.clear();
+    this->Scene.Release();
     this->Window = nullptr;
     this->Probed = false;
   }
 
-  // The capability check and the core's objects, once per window.
+  // The capability check and the scene's context, once per window.
   bool Attach(vtkOpenGLRenderWindow* window, std::string& reason)
   {
     if (this->Window != window)
@@ -107,13 +78,9 @@ struct vtkOpenGLHistoPyramidIsosurfaces::Internals
       if (this->Usable)
       {
         ScopedContext context(window);
-        this->GL = vtkMedicalGLCapabilities::LoadCoreApi(window, this->Reason);
-        this->Usable = this->GL != nullptr;
-        if (this->Usable)
-        {
-          this->Pyramid.reset(new mediso::HistoPyramidGL(this->GL));
-          this->Renderer.reset(new mediso::IsosurfaceRendererGL(this->GL));
-        }
+        auto gl = vtkMedicalGLCapabilities::LoadCoreApi(window, this->Reason);
+        this->Usable = gl != nullptr;
+        this->Scene.SetContext(std::move(gl));
       }
     }
     reason = this->Reason;
@@ -151,15 +118,21 @@ void vtkOpenGLHistoPyramidIsosurfaces::ReleaseGraphicsResources(vtkWindow* win)
 }
 
 //------------------------------------------------------------------------------
+const mediso::IsosurfaceSceneStats& vtkOpenGLHistoPyramidIsosurfaces::GetStats() const
+{
+  return this->Impl->Scene.GetStats();
+}
+
+//------------------------------------------------------------------------------
 std::uint64_t vtkOpenGLHistoPyramidIsosurfaces::GetGPUMemoryBytes() const
 {
-  return this->Impl->Pyramid ? this->Impl->Pyramid->GetGPUMemoryBytes() : 0;
+  return this->Impl->Scene.GetGPUMemoryBytes();
 }
 
 //------------------------------------------------------------------------------
 std::uint64_t vtkOpenGLHistoPyramidIsosurfaces::GetFrameBufferBytes() const
 {
-  return this->Impl->Renderer ? this->Impl->Renderer->GetFrameBufferBytes() : 0;
+  return this->Impl->Scene.GetFrameBufferBytes();
 }
 
 //------------------------------------------------------------------------------
@@ -168,7 +141,6 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
   bool allowPointFootprint, bool firstHitPass, std::string& reason)
 {
   Internals& impl = *this->Impl;
-  this->NumberOfPrimitives = 0;
   auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
   if (!renWin)
   {
@@ -187,72 +159,34 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
   }
   ScopedContext context(renWin);
 
-  // 1. The one rebuild decision: upload when the array, its values or the
-  //    size change; build when the isovalues change or after an upload.
-  int dims[3];
-  image->GetDimensions(dims);
-  const bool sameVolume = impl.UploadedArray == scalars &&
-    impl.UploadedArrayTime == scalars->GetMTime() && std::equal(dims, dims + 3, impl.UploadedDims);
-  std::vector<double> isovalues;
+  // 1. The volume and the surfaces: the scene uploads when the array's
+  //    values, type or size change (its modification time is the stamp) and
+  //    builds when the isovalues change or after an upload.
+  mediso::VolumeDescription volume;
+  volume.Type = type;
+  volume.Data = scalars->GetVoidPointer(0);
+  image->GetDimensions(volume.Dims);
+  volume.Stamp = scalars->GetMTime();
+  if (!impl.Scene.SetVolume(volume, reason))
+  {
+    return false;
+  }
+  std::vector<mediso::IsosurfaceLook> looks;
   for (const Surface& s : surfaces)
   {
-    isovalues.push_back(s.Value);
+    mediso::IsosurfaceLook look;
+    look.Value = s.Value;
+    for (int c = 0; c < 3; ++c)
+    {
+      look.Color[c] = static_cast<float>(s.Color[c]);
+    }
+    look.Opacity = static_cast<float>(s.Opacity);
+    looks.push_back(look);
   }
-  if (!sameVolume)
+  impl.Scene.SetSurfaces(looks);
+  if (!impl.Scene.Update(reason))
   {
-    impl.BuiltIsovalues.clear();
-    impl.UploadedArray = nullptr;
-    // UploadVolume's CPU-side copies: doubles converted to float, and rows
-    // padded to a multiple of 4 points; past the allowance the CPU path
-    // (with its own check) draws instead.
-    const std::uint64_t points = static_cast<std::uint64_t>(dims[0]) * dims[1] * dims[2];
-    const std::uint64_t valueBytes = type == mediso::ScalarType::Float64
-      ? 4
-      : static_cast<std::uint64_t>(scalars->GetDataTypeSize());
-    std::uint64_t staging = type == mediso::ScalarType::Float64 ? 4 * points : 0;
-    if (dims[0] % 4 != 0)
-    {
-      staging += static_cast<std::uint64_t>(dims[0] + 3) / 4 * 4 * valueBytes * dims[1] * dims[2];
-    }
-    if (staging > 0 &&
-      !mediso::FitsInProcessMemory(staging, "the volume's copy for the GPU upload", reason))
-    {
-      return false;
-    }
-    bool uploaded = false;
-    try
-    {
-      uploaded =
-        impl.Pyramid->UploadVolume(type, scalars->GetVoidPointer(0), dims, ParallelFor, reason);
-    }
-    catch (const std::bad_alloc&)
-    {
-      reason = "memory ran out while copying the volume for the GPU upload";
-    }
-    if (!uploaded)
-    {
-      return false;
-    }
-    ++this->NumberOfVolumeUploads;
-    impl.UploadedArray = scalars;
-    impl.UploadedArrayTime = scalars->GetMTime();
-    std::copy(dims, dims + 3, impl.UploadedDims);
-  }
-  if (isovalues != impl.BuiltIsovalues)
-  {
-    vtkNew<vtkTimerLog> timer;
-    timer->StartTimer();
-    impl.BuiltIsovalues.clear();
-    if (!impl.Pyramid->Build(isovalues, reason))
-    {
-      return false;
-    }
-    timer->StopTimer(); // Build() ends by reading the total back: the passes are done
-    this->LastBuildSeconds = timer->GetElapsedTime();
-    this->LastBuildTilesDrawn = impl.Pyramid->GetLastTilesDrawn();
-    this->LastBuildTiles = impl.Pyramid->GetNumberOfTiles();
-    ++this->NumberOfPyramidBuilds;
-    impl.BuiltIsovalues = isovalues;
+    return false;
   }
 
   // 2. The frame: cell-index space (0-based on the extent) to view and clip.
@@ -280,19 +214,8 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
   const int viewport[4] = { origin[0], origin[1], size[0], size[1] };
   std::copy(viewport, viewport + 4, frame.Viewport);
 
-  // 3. The looks, the material and the renderer's lights (view space,
-  //    towards the light; diffuse colour times intensity).
-  for (const Surface& s : surfaces)
-  {
-    mediso::IsosurfaceLook look;
-    look.Value = s.Value;
-    for (int c = 0; c < 3; ++c)
-    {
-      look.Color[c] = static_cast<float>(s.Color[c]);
-    }
-    look.Opacity = static_cast<float>(s.Opacity);
-    frame.Surfaces.push_back(look);
-  }
+  // 3. The material and the renderer's lights (view space, towards the
+  //    light; diffuse colour times intensity).
   vtkVolumeProperty* property = vol->GetProperty();
   frame.Ambient = static_cast<float>(property->GetAmbient());
   frame.Diffuse = static_cast<float>(property->GetDiffuse());
@@ -335,17 +258,13 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
   frame.FirstHitPass = firstHitPass;
 
   // 4. Draw.
-  mediso::IsosurfaceFrameStats stats;
-  if (!impl.Renderer->Render(*impl.Pyramid, frame, stats, reason))
+  if (!impl.Scene.Render(frame, reason))
   {
     // A program that does not build will not build next frame either.
     impl.Usable = false;
     impl.Reason = reason;
     return false;
   }
-  this->NumberOfPrimitives = stats.Primitives;
-  this->LastPointFootprint = stats.PointFootprint;
-  this->LastFirstHitPass = stats.FirstHit;
   return true;
 }
 
@@ -353,8 +272,9 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
 void vtkOpenGLHistoPyramidIsosurfaces::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "NumberOfPrimitives: " << this->NumberOfPrimitives << "\n";
-  os << indent << "NumberOfPyramidBuilds: " << this->NumberOfPyramidBuilds << "\n";
-  os << indent << "NumberOfVolumeUploads: " << this->NumberOfVolumeUploads << "\n";
+  const mediso::IsosurfaceSceneStats& stats = this->GetStats();
+  os << indent << "NumberOfPrimitives: " << stats.Primitives << "\n";
+  os << indent << "NumberOfPyramidBuilds: " << stats.PyramidBuilds << "\n";
+  os << indent << "NumberOfVolumeUploads: " << stats.VolumeUploads << "\n";
   os << indent << "GPUMemoryBytes: " << this->GetGPUMemoryBytes() << "\n";
 }

@@ -3,21 +3,22 @@
  * @class   vtkOpenGLHistoPyramidIsosurfaces
  * @brief   The GPU path of vtkHistoPyramidIsoMapper: a VTK shell over the portable GPU core.
  *
- * All GPU work is the VTK-free core's (mediso::HistoPyramidGL builds the
- * pyramid, mediso::IsosurfaceRendererGL draws; OpenGL 3.2 core / ES 3.0,
- * the same code mediso-render and the web page run). This class is what
- * VTK adds, in the shape of vtkOpenGLGPUVolumeRayCastMapper:
+ * All GPU work is the VTK-free core's, through its one unit
+ * mediso::IsosurfaceScene (OpenGL 3.2 core / ES 3.0, the same code
+ * mediso-render and the web page run): the scene uploads the volume only
+ * when its array, values or size change and rebuilds the pyramid only when
+ * the isovalues or the volume change (camera moves reuse both). This class
+ * is what VTK adds, in the shape of vtkOpenGLGPUVolumeRayCastMapper:
  * - one capability check per window (vtkMedicalGLCapabilities) and the
  *   core's view of the window's context, with VTK's GLEW functions;
- * - one rebuild decision (Prepare()): the volume is uploaded again only when
- *   its array, values or size change, the pyramid rebuilt only when the
- *   isovalues or the volume change; camera moves reuse both;
+ * - the volume as the scene's description (the array's values, type and
+ *   size, its modification time as the stamp);
  * - the camera (cell-index space to view through the image's index-to-
  *   physical matrix, its extent and the volume's matrix; the projection)
  *   and the renderer's lights (view-space directions, diffuse colour times
  *   intensity) and the property's material, as the core's frame;
  * - the render window's context made current around every call, and the
- *   core's objects released with the window's resources.
+ *   scene's GL objects released with the window's resources.
  *
  * vtkHistoPyramidIsoMapper checks the input and builds the list of
  * surfaces; when RenderIsosurfaces() says the path cannot run (with the
@@ -28,6 +29,7 @@
 #ifndef vtkOpenGLHistoPyramidIsosurfaces_h
 #define vtkOpenGLHistoPyramidIsosurfaces_h
 
+#include "IsosurfaceFrame.h"                 // For mediso::IsosurfaceSceneStats
 #include "MedicalIsosurfacesMappersModule.h" // For export macro
 #include "vtkObject.h"
 
@@ -66,23 +68,11 @@ public:
     vtkDataArray* scalars, const std::vector<Surface>& surfaces, bool allowPointFootprint,
     bool firstHitPass, std::string& reason);
 
-  ///@{
-  /// What the last successful RenderIsosurfaces() did.
-  vtkGetMacro(NumberOfPrimitives, std::uint64_t);
-  vtkGetMacro(LastPointFootprint, bool);
-  vtkGetMacro(LastFirstHitPass, bool);
-  ///@}
-
-  ///@{
-  /// The last pyramid build: seconds, level-1 tiles drawn and in all.
-  vtkGetMacro(LastBuildSeconds, double);
-  vtkGetMacro(LastBuildTilesDrawn, std::uint64_t);
-  vtkGetMacro(LastBuildTiles, std::uint64_t);
-  ///@}
-
-  /// Pyramid builds and volume uploads so far.
-  vtkGetMacro(NumberOfPyramidBuilds, std::uint64_t);
-  vtkGetMacro(NumberOfVolumeUploads, std::uint64_t);
+  /**
+   * What the GPU path did (the scene's stats: the last frame drawn, the last
+   * pyramid build and volume upload, the builds and uploads so far).
+   */
+  const mediso::IsosurfaceSceneStats& GetStats() const;
 
   /// GPU memory held for the volume (volume and pyramid), and the first-hit buffers.
   std::uint64_t GetGPUMemoryBytes() const;
@@ -98,15 +88,6 @@ protected:
 private:
   vtkOpenGLHistoPyramidIsosurfaces(const vtkOpenGLHistoPyramidIsosurfaces&) = delete;
   void operator=(const vtkOpenGLHistoPyramidIsosurfaces&) = delete;
-
-  std::uint64_t NumberOfPrimitives = 0;
-  bool LastPointFootprint = false;
-  bool LastFirstHitPass = false;
-  double LastBuildSeconds = 0.0;
-  std::uint64_t LastBuildTilesDrawn = 0;
-  std::uint64_t LastBuildTiles = 0;
-  std::uint64_t NumberOfPyramidBuilds = 0;
-  std::uint64_t NumberOfVolumeUploads = 0;
 
   struct Internals;
   std::unique_ptr<Internals> Impl;

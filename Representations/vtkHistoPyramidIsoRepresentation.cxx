@@ -172,7 +172,7 @@ const char* vtkHistoPyramidIsoRepresentation::GetFallbackReason()
 //------------------------------------------------------------------------------
 double vtkHistoPyramidIsoRepresentation::GetNumberOfPrimitives()
 {
-  return static_cast<double>(this->IsoMapper->GetNumberOfPrimitives());
+  return static_cast<double>(this->IsoMapper->GetGPUStats().Primitives);
 }
 
 //------------------------------------------------------------------------------
@@ -184,7 +184,7 @@ double vtkHistoPyramidIsoRepresentation::GetNumberOfFallbackTriangles()
 //------------------------------------------------------------------------------
 double vtkHistoPyramidIsoRepresentation::GetNumberOfPyramidBuilds()
 {
-  return static_cast<double>(this->IsoMapper->GetNumberOfPyramidBuilds());
+  return static_cast<double>(this->IsoMapper->GetGPUStats().PyramidBuilds);
 }
 
 //------------------------------------------------------------------------------

@@ -64,15 +64,19 @@ int crossingMask(VALUE_TYPE lo, VALUE_TYPE hi)
   return mask;
 }
 
-// Number of set bits of a crossing mask (at most 8 bits are used).
+// Number of set bits of each of 4 masks of at most 8 bits (crossing masks,
+// level 1's child masks): the one popcount of the shaders, since GLSL ES 3.00
+// has no bitCount(). Pairs, then nibbles, then the byte.
+uvec4 bitCount8(uvec4 m)
+{
+  m = (m & 0x55u) + ((m >> 1u) & 0x55u);
+  m = (m & 0x33u) + ((m >> 2u) & 0x33u);
+  return (m & 0x0Fu) + (m >> 4u);
+}
+
 uint bitCount8(int mask)
 {
-  uint n = 0u;
-  for (int t = 0; t < 8; ++t)
-  {
-    n += uint((mask >> t) & 1);
-  }
-  return n;
+  return bitCount8(uvec4(uint(mask), 0u, 0u, 0u)).x;
 }
 
 // Crossing mask of cell c (0 outside the real cell grid and, for float data,

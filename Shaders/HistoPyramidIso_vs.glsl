@@ -32,9 +32,8 @@
 // along x, so a row of the node's 3 points takes 2 fetches at most). With
 // one isovalue (MEDISO_CHILD_MASKS) level 1 holds each node's child mask
 // instead of its count, and the last step down reads it with the counts
-// (descendToMasks()): the recount's crossing tests are skipped (an eighth
-// of this stage's time on the CT: median of 6 paired runs drawing with the
-// rasteriser discarding), the node's points are still read for the corners.
+// (descendToMasks()): the recount's crossing tests are skipped, the node's
+// points are still read for the corners.
 //
 // Footprint. This stage makes the cell's footprint itself, over the
 // bounding rectangle, on screen, of the box that holds the surface in the
@@ -154,8 +153,7 @@ void childTexels(usampler2D lower, ivec3 factor, ivec3 shifts, ivec3 node, out u
 // dx + 2 dy (a component beyond an axis of one node holds 0): two fetches
 // give all 8 counts. Straight-line code, no loop (factor is a literal at
 // every call, so the second fetch folds away where z has one node): chained
-// loops made llvmpipe's LLVM compile time double with every level (13 s for
-// the CT's 7 levels against 2 s without loops).
+// loops made llvmpipe's LLVM compile time double with every level.
 void descend(usampler2D lower, ivec3 factor, ivec3 shifts, vec3 childSpan, inout ivec3 node,
   inout uint index)
 {
@@ -172,19 +170,13 @@ void descend(usampler2D lower, ivec3 factor, ivec3 shifts, vec3 childSpan, inout
 // child cell c crosses the isovalue, so the node's count is the number of
 // bits set and `bits` returns the chosen node's mask. The cells of the node
 // then need no recount.
-uvec4 bitCounts(uvec4 m)
-{
-  m = (m & 0x55u) + ((m >> 1u) & 0x55u);
-  m = (m & 0x33u) + ((m >> 2u) & 0x33u);
-  return (m & 0x0Fu) + (m >> 4u);
-}
 
 void descendToMasks(usampler2D lower, ivec3 factor, ivec3 shifts, vec3 childSpan,
   inout ivec3 node, inout uint index, out int bits)
 {
   uvec4 low, high;
   childTexels(lower, factor, shifts, node, low, high);
-  int child = pickChild(bitCounts(low), bitCounts(high), orderMask(node, factor, childSpan), index);
+  int child = pickChild(bitCount8(low), bitCount8(high), orderMask(node, factor, childSpan), index);
   node = node * factor + ivec3(child & 1, (child >> 1) & 1, (child >> 2) & 1);
   uvec4 layer = child < 4 ? low : high;
   int a = child & 3;
@@ -420,7 +412,7 @@ void footprint(ivec3 c, vec3 boxLo, vec3 boxHi)
   // A footprint covers the pixels whose centres lie in it; a margin of a
   // tenth of a pixel (plus the point size granularity) keeps those whose
   // centres lie on its edges, whatever the rasteriser's tie rule. (A whole
-  // pixel of margin costs a 3-pixel point 78% more fragments.)
+  // pixel of margin would cost a small point far more fragments.)
 #ifdef MEDISO_POINT_FOOTPRINT
   vec2 pixels = 0.5 * (hi - lo) * viewportSize;
   gl_PointSize = min(max(pixels.x, pixels.y) + pointMargin, maxPointSize);
@@ -514,10 +506,8 @@ void main()
   MEDISO_CHILD(5, 1, 0, 1)
   MEDISO_CHILD(6, 0, 1, 1)
   MEDISO_CHILD(7, 1, 1, 1)
-  uvec4 countsLow = uvec4(bitCount8(masksLow.x), bitCount8(masksLow.y), bitCount8(masksLow.z),
-    bitCount8(masksLow.w));
-  uvec4 countsHigh = uvec4(bitCount8(masksHigh.x), bitCount8(masksHigh.y),
-    bitCount8(masksHigh.z), bitCount8(masksHigh.w));
+  uvec4 countsLow = bitCount8(uvec4(masksLow));
+  uvec4 countsHigh = bitCount8(uvec4(masksHigh));
 #endif
   int c = pickChild(countsLow, countsHigh, orderMask(node, firstFactor, vec3(1.0)), index);
   ivec3 cell = first + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);

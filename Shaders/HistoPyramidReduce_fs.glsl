@@ -30,9 +30,7 @@ MEDISO_OUTPUT(0) uvec4 fragOutput0;
 uint sum4(uvec4 v)
 {
 #ifdef MEDISO_LOWER_CHILD_MASKS
-  v = (v & 0x55u) + ((v >> 1u) & 0x55u);
-  v = (v & 0x33u) + ((v >> 2u) & 0x33u);
-  v = (v & 0x0Fu) + (v >> 4u);
+  v = bitCount8(v);
 #endif
   return v.x + v.y + v.z + v.w;
 }

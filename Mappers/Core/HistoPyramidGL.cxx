@@ -2,57 +2,23 @@
 #include "HistoPyramidGL.h"
 
 #include "GLObjects.h"
-#include "HistoPyramidGLInternals.h"
 #include "MedisoShaders.h"
+#include "ProcessMemory.h"
 
 #include <algorithm>
+#include <array>
 #include <bitset>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <new>
+#include <sstream>
 
 namespace mediso
 {
 namespace
 {
 using namespace glcore;
-
-// Texels per row of the stored volume: 4 points to a texel along x.
-int PackedVolumeWidth(int pointsX)
-{
-  return (pointsX + 3) / 4;
-}
-
-// The volume as its texture stores it: texel (i, j, k) holds points
-// (4 i + c, j, k) in component c, and where a row's points run out, its last
-// texel repeats the row's last point (so a read past the end of a row gives
-// the value a clamp to the volume would). Rows are copied as bytes, so the
-// values keep their type. Readers: pointQuad() and pointValue() in
-// HistoPyramidCommon.glsl.
-std::vector<unsigned char> PackVolumeRows(
-  const void* data, const int points[3], int bytesPerValue, const GLParallelFor& parallel)
-{
-  const std::size_t inRow = static_cast<std::size_t>(points[0]) * bytesPerValue;
-  const std::size_t outRow = static_cast<std::size_t>(4 * PackedVolumeWidth(points[0])) * bytesPerValue;
-  const std::int64_t rows = static_cast<std::int64_t>(points[1]) * points[2];
-  std::vector<unsigned char> packed(outRow * static_cast<std::size_t>(rows));
-  const unsigned char* in = static_cast<const unsigned char*>(data);
-  parallel(0, rows,
-    [&](std::int64_t begin, std::int64_t end)
-    {
-      for (std::int64_t r = begin; r < end; ++r)
-      {
-        const unsigned char* from = in + inRow * r;
-        unsigned char* to = packed.data() + outRow * r;
-        std::copy(from, from + inRow, to);
-        for (std::size_t pad = inRow; pad < outRow; pad += bytesPerValue)
-        {
-          std::copy(from + inRow - bytesPerValue, from + inRow, to + pad);
-        }
-      }
-    });
-  return packed;
-}
 
 // The texture format of the stored volume (RGBA of the value type).
 struct VolumeFormat
@@ -82,90 +48,6 @@ VolumeFormat VolumeFormatOf(ScalarType type)
   }
 }
 
-// The range of point values each level-1 tile's real cells read: out[2 t]
-// the least and out[2 t + 1] the greatest (t = x + tiles.x (y + tiles.y z)),
-// as R (int32, uint32 or float: every value of T is exact in it). An empty
-// tile (padding cells only, or only NaN values) gets least > greatest, which
-// no threshold lies between. NaN values are left out: a cell with a NaN
-// corner counts nothing anyway.
-template <typename T, typename R>
-void ComputeTileRanges(const T* data, const int points[3], const PyramidLayout& layout,
-  const GLParallelFor& parallel, std::vector<R>& out)
-{
-  const auto tiles = layout.TileCounts();
-  const auto factor = layout.Factor(1);
-  const int cells[3] = { points[0] - 1, points[1] - 1, points[2] - 1 };
-  // Cells per tile along x and y (a packed texel holds 2 nodes per axis).
-  const int span[2] = { 2 * PyramidLayout::TileTexels * factor[0],
-    2 * PyramidLayout::TileTexels * factor[1] };
-  const std::size_t perSlice = static_cast<std::size_t>(tiles[0]) * tiles[1];
-  const R none = std::numeric_limits<R>::has_infinity ? std::numeric_limits<R>::infinity()
-                                                      : std::numeric_limits<R>::max();
-  const R noneHigh = std::numeric_limits<R>::has_infinity ? -std::numeric_limits<R>::infinity()
-                                                          : std::numeric_limits<R>::lowest();
-  out.assign(2 * perSlice * tiles[2], R());
-  parallel(0, tiles[2],
-    [&](std::int64_t sliceBegin, std::int64_t sliceEnd)
-    {
-      std::vector<R> rowLow(tiles[0]), rowHigh(tiles[0]);
-      for (std::int64_t slice = sliceBegin; slice < sliceEnd; ++slice)
-      {
-        R* ranges = out.data() + 2 * perSlice * slice;
-        for (std::size_t t = 0; t < perSlice; ++t)
-        {
-          ranges[2 * t] = none;
-          ranges[2 * t + 1] = noneHigh;
-        }
-        // The slice's cells along z, and so its points [z0, z1].
-        const int z0 = static_cast<int>(slice) * factor[2];
-        if (z0 >= cells[2])
-        {
-          continue;
-        }
-        const int z1 = std::min(z0 + factor[2], cells[2]);
-        for (int z = z0; z <= z1; ++z)
-        {
-          for (int y = 0; y < points[1]; ++y)
-          {
-            const T* row = data + (static_cast<std::size_t>(z) * points[1] + y) * points[0];
-            // Each tile's points of this row: x in [tx span, min((tx + 1) span, cells)].
-            for (int tx = 0; tx < tiles[0]; ++tx)
-            {
-              R low = none, high = noneHigh;
-              const int x0 = tx * span[0];
-              const int x1 = std::min(x0 + span[0], cells[0]);
-              for (int x = x0; x <= x1 && x0 < cells[0]; ++x)
-              {
-                const R v = static_cast<R>(row[x]);
-                low = v < low ? v : low; // NaN compares false: left out
-                high = v > high ? v : high;
-              }
-              rowLow[tx] = low;
-              rowHigh[tx] = high;
-            }
-            // The row belongs to the tiles whose points along y hold y: one,
-            // or two where it is the boundary between them.
-            const int ty = std::min(y / span[1], tiles[1] - 1);
-            for (int t = ty; t >= 0 && t >= ty - 1; --t)
-            {
-              const int ya = t * span[1];
-              if (ya >= cells[1] || y < ya || y > std::min(ya + span[1], cells[1]))
-              {
-                continue;
-              }
-              R* tile = ranges + 2 * static_cast<std::size_t>(t) * tiles[0];
-              for (int tx = 0; tx < tiles[0]; ++tx)
-              {
-                tile[2 * tx] = rowLow[tx] < tile[2 * tx] ? rowLow[tx] : tile[2 * tx];
-                tile[2 * tx + 1] = rowHigh[tx] > tile[2 * tx + 1] ? rowHigh[tx] : tile[2 * tx + 1];
-              }
-            }
-          }
-        }
-      }
-    });
-}
-
 int Log2(int powerOfTwo)
 {
   int shift = 0;
@@ -175,16 +57,54 @@ int Log2(int powerOfTwo)
   }
   return shift;
 }
-
-void SerialFor(std::int64_t begin, std::int64_t end,
-  const std::function<void(std::int64_t, std::int64_t)>& body)
-{
-  if (begin < end)
-  {
-    body(begin, end);
-  }
-}
 } // namespace
+
+//------------------------------------------------------------------------------
+// The GL objects and the CPU-side state of the pyramid.
+struct HistoPyramidGL::Internals
+{
+  std::shared_ptr<const GLApi> GL;
+  GLParallelFor Parallel;
+
+  // The volume: a 3D texture, 4 points to a texel along x.
+  Name Volume;
+  ScalarType Type = ScalarType::Float32;
+  int Points[3] = { 0, 0, 0 };
+  PyramidLayout Layout;
+  // Per level-1 tile, the least and greatest value its cells read.
+  VolumeTiles Tiles;
+
+  // The stored levels (index = level; 0 is empty), each a 2D atlas.
+  std::vector<Name> Levels;
+  bool Built = false;
+  std::uint64_t Total = 0;
+  IsoThresholds Current; // of the last successful Build()
+  bool ChildMasks = false;
+  std::uint64_t TilesDrawn = 0;
+
+  // The passes.
+  Name FBO;
+  Name TileBuffer;      // the level-1 pass's rectangles
+  Name TileVertexArray; // with attribute 0 reading TileBuffer
+  Name EmptyVertexArray;
+  ProgramCache Programs;
+
+  /// A stored level's atlas layout as the shaders take it: log2 of px, py, columns.
+  std::array<int, 3> Shifts(int level) const;
+  /// The value type's #defines.
+  std::string Declarations() const;
+  /// The hook that puts HistoPyramidCommon.glsl in a shader.
+  Hooks CommonHooks() const;
+  /// The uniforms of HistoPyramidCommon.glsl on the bound program; the volume is on `volumeUnit`.
+  void SetCommonUniforms(Program& program, const IsoThresholds& t, int volumeUnit) const;
+
+  bool Target(GLuint texture, int width, int height, std::string& error);
+  Program* Pass(
+    const char* vertex, const char* fragment, const std::string& defines, std::string& error);
+  void DrawFullScreen();
+  void ReleaseLevels();
+  void ReleaseAll();
+};
 
 //------------------------------------------------------------------------------
 std::array<int, 3> HistoPyramidGL::Internals::Shifts(int level) const
@@ -198,13 +118,13 @@ std::string HistoPyramidGL::Internals::Declarations() const
   return ValueKindDefines(ValueKindOf(this->Type));
 }
 
-glcore::Hooks HistoPyramidGL::Internals::CommonHooks() const
+Hooks HistoPyramidGL::Internals::CommonHooks() const
 {
   return { { "HistoPyramidCommon", shaders::HistoPyramidCommon } };
 }
 
 void HistoPyramidGL::Internals::SetCommonUniforms(
-  glcore::Program& program, const IsoThresholds& t, int volumeUnit) const
+  Program& program, const IsoThresholds& t, int volumeUnit) const
 {
   program.Set("volume", volumeUnit);
   program.Set("numberOfThresholds", t.Count);
@@ -241,9 +161,7 @@ void HistoPyramidGL::Internals::ReleaseAll()
   this->TileVertexArray.Reset();
   this->EmptyVertexArray.Reset();
   this->Programs.Clear();
-  this->IntRanges.clear();
-  this->UIntRanges.clear();
-  this->FloatRanges.clear();
+  this->Tiles.Clear();
   this->Points[0] = this->Points[1] = this->Points[2] = 0;
   this->Layout = PyramidLayout();
   this->TilesDrawn = 0;
@@ -297,6 +215,68 @@ const std::vector<int>& HistoPyramidGL::GetCountedIsovalues() const
 bool HistoPyramidGL::GetLevelOneHoldsChildMasks() const
 {
   return this->Impl->Built && this->Impl->ChildMasks;
+}
+
+const GLApi* HistoPyramidGL::GetGLApi() const
+{
+  return this->Impl->GL.get();
+}
+
+//------------------------------------------------------------------------------
+HistoPyramidWalk HistoPyramidGL::GetWalk() const
+{
+  const Internals& impl = *this->Impl;
+  HistoPyramidWalk walk;
+  if (!impl.Built)
+  {
+    return walk;
+  }
+  const PyramidLayout& layout = impl.Layout;
+  const int numLevels = layout.GetNumberOfLevels();
+  if (impl.ChildMasks)
+  {
+    walk.Defines = "#define MEDISO_CHILD_MASKS 1\n";
+  }
+  walk.Defines += impl.Declarations();
+  std::ostringstream levels, descent;
+  for (int l = 1; l + 1 < numLevels; ++l)
+  {
+    levels << "uniform usampler2D level" << l << ";\n";
+  }
+  // One step down per level, with the level's constants: with one isovalue
+  // the last step reads level 1's child masks with the counts.
+  for (int l = numLevels - 1; l >= 2; --l)
+  {
+    const int c = l - 1;
+    const auto factor = layout.Factor(l);
+    const auto span = layout.CellsPerNode(c);
+    const auto shifts = impl.Shifts(c);
+    const bool toMasks = impl.ChildMasks && c == 1;
+    descent << (toMasks ? "  descendToMasks(level" : "  descend(level") << c << ", ivec3("
+            << factor[0] << ", " << factor[1] << ", " << factor[2] << "), ivec3(" << shifts[0]
+            << ", " << shifts[1] << ", " << shifts[2] << "), vec3(" << span[0] << ".0, " << span[1]
+            << ".0, " << span[2] << ".0), node, index" << (toMasks ? ", nodeBits" : "") << ");\n";
+  }
+  walk.Hooks = impl.CommonHooks();
+  walk.Hooks.emplace_back("HistoPyramidLevels", levels.str());
+  walk.Hooks.emplace_back("HistoPyramidDescent", descent.str());
+  walk.TextureUnits = numLevels - 1;
+  return walk;
+}
+
+void HistoPyramidGL::BindWalk(Program& program, int firstUnit) const
+{
+  const Internals& impl = *this->Impl;
+  const GLApi& gl = *impl.GL;
+  const PyramidLayout& layout = impl.Layout;
+  BindTextureUnit(gl, firstUnit, GL_TEXTURE_3D, impl.Volume.Get());
+  impl.SetCommonUniforms(program, impl.Current, firstUnit);
+  for (int l = 1; l + 1 < layout.GetNumberOfLevels(); ++l)
+  {
+    BindTextureUnit(gl, firstUnit + l, GL_TEXTURE_2D, impl.Levels[l].Get());
+    program.Set(("level" + std::to_string(l)).c_str(), firstUnit + l);
+  }
+  program.Set3i("firstFactor", layout.Factor(1).data());
 }
 
 std::uint64_t HistoPyramidGL::GetNumberOfTiles() const
@@ -391,15 +371,37 @@ bool HistoPyramidGL::UploadVolume(ScalarType type, const void* values, const int
       return false;
     }
   }
-  const GLParallelFor& run = parallel ? parallel : GLParallelFor(SerialFor);
+  const GLParallelFor run = SerialIfEmpty(parallel);
   const std::int64_t numPoints = static_cast<std::int64_t>(points[0]) * points[1] * points[2];
+  const VolumeFormat format = VolumeFormatOf(type);
+
+  // The CPU-side copies the upload makes (doubles converted to float, rows
+  // padded to whole texels) must fit in what the process may still allocate;
+  // a host then falls back with the reason instead of aborting.
+  std::uint64_t staging = type == ScalarType::Float64 ? 4 * static_cast<std::uint64_t>(numPoints) : 0;
+  if (points[0] % 4 != 0)
+  {
+    staging += static_cast<std::uint64_t>(4 * width) * format.BytesPerValue * points[1] * points[2];
+  }
+  if (staging > 0 && !FitsInProcessMemory(staging, "the volume's copy for the GPU upload", error))
+  {
+    return false;
+  }
 
   // Double data is converted to float; every other type goes up as it is.
   std::vector<float> converted;
   const void* data = values;
   if (type == ScalarType::Float64)
   {
-    converted.resize(static_cast<std::size_t>(numPoints));
+    try
+    {
+      converted.resize(static_cast<std::size_t>(numPoints));
+    }
+    catch (const std::bad_alloc&)
+    {
+      error = "memory ran out while copying the volume for the GPU upload";
+      return false;
+    }
     const double* d = static_cast<const double*>(values);
     run(0, numPoints,
       [&](std::int64_t begin, std::int64_t end)
@@ -411,7 +413,19 @@ bool HistoPyramidGL::UploadVolume(ScalarType type, const void* values, const int
       });
     data = converted.data();
   }
-  const VolumeFormat format = VolumeFormatOf(type);
+  std::vector<unsigned char> packed;
+  if (points[0] % 4 != 0)
+  {
+    try
+    {
+      packed = PackVolumeRows(data, points, format.BytesPerValue, run);
+    }
+    catch (const std::bad_alloc&)
+    {
+      error = "memory ran out while copying the volume for the GPU upload";
+      return false;
+    }
+  }
 
   ScopedGLState saved(gl, 1);
   gl.TakeErrors();
@@ -429,11 +443,6 @@ bool HistoPyramidGL::UploadVolume(ScalarType type, const void* values, const int
   f.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
   f.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
   {
-    std::vector<unsigned char> packed;
-    if (points[0] % 4 != 0)
-    {
-      packed = PackVolumeRows(data, points, format.BytesPerValue, run);
-    }
     f.TexImage3D(GL_TEXTURE_3D, 0, static_cast<GLint>(format.InternalFormat), width, points[1],
       points[2], 0, format.Format, format.Type, packed.empty() ? data : packed.data());
   }
@@ -448,28 +457,7 @@ bool HistoPyramidGL::UploadVolume(ScalarType type, const void* values, const int
 
   // The value range under each tile of level 1, which lets the level-1 pass
   // draw only the tiles an isovalue can cross.
-  impl.IntRanges.clear();
-  impl.UIntRanges.clear();
-  impl.FloatRanges.clear();
-  const ScalarType rangeType = type == ScalarType::Float64 ? ScalarType::Float32 : type;
-  VisitScalarType(rangeType,
-    [&](auto tag)
-    {
-      using T = decltype(tag);
-      const T* typed = static_cast<const T*>(data);
-      switch (ValueKindOf(type))
-      {
-        case ValueKind::Signed:
-          ComputeTileRanges(typed, points, layout, run, impl.IntRanges);
-          break;
-        case ValueKind::Unsigned:
-          ComputeTileRanges(typed, points, layout, run, impl.UIntRanges);
-          break;
-        case ValueKind::Float:
-          ComputeTileRanges(typed, points, layout, run, impl.FloatRanges);
-          break;
-      }
-    });
+  impl.Tiles.Compute(type, data, points, layout, run);
   impl.Type = type;
   impl.Layout = layout;
   impl.Parallel = run;
@@ -478,82 +466,6 @@ bool HistoPyramidGL::UploadVolume(ScalarType type, const void* values, const int
 }
 
 //------------------------------------------------------------------------------
-// The rectangles of the level-1 pass: per slice and row of tiles, each run of
-// tiles whose range holds a threshold, as two triangles in atlas texels.
-std::vector<std::uint16_t> HistoPyramidGL::Internals::ActiveTileRectangles(
-  const IsoThresholds& thresholds, std::uint64_t& tilesDrawn) const
-{
-  const auto tiles = this->Layout.TileCounts();
-  const auto packed = this->Layout.Packed(1);
-  const std::size_t perSlice = static_cast<std::size_t>(tiles[0]) * tiles[1];
-  auto active = [&](std::size_t t) -> bool
-  {
-    switch (thresholds.Kind)
-    {
-      case ValueKind::Signed:
-        return thresholds.Crosses(this->IntRanges[2 * t], this->IntRanges[2 * t + 1]);
-      case ValueKind::Unsigned:
-        return thresholds.Crosses(this->UIntRanges[2 * t], this->UIntRanges[2 * t + 1]);
-      default:
-        return thresholds.Crosses(this->FloatRanges[2 * t], this->FloatRanges[2 * t + 1]);
-    }
-  };
-  // Per slice, in parallel; then joined in slice order.
-  std::vector<std::vector<std::uint16_t>> slices(static_cast<std::size_t>(tiles[2]));
-  std::vector<std::uint64_t> counts(static_cast<std::size_t>(tiles[2]), 0);
-  this->Parallel(0, tiles[2],
-    [&](std::int64_t begin, std::int64_t end)
-    {
-      for (std::int64_t z = begin; z < end; ++z)
-      {
-        std::vector<std::uint16_t>& out = slices[z];
-        for (int ty = 0; ty < tiles[1]; ++ty)
-        {
-          for (int tx = 0; tx < tiles[0];)
-          {
-            const std::size_t t = perSlice * z + static_cast<std::size_t>(ty) * tiles[0];
-            if (!active(t + tx))
-            {
-              ++tx;
-              continue;
-            }
-            int end = tx + 1;
-            while (end < tiles[0] && active(t + end))
-            {
-              ++end;
-            }
-            counts[z] += static_cast<std::uint64_t>(end - tx);
-            const auto lo = this->Layout.AtlasTexel(1, tx * PyramidLayout::TileTexels,
-              ty * PyramidLayout::TileTexels, static_cast<int>(z));
-            const int w = std::min(end * PyramidLayout::TileTexels, packed[0]) - tx * PyramidLayout::TileTexels;
-            const int h = std::min((ty + 1) * PyramidLayout::TileTexels, packed[1]) -
-              ty * PyramidLayout::TileTexels;
-            const std::uint16_t x0 = static_cast<std::uint16_t>(lo[0]);
-            const std::uint16_t y0 = static_cast<std::uint16_t>(lo[1]);
-            const std::uint16_t x1 = static_cast<std::uint16_t>(lo[0] + w);
-            const std::uint16_t y1 = static_cast<std::uint16_t>(lo[1] + h);
-            out.insert(out.end(), { x0, y0, x1, y0, x0, y1, x0, y1, x1, y0, x1, y1 });
-            tx = end;
-          }
-        }
-      }
-    });
-  std::vector<std::uint16_t> all;
-  std::size_t size = 0;
-  for (const auto& s : slices)
-  {
-    size += s.size();
-  }
-  all.reserve(size);
-  tilesDrawn = 0;
-  for (std::size_t z = 0; z < slices.size(); ++z)
-  {
-    all.insert(all.end(), slices[z].begin(), slices[z].end());
-    tilesDrawn += counts[z];
-  }
-  return all;
-}
-
 // Makes `texture` (a 2D texture) the only colour target, with the viewport over it.
 bool HistoPyramidGL::Internals::Target(GLuint texture, int width, int height, std::string& error)
 {
@@ -575,7 +487,7 @@ bool HistoPyramidGL::Internals::Target(GLuint texture, int width, int height, st
 
 // A pass program: the full-screen triangle (or the level-1 rectangles) with
 // fragment shader `fragment`, the value type's defines and `defines`.
-glcore::Program* HistoPyramidGL::Internals::Pass(
+Program* HistoPyramidGL::Internals::Pass(
   const char* vertex, const char* fragment, const std::string& defines, std::string& error)
 {
   const Hooks hooks = this->CommonHooks();
@@ -673,7 +585,8 @@ bool HistoPyramidGL::Build(const std::vector<double>& isovalues, std::string& er
 
   // 3. Level 1 from the volume: cleared to 0, then the active tiles' rectangles.
   std::uint64_t tilesDrawn = 0;
-  const std::vector<std::uint16_t> rectangles = impl.ActiveTileRectangles(thresholds, tilesDrawn);
+  const std::vector<std::uint16_t> rectangles =
+    impl.Tiles.ActiveRectangles(thresholds, impl.Parallel, tilesDrawn);
   {
     const auto atlas = layout.AtlasSize(1);
     if (!impl.Target(impl.Levels[1].Get(), atlas[0], atlas[1], error))

@@ -50,22 +50,45 @@
 
 #include "PyramidLayout.h"
 #include "ScalarTypes.h"
+#include "VolumeTiles.h"
 
 #include <array>
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mediso
 {
 class GLApi;
-class IsosurfaceRendererGL;
+namespace glcore
+{
+class Program;
+}
 
-/// Runs body(begin, end) over sub-ranges that together cover [begin, end), possibly concurrently.
-using GLParallelFor =
-  std::function<void(std::int64_t, std::int64_t, const std::function<void(std::int64_t, std::int64_t)>&)>;
+/**
+ * What a drawing program needs to walk a built pyramid down to its cells:
+ * primitive k finds the cell and isovalue it draws by descending from the
+ * top, at each node choosing the child whose running count holds k (see
+ * HistoPyramidIso_vs.glsl). GLSL cannot index an array of samplers with a
+ * variable, and each level has its own size, format and atlas layout, so the
+ * walk is written for one pyramid layout: one sampler per stored level and
+ * one descend() call per level with that level's constants, which the
+ * pyramid emits (HistoPyramidGL::GetWalk()) and binds
+ * (HistoPyramidGL::BindWalk()) itself.
+ */
+struct HistoPyramidWalk
+{
+  /// The volume's value type (VALUE_TYPE, ...), and MEDISO_CHILD_MASKS where level 1 holds child masks.
+  std::string Defines;
+  /// Snippets for a shader's //MEDISO::HistoPyramidCommon (the volume and
+  /// counting code), //MEDISO::HistoPyramidLevels (the level samplers) and
+  /// //MEDISO::HistoPyramidDescent (the steps down) hooks (glcore::Hooks).
+  std::vector<std::pair<std::string, std::string>> Hooks;
+  /// Texture units BindWalk() uses from its first: the volume, then stored levels 1 to top - 1.
+  int TextureUnits = 0;
+};
 
 class HistoPyramidGL
 {
@@ -124,6 +147,21 @@ public:
   std::uint64_t GetLastTilesDrawn() const;
   ///@}
 
+  ///@{
+  /**
+   * The walk of the last successful Build() (empty before one), and its
+   * binding: the volume and the levels on texture units `firstUnit` to
+   * `firstUnit` + TextureUnits - 1, and the walk's uniforms (samplers,
+   * thresholds, cell dimensions, level-1 factors) on `program`, which must be
+   * in use and composed with GetWalk()'s defines and hooks.
+   */
+  HistoPyramidWalk GetWalk() const;
+  void BindWalk(glcore::Program& program, int firstUnit) const;
+  ///@}
+
+  /// The context's functions the pyramid was made with (a drawing program must use the same).
+  const GLApi* GetGLApi() const;
+
   /// Bytes of GPU memory held now (volume texture and level atlases).
   std::uint64_t GetGPUMemoryBytes() const;
 
@@ -144,7 +182,6 @@ public:
   void Release();
 
 private:
-  friend class IsosurfaceRendererGL;
   struct Internals;
   std::unique_ptr<Internals> Impl;
 };

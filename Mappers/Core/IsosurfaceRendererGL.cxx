@@ -2,7 +2,7 @@
 #include "IsosurfaceRendererGL.h"
 
 #include "GLObjects.h"
-#include "HistoPyramidGLInternals.h"
+#include "HistoPyramidGL.h"
 #include "Matrix4.h"
 #include "MedisoShaders.h"
 
@@ -132,12 +132,90 @@ void NormalMatrix(const Matrix& m, double out[9])
     out[k] = cof[k] * s;
   }
 }
-} // namespace
 
-int IsosurfaceFrame::LightsUsed() const
+// What one frame draws and how, chosen from the frame and the pyramid before
+// any GL call: the isovalues' uniforms, the matrices, the footprint, the
+// first-hit pass (turned off again when its buffers cannot be made) and the
+// culling of cells off screen.
+struct FrameVariant
 {
-  return std::max(0, std::min(this->NumberOfLights, MaximumLights));
+  std::uint64_t Total = 0;
+  int Cells[3] = { 0, 0, 0 };
+  int Counted = 0; // isovalues the pyramid counts
+  float IsoValues[MaximumIsovalues] = { 0 };
+  float IsoColors[4 * MaximumIsovalues] = { 0 };
+  bool Translucent = false;
+  Matrix IndexToView, Projection, IndexToClip, ClipToIndex;
+  float EyeIndex[4] = { 0, 0, 0, 0 };
+  double GradientToView[9] = { 0 };
+  bool Points = false;
+  bool FirstHit = false;
+  bool Cull = false;
+
+  // Several opaque isovalues in the first-hit pass: one primitive per cell
+  // whose fragments take the nearest hit of the cell's isovalues.
+  bool Nearest() const { return this->FirstHit && this->Counted > 1; }
+  // Each cell drawn once, with all its isovalues.
+  bool OneRankPerCell() const { return this->Translucent || this->Nearest(); }
+};
+
+// Step 1: the variant. "" or why the frame cannot be drawn.
+std::string ChooseVariant(
+  const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame, float maxPointSize, FrameVariant& v)
+{
+  // Isovalues in the pyramid's threshold order, their colours.
+  const std::vector<int>& counted = pyramid.GetCountedIsovalues();
+  v.Total = pyramid.GetTotal();
+  v.Counted = static_cast<int>(counted.size());
+  for (std::size_t t = 0; t < counted.size(); ++t)
+  {
+    if (counted[t] < 0 || counted[t] >= static_cast<int>(frame.Surfaces.size()))
+    {
+      return "the frame's surfaces are not those the pyramid was built for";
+    }
+    const IsosurfaceLook& s = frame.Surfaces[static_cast<std::size_t>(counted[t])];
+    v.IsoValues[t] = static_cast<float>(s.Value);
+    for (int c = 0; c < 3; ++c)
+    {
+      v.IsoColors[4 * t + c] = s.Color[c];
+    }
+    v.IsoColors[4 * t + 3] = s.Opacity;
+    v.Translucent = v.Translucent || s.Opacity < 1.0f;
+  }
+
+  // Matrices: cell-index space to view and clip, the eye in index space.
+  v.IndexToView = matrix4::FromArray(frame.IndexToView);
+  v.Projection = matrix4::FromArray(frame.Projection);
+  v.IndexToClip = matrix4::Multiply(v.Projection, v.IndexToView);
+  Matrix viewToIndex;
+  if (!matrix4::Invert(v.IndexToView, viewToIndex) ||
+    !matrix4::Invert(v.IndexToClip, v.ClipToIndex))
+  {
+    return "the volume's transformation to the view is singular";
+  }
+  const double eyeView[4] = { 0.0, 0.0, frame.Parallel ? 1.0 : 0.0, frame.Parallel ? 0.0 : 1.0 };
+  const auto eye = matrix4::Transform(viewToIndex, eyeView);
+  for (int a = 0; a < 4; ++a)
+  {
+    v.EyeIndex[a] = static_cast<float>(eye[a]);
+  }
+  NormalMatrix(v.IndexToView, v.GradientToView);
+
+  // The footprint (points where they provably cover every cell) and the
+  // first-hit pass (opaque frames with points).
+  const auto& cells = pyramid.GetLayout().GetCells();
+  std::copy(cells.begin(), cells.end(), v.Cells);
+  v.Points = frame.AllowPointFootprint &&
+    PointsCoverCells(v.IndexToView, v.Projection, v.Cells, frame.NearPlane, frame.Parallel,
+      frame.Viewport, maxPointSize);
+  v.FirstHit = frame.FirstHitPass && v.Points && !v.Translucent;
+  // Cells off screen are dropped in the vertex stage only where part of the
+  // volume is: in a whole-volume view the test is not compiled in at all (a
+  // uniform branch still costs a software rasteriser its instructions).
+  v.Cull = !BoxInsideClipVolume(v.IndexToClip, v.Cells);
+  return "";
 }
+} // namespace
 
 void SetLightingUniforms(Program& program, const IsosurfaceFrame& frame)
 {
@@ -231,6 +309,13 @@ struct IsosurfaceRendererGL::Internals
     return "";
   }
 
+  Program* ComposeProgram(const HistoPyramidWalk& walk, const IsosurfaceFrame& frame,
+    const FrameVariant& v, std::string& error);
+  void SetUniforms(Program& program, const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
+    const FrameVariant& v);
+  std::string DrawFirstHit(
+    const FrameVariant& v, GLuint hostFramebuffer, const ScopedGLState& saved);
+
   void DrawCells(bool points, std::uint64_t total)
   {
     const GLApi::Functions& f = this->GL->F();
@@ -267,25 +352,163 @@ std::uint64_t IsosurfaceRendererGL::GetFrameBufferBytes() const
 }
 
 //------------------------------------------------------------------------------
+// Step 3: the program of this variant and pyramid walk.
+Program* IsosurfaceRendererGL::Internals::ComposeProgram(const HistoPyramidWalk& walk,
+  const IsosurfaceFrame& frame, const FrameVariant& v, std::string& error)
+{
+  const GLApi& gl = *this->GL;
+  std::ostringstream defines;
+  if (v.Points)
+  {
+    defines << "#define MEDISO_POINT_FOOTPRINT 1\n";
+  }
+  if (v.Translucent)
+  {
+    defines << "#define MEDISO_TRANSLUCENT 1\n";
+  }
+  if (v.FirstHit)
+  {
+    defines << "#define MEDISO_FIRST_HIT 1\n";
+  }
+  if (v.Nearest())
+  {
+    defines << "#define MEDISO_NEAREST 1\n";
+  }
+  if (v.Cull)
+  {
+    defines << "#define MEDISO_CULL_CELLS 1\n";
+  }
+  defines << "#define MEDISO_LIGHTS " << frame.LightsUsed() << "\n";
+  defines << "#define MEDISO_ISOVALUES " << (v.OneRankPerCell() ? v.Counted : MaximumIsovalues)
+          << "\n";
+  defines << walk.Defines;
+  const bool conservative = !gl.IsES() && gl.HasConservativeDepth() && !v.FirstHit;
+  const Hooks fragmentHooks = { { "FragmentExtensions",
+    conservative ? "#extension GL_ARB_conservative_depth : require\nlayout(depth_greater) out "
+                   "float gl_FragDepth;"
+                 : "" } };
+  Program* program =
+    this->Programs.Get(gl, defines.str(), Compose(shaders::HistoPyramidIso_vs, walk.Hooks),
+      Compose(shaders::HistoPyramidIso_fs, fragmentHooks), error);
+  if (!program)
+  {
+    error = "the isosurface shaders do not build: " + error;
+  }
+  return program;
+}
+
+// Step 4: the pass's state, textures and uniforms (the walk's on units 0..),
+// the vertex array and the viewport the cells are drawn in.
+void IsosurfaceRendererGL::Internals::SetUniforms(Program& program, const HistoPyramidGL& pyramid,
+  const IsosurfaceFrame& frame, const FrameVariant& v)
+{
+  const GLApi& gl = *this->GL;
+  const GLApi::Functions& f = gl.F();
+  f.Enable(GL_DEPTH_TEST);
+  f.Disable(GL_CULL_FACE);
+  f.Disable(GL_SCISSOR_TEST);
+  f.Disable(GL_STENCIL_TEST);
+  f.Disable(GL_RASTERIZER_DISCARD);
+  f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  SetSurfacePassBlending(gl, v.Translucent);
+  if (v.Points && !gl.IsES())
+  {
+    f.Enable(GL_PROGRAM_POINT_SIZE); // gl_PointSize (always honoured on GL ES)
+  }
+  program.Use();
+  pyramid.BindWalk(program, 0);
+  program.Set4f("eyeIndex", v.EyeIndex);
+  program.Set("backToFront", v.Translucent ? 1 : 0);
+  program.Set("oneRankPerCell", v.OneRankPerCell() ? 1 : 0);
+  program.Set("parallelProjection", frame.Parallel ? 1 : 0);
+  program.SetMatrix4("indexToClip", v.IndexToClip.data());
+  program.SetMatrix4("indexToView", v.IndexToView.data());
+  program.SetMatrix4("clipToIndex", v.ClipToIndex.data());
+  program.SetMatrix3("gradientToView", v.GradientToView);
+  program.Set1fv("isovalues", MaximumIsovalues, v.IsoValues);
+  program.Set4fv("isoColors", MaximumIsovalues, v.IsoColors);
+  SetLightingUniforms(program, frame);
+  // Where the cells are drawn: the viewport, or in the first-hit pass the
+  // same viewport in buffers whose pixel (0, 0) is window pixel HitRect.xy.
+  const int* viewport = frame.Viewport;
+  const int drawOrigin[2] = { v.FirstHit ? viewport[0] - this->HitRect[0] : viewport[0],
+    v.FirstHit ? viewport[1] - this->HitRect[1] : viewport[1] };
+  program.Set2f("viewportSize", static_cast<float>(viewport[2]), static_cast<float>(viewport[3]));
+  const float viewportF[4] = { static_cast<float>(drawOrigin[0]), static_cast<float>(drawOrigin[1]),
+    static_cast<float>(viewport[2]), static_cast<float>(viewport[3]) };
+  program.Set4f("viewport", viewportF);
+  program.Set("maxPointSize", gl.GetMaxPointSize());
+  // Pixels whose centres lie on a footprint's edges stay covered whatever the
+  // tie rule, and a point size rounded down to the granularity still covers.
+  program.Set("pointMargin", 0.1f + gl.GetPointSizeGranularity());
+  if (!this->VertexArray)
+  {
+    this->VertexArray = Name(gl, NameKind::VertexArray);
+  }
+  f.BindVertexArray(this->VertexArray.Get());
+  f.Viewport(drawOrigin[0], drawOrigin[1], viewport[2], viewport[3]);
+}
+
+// Step 5 (first-hit pass): the cells into the buffers, then their hits into
+// the host's framebuffer. "" or why not.
+std::string IsosurfaceRendererGL::Internals::DrawFirstHit(
+  const FrameVariant& v, GLuint hostFramebuffer, const ScopedGLState& saved)
+{
+  const GLApi& gl = *this->GL;
+  const GLApi::Functions& f = gl.F();
+  // Pass 1: into the buffers, cleared to no hit; every primitive has the
+  // same depth and the test is GL_LESS, so each pixel keeps its first hit
+  // in drawing order (front to back: the nearest), and the test runs
+  // before the fragment stage.
+  f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, this->HitFBO.Get());
+  const GLfloat clearColor[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
+  const GLfloat one = 1.0f;
+  f.ClearBufferfv(GL_COLOR, 0, clearColor);
+  f.ClearBufferfv(GL_DEPTH, 0, &one);
+  // (Attachment 1 needs no clear: its texels are read only where a hit wrote them.)
+  f.DepthFunc(GL_LESS);
+  this->DrawCells(v.Points, v.Total);
+  // Pass 2: the hits into the host's framebuffer over HitRect, with the
+  // host's depth test.
+  f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, hostFramebuffer);
+  saved.RestoreDepthFunc();
+  std::string error;
+  Program* composite = this->Programs.Get(
+    gl, "", shaders::HistoPyramidFullScreen_vs, shaders::HistoPyramidComposite_fs, error);
+  if (!composite)
+  {
+    return "the first-hit composite shader does not build: " + error;
+  }
+  composite->Use();
+  BindTextureUnit(gl, 0, GL_TEXTURE_2D, this->HitColor.Get());
+  BindTextureUnit(gl, 1, GL_TEXTURE_2D, this->HitDepth.Get());
+  composite->Set("hitColor", 0);
+  composite->Set("hitDepth", 1);
+  composite->Set2i("hitOrigin", this->HitRect[0], this->HitRect[1]);
+  f.Viewport(this->HitRect[0], this->HitRect[1], this->HitRect[2], this->HitRect[3]);
+  f.DrawArrays(GL_TRIANGLES, 0, 3);
+  return "";
+}
+
+//------------------------------------------------------------------------------
 bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
   IsosurfaceFrameStats& stats, std::string& error)
 {
   Internals& impl = *this->Impl;
   const GLApi& gl = *impl.GL;
   const GLApi::Functions& f = gl.F();
-  const HistoPyramidGL::Internals& pyr = *pyramid.Impl;
   stats = IsosurfaceFrameStats();
-  if (!pyr.Built)
+  if (!pyramid.IsBuilt())
   {
     error = "the pyramid is not built";
     return false;
   }
-  if (pyr.GL.get() != impl.GL.get())
+  if (pyramid.GetGLApi() != impl.GL.get())
   {
     error = "the pyramid belongs to another context";
     return false;
   }
-  const std::uint64_t total = pyr.Total;
+  const std::uint64_t total = pyramid.GetTotal();
   stats.Primitives = total;
   if (total == 0)
   {
@@ -296,244 +519,61 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
     error = "more active cells than one draw call can take";
     return false;
   }
-  const PyramidLayout& layout = pyr.Layout;
-  const int numLevels = layout.GetNumberOfLevels();
-  // Stored levels read by the vertex stage (1 .. numLevels - 2) and the volume.
-  if (numLevels - 1 > gl.GetMaxVertexTextureUnits())
+  // The stored levels the vertex stage reads, and the volume.
+  const HistoPyramidWalk walk = pyramid.GetWalk();
+  if (walk.TextureUnits > gl.GetMaxVertexTextureUnits())
   {
-    error = "the pyramid needs " + std::to_string(numLevels - 1) +
+    error = "the pyramid needs " + std::to_string(walk.TextureUnits) +
       " vertex texture units, the context has " + std::to_string(gl.GetMaxVertexTextureUnits());
     return false;
   }
 
-  // 1. Isovalues in the pyramid's threshold order, their colours.
-  const std::vector<int>& counted = pyr.Current.Indices;
-  float isoValues[MaximumIsovalues] = { 0 };
-  float isoColors[4 * MaximumIsovalues] = { 0 };
-  bool translucent = false;
-  for (std::size_t t = 0; t < counted.size(); ++t)
+  // 1. Choose the variant.
+  FrameVariant v;
+  const std::string unusable = ChooseVariant(pyramid, frame, gl.GetMaxPointSize(), v);
+  if (!unusable.empty())
   {
-    if (counted[t] < 0 || counted[t] >= static_cast<int>(frame.Surfaces.size()))
-    {
-      error = "the frame's surfaces are not those the pyramid was built for";
-      return false;
-    }
-    const IsosurfaceLook& s = frame.Surfaces[static_cast<std::size_t>(counted[t])];
-    isoValues[t] = static_cast<float>(s.Value);
-    for (int c = 0; c < 3; ++c)
-    {
-      isoColors[4 * t + c] = s.Color[c];
-    }
-    isoColors[4 * t + 3] = s.Opacity;
-    translucent = translucent || s.Opacity < 1.0f;
-  }
-
-  // 2. Matrices: cell-index space to view and clip, the eye in index space.
-  const Matrix indexToView = matrix4::FromArray(frame.IndexToView);
-  const Matrix projection = matrix4::FromArray(frame.Projection);
-  const Matrix indexToClip = matrix4::Multiply(projection, indexToView);
-  Matrix viewToIndex, clipToIndex;
-  if (!matrix4::Invert(indexToView, viewToIndex) || !matrix4::Invert(indexToClip, clipToIndex))
-  {
-    error = "the volume's transformation to the view is singular";
+    error = unusable;
     return false;
   }
-  const double eyeView[4] = { 0.0, 0.0, frame.Parallel ? 1.0 : 0.0, frame.Parallel ? 0.0 : 1.0 };
-  const auto eye = matrix4::Transform(viewToIndex, eyeView);
-  double gradientToView[9];
-  NormalMatrix(indexToView, gradientToView);
 
-  // 3. The footprint (points where they provably cover every cell) and the
-  //    first-hit pass (opaque frames with points); its buffers are made
-  //    before the program is chosen, so that a context that cannot make them
-  //    draws in one pass instead.
-  const int* viewport = frame.Viewport;
-  const int cells[3] = { layout.GetCells()[0], layout.GetCells()[1], layout.GetCells()[2] };
-  const bool points = frame.AllowPointFootprint &&
-    PointsCoverCells(indexToView, projection, cells, frame.NearPlane, frame.Parallel, viewport,
-      gl.GetMaxPointSize());
-  const int units = std::max(numLevels - 1, 2);
-  ScopedGLState saved(gl, units);
+  // 2. The first-hit pass's buffers, made before the program is chosen, so
+  //    that a context that cannot make them draws in one pass instead (the
+  //    same image).
+  ScopedGLState saved(gl, std::max(walk.TextureUnits, 2));
   gl.TakeErrors();
   GLint hostFramebuffer = 0;
   f.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &hostFramebuffer);
-  bool firstHit = frame.FirstHitPass && points && !translucent;
-  if (firstHit)
+  if (v.FirstHit)
   {
-    ProjectedRectangle(indexToClip, cells, viewport, impl.HitRect);
-    const std::string problem = impl.PrepareFirstHit(impl.HitRect[2], impl.HitRect[3], viewport);
+    ProjectedRectangle(v.IndexToClip, v.Cells, frame.Viewport, impl.HitRect);
+    const std::string problem =
+      impl.PrepareFirstHit(impl.HitRect[2], impl.HitRect[3], frame.Viewport);
     f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(hostFramebuffer));
-    if (!problem.empty())
-    {
-      // Drawn in one pass instead: the same image.
-      firstHit = false;
-    }
+    v.FirstHit = problem.empty();
   }
-  // Several opaque isovalues in the first-hit pass: one primitive per cell
-  // whose fragments take the nearest hit of the cell's isovalues.
-  const bool nearest = firstHit && counted.size() > 1;
-  const bool childMasks = pyr.ChildMasks;
 
-  // 4. The program of this variant and pyramid layout.
-  std::ostringstream defines, levels, descent;
-  if (points)
-  {
-    defines << "#define MEDISO_POINT_FOOTPRINT 1\n";
-  }
-  if (translucent)
-  {
-    defines << "#define MEDISO_TRANSLUCENT 1\n";
-  }
-  if (firstHit)
-  {
-    defines << "#define MEDISO_FIRST_HIT 1\n";
-  }
-  if (nearest)
-  {
-    defines << "#define MEDISO_NEAREST 1\n";
-  }
-  if (childMasks)
-  {
-    defines << "#define MEDISO_CHILD_MASKS 1\n";
-  }
-  // Cells off screen are dropped in the vertex stage only where part of the
-  // volume is: in a whole-volume view the test is not compiled in at all (as a
-  // uniform branch it still cost llvmpipe about 5% of a rotation frame).
-  if (!BoxInsideClipVolume(indexToClip, cells))
-  {
-    defines << "#define MEDISO_CULL_CELLS 1\n";
-  }
-  defines << "#define MEDISO_LIGHTS " << frame.LightsUsed() << "\n";
-  defines << "#define MEDISO_ISOVALUES "
-          << (translucent || nearest ? static_cast<int>(counted.size()) : MaximumIsovalues) << "\n";
-  defines << pyr.Declarations();
-  for (int l = 1; l + 1 < numLevels; ++l)
-  {
-    levels << "uniform usampler2D level" << l << ";\n";
-  }
-  // One step down per level, with the level's constants: with one isovalue
-  // the last step reads level 1's child masks with the counts.
-  for (int l = numLevels - 1; l >= 2; --l)
-  {
-    const int c = l - 1;
-    const auto factor = layout.Factor(l);
-    const auto span = layout.CellsPerNode(c);
-    const auto shifts = pyr.Shifts(c);
-    const bool toMasks = childMasks && c == 1;
-    descent << (toMasks ? "  descendToMasks(level" : "  descend(level") << c << ", ivec3("
-            << factor[0] << ", " << factor[1] << ", " << factor[2] << "), ivec3(" << shifts[0]
-            << ", " << shifts[1] << ", " << shifts[2] << "), vec3(" << span[0] << ".0, " << span[1]
-            << ".0, " << span[2] << ".0), node, index" << (toMasks ? ", nodeBits" : "") << ");\n";
-  }
-  const Hooks common = pyr.CommonHooks();
-  Hooks vertexHooks = common;
-  vertexHooks.emplace_back("HistoPyramidLevels", levels.str());
-  vertexHooks.emplace_back("HistoPyramidDescent", descent.str());
-  const bool conservative = !gl.IsES() && gl.HasConservativeDepth() && !firstHit;
-  Hooks fragmentHooks = { { "FragmentExtensions",
-    conservative
-      ? "#extension GL_ARB_conservative_depth : require\nlayout(depth_greater) out float gl_FragDepth;"
-      : "" } };
-  Program* program = impl.Programs.Get(gl, defines.str(),
-    Compose(shaders::HistoPyramidIso_vs, vertexHooks),
-    Compose(shaders::HistoPyramidIso_fs, fragmentHooks), error);
+  // 3. Compose the program, 4. set its state and uniforms.
+  Program* program = impl.ComposeProgram(walk, frame, v, error);
   if (!program)
   {
-    error = "the isosurface shaders do not build: " + error;
     return false;
   }
+  impl.SetUniforms(*program, pyramid, frame, v);
 
-  // 5. State, textures, uniforms.
-  f.Enable(GL_DEPTH_TEST);
-  f.Disable(GL_CULL_FACE);
-  f.Disable(GL_SCISSOR_TEST);
-  f.Disable(GL_STENCIL_TEST);
-  f.Disable(GL_RASTERIZER_DISCARD);
-  f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  SetSurfacePassBlending(gl, translucent);
-  if (points && !gl.IsES())
+  // 5. Draw the cells, through the first-hit pass or in one.
+  if (v.FirstHit)
   {
-    f.Enable(GL_PROGRAM_POINT_SIZE); // gl_PointSize (always honoured on GL ES)
-  }
-  program->Use();
-  BindTextureUnit(gl, 0, GL_TEXTURE_3D, pyr.Volume.Get());
-  pyr.SetCommonUniforms(*program, pyr.Current, 0);
-  for (int l = 1; l + 1 < numLevels; ++l)
-  {
-    BindTextureUnit(gl, l, GL_TEXTURE_2D, pyr.Levels[l].Get());
-    program->Set(("level" + std::to_string(l)).c_str(), l);
-  }
-  program->Set3i("firstFactor", layout.Factor(1).data());
-  const float eyeIndex[4] = { static_cast<float>(eye[0]), static_cast<float>(eye[1]),
-    static_cast<float>(eye[2]), static_cast<float>(eye[3]) };
-  program->Set4f("eyeIndex", eyeIndex);
-  program->Set("backToFront", translucent ? 1 : 0);
-  program->Set("oneRankPerCell", translucent || nearest ? 1 : 0);
-  program->Set("parallelProjection", frame.Parallel ? 1 : 0);
-  program->SetMatrix4("indexToClip", indexToClip.data());
-  program->SetMatrix4("indexToView", indexToView.data());
-  program->SetMatrix4("clipToIndex", clipToIndex.data());
-  program->SetMatrix3("gradientToView", gradientToView);
-  program->Set1fv("isovalues", MaximumIsovalues, isoValues);
-  program->Set4fv("isoColors", MaximumIsovalues, isoColors);
-  SetLightingUniforms(*program, frame);
-  // Where the cells are drawn: the viewport, or in the first-hit pass the
-  // same viewport in buffers whose pixel (0, 0) is window pixel HitRect.xy.
-  const int drawOrigin[2] = { firstHit ? viewport[0] - impl.HitRect[0] : viewport[0],
-    firstHit ? viewport[1] - impl.HitRect[1] : viewport[1] };
-  program->Set2f("viewportSize", static_cast<float>(viewport[2]), static_cast<float>(viewport[3]));
-  const float viewportF[4] = { static_cast<float>(drawOrigin[0]), static_cast<float>(drawOrigin[1]),
-    static_cast<float>(viewport[2]), static_cast<float>(viewport[3]) };
-  program->Set4f("viewport", viewportF);
-  program->Set("maxPointSize", gl.GetMaxPointSize());
-  // Pixels whose centres lie on a footprint's edges stay covered whatever the
-  // tie rule, and a point size rounded down to the granularity still covers.
-  program->Set("pointMargin", 0.1f + gl.GetPointSizeGranularity());
-  if (!impl.VertexArray)
-  {
-    impl.VertexArray = Name(gl, NameKind::VertexArray);
-  }
-  f.BindVertexArray(impl.VertexArray.Get());
-  f.Viewport(drawOrigin[0], drawOrigin[1], viewport[2], viewport[3]);
-
-  // 6. Draw.
-  if (firstHit)
-  {
-    // Pass 1: into the buffers, cleared to no hit; every primitive has the
-    // same depth and the test is GL_LESS, so each pixel keeps its first hit
-    // in drawing order (front to back: the nearest), and the test runs
-    // before the fragment stage.
-    f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, impl.HitFBO.Get());
-    const GLfloat clearColor[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
-    const GLfloat one = 1.0f;
-    f.ClearBufferfv(GL_COLOR, 0, clearColor);
-    f.ClearBufferfv(GL_DEPTH, 0, &one);
-    // (Attachment 1 needs no clear: its texels are read only where a hit wrote them.)
-    f.DepthFunc(GL_LESS);
-    impl.DrawCells(points, total);
-    // Pass 2: the hits into the host's framebuffer over HitRect, with the
-    // host's depth test.
-    f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(hostFramebuffer));
-    saved.RestoreDepthFunc();
-    Program* composite = impl.Programs.Get(gl, "", shaders::HistoPyramidFullScreen_vs,
-      shaders::HistoPyramidComposite_fs, error);
-    if (!composite)
+    const std::string problem = impl.DrawFirstHit(v, static_cast<GLuint>(hostFramebuffer), saved);
+    if (!problem.empty())
     {
-      error = "the first-hit composite shader does not build: " + error;
+      error = problem;
       return false;
     }
-    composite->Use();
-    BindTextureUnit(gl, 0, GL_TEXTURE_2D, impl.HitColor.Get());
-    BindTextureUnit(gl, 1, GL_TEXTURE_2D, impl.HitDepth.Get());
-    composite->Set("hitColor", 0);
-    composite->Set("hitDepth", 1);
-    composite->Set2i("hitOrigin", impl.HitRect[0], impl.HitRect[1]);
-    f.Viewport(impl.HitRect[0], impl.HitRect[1], impl.HitRect[2], impl.HitRect[3]);
-    f.DrawArrays(GL_TRIANGLES, 0, 3);
   }
   else
   {
-    impl.DrawCells(points, total);
+    impl.DrawCells(v.Points, total);
   }
   const std::string errors = gl.TakeErrors();
   if (!errors.empty())
@@ -541,8 +581,8 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
     error = "drawing the isosurfaces failed: " + errors;
     return false;
   }
-  stats.PointFootprint = points;
-  stats.FirstHit = firstHit;
+  stats.PointFootprint = v.Points;
+  stats.FirstHit = v.FirstHit;
   return true;
 }
 

@@ -33,6 +33,17 @@
  *    rasteriser runs every branch of a shader under SIMD masks, so one
  *    mode's code must not sit in another's program.
  *
+ * Render() runs in named steps, as vtkVolumeShaderComposer.h names its
+ * ReplaceShader* steps: choose the variant (isovalues in the pyramid's
+ * order, matrices, footprint, first hit, culling), make the first-hit
+ * buffers, compose the program (the variant's defines and the pyramid's
+ * walk, HistoPyramidGL::GetWalk(): the renderer knows nothing of the
+ * pyramid's textures), set its state and uniforms (the walk's bound by
+ * HistoPyramidGL::BindWalk()), draw the cells (through the first-hit pass
+ * or in one).
+ *
+ * Hosts do not call the renderer: IsosurfaceScene does.
+ *
  * The renderer draws into the framebuffer bound when Render() is called,
  * with the depth function the host has set, and restores every piece of
  * state it changes.
@@ -40,59 +51,16 @@
 #ifndef MedicalIsosurfaces_IsosurfaceRendererGL_h
 #define MedicalIsosurfaces_IsosurfaceRendererGL_h
 
+#include "IsosurfaceFrame.h"
+
 #include <cstdint>
 #include <memory>
 #include <string>
-#include <vector>
 
 namespace mediso
 {
 class GLApi;
 class HistoPyramidGL;
-
-/// Most lights a frame takes.
-constexpr int MaximumLights = 6;
-
-/// One isosurface: its value, colour and opacity (0 < opacity <= 1).
-struct IsosurfaceLook
-{
-  double Value = 0.0;
-  float Color[3] = { 1.0f, 1.0f, 1.0f };
-  float Opacity = 1.0f;
-};
-
-/// What a frame draws, and from where. Matrices are row-major, column vectors (VTK's convention).
-struct IsosurfaceFrame
-{
-  /// Cell-index space (point (i, j, k) of the volume at (i, j, k)) to the camera's view space.
-  double IndexToView[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
-  /// View space to clip space (OpenGL's convention: the camera looks down -z).
-  double Projection[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
-  bool Parallel = false;
-  /// Distance from the eye to the near clipping plane (view space).
-  double NearPlane = 0.01;
-  /// The viewport in the bound framebuffer's pixels (x, y, width, height).
-  int Viewport[4] = { 0, 0, 1, 1 };
-  /// The isosurfaces, exactly those the pyramid was last built for, in the same order.
-  std::vector<IsosurfaceLook> Surfaces;
-  /// Lights: directions towards the light in view space, and colours (times intensity).
-  int NumberOfLights = 0;
-  float LightDirections[MaximumLights][3] = {};
-  float LightColors[MaximumLights][3] = {};
-  float Ambient = 0.1f;
-  float Diffuse = 0.7f;
-  float Specular = 0.2f;
-  float SpecularPower = 10.0f;
-  /// Let the renderer draw point sprites where they provably cover every cell.
-  bool AllowPointFootprint = true;
-  /// Draw opaque frames with point footprints through the first-hit pass.
-  bool FirstHitPass = true;
-
-  /// The lights a program draws with (NumberOfLights within 0..MaximumLights): its
-  /// MEDISO_LIGHTS, a constant of the program, since a software rasteriser runs every
-  /// iteration of a loop with a uniform bound for every fragment.
-  int LightsUsed() const;
-};
 
 namespace glcore
 {

@@ -9,7 +9,7 @@
 #define MedicalIsosurfaces_SceneView_h
 
 #include "Camera.h"
-#include "IsosurfaceRendererGL.h"
+#include "IsosurfaceFrame.h"
 
 namespace mediso
 {

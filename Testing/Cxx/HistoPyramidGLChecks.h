@@ -2,7 +2,7 @@
 // The checks of the GPU core's HistoPyramid (mediso::HistoPyramidGL) against
 // the CPU model mediso::HistoPyramid, node for node, in whatever context is
 // current: TestHistoPyramidGLCore runs them on EGL contexts of OpenGL ES 3.0
-// and OpenGL 3.2 core (no VTK, no X display), TestOpenGLHistoPyramid inside a
+// and OpenGL 3.2 core (no VTK, no X display), TestHistoPyramidGLVTKWindow inside a
 // VTK render window. For the phantom stored as each supported scalar type and
 // many isovalue sets (single isovalues across the range, isovalues equal to
 // data values and just beside them, sets of 2 to 8, duplicates, NaN), and for

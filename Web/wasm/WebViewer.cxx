@@ -4,13 +4,12 @@
  * @brief The web page's render module: the GPU core on the browser's WebGL2, compiled to WebAssembly.
  *
  * The paper's client runs "the same render module" as the server. Here that
- * is the GPU core of Mappers/Core (mediso::HistoPyramidGL and
- * IsosurfaceRendererGL), byte for byte the code the ParaView mapper and
- * mediso-render run, on a WebGL2 context of a canvas, with the functions
- * Emscripten links in (GLFunctionList.h). JavaScript (Web/static/app.js) hands
- * it the volume once and then only parameters: isovalues, colours, the
- * camera. WebViewer holds the scene (volume placement, camera, surfaces) and
- * rebuilds the pyramid only when the isovalues change.
+ * is the GPU core of Mappers/Core (mediso::IsosurfaceScene), byte for byte
+ * the code the ParaView mapper and mediso-render run, on a WebGL2 context of a canvas, with the
+ * functions Emscripten links in (GLFunctionList.h). JavaScript (Web/static/app.js) hands it the
+ * volume once and then only parameters: isovalues, colours, the camera. WebViewer holds the
+ * volume's placement and the camera; the core's scene rebuilds the pyramid only when the isovalues
+ * change.
  *
  * The CPU path, for clients whose GPU cannot afford the GPU path (a software
  * rasteriser, small limits): the BlockLOD core (Filters/Core, the code of
@@ -26,8 +25,7 @@
 #include "GLApiFunctions.h"
 #include "GLProbe.h"
 #include "HistoPyramid.h"
-#include "HistoPyramidGL.h"
-#include "IsosurfaceRendererGL.h"
+#include "IsosurfaceScene.h"
 #include "MeshRenderer.h"
 #include "PyramidLayout.h"
 #include "ScalarTypes.h"
@@ -174,8 +172,8 @@ public:
       this->Error = "this WebGL2 cannot run the GPU path: " + error;
       return;
     }
-    this->Pyramid.reset(new HistoPyramidGL(this->GL));
-    this->Renderer.reset(new IsosurfaceRendererGL(this->GL));
+    this->Scene.reset(new IsosurfaceScene(nullptr));
+    this->Scene->SetContext(this->GL);
     this->Meshes.reset(new web::MeshRenderer(this->GL));
   }
 
@@ -184,13 +182,9 @@ public:
     if (this->Context > 0)
     {
       emscripten_webgl_make_context_current(this->Context);
-      if (this->Pyramid)
+      if (this->Scene)
       {
-        this->Pyramid->Release();
-      }
-      if (this->Renderer)
-      {
-        this->Renderer->Release();
+        this->Scene->Release();
       }
       if (this->Meshes)
       {
@@ -240,14 +234,6 @@ public:
     this->Type = static_cast<ScalarType>(type);
     this->Data = reinterpret_cast<const void*>(bytes);
     emscripten_webgl_make_context_current(this->Context);
-    std::string error;
-    if (!this->Pyramid->UploadVolume(this->Type, this->Data, this->Placement.Dimensions, nullptr,
-          error))
-    {
-      this->LastError = error;
-      return false;
-    }
-    this->BuiltValues.clear();
     VolumeDescription description;
     description.Type = this->Type;
     description.Data = this->Data;
@@ -255,6 +241,12 @@ public:
     std::copy(this->Placement.Origin, this->Placement.Origin + 3, description.Origin);
     std::copy(this->Placement.Spacing, this->Placement.Spacing + 3, description.Spacing);
     description.Stamp = ++this->VolumeStamp;
+    std::string error;
+    if (!this->Scene->SetVolume(description, error))
+    {
+      this->LastError = error;
+      return false;
+    }
     this->CPU.SetVolume(description);
     this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
     this->ResetCamera();
@@ -362,16 +354,7 @@ public:
         looks.push_back(look);
       }
     }
-    std::sort(looks.begin(), looks.end(),
-      [](const IsosurfaceLook& a, const IsosurfaceLook& b) { return a.Value < b.Value; });
-    looks.erase(std::unique(looks.begin(), looks.end(),
-                  [](const IsosurfaceLook& a, const IsosurfaceLook& b) { return a.Value == b.Value; }),
-      looks.end());
-    if (looks.size() > static_cast<std::size_t>(MaximumIsovalues))
-    {
-      looks.resize(MaximumIsovalues);
-    }
-    this->Frame.Surfaces = looks;
+    this->Frame.Surfaces = IsosurfaceScene::Normalize(looks).Surfaces;
     return true;
   }
 
@@ -472,16 +455,21 @@ public:
       }
       this->LastBuildMs = emscripten_get_now() - start;
     }
-    else if (values != this->BuiltValues && !values.empty())
+    else if (!values.empty())
     {
+      // The scene builds only when the isovalues changed.
+      const std::uint64_t builds = this->Scene->GetStats().PyramidBuilds;
+      this->Scene->SetSurfaces(this->Frame.Surfaces);
       std::string error;
-      if (!this->Pyramid->Build(values, error))
+      if (!this->Scene->Update(error))
       {
         this->LastError = error;
         return false;
       }
-      this->BuiltValues = values;
-      this->LastBuildMs = emscripten_get_now() - start;
+      if (this->Scene->GetStats().PyramidBuilds != builds)
+      {
+        this->LastBuildMs = emscripten_get_now() - start;
+      }
     }
     double bounds[6];
     this->Placement.Bounds(bounds);
@@ -497,13 +485,16 @@ public:
     const GLfloat one = 1.0f;
     f.ClearBufferfv(GL_COLOR, 0, background);
     f.ClearBufferfv(GL_DEPTH, 0, &one);
-    this->Stats = IsosurfaceFrameStats();
+    this->Stats = IsosurfaceSceneStats();
     std::string error;
-    if (!this->CPUPath && !values.empty() &&
-      !this->Renderer->Render(*this->Pyramid, this->Frame, this->Stats, error))
+    if (!this->CPUPath && !values.empty())
     {
-      this->LastError = error;
-      return false;
+      if (!this->Scene->Render(this->Frame, error))
+      {
+        this->LastError = error;
+        return false;
+      }
+      this->Stats = this->Scene->GetStats();
     }
     // The CPU path's surfaces and the server's result, in world coordinates.
     if (this->Meshes->GetNumberOfMeshes() > 0)
@@ -540,9 +531,10 @@ public:
     stats.set("firstHit", this->Stats.FirstHit);
     stats.set("buildMs", this->LastBuildMs);
     stats.set("frameMs", this->LastFrameMs);
-    stats.set("gpuBytes", this->Pyramid ? static_cast<double>(this->Pyramid->GetGPUMemoryBytes()) : 0.0);
+    stats.set(
+      "gpuBytes", this->Scene ? static_cast<double>(this->Scene->GetGPUMemoryBytes()) : 0.0);
     stats.set("frameBufferBytes",
-      this->Renderer ? static_cast<double>(this->Renderer->GetFrameBufferBytes()) : 0.0);
+      this->Scene ? static_cast<double>(this->Scene->GetFrameBufferBytes()) : 0.0);
     stats.set("error", this->LastError);
     return stats;
   }
@@ -655,16 +647,14 @@ private:
   std::string Error;
   std::string LastError;
   std::shared_ptr<const GLApi> GL;
-  std::unique_ptr<HistoPyramidGL> Pyramid;
-  std::unique_ptr<IsosurfaceRendererGL> Renderer;
+  std::unique_ptr<IsosurfaceScene> Scene;
   VolumePlacement Placement;
   ScalarType Type = ScalarType::Int16;
   const void* Data = nullptr;
   Camera View;
   bool Parallel = false;
   IsosurfaceFrame Frame;
-  IsosurfaceFrameStats Stats;
-  std::vector<double> BuiltValues;
+  IsosurfaceSceneStats Stats; // of the last frame the GPU path drew (zero otherwise)
   int Width = 640, Height = 480;
   float Background[3] = { 0.1f, 0.12f, 0.16f };
   double LastBuildMs = 0.0, LastFrameMs = 0.0;
@@ -732,11 +722,11 @@ val GPUVolume(int type, const val& dims)
   {
     points[a] = std::max(1, dims[a].as<int>());
   }
-  const std::array<int, 3> texture = HistoPyramidGL::VolumeTextureSize(points);
+  const std::array<int, 3> texture = IsosurfaceScene::VolumeTextureSize(points);
   val out = val::object();
   out.set("bytes",
     static_cast<double>(
-      HistoPyramidGL::EstimateGPUMemoryBytes(static_cast<ScalarType>(type), points)));
+      IsosurfaceScene::EstimateGPUMemoryBytes(static_cast<ScalarType>(type), points)));
   val size = val::array();
   for (int t : texture)
   {

@@ -17,7 +17,7 @@
 
 #include <iostream>
 
-int TestOpenGLHistoPyramid(int, char*[])
+int TestHistoPyramidGLVTKWindow(int, char*[])
 {
   vtkNew<vtkRenderWindow> renWin;
   renWin->SetOffScreenRendering(1);
@@ -46,7 +46,7 @@ int TestOpenGLHistoPyramid(int, char*[])
     std::cout << "the core cannot use the window's context: " << error << "\n";
     return 1;
   }
-  const int result = pyramid_checks::RunAll(gl, "TestOpenGLHistoPyramid passed");
+  const int result = pyramid_checks::RunAll(gl, "TestHistoPyramidGLVTKWindow passed");
   renWin->Render(); // the window still renders
   return result;
 }

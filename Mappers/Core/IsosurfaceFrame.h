@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file IsosurfaceFrame.h
+ * @brief What one frame of isosurfaces shows, and from where (no GL, no VTK).
+ *
+ * The hosts of the GPU core (the ParaView mapper's shell, mediso-render, the
+ * web page) describe a frame with these plain structures: the surfaces'
+ * looks, the volume's cell-index space seen by a camera, the lights and the
+ * material. IsosurfaceScene draws it; the web page's mesh renderer shades
+ * its triangles with the same lights and material. IsosurfaceSceneStats is
+ * what the scene says it did, which the hosts forward whole (the VTK mapper
+ * and the ParaView representation, the program's --stats, the page's stats()).
+ */
+#ifndef MedicalIsosurfaces_IsosurfaceFrame_h
+#define MedicalIsosurfaces_IsosurfaceFrame_h
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+namespace mediso
+{
+
+/// Most lights a frame takes.
+constexpr int MaximumLights = 6;
+
+/// One isosurface: its value, colour and opacity (0 < opacity <= 1).
+struct IsosurfaceLook
+{
+  double Value = 0.0;
+  float Color[3] = { 1.0f, 1.0f, 1.0f };
+  float Opacity = 1.0f;
+};
+
+/// What a frame draws, and from where. Matrices are row-major, column vectors (VTK's convention).
+struct IsosurfaceFrame
+{
+  /// Cell-index space (point (i, j, k) of the volume at (i, j, k)) to the camera's view space.
+  double IndexToView[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
+  /// View space to clip space (OpenGL's convention: the camera looks down -z).
+  double Projection[16] = { 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1 };
+  bool Parallel = false;
+  /// Distance from the eye to the near clipping plane (view space).
+  double NearPlane = 0.01;
+  /// The viewport in the bound framebuffer's pixels (x, y, width, height).
+  int Viewport[4] = { 0, 0, 1, 1 };
+  /// The isosurfaces, exactly those the pyramid was last built for, in the same order
+  /// (IsosurfaceScene fills them in from its own list).
+  std::vector<IsosurfaceLook> Surfaces;
+  /// Lights: directions towards the light in view space, and colours (times intensity).
+  int NumberOfLights = 0;
+  float LightDirections[MaximumLights][3] = {};
+  float LightColors[MaximumLights][3] = {};
+  float Ambient = 0.1f;
+  float Diffuse = 0.7f;
+  float Specular = 0.2f;
+  float SpecularPower = 10.0f;
+  /// Let the renderer draw point sprites where they provably cover every cell.
+  bool AllowPointFootprint = true;
+  /// Draw opaque frames with point footprints through the first-hit pass.
+  bool FirstHitPass = true;
+
+  /// The lights a program draws with (NumberOfLights within 0..MaximumLights): its
+  /// MEDISO_LIGHTS, a constant of the program, since a software rasteriser runs every
+  /// iteration of a loop with a uniform bound for every fragment.
+  int LightsUsed() const { return std::max(0, std::min(this->NumberOfLights, MaximumLights)); }
+};
+
+/// What IsosurfaceScene did: its last frame, its last pyramid build and volume upload, and its work
+/// so far.
+struct IsosurfaceSceneStats
+{
+  ///@{
+  /// The last frame: the primitives (active cell-isovalue pairs) it drew, whether as point
+  /// sprites (else quads over each cell's box) and through the first-hit pass.
+  std::uint64_t Primitives = 0;
+  bool PointFootprint = false;
+  bool FirstHit = false;
+  ///@}
+
+  ///@{
+  /// The last pyramid build: seconds (its passes and the read-back of the total), the level-1
+  /// tiles it drew (those whose value range holds an isovalue) and the volume's tiles.
+  double BuildSeconds = 0.0;
+  std::uint64_t BuildTilesDrawn = 0;
+  std::uint64_t BuildTiles = 0;
+  ///@}
+
+  /// Seconds the last volume upload took (packing, tile ranges, the 3D texture).
+  double UploadSeconds = 0.0;
+
+  ///@{
+  /// Pyramid builds and volume uploads so far (camera moves do neither).
+  std::uint64_t PyramidBuilds = 0;
+  std::uint64_t VolumeUploads = 0;
+  ///@}
+};
+
+} // namespace mediso
+
+#endif

@@ -1,0 +1,280 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "IsosurfaceScene.h"
+
+#include "HistoPyramidGL.h"
+#include "IsosurfaceRendererGL.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+namespace mediso
+{
+namespace
+{
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::duration d)
+{
+  return std::chrono::duration<double>(d).count();
+}
+
+// Whether two descriptions give the same volume texture.
+bool SameVolume(const VolumeDescription& a, const VolumeDescription& b)
+{
+  return a.Type == b.Type && a.Data == b.Data && a.Stamp == b.Stamp &&
+    std::equal(a.Dims, a.Dims + 3, b.Dims);
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+struct IsosurfaceScene::Internals
+{
+  GLParallelFor Parallel;
+  std::shared_ptr<const GLApi> GL;
+  std::unique_ptr<HistoPyramidGL> Pyramid;
+  std::unique_ptr<IsosurfaceRendererGL> Renderer;
+
+  // What the uploaded volume and the built pyramid were made from.
+  bool HasVolume = false;
+  VolumeDescription Volume;
+  std::vector<double> BuiltValues;
+
+  std::vector<IsosurfaceLook> Surfaces;
+  IsosurfaceSceneStats Stats;
+};
+
+IsosurfaceScene::IsosurfaceScene(GLParallelFor parallel)
+  : Impl(new Internals)
+{
+  this->Impl->Parallel = std::move(parallel);
+}
+
+IsosurfaceScene::~IsosurfaceScene() = default;
+
+void IsosurfaceScene::SetContext(std::shared_ptr<const GLApi> gl)
+{
+  Internals& impl = *this->Impl;
+  impl.GL = std::move(gl);
+  impl.Pyramid.reset(impl.GL ? new HistoPyramidGL(impl.GL) : nullptr);
+  impl.Renderer.reset(impl.GL ? new IsosurfaceRendererGL(impl.GL) : nullptr);
+  impl.HasVolume = false;
+  impl.BuiltValues.clear();
+}
+
+bool IsosurfaceScene::HasContext() const
+{
+  return this->Impl->GL != nullptr;
+}
+
+void IsosurfaceScene::Release()
+{
+  Internals& impl = *this->Impl;
+  if (impl.Pyramid)
+  {
+    impl.Pyramid->Release();
+  }
+  if (impl.Renderer)
+  {
+    impl.Renderer->Release();
+  }
+  impl.Pyramid.reset();
+  impl.Renderer.reset();
+  impl.GL.reset();
+  impl.HasVolume = false;
+  impl.BuiltValues.clear();
+}
+
+//------------------------------------------------------------------------------
+bool IsosurfaceScene::SetVolume(const VolumeDescription& volume, std::string& error)
+{
+  Internals& impl = *this->Impl;
+  if (!impl.Pyramid)
+  {
+    error = "the scene has no OpenGL context";
+    return false;
+  }
+  // The one upload decision: the values, their type or the size changed.
+  if (impl.HasVolume && SameVolume(volume, impl.Volume))
+  {
+    return true;
+  }
+  impl.HasVolume = false;
+  impl.BuiltValues.clear();
+  const auto start = Clock::now();
+  if (!impl.Pyramid->UploadVolume(volume.Type, volume.Data, volume.Dims, impl.Parallel, error))
+  {
+    return false;
+  }
+  impl.Stats.UploadSeconds = Seconds(Clock::now() - start);
+  ++impl.Stats.VolumeUploads;
+  impl.HasVolume = true;
+  impl.Volume = volume;
+  return true;
+}
+
+bool IsosurfaceScene::HasVolume() const
+{
+  return this->Impl->HasVolume;
+}
+
+//------------------------------------------------------------------------------
+SurfaceSelection IsosurfaceScene::Normalize(const std::vector<IsosurfaceLook>& looks)
+{
+  SurfaceSelection out;
+  std::vector<std::pair<double, int>> values; // value, index in `looks`
+  for (std::size_t i = 0; i < looks.size(); ++i)
+  {
+    if (std::isnan(looks[i].Value))
+    {
+      ++out.NotANumber;
+    }
+    else
+    {
+      values.emplace_back(looks[i].Value, static_cast<int>(i));
+    }
+  }
+  if (out.NotANumber > 0)
+  {
+    std::ostringstream note;
+    note << out.NotANumber << " of the " << looks.size() << " isovalues "
+         << (out.NotANumber == 1 ? "is" : "are")
+         << " not a number (NaN): an isosurface needs a numeric value; "
+         << (values.empty() ? "nothing is drawn." : "the others are drawn.");
+    out.Notes.push_back(note.str());
+  }
+  std::stable_sort(values.begin(), values.end(),
+    [](const std::pair<double, int>& a, const std::pair<double, int>& b)
+    { return a.first < b.first; });
+  for (std::size_t i = 1; i < values.size(); ++i)
+  {
+    if (values[i].first == values[i - 1].first &&
+      (out.Repeated.empty() || out.Repeated.back() != values[i].first))
+    {
+      out.Repeated.push_back(values[i].first);
+    }
+  }
+  values.erase(std::unique(values.begin(), values.end(),
+                 [](const std::pair<double, int>& a, const std::pair<double, int>& b)
+                 { return a.first == b.first; }),
+    values.end());
+  out.Distinct = values.size();
+  if (values.size() > static_cast<std::size_t>(MaximumIsovalues))
+  {
+    std::ostringstream note;
+    note << values.size() << " isovalues requested; only the lowest " << MaximumIsovalues
+         << " are drawn.";
+    out.Notes.push_back(note.str());
+    values.resize(MaximumIsovalues);
+  }
+  for (const auto& v : values)
+  {
+    out.Surfaces.push_back(looks[static_cast<std::size_t>(v.second)]);
+    out.Sources.push_back(v.second);
+  }
+  return out;
+}
+
+SurfaceSelection IsosurfaceScene::SetSurfaces(const std::vector<IsosurfaceLook>& looks)
+{
+  SurfaceSelection selection = Normalize(looks);
+  this->Impl->Surfaces = selection.Surfaces;
+  return selection;
+}
+
+const std::vector<IsosurfaceLook>& IsosurfaceScene::GetSurfaces() const
+{
+  return this->Impl->Surfaces;
+}
+
+//------------------------------------------------------------------------------
+bool IsosurfaceScene::Update(std::string& error)
+{
+  Internals& impl = *this->Impl;
+  std::vector<double> values;
+  for (const IsosurfaceLook& s : impl.Surfaces)
+  {
+    values.push_back(s.Value);
+  }
+  // The one build decision: the isovalues changed, or the volume did (an upload forgets them).
+  if (values.empty() || (impl.HasVolume && values == impl.BuiltValues))
+  {
+    return true;
+  }
+  if (!impl.HasVolume)
+  {
+    error = "Build needs a volume uploaded first"; // HistoPyramidGL's words
+    return false;
+  }
+  impl.BuiltValues.clear();
+  const auto start = Clock::now();
+  if (!impl.Pyramid->Build(values, error))
+  {
+    return false;
+  }
+  // Build() ends by reading the total back: the passes are done.
+  impl.Stats.BuildSeconds = Seconds(Clock::now() - start);
+  impl.Stats.BuildTilesDrawn = impl.Pyramid->GetLastTilesDrawn();
+  impl.Stats.BuildTiles = impl.Pyramid->GetNumberOfTiles();
+  ++impl.Stats.PyramidBuilds;
+  impl.BuiltValues = std::move(values);
+  return true;
+}
+
+bool IsosurfaceScene::Render(const IsosurfaceFrame& frame, std::string& error)
+{
+  Internals& impl = *this->Impl;
+  IsosurfaceSceneStats& stats = impl.Stats;
+  stats.Primitives = 0;
+  stats.PointFootprint = false;
+  stats.FirstHit = false;
+  if (!this->Update(error))
+  {
+    return false;
+  }
+  if (impl.Surfaces.empty())
+  {
+    return true; // nothing to draw
+  }
+  IsosurfaceFrame drawn = frame;
+  drawn.Surfaces = impl.Surfaces;
+  IsosurfaceFrameStats frameStats;
+  if (!impl.Renderer->Render(*impl.Pyramid, drawn, frameStats, error))
+  {
+    return false;
+  }
+  stats.Primitives = frameStats.Primitives;
+  stats.PointFootprint = frameStats.PointFootprint;
+  stats.FirstHit = frameStats.FirstHit;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+const IsosurfaceSceneStats& IsosurfaceScene::GetStats() const
+{
+  return this->Impl->Stats;
+}
+
+std::uint64_t IsosurfaceScene::GetGPUMemoryBytes() const
+{
+  return this->Impl->Pyramid ? this->Impl->Pyramid->GetGPUMemoryBytes() : 0;
+}
+
+std::array<int, 3> IsosurfaceScene::VolumeTextureSize(const int points[3])
+{
+  return HistoPyramidGL::VolumeTextureSize(points);
+}
+
+std::uint64_t IsosurfaceScene::EstimateGPUMemoryBytes(ScalarType type, const int points[3])
+{
+  return HistoPyramidGL::EstimateGPUMemoryBytes(type, points);
+}
+
+std::uint64_t IsosurfaceScene::GetFrameBufferBytes() const
+{
+  return this->Impl->Renderer ? this->Impl->Renderer->GetFrameBufferBytes() : 0;
+}
+
+} // namespace mediso

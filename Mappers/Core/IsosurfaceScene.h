@@ -1,0 +1,147 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file IsosurfaceScene.h
+ * @brief The GPU render module as one unit: a volume, its isosurfaces, and
+ * the frames drawn of them (OpenGL 3.2 core or ES 3.0; no VTK).
+ *
+ * Every host of the GPU path (the ParaView mapper's shell
+ * vtkOpenGLHistoPyramidIsosurfaces, mediso-render, the web page's
+ * WebViewer) drives the same three calls, and nothing else of the core:
+ *
+ * -# SetVolume(): the volume, described by a VolumeDescription (its type,
+ *    values, size and the host's Stamp of the values). It is uploaded only
+ *    when one of these changes; the pyramid is then built again.
+ * -# SetSurfaces(): the isosurfaces, normalised once for every host
+ *    (Normalize(): NaN values left out, increasing values, each once, at
+ *    most MaximumIsovalues, with the reason for what is left out).
+ * -# Render(): the frame (camera, lights, material, footprint options; its
+ *    surfaces are the scene's), after Update(), which builds the pyramid
+ *    when the surfaces' values or the volume changed since the last build.
+ *    Camera moves reuse the uploaded volume and the built pyramid.
+ *
+ * These are the scene's one upload decision and one build decision, as
+ * vtkOpenGLGPUVolumeRayCastMapper keeps one ShaderRebuildNeeded predicate;
+ * GetStats() says what they did, in one structure the hosts forward whole.
+ * Inside, HistoPyramidGL builds the pyramid (and owns its walk) and
+ * IsosurfaceRendererGL draws it; no host includes either.
+ *
+ * The context of SetContext() (or one sharing its objects) must be current
+ * in every call that touches GL: SetVolume(), Update(), Render(),
+ * Release() and the destructor. Release() frees every GL object but keeps
+ * the surfaces and the counts of GetStats(), so that a host can move the
+ * scene to another context (SetContext()) as VTK moves a mapper to another
+ * window.
+ */
+#ifndef MedicalIsosurfaces_IsosurfaceScene_h
+#define MedicalIsosurfaces_IsosurfaceScene_h
+
+#include "BlockLODVolume.h" // VolumeDescription
+#include "IsosurfaceFrame.h"
+#include "VolumeTiles.h" // GLParallelFor
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mediso
+{
+class GLApi;
+
+/// A list of isosurfaces as the scene draws them, and what was left out of the list given.
+struct SurfaceSelection
+{
+  /// Increasing values, each once, at most MaximumIsovalues.
+  std::vector<IsosurfaceLook> Surfaces;
+  /// For each of Surfaces, its index in the list given.
+  std::vector<int> Sources;
+  /// How many values of the list given are NaN (left out).
+  int NotANumber = 0;
+  /// Values given more than once, in increasing order (each drawn once, with its first look).
+  std::vector<double> Repeated;
+  /// Distinct values given (the lowest MaximumIsovalues of them are kept).
+  std::size_t Distinct = 0;
+  /// One sentence for each kind of value left out: the NaN ones, those over the limit.
+  std::vector<std::string> Notes;
+};
+
+class IsosurfaceScene
+{
+public:
+  /// `parallel` runs the volume's CPU work (packing, tile ranges); empty: serially.
+  explicit IsosurfaceScene(GLParallelFor parallel);
+  ~IsosurfaceScene();
+  IsosurfaceScene(const IsosurfaceScene&) = delete;
+  IsosurfaceScene& operator=(const IsosurfaceScene&) = delete;
+
+  /**
+   * Draw with `gl`'s context from now on. A scene that holds GL objects
+   * must be Release()d first (in its old context).
+   */
+  void SetContext(std::shared_ptr<const GLApi> gl);
+  bool HasContext() const;
+
+  /**
+   * Adopt a volume: uploaded when its Type, Data, Dims or Stamp differ from
+   * the current volume's (the rest of the description does not change the
+   * GPU's copy). False, with the reason in @a error, when it cannot be
+   * uploaded (over the context's texture limits, a GL failure); the scene
+   * then has no volume until one uploads.
+   */
+  bool SetVolume(const VolumeDescription& volume, std::string& error);
+  bool HasVolume() const;
+
+  /**
+   * The surfaces `looks` say, as every host draws them: NaN values left out,
+   * sorted by value (stably: a repeated value keeps its first look), each
+   * value once, the lowest MaximumIsovalues kept; the notes say what was
+   * left out and why.
+   */
+  static SurfaceSelection Normalize(const std::vector<IsosurfaceLook>& looks);
+
+  /// Adopt `looks`, normalised (see Normalize(), whose result it returns).
+  SurfaceSelection SetSurfaces(const std::vector<IsosurfaceLook>& looks);
+  const std::vector<IsosurfaceLook>& GetSurfaces() const;
+
+  /**
+   * Build the pyramid if the surfaces' values or the volume changed since
+   * the last build (nothing to build without surfaces). False, with the
+   * reason, when there is no volume or the build fails.
+   */
+  bool Update(std::string& error);
+
+  /**
+   * Update(), then draw the scene's surfaces for `frame` (its Surfaces are
+   * ignored) into the bound draw framebuffer with the host's depth function.
+   * No surfaces draw nothing. False, with the reason, when the update fails,
+   * a program does not build, the context lacks what the frame needs, or a
+   * GL call fails.
+   */
+  bool Render(const IsosurfaceFrame& frame, std::string& error);
+
+  /// What the scene did (see IsosurfaceSceneStats).
+  const IsosurfaceSceneStats& GetStats() const;
+
+  /// Bytes of GPU memory held now for the volume (its texture and the pyramid).
+  std::uint64_t GetGPUMemoryBytes() const;
+
+  /// The volume texture's size in texels for a volume of `points` (4 points to a texel along x).
+  static std::array<int, 3> VolumeTextureSize(const int points[3]);
+  /// What GetGPUMemoryBytes() will be once a volume of `type` and `points` is uploaded and built.
+  static std::uint64_t EstimateGPUMemoryBytes(ScalarType type, const int points[3]);
+  /// Bytes of the first-hit pass's buffers (0 until one is drawn).
+  std::uint64_t GetFrameBufferBytes() const;
+
+  /// Frees every GL object and forgets the volume and the context (which must be current).
+  void Release();
+
+private:
+  struct Internals;
+  std::unique_ptr<Internals> Impl;
+};
+
+} // namespace mediso
+
+#endif

@@ -1,0 +1,256 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "VolumeTiles.h"
+
+#include <algorithm>
+#include <limits>
+
+namespace mediso
+{
+namespace
+{
+// out[2 t] the least and out[2 t + 1] the greatest point value of tile t's
+// real cells, as R (every value of T is exact in it).
+template<typename T, typename R>
+void ComputeTileRanges(const T* data, const int points[3], const PyramidLayout& layout,
+  const GLParallelFor& parallel, std::vector<R>& out)
+{
+  const auto tiles = layout.TileCounts();
+  const auto factor = layout.Factor(1);
+  const int cells[3] = { points[0] - 1, points[1] - 1, points[2] - 1 };
+  // Cells per tile along x and y (a packed texel holds 2 nodes per axis).
+  const int span[2] = { 2 * PyramidLayout::TileTexels * factor[0],
+    2 * PyramidLayout::TileTexels * factor[1] };
+  const std::size_t perSlice = static_cast<std::size_t>(tiles[0]) * tiles[1];
+  const R none = std::numeric_limits<R>::has_infinity ? std::numeric_limits<R>::infinity()
+                                                      : std::numeric_limits<R>::max();
+  const R noneHigh = std::numeric_limits<R>::has_infinity ? -std::numeric_limits<R>::infinity()
+                                                          : std::numeric_limits<R>::lowest();
+  out.assign(2 * perSlice * tiles[2], R());
+  parallel(0, tiles[2],
+    [&](std::int64_t sliceBegin, std::int64_t sliceEnd)
+    {
+      std::vector<R> rowLow(tiles[0]), rowHigh(tiles[0]);
+      for (std::int64_t slice = sliceBegin; slice < sliceEnd; ++slice)
+      {
+        R* ranges = out.data() + 2 * perSlice * slice;
+        for (std::size_t t = 0; t < perSlice; ++t)
+        {
+          ranges[2 * t] = none;
+          ranges[2 * t + 1] = noneHigh;
+        }
+        // The slice's cells along z, and so its points [z0, z1].
+        const int z0 = static_cast<int>(slice) * factor[2];
+        if (z0 >= cells[2])
+        {
+          continue;
+        }
+        const int z1 = std::min(z0 + factor[2], cells[2]);
+        for (int z = z0; z <= z1; ++z)
+        {
+          for (int y = 0; y < points[1]; ++y)
+          {
+            const T* row = data + (static_cast<std::size_t>(z) * points[1] + y) * points[0];
+            // Each tile's points of this row: x in [tx span, min((tx + 1) span, cells)].
+            for (int tx = 0; tx < tiles[0]; ++tx)
+            {
+              R low = none, high = noneHigh;
+              const int x0 = tx * span[0];
+              const int x1 = std::min(x0 + span[0], cells[0]);
+              for (int x = x0; x <= x1 && x0 < cells[0]; ++x)
+              {
+                const R v = static_cast<R>(row[x]);
+                low = v < low ? v : low; // NaN compares false: left out
+                high = v > high ? v : high;
+              }
+              rowLow[tx] = low;
+              rowHigh[tx] = high;
+            }
+            // The row belongs to the tiles whose points along y hold y: one,
+            // or two where it is the boundary between them.
+            const int ty = std::min(y / span[1], tiles[1] - 1);
+            for (int t = ty; t >= 0 && t >= ty - 1; --t)
+            {
+              const int ya = t * span[1];
+              if (ya >= cells[1] || y < ya || y > std::min(ya + span[1], cells[1]))
+              {
+                continue;
+              }
+              R* tile = ranges + 2 * static_cast<std::size_t>(t) * tiles[0];
+              for (int tx = 0; tx < tiles[0]; ++tx)
+              {
+                tile[2 * tx] = rowLow[tx] < tile[2 * tx] ? rowLow[tx] : tile[2 * tx];
+                tile[2 * tx + 1] = rowHigh[tx] > tile[2 * tx + 1] ? rowHigh[tx] : tile[2 * tx + 1];
+              }
+            }
+          }
+        }
+      }
+    });
+}
+
+void SerialFor(
+  std::int64_t begin, std::int64_t end, const std::function<void(std::int64_t, std::int64_t)>& body)
+{
+  if (begin < end)
+  {
+    body(begin, end);
+  }
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+GLParallelFor SerialIfEmpty(const GLParallelFor& parallel)
+{
+  return parallel ? parallel : GLParallelFor(SerialFor);
+}
+
+int PackedVolumeWidth(int pointsX)
+{
+  return (pointsX + 3) / 4;
+}
+
+std::vector<unsigned char> PackVolumeRows(
+  const void* data, const int points[3], int bytesPerValue, const GLParallelFor& parallel)
+{
+  const std::size_t inRow = static_cast<std::size_t>(points[0]) * bytesPerValue;
+  const std::size_t outRow =
+    static_cast<std::size_t>(4 * PackedVolumeWidth(points[0])) * bytesPerValue;
+  const std::int64_t rows = static_cast<std::int64_t>(points[1]) * points[2];
+  std::vector<unsigned char> packed(outRow * static_cast<std::size_t>(rows));
+  const unsigned char* in = static_cast<const unsigned char*>(data);
+  SerialIfEmpty(parallel)(0, rows,
+    [&](std::int64_t begin, std::int64_t end)
+    {
+      for (std::int64_t r = begin; r < end; ++r)
+      {
+        const unsigned char* from = in + inRow * r;
+        unsigned char* to = packed.data() + outRow * r;
+        std::copy(from, from + inRow, to);
+        for (std::size_t pad = inRow; pad < outRow; pad += bytesPerValue)
+        {
+          std::copy(from + inRow - bytesPerValue, from + inRow, to + pad);
+        }
+      }
+    });
+  return packed;
+}
+
+//------------------------------------------------------------------------------
+void VolumeTiles::Compute(ScalarType type, const void* data, const int points[3],
+  const PyramidLayout& layout, const GLParallelFor& parallel)
+{
+  this->Clear();
+  const GLParallelFor run = SerialIfEmpty(parallel);
+  const ScalarType rangeType = type == ScalarType::Float64 ? ScalarType::Float32 : type;
+  VisitScalarType(rangeType,
+    [&](auto tag)
+    {
+      using T = decltype(tag);
+      const T* typed = static_cast<const T*>(data);
+      switch (ValueKindOf(type))
+      {
+        case ValueKind::Signed:
+          ComputeTileRanges(typed, points, layout, run, this->IntRanges);
+          break;
+        case ValueKind::Unsigned:
+          ComputeTileRanges(typed, points, layout, run, this->UIntRanges);
+          break;
+        case ValueKind::Float:
+          ComputeTileRanges(typed, points, layout, run, this->FloatRanges);
+          break;
+      }
+    });
+  this->Layout = layout;
+}
+
+void VolumeTiles::Clear()
+{
+  this->Layout = PyramidLayout();
+  this->IntRanges.clear();
+  this->UIntRanges.clear();
+  this->FloatRanges.clear();
+}
+
+std::uint64_t VolumeTiles::GetNumberOfTiles() const
+{
+  return (this->IntRanges.size() + this->UIntRanges.size() + this->FloatRanges.size()) / 2;
+}
+
+bool VolumeTiles::IsActive(const IsoThresholds& thresholds, std::size_t t) const
+{
+  switch (thresholds.Kind)
+  {
+    case ValueKind::Signed:
+      return thresholds.Crosses(this->IntRanges[2 * t], this->IntRanges[2 * t + 1]);
+    case ValueKind::Unsigned:
+      return thresholds.Crosses(this->UIntRanges[2 * t], this->UIntRanges[2 * t + 1]);
+    default:
+      return thresholds.Crosses(this->FloatRanges[2 * t], this->FloatRanges[2 * t + 1]);
+  }
+}
+
+std::vector<std::uint16_t> VolumeTiles::ActiveRectangles(
+  const IsoThresholds& thresholds, const GLParallelFor& parallel, std::uint64_t& tilesDrawn) const
+{
+  const PyramidLayout& layout = this->Layout;
+  const auto tiles = layout.TileCounts();
+  const auto packed = layout.Packed(1);
+  const std::size_t perSlice = static_cast<std::size_t>(tiles[0]) * tiles[1];
+  // Per slice, in parallel; then joined in slice order.
+  std::vector<std::vector<std::uint16_t>> slices(static_cast<std::size_t>(tiles[2]));
+  std::vector<std::uint64_t> counts(static_cast<std::size_t>(tiles[2]), 0);
+  SerialIfEmpty(parallel)(0, tiles[2],
+    [&](std::int64_t begin, std::int64_t end)
+    {
+      for (std::int64_t z = begin; z < end; ++z)
+      {
+        std::vector<std::uint16_t>& out = slices[z];
+        for (int ty = 0; ty < tiles[1]; ++ty)
+        {
+          for (int tx = 0; tx < tiles[0];)
+          {
+            const std::size_t t = perSlice * z + static_cast<std::size_t>(ty) * tiles[0];
+            if (!this->IsActive(thresholds, t + tx))
+            {
+              ++tx;
+              continue;
+            }
+            int end = tx + 1;
+            while (end < tiles[0] && this->IsActive(thresholds, t + end))
+            {
+              ++end;
+            }
+            counts[z] += static_cast<std::uint64_t>(end - tx);
+            const auto lo = layout.AtlasTexel(1, tx * PyramidLayout::TileTexels,
+              ty * PyramidLayout::TileTexels, static_cast<int>(z));
+            const int w =
+              std::min(end * PyramidLayout::TileTexels, packed[0]) - tx * PyramidLayout::TileTexels;
+            const int h = std::min((ty + 1) * PyramidLayout::TileTexels, packed[1]) -
+              ty * PyramidLayout::TileTexels;
+            const std::uint16_t x0 = static_cast<std::uint16_t>(lo[0]);
+            const std::uint16_t y0 = static_cast<std::uint16_t>(lo[1]);
+            const std::uint16_t x1 = static_cast<std::uint16_t>(lo[0] + w);
+            const std::uint16_t y1 = static_cast<std::uint16_t>(lo[1] + h);
+            out.insert(out.end(), { x0, y0, x1, y0, x0, y1, x0, y1, x1, y0, x1, y1 });
+            tx = end;
+          }
+        }
+      }
+    });
+  std::vector<std::uint16_t> all;
+  std::size_t size = 0;
+  for (const auto& s : slices)
+  {
+    size += s.size();
+  }
+  all.reserve(size);
+  tilesDrawn = 0;
+  for (std::size_t z = 0; z < slices.size(); ++z)
+  {
+    all.insert(all.end(), slices[z].begin(), slices[z].end());
+    tilesDrawn += counts[z];
+  }
+  return all;
+}
+
+} // namespace mediso

@@ -1,0 +1,98 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file VolumeTiles.h
+ * @brief What the GPU pyramid needs from a volume on the CPU: its rows as the
+ * volume texture stores them, and the value range of every level-1 tile (no GL, no VTK).
+ *
+ * HistoPyramidGL keeps the volume as a 3D texture of 4 points to a texel
+ * along x, and draws level 1 only over the tiles an isovalue can cross
+ * (mediso::PyramidLayout::TileTexels texels of level 1 a side, one slice of
+ * nodes deep). Both are plain data work, done once per volume:
+ *
+ * - PackVolumeRows() pads every row to a whole number of texels;
+ * - VolumeTiles::Compute() takes, for every tile, the least and greatest
+ *   value its cells read (in the type the thresholds have: int32, uint32 or
+ *   float, which hold every value of the volume's type exactly);
+ * - VolumeTiles::ActiveRectangles() turns, for one set of thresholds, the
+ *   tiles whose range holds one into the level-1 pass's vertices: per slice
+ *   and row of tiles, each run of active tiles as one rectangle.
+ *
+ * A tile's points are linked by cell edges, so an isovalue in its range
+ * means one of its cells crosses it: skipping the other tiles changes no count.
+ */
+#ifndef MedicalIsosurfaces_VolumeTiles_h
+#define MedicalIsosurfaces_VolumeTiles_h
+
+#include "IsoThresholds.h"
+#include "PyramidLayout.h"
+#include "ScalarTypes.h"
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace mediso
+{
+
+/// Runs body(begin, end) over sub-ranges that together cover [begin, end), possibly concurrently.
+using GLParallelFor = std::function<void(
+  std::int64_t, std::int64_t, const std::function<void(std::int64_t, std::int64_t)>&)>;
+
+/// The parallel-for to use: `parallel`, or one that runs the whole range at once when it is empty.
+GLParallelFor SerialIfEmpty(const GLParallelFor& parallel);
+
+/// Texels per row of the stored volume: 4 points to a texel along x.
+int PackedVolumeWidth(int pointsX);
+
+/**
+ * The volume as its texture stores it: texel (i, j, k) holds points
+ * (4 i + c, j, k) in component c, and where a row's points run out, its last
+ * texel repeats the row's last point (so a read past the end of a row gives
+ * the value a clamp to the volume would). Rows are copied as bytes, so the
+ * values keep their type. Readers: pointQuad() and pointValue() in
+ * HistoPyramidCommon.glsl.
+ */
+std::vector<unsigned char> PackVolumeRows(
+  const void* data, const int points[3], int bytesPerValue, const GLParallelFor& parallel);
+
+/// The value range of every level-1 tile of a volume, and the active ones' rectangles.
+class VolumeTiles
+{
+public:
+  /**
+   * The ranges of `data` (`type`, x fastest, `points` per axis; Float64 is
+   * read as the float data it becomes on the GPU, so pass it converted) on
+   * `layout`'s tiles. An empty tile (padding cells only, or only NaN values)
+   * gets least > greatest, which no threshold lies between; NaN values are
+   * left out (a cell with a NaN corner counts nothing anyway).
+   */
+  void Compute(ScalarType type, const void* data, const int points[3], const PyramidLayout& layout,
+    const GLParallelFor& parallel);
+
+  void Clear();
+
+  /// Tiles of the last Compute() (0 after Clear()).
+  std::uint64_t GetNumberOfTiles() const;
+
+  /**
+   * The level-1 pass's vertices for `thresholds` (of the volume's value
+   * kind): per slice and row of tiles, each run of tiles whose range holds a
+   * threshold, as two triangles in level-1 atlas texels (x, y pairs).
+   * @a tilesDrawn is the number of tiles they cover.
+   */
+  std::vector<std::uint16_t> ActiveRectangles(const IsoThresholds& thresholds,
+    const GLParallelFor& parallel, std::uint64_t& tilesDrawn) const;
+
+  /// Whether tile t's range holds a threshold (t = x + tiles.x (y + tiles.y z)).
+  bool IsActive(const IsoThresholds& thresholds, std::size_t t) const;
+
+private:
+  PyramidLayout Layout;
+  std::vector<std::int32_t> IntRanges; // least, greatest per tile, by the value kind
+  std::vector<std::uint32_t> UIntRanges;
+  std::vector<float> FloatRanges;
+};
+
+} // namespace mediso
+
+#endif

@@ -1,0 +1,215 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Unit test of the GPU pyramid's CPU-side volume work (Mappers/Core/VolumeTiles),
+// without VTK or OpenGL:
+//  - PackVolumeRows() keeps every value and pads each row with its last point;
+//  - a level-1 tile is active for a set of isovalues exactly when one of its
+//    cells crosses one (a superset where the volume has NaN values, whose
+//    cells cross nothing), for several scalar types and shapes that fill no
+//    whole tile;
+//  - ActiveRectangles() covers exactly the active tiles' texels.
+#include "MedicalTestUtilities.h"
+
+#include "IsoThresholds.h"
+#include "PyramidLayout.h"
+#include "VolumeTiles.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace
+{
+using medical_test::Check;
+using mediso::PyramidLayout;
+
+std::string Shape(const int points[3])
+{
+  return std::to_string(points[0]) + "x" + std::to_string(points[1]) + "x" +
+    std::to_string(points[2]);
+}
+
+template<typename T>
+void CheckPacking(const std::vector<T>& values, const int points[3])
+{
+  const int width = mediso::PackedVolumeWidth(points[0]);
+  const std::vector<unsigned char> packed =
+    mediso::PackVolumeRows(values.data(), points, static_cast<int>(sizeof(T)), {});
+  const std::size_t rows = static_cast<std::size_t>(points[1]) * points[2];
+  bool ok = packed.size() == 4 * static_cast<std::size_t>(width) * rows * sizeof(T);
+  for (std::size_t r = 0; ok && r < rows; ++r)
+  {
+    for (int x = 0; x < 4 * width; ++x)
+    {
+      T got;
+      std::memcpy(&got, packed.data() + (4 * width * r + x) * sizeof(T), sizeof(T));
+      const T expected = values[r * points[0] + std::min(x, points[0] - 1)];
+      ok = ok && std::memcmp(&got, &expected, sizeof(T)) == 0;
+    }
+  }
+  Check(ok, Shape(points) + ": packed rows keep every value and repeat a row's last point");
+}
+
+// Every cell's crossing, in double precision (a NaN corner crosses nothing).
+template<typename T>
+bool CellCrosses(const std::vector<T>& v, const int points[3], int x, int y, int z,
+  const std::vector<double>& isovalues)
+{
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (int c = 0; c < 8; ++c)
+  {
+    const std::size_t id =
+      (static_cast<std::size_t>(z + (c >> 2)) * points[1] + y + ((c >> 1) & 1)) * points[0] + x +
+      (c & 1);
+    const double value = static_cast<double>(v[id]);
+    if (std::isnan(value))
+    {
+      return false;
+    }
+    lo = std::min(lo, value);
+    hi = std::max(hi, value);
+  }
+  for (double iso : isovalues)
+  {
+    if (lo < iso && iso <= hi)
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+template<typename T>
+void CheckTiles(const std::vector<T>& values, const int points[3],
+  const std::vector<std::vector<double>>& isovalueSets, bool hasNaN)
+{
+  const int cells[3] = { points[0] - 1, points[1] - 1, points[2] - 1 };
+  const PyramidLayout layout(cells);
+  const auto tiles = layout.TileCounts();
+  const auto factor = layout.Factor(1);
+  const auto packed = layout.Packed(1);
+  const int span[2] = { 2 * PyramidLayout::TileTexels * factor[0],
+    2 * PyramidLayout::TileTexels * factor[1] };
+  const std::size_t numTiles = static_cast<std::size_t>(tiles[0]) * tiles[1] * tiles[2];
+  const mediso::ScalarType type = mediso::ScalarTypeOf<T>();
+  // A parallel-for that cuts the range in pieces, as a host's would.
+  const mediso::GLParallelFor pieces =
+    [](std::int64_t begin, std::int64_t end,
+      const std::function<void(std::int64_t, std::int64_t)>& body)
+  {
+    for (std::int64_t b = begin; b < end; b += 3)
+    {
+      body(b, std::min(end, b + 3));
+    }
+  };
+  mediso::VolumeTiles volumeTiles;
+  volumeTiles.Compute(type, values.data(), points, layout, pieces);
+  Check(volumeTiles.GetNumberOfTiles() == numTiles, Shape(points) + ": one range per tile");
+
+  for (const auto& isovalues : isovalueSets)
+  {
+    const mediso::IsoThresholds thresholds = mediso::MakeIsoThresholds(type, isovalues);
+    std::vector<char> crossed(numTiles, 0);
+    for (int z = 0; z < cells[2]; ++z)
+      for (int y = 0; y < cells[1]; ++y)
+        for (int x = 0; x < cells[0]; ++x)
+        {
+          if (CellCrosses(values, points, x, y, z, isovalues))
+          {
+            crossed[x / span[0] + tiles[0] * (y / span[1] + tiles[1] * (z / factor[2]))] = 1;
+          }
+        }
+    bool exact = true, cover = true;
+    std::uint64_t active = 0, activeTexels = 0;
+    for (std::size_t t = 0; t < numTiles; ++t)
+    {
+      const bool on = volumeTiles.IsActive(thresholds, t);
+      cover = cover && (on || !crossed[t]);
+      exact = exact && on == static_cast<bool>(crossed[t]);
+      if (on)
+      {
+        ++active;
+        const int tx = static_cast<int>(t % tiles[0]);
+        const int ty = static_cast<int>((t / tiles[0]) % tiles[1]);
+        activeTexels +=
+          static_cast<std::uint64_t>(std::min((tx + 1) * PyramidLayout::TileTexels, packed[0]) -
+            tx * PyramidLayout::TileTexels) *
+          (std::min((ty + 1) * PyramidLayout::TileTexels, packed[1]) -
+            ty * PyramidLayout::TileTexels);
+      }
+    }
+    std::string what = Shape(points) + ", isovalues";
+    for (double iso : isovalues)
+    {
+      what += " " + std::to_string(iso);
+    }
+    Check(cover, what + ": every tile with a crossing cell is active");
+    if (!hasNaN)
+    {
+      Check(exact, what + ": a tile is active exactly when one of its cells crosses");
+    }
+
+    std::uint64_t drawn = 0;
+    const std::vector<std::uint16_t> rectangles =
+      volumeTiles.ActiveRectangles(thresholds, pieces, drawn);
+    const auto atlas = layout.AtlasSize(1);
+    bool inside = rectangles.size() % 12 == 0;
+    std::uint64_t texels = 0;
+    for (std::size_t r = 0; inside && r < rectangles.size(); r += 12)
+    {
+      // Two triangles: (x0, y0), (x1, y0), (x0, y1) and (x0, y1), (x1, y0), (x1, y1).
+      const int x0 = rectangles[r], y0 = rectangles[r + 1], x1 = rectangles[r + 2],
+                y1 = rectangles[r + 5];
+      inside = x0 < x1 && y0 < y1 && x1 <= atlas[0] && y1 <= atlas[1];
+      texels += static_cast<std::uint64_t>(x1 - x0) * (y1 - y0);
+    }
+    Check(inside && drawn == active && texels == activeTexels,
+      what + ": the rectangles cover the active tiles' texels (" + std::to_string(drawn) + " of " +
+        std::to_string(numTiles) + " tiles)");
+  }
+}
+
+template<typename T>
+std::vector<T> RandomVolume(const int points[3], double lo, double hi, std::mt19937& random)
+{
+  // Smooth enough that tiles differ: a ramp along z plus noise.
+  std::uniform_real_distribution<double> noise(0.0, 0.25 * (hi - lo));
+  std::vector<T> v(static_cast<std::size_t>(points[0]) * points[1] * points[2]);
+  for (int z = 0; z < points[2]; ++z)
+    for (int y = 0; y < points[1]; ++y)
+      for (int x = 0; x < points[0]; ++x)
+      {
+        const double ramp =
+          lo + 0.75 * (hi - lo) * (x + y + z) / (points[0] + points[1] + points[2]);
+        v[(static_cast<std::size_t>(z) * points[1] + y) * points[0] + x] =
+          static_cast<T>(std::floor(ramp + noise(random)));
+      }
+  return v;
+}
+} // namespace
+
+int main()
+{
+  std::mt19937 random(7);
+  const int shapes[][3] = { { 2, 2, 2 }, { 5, 3, 2 }, { 41, 37, 33 }, { 70, 19, 6 },
+    { 18, 66, 9 } };
+  for (const auto& points : shapes)
+  {
+    const auto shorts = RandomVolume<std::int16_t>(points, -1000.0, 1000.0, random);
+    CheckPacking(shorts, points);
+    CheckTiles(
+      shorts, points, { { 0.0 }, { -400.5, 300.0 }, { -2000.0 }, { 200.0, 400.0, 600.0 } }, false);
+    const auto bytes = RandomVolume<std::uint8_t>(points, 0.0, 255.0, random);
+    CheckPacking(bytes, points);
+    CheckTiles(bytes, points, { { 100.0 }, { 30.5, 180.0 } }, false);
+    auto floats = RandomVolume<float>(points, -1.0, 1.0, random);
+    floats[floats.size() / 3] = std::numeric_limits<float>::quiet_NaN();
+    CheckPacking(floats, points);
+    CheckTiles(floats, points, { { 0.0 }, { -0.5, 0.25 } }, true);
+  }
+  return medical_test::Finish("VolumeTiles core: all checks passed");
+}
