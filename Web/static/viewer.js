@@ -71,17 +71,16 @@ function backingStore(box, dpr = window.devicePixelRatio || 1) {
 /**
  * Keeps the canvas's backing store at its CSS size times the device pixel ratio (the window
  * resized, the panel hidden, the page zoomed or moved to another screen), redrawing at once: a
- * resized canvas is cleared. Not with the size= parameter, which fixes it.
+ * resized canvas is cleared. Not with the size= parameter, which fixes it. The size is the CSS
+ * box times devicePixelRatio rather than the observer's device-pixel box, which Chromium's
+ * emulated pixel ratios (tests) leave in CSS pixels.
  */
 export function fitCanvas(canvas) {
   if (params.get("size")) {
     return;
   }
-  const observer = new ResizeObserver((entries) => {
-    const entry = entries[entries.length - 1];
-    const exact = entry.devicePixelContentBoxSize && entry.devicePixelContentBoxSize[0];
-    const [width, height] = exact ? [exact.inlineSize, exact.blockSize] :
-      backingStore({ width: entry.contentRect.width, height: entry.contentRect.height });
+  const fit = () => {
+    const [width, height] = backingStore(canvas.getBoundingClientRect());
     if (width === canvas.width && height === canvas.height) {
       return;
     }
@@ -89,12 +88,16 @@ export function fitCanvas(canvas) {
     if (state.volumePointer) {
       renderNow();
     }
-  });
-  try { // device pixels: a change of the pixel ratio alone (zoom, another screen) is seen too
-    observer.observe(canvas, { box: "device-pixel-content-box" });
-  } catch {
-    observer.observe(canvas);
-  }
+  };
+  new ResizeObserver(fit).observe(canvas);
+  // The pixel ratio alone changed (zoom, another screen): the CSS box may stay the same.
+  const watchRatio = () => {
+    matchMedia("(resolution: " + window.devicePixelRatio + "dppx)").addEventListener("change", () => {
+      fit();
+      watchRatio();
+    }, { once: true });
+  };
+  watchRatio();
 }
 
 /** Called after every frame with the module's view (the orientation marker). */
