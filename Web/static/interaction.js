@@ -77,9 +77,10 @@ export function interact(canvas, { reset, changed }) {
     zoomAt(canvas, e.clientX - box.left, e.clientY - box.top, Math.pow(1.1, -e.deltaY / 100));
     moved();
   }, { passive: false });
-  // Keys anywhere on the page but in a text field or a list.
+  // Keys anywhere on the page but in a box or a list (the buttons keep them: after a view button,
+  // the arrows turn that view).
   document.addEventListener("keydown", (e) => {
-    if (e.ctrlKey || e.metaKey || e.altKey || e.target.closest?.("input, select, textarea, button")) {
+    if (e.ctrlKey || e.metaKey || e.altKey || e.target.closest?.("input, select, textarea")) {
       return;
     }
     const turns = { ArrowLeft: [5, 0], ArrowRight: [-5, 0], ArrowUp: [0, 5], ArrowDown: [0, -5] };
