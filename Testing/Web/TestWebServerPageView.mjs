@@ -9,7 +9,9 @@
 //   same way.
 // - navigation: a right-drag and a shift-drag of 120 px move the focal point by 120 px of the
 //   focal plane (within 5%) across the view, and turn it by less than 0.001 degree; a left-drag
-//   does turn it (more than 10 degrees); `r` gives the anterior view and the first focal point back.
+//   does turn it (more than 10 degrees); a wheel step 100 px off the centre dollies 1.1x nearer
+//   and moves the focal point 1 - 1/1.1 of the way to the point under the cursor (within 2%); `r`
+//   gives the anterior view and the first focal point back.
 // - the canvas fills the window at the device pixel ratio: at 1920x1080 (ratio 1) and 800x600
 //   (ratio 2) its backing store is its CSS size times the ratio (within 1 pixel), the view keeps
 //   at least 400x500 CSS pixels at 800x600, the window resized follows (a narrow window puts the
@@ -171,6 +173,25 @@ const phantomServer = await startServer(["phantom:48"]);
   const turned = await drag(120, { button: "left" });
   const turn = Math.acos(Math.min(1, dot(turned.world.direction, before.world.direction))) * 180 / Math.PI;
   checks.check(turn > 10, "a left-drag turns the view (" + turn.toFixed(1) + " degrees)");
+  // The wheel at a point off the centre: nearer, and the focal point moved towards that point
+  // (the point under the cursor stays: the focal point moves by (1 - 1/f) of its offset).
+  const beforeWheel = await page.evaluate(() => window.mediso.getView());
+  await page.mouse.move(cx + 100, cy);
+  await page.mouse.wheel(0, -100);
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  const wheeled = await page.evaluate(() => window.mediso.getView());
+  const d0 = len(sub(beforeWheel.position, beforeWheel.focalPoint)), d1 = len(sub(wheeled.position, wheeled.focalPoint));
+  const shift = len(sub(wheeled.focalPoint, beforeWheel.focalPoint));
+  const perPixelNow = 2 * d0 * Math.tan(beforeWheel.viewAngle * Math.PI / 360) / box.height;
+  const expected = 100 * perPixelNow * (1 - 1 / 1.1);
+  const w = beforeWheel.world, right = [
+    w.direction[1] * w.viewUp[2] - w.direction[2] * w.viewUp[1],
+    w.direction[2] * w.viewUp[0] - w.direction[0] * w.viewUp[2],
+    w.direction[0] * w.viewUp[1] - w.direction[1] * w.viewUp[0]];
+  const along = dot(sub(wheeled.world.focalPoint, w.focalPoint), right) / (shift || 1);
+  checks.check(Math.abs(d0 / d1 - 1.1) < 1e-3 && Math.abs(shift / expected - 1) < 0.02 && along > 0.999,
+    "the wheel zooms at the cursor: distance " + d0.toFixed(1) + " -> " + d1.toFixed(1) + " mm, the focal point moved " +
+    shift.toFixed(2) + " mm towards it (" + expected.toFixed(2) + " expected)");
   await page.locator("#view").focus();
   await page.keyboard.press("r");
   await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));

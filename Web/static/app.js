@@ -56,7 +56,8 @@ async function start() {
   const link = readLink(location.hash, d.range, state.facts.maximumIsovalues);
   if (link.notes.length) {
     $("link-note").hidden = false;
-    $("link-note").textContent = "Ignored in the link: " + link.notes.join("; ") + ".";
+    $("link-note").textContent = "Ignored in the link: " + link.notes.join("; ") + ". (Click to close.)";
+    $("link-note").onclick = () => { $("link-note").hidden = true; };
   }
   if (link.path) {
     state.requestedPath = link.path;
