@@ -237,6 +237,11 @@ if args.case == "budget":
         check(stats["level"] == 2, "%s: the volume is fetched at level 2 (got %d)" % (path, stats["level"]))
         check("level 2" in stats["levelNote"] and "budget" in stats["levelNote"],
               "%s: the page says why it took level 2" % path)
+        stride = strides[2]
+        ordinal = "%d%s" % (stride, "th" if 11 <= stride % 100 <= 13 else
+                            {1: "st", 2: "nd", 3: "rd"}.get(stride % 10, "th"))
+        check("every %s point" % ordinal in stats["levelNote"],
+              "%s: the note says every %s point" % (path, ordinal))
         check(stats["bytesReceived"] < 0.2 * 72 ** 3 * 2,
               "%s: the bytes received (%d) are those of the coarse level" % (path, stats["bytesReceived"]))
 elif args.case == "nowebgl":

@@ -9,19 +9,25 @@
 //   volume.js       the counted requests and the volume, fetched once per level
 //   path.js         the GPU or the CPU path, and the level of the volume each can afford
 //   viewer.js       the WebAssembly module, its viewer, the frames; the facts the module states
-//   interaction.js  mouse and wheel on the canvas
+//   interaction.js  mouse, wheel and keys on the canvas (turn, pan, zoom at the cursor, reset)
+//   orientation.js  patient space (LPS): the views, the orientation marker, getView().world
+//   link.js         the surfaces, camera and path in the URL's fragment
 //   surfaces.js     the surface list
 //   readout.js      the stats, the notes, and why the page cannot run
 //   operations.js   the "On the server" panel
 //   ply.js          the server's surfaces, read
 
 import { interact } from "./interaction.js";
+import { linkedView, readLink, scheduleLink } from "./link.js";
 import { setupOperations } from "./operations.js";
+import { VIEWS, applyNamedView, drawMarker, markerLabels, sceneView, setDataset, withWorld }
+  from "./orientation.js";
 import { applyPath, drawnLevel, requestPath } from "./path.js";
 import { fps, showDataset, unsupported, updateReadout } from "./readout.js";
 import { $, params, state } from "./state.js";
 import { replaceSurfaces, setupSurfaceList } from "./surfaces.js";
-import { change, clearMesh, renderNow, showMesh, startViewer } from "./viewer.js";
+import { afterFrame, change, clearMesh, fitCanvas, renderNow, requestFrame, showMesh, startViewer }
+  from "./viewer.js";
 import { countBytes, request, requestJSON, sessionToken } from "./volume.js";
 
 async function start() {
@@ -43,7 +49,26 @@ async function start() {
   state.dataset = list.datasets[0];
   const d = state.dataset;
   showDataset(d);
+  const placement = setDataset(d);
+  $("space").textContent = "Shown in " + placement.space + "." +
+    (placement.note ? " Note: " + placement.note + "." : "");
+  // The view a reload or a shared link asks for (link.js); what cannot be used is said.
+  const link = readLink(location.hash, d.range, state.facts.maximumIsovalues);
+  if (link.notes.length) {
+    $("link-note").hidden = false;
+    $("link-note").textContent = "Ignored in the link: " + link.notes.join("; ") + ". (Click to close.)";
+    $("link-note").onclick = () => { $("link-note").hidden = true; };
+  }
+  if (link.path) {
+    state.requestedPath = link.path;
+  }
+  fitCanvas(canvas);
   await applyPath();
+  if (link.camera) {
+    state.viewer.setView(linkedView(link.camera));
+  } else {
+    applyNamedView("anterior");
+  }
   $("path").onchange = async () => {
     await requestPath($("path").value);
     change(() => {});
@@ -53,7 +78,31 @@ async function start() {
     change(() => {});
   };
   setupSurfaceList();
-  interact(canvas);
+  if (link.surfaces) {
+    replaceSurfaces(link.surfaces, true);
+  }
+  const reset = () => applyNamedView("anterior");
+  interact(canvas, { reset, changed: scheduleLink });
+  for (const button of document.querySelectorAll("#views [data-view]")) {
+    button.onclick = () => {
+      applyNamedView(button.dataset.view);
+      requestFrame();
+    };
+  }
+  $("reset").onclick = () => {
+    reset();
+    requestFrame();
+  };
+  $("toggle-panel").onclick = () => {
+    const collapsed = $("app").classList.toggle("collapsed");
+    $("toggle-panel").textContent = collapsed ? "Show panel" : "Hide panel";
+    $("toggle-panel").setAttribute("aria-expanded", String(!collapsed));
+  };
+  // After every frame: the marker for the camera drawn, and the URL's state written soon.
+  afterFrame.push(() => {
+    drawMarker($("marker"), state.viewer.getView());
+    scheduleLink();
+  });
   renderNow();
   // The "On the server" panel (Web/static/operations.js) is given what it needs here.
   setupOperations({
@@ -87,12 +136,31 @@ window.mediso = {
     replaceSurfaces(surfaces, false);
     return window.mediso.stats();
   },
+  // The camera in the module's scene frame (VTK's conventions; the fields ParaView's camera
+  // has), or, given {world: {position, focalPoint, viewUp}}, in patient space (LPS mm).
   async setView(view) {
-    state.viewer.setView(view);
+    const scene = view.world ? Object.assign({}, view, sceneView(view.world)) : view;
+    state.viewer.setView(scene);
     renderNow();
-    return state.viewer.getView();
+    return window.mediso.getView();
   },
-  getView: () => state.viewer.getView(),
+  // {position, focalPoint, viewUp, viewAngle, parallelScale} in the scene frame, and world:
+  // {space: "LPS", position, focalPoint, viewUp, direction (of projection, unit)} in patient
+  // space (orientation.js).
+  getView: () => withWorld(state.viewer.getView()),
+  // One of VIEWS' names (anterior, posterior, left, right, superior, inferior), drawn.
+  async setNamedView(name) {
+    if (!VIEWS[name]) {
+      throw new Error(name + " is not one of " + Object.keys(VIEWS).join(", "));
+    }
+    applyNamedView(name);
+    renderNow();
+    return window.mediso.getView();
+  },
+  // The orientation marker as drawn: each label's x (right), y (up) and toward (the viewer).
+  orientation: () => ({ space: $("space").textContent, labels: markerLabels(state.viewer.getView()) }),
+  // The surfaces drawn now: [{value, color: [r, g, b], opacity}].
+  getSurfaces: () => state.surfaces.map((s) => ({ value: s.value, color: [...s.color], opacity: s.opacity })),
   // Lighting material and background (tests match them with ParaView's).
   async setLook({ ambient, diffuse, specular, specularPower, background }) {
     if (ambient !== undefined) {

@@ -11,6 +11,13 @@ import { loadVolume } from "./volume.js";
 // their cache take the rest.
 const CPU_VOLUME_SHARE = 2;
 
+/** 1st, 2nd, 3rd, 4th, ..., 11th, 12th, 13th, ..., 21st. */
+export function ordinal(n) {
+  const tens = n % 100, ones = n % 10;
+  const suffix = tens >= 11 && tens <= 13 ? "th" : ["th", "st", "nd", "rd"][ones] || "th";
+  return n + suffix;
+}
+
 // The finest level of the volume a path can afford. GPU: its texture within the WebGL limits,
 // the volume texture and the pyramid within the budget. CPU: the volume within its share.
 function chooseLevel(dataset, info, budgetMB, path) {
@@ -25,7 +32,7 @@ function chooseLevel(dataset, info, budgetMB, path) {
     const fitsBudget = (gpu ? gpu.bytes : CPU_VOLUME_SHARE * level.bytes) <= budgetMB * 1e6;
     if (fitsGL && fitsBudget) {
       const why = k === full ? "" :
-        "The volume is sent at level " + k + " (every " + strides[k] + "th point, " +
+        "The volume is sent at level " + k + " (every " + ordinal(strides[k]) + " point, " +
         d.join("x") + "): the full " + dataset.dims.join("x") + " volume exceeds " +
         (fitsGL ? "the memory budget." : "this WebGL's 3D texture limit.");
       return { level: k, why };

@@ -30,7 +30,8 @@ export const state = Object.seal({
   bytesSent: 0,
   bytesReceived: 0,
 
-  // path.js: the path asked for ("auto", "gpu", "cpu"), the path drawn, and why.
+  // path.js: the path asked for ("auto", "gpu", "cpu"; app.js sets it once from the URL's
+  // fragment, before the first applyPath), the path drawn, and why.
   requestedPath: params.get("path") || "auto",
   path: "gpu",
   reason: "",

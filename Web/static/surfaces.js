@@ -26,6 +26,28 @@ function fromHex(text) {
   return [1, 3, 5].map((i) => parseInt(text.substr(i, 2), 16) / 255);
 }
 
+// A control with its visible label.
+function labelled(text, control) {
+  const label = document.createElement("label");
+  label.append(text + " ", control);
+  return label;
+}
+
+/**
+ * Reads a number box: the number when it is one within [lo, hi], else null with the reason
+ * shown in `message` beside it and the box marked invalid (the surface keeps its last value).
+ */
+function checked(box, message, what, lo, hi) {
+  const text = box.value.trim();
+  const x = Number(text);
+  const ok = text !== "" && Number.isFinite(x) && x >= lo && x <= hi;
+  box.setAttribute("aria-invalid", String(!ok));
+  message.textContent = ok ? "" : (text === "" ? "An empty " + what + " is not used" :
+    JSON.stringify(text) + " is not used") + ": the " + what + " is a number within " + lo +
+    ".." + hi + ".";
+  return ok ? x : null;
+}
+
 /** The rows of the list, made again from state.surfaces. */
 export function buildSurfaceList() {
   const d = state.dataset;
@@ -35,19 +57,39 @@ export function buildSurfaceList() {
     const row = document.createElement("div");
     row.className = "surface";
     const value = Object.assign(document.createElement("input"),
-      { type: "number", step: "any", value: s.value });
-    const color = Object.assign(document.createElement("input"), { type: "color", value: hex(s.color) });
+      { type: "number", step: "any", min: d.range[0], max: d.range[1], value: s.value,
+        className: "isovalue" });
+    const color = Object.assign(document.createElement("input"),
+      { type: "color", value: hex(s.color), className: "color" });
     const opacity = Object.assign(document.createElement("input"),
-      { type: "number", min: 0, max: 1, step: 0.05, value: s.opacity, title: "opacity" });
-    const remove = Object.assign(document.createElement("button"), { textContent: "x" });
+      { type: "number", min: 0, max: 1, step: 0.05, value: s.opacity, className: "opacity" });
+    const remove = Object.assign(document.createElement("button"),
+      { textContent: "Remove", title: "Remove surface " + (i + 1) });
     const slider = Object.assign(document.createElement("input"),
       { type: "range", min: d.range[0], max: d.range[1], step: "any", value: s.value });
-    value.oninput = () => change(() => { s.value = Number(value.value); slider.value = value.value; });
-    slider.oninput = () => change(() => { s.value = Number(slider.value); value.value = slider.value; });
+    slider.setAttribute("aria-label", "Isovalue of surface " + (i + 1) + ", " + d.range[0] + " to " + d.range[1]);
+    const message = Object.assign(document.createElement("div"), { className: "message", role: "alert" });
+    value.oninput = () => {
+      const x = checked(value, message, "isovalue", d.range[0], d.range[1]);
+      if (x !== null) {
+        change(() => { s.value = x; slider.value = String(x); });
+      }
+    };
+    slider.oninput = () => change(() => {
+      s.value = Number(slider.value);
+      value.value = slider.value;
+      checked(value, message, "isovalue", d.range[0], d.range[1]);
+    });
     color.oninput = () => change(() => { s.color = fromHex(color.value); });
-    opacity.oninput = () => change(() => { s.opacity = Math.min(1, Math.max(0, Number(opacity.value))); });
+    opacity.oninput = () => {
+      const x = checked(opacity, message, "opacity", 0, 1);
+      if (x !== null) {
+        change(() => { s.opacity = x; });
+      }
+    };
     remove.onclick = () => change(() => { state.surfaces.splice(i, 1); buildSurfaceList(); });
-    row.append(value, color, opacity, remove, slider);
+    row.append(labelled("Isovalue", value), labelled("Colour", color), labelled("Opacity", opacity),
+      remove, slider, message);
     box.append(row);
   });
   const pick = $("op-surface");

@@ -45,8 +45,11 @@ function readFacts(M) {
 export async function startViewer(canvas, probe) {
   state.module = await loadModule();
   state.facts = readFacts(state.module);
-  if (params.get("size")) { // WIDTHxHEIGHT (tests, benchmarks)
+  if (params.get("size")) { // WIDTHxHEIGHT (tests, benchmarks): a fixed backing store
     [canvas.width, canvas.height] = params.get("size").split("x").map(Number);
+    canvas.classList.add("fixed");
+  } else {
+    [canvas.width, canvas.height] = backingStore(canvas.getBoundingClientRect());
   }
   state.viewer = new state.module.WebViewer("#view");
   state.viewer.resize(canvas.width, canvas.height);
@@ -59,6 +62,46 @@ export async function startViewer(canvas, probe) {
   state.software = /SwiftShader|llvmpipe|softpipe|Software/i.test(state.unmaskedRenderer);
   return true;
 }
+
+// The canvas's backing store for a CSS box: its size times the device pixel ratio.
+function backingStore(box, dpr = window.devicePixelRatio || 1) {
+  return [Math.max(1, Math.round(box.width * dpr)), Math.max(1, Math.round(box.height * dpr))];
+}
+
+/**
+ * Keeps the canvas's backing store at its CSS size times the device pixel ratio (the window
+ * resized, the panel hidden, the page zoomed or moved to another screen), redrawing at once: a
+ * resized canvas is cleared. Not with the size= parameter, which fixes it. The size is the CSS
+ * box times devicePixelRatio rather than the observer's device-pixel box, which Chromium's
+ * emulated pixel ratios (tests) leave in CSS pixels.
+ */
+export function fitCanvas(canvas) {
+  if (params.get("size")) {
+    return;
+  }
+  const fit = () => {
+    const [width, height] = backingStore(canvas.getBoundingClientRect());
+    if (width === canvas.width && height === canvas.height) {
+      return;
+    }
+    state.viewer.resize(width, height);
+    if (state.volumePointer) {
+      renderNow();
+    }
+  };
+  new ResizeObserver(fit).observe(canvas);
+  // The pixel ratio alone changed (zoom, another screen): the CSS box may stay the same.
+  const watchRatio = () => {
+    matchMedia("(resolution: " + window.devicePixelRatio + "dppx)").addEventListener("change", () => {
+      fit();
+      watchRatio();
+    }, { once: true });
+  };
+  watchRatio();
+}
+
+/** Called after every frame with the module's view (the orientation marker). */
+export const afterFrame = [];
 
 /** Draws now and waits for the GPU: the time of a change + frame. */
 export function renderNow() {
@@ -81,6 +124,9 @@ export function renderNow() {
   state.triangles = stats.triangles;
   state.cpuLevel = stats.cpuLevel;
   updateReadout();
+  for (const call of afterFrame) {
+    call();
+  }
   return ms;
 }
 

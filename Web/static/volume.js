@@ -71,13 +71,20 @@ export async function loadVolume(level) {
   const origin = response.headers.get("X-Mediso-Origin").split(",").map(Number);
   const bytes = unshuffle(new Uint8Array(body), type.bytes);
   const M = state.module;
+  const pointerBefore = state.volumePointer;
   if (state.volumePointer) {
     M._free(state.volumePointer);
   }
   state.volumePointer = M._malloc(bytes.length);
   M.HEAPU8.set(bytes, state.volumePointer);
   state.level = level;
+  // The module resets its camera with a new volume; another level of the same volume keeps the
+  // view the user has.
+  const kept = pointerBefore ? state.viewer.getView() : null;
   if (!state.viewer.setVolume(type.value, state.volumePointer, dims, spacing, origin)) {
     throw new Error("the volume cannot be uploaded: " + state.viewer.stats().error);
+  }
+  if (kept) {
+    state.viewer.setView(kept);
   }
 }
