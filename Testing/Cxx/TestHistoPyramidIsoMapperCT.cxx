@@ -11,19 +11,16 @@
 #include "vtkRegressionTestImage.h"
 #include "vtkRenderWindowInteractor.h"
 #include "vtkRenderer.h"
-#include <vtksys/SystemTools.hxx>
 
 #include <cstdio>
 #include <string>
 
 int TestHistoPyramidIsoMapperCT(int argc, char* argv[])
 {
-  const std::string ct = medical_test::DataFile("ct_head.mha");
-  if (!vtksys::SystemTools::FileExists(ct))
+  const std::string ct = medical_test::CachedDataFile("ct_head.mha", "the real CT");
+  if (ct.empty())
   {
-    std::printf("SKIP: the real CT is not cached (%s); run python3 Python/fetch_data.py\n",
-      ct.c_str());
-    return 125;
+    return medical_test::SkipReturnCode;
   }
   vtkNew<vtkRenderWindow> renWin;
   renWin->SetSize(800, 400);
