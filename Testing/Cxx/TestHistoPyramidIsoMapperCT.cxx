@@ -5,11 +5,10 @@
 // (Python/fetch_data.py) or the GL lacks what the GPU path needs.
 #include "IsoMapperTestScenes.h"
 #include "MedicalTestUtilities.h"
+#include "RenderTestUtilities.h"
 
 #include "vtkCamera.h"
 #include "vtkMetaImageReader.h"
-#include "vtkRegressionTestImage.h"
-#include "vtkRenderWindowInteractor.h"
 #include "vtkRenderer.h"
 
 #include <cstdio>
@@ -64,13 +63,7 @@ int TestHistoPyramidIsoMapperCT(int argc, char* argv[])
     medical_test::Check(
       mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath, "drawn by the GPU path");
   }
-  const int result = vtkRegressionTestImage(renWin);
-  if (result == vtkRegressionTester::DO_INTERACTOR)
-  {
-    vtkNew<vtkRenderWindowInteractor> iren;
-    iren->SetRenderWindow(renWin);
-    iren->Start();
-  }
+  const int result = medical_test::CompareWithBaseline(argc, argv, renWin);
   medical_test::Check(result != vtkRegressionTester::FAILED, "image matches the baseline");
   return medical_test::Finish("TestHistoPyramidIsoMapperCT");
 }
