@@ -5,6 +5,7 @@ translucent over bone 400 HU opaque, colours and opacities from the HU colour
 and opacity maps), reading the representation's read-only properties from the
 process that rendered, and image checks on saved screenshots.
 """
+import argparse
 import os
 
 from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
@@ -22,6 +23,18 @@ SKIN, BONE = -500.0, 400.0
 from clientserver import Checks as Checker  # noqa: E402,F401
 # The tests reach captured() as hp.captured (Testing/Python/checks.py has it).
 from checks import captured  # noqa: E402,F401
+
+
+def parse_args(expect_fallback=False):
+    """The arguments ctest gives a representation test: --plugin (default $MEDISO_PLUGIN) and
+    --out (the folder of its screenshots); with expect_fallback also --expect-fallback (the run
+    with MEDISO_DISABLE_GPU_PATH=1, where the fallback must draw)."""
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--plugin", default=os.environ.get("MEDISO_PLUGIN"))
+    parser.add_argument("--out", required=True)
+    if expect_fallback:
+        parser.add_argument("--expect-fallback", action="store_true")
+    return parser.parse_args()
 
 
 def make_view(size=SIZE):
