@@ -2,16 +2,24 @@
 tables are written.
 
     from benchmark_common import data_file, cpu_model, load_average, fmt_s, table
+    from benchmark_common import ROOT, progress_printer, result_records, write_report
 
 data_dir() is the project's one data-directory rule for Python (fetch_data.resolve_cache_dir:
 $MEDISO_DATA_DIR, else ${XDG_CACHE_HOME:-$HOME/.cache}/medical-isosurfaces); the C++ tests
 state the same rule in Testing/Cxx/MedicalTestUtilities.h (MedicalDataDirectory).
 """
+import json
 import os
 import platform
 import socket
 
 from fetch_data import resolve_cache_dir
+
+# The repository's root (the benchmarks find the build's binaries and scripts below it).
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+# What starts a result line of BenchmarkHistoPyramidIsoMapper's output: a JSON object follows.
+RESULT_TAG = "bench-result: "
 
 
 def data_dir():
@@ -76,3 +84,25 @@ def table(headers, rows):
              "|" + "|".join(["---"] + ["---:"] * (len(headers) - 1)) + "|"]
     lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
     return lines
+
+
+def progress_printer(who):
+    """A function that prints a progress line prefixed with `who`, at once (the runs are long)."""
+    def progress(message):
+        print(who + ": " + message, flush=True)
+    return progress
+
+
+def result_records(output):
+    """The records (dicts) of BenchmarkHistoPyramidIsoMapper's output: its RESULT_TAG lines."""
+    return [json.loads(line[len(RESULT_TAG):]) for line in output.splitlines()
+            if line.startswith(RESULT_TAG)]
+
+
+def write_report(lines, out):
+    """Prints a report's lines and, where `out` names a file, writes them there too."""
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if out:
+        with open(out, "w") as f:
+            f.write(text)

@@ -16,7 +16,6 @@ machine has: on llvmpipe here, and unchanged on a GPU machine with only a driver
 there: no ParaView).
 """
 import argparse
-import json
 import os
 import statistics
 import subprocess
@@ -24,15 +23,10 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from benchmark_common import cpu_model, data_dir, load_average  # noqa: E402
+from benchmark_common import (ROOT, cpu_model, data_dir, load_average, progress_printer,  # noqa: E402
+                              result_records, write_report)
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
-RESULT_TAG = "bench-result: "
-
-
-def progress(message):
-    print("headless: " + message, flush=True)
+progress = progress_printer("headless")
 
 
 def parse_args(argv):
@@ -106,8 +100,7 @@ def run_mapper(args, name, window):
                "--methods", "hp"]
     env = dict(os.environ, VTK_SMP_BACKEND_IN_USE="STDThread")
     out = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
-    records = [json.loads(l[len(RESULT_TAG):]) for l in out.stdout.splitlines()
-               if l.startswith(RESULT_TAG)]
+    records = result_records(out.stdout)
     rows = {}
     for r in records:
         if r["kind"] == "rotation":
@@ -181,11 +174,7 @@ def main(argv):
         lines.append("| %s | %s | %s | %.1f | %.1f | %.2f |" % (key[0], key[1], key[2], a, b,
                                                               a / b if b == b and b > 0 else
                                                               float("nan")))
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if args.out:
-        with open(args.out, "w") as f:
-            f.write(text)
+    write_report(lines, args.out)
     return 0
 
 

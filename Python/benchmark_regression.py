@@ -14,7 +14,6 @@ measure) the table gives both medians and the median, min and max over the round
 ratio this / baseline: below 1 is faster. Not a test: timings go to tables, never to ctest.
 """
 import argparse
-import json
 import os
 import statistics
 import subprocess
@@ -22,15 +21,10 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from benchmark_common import cpu_model, data_file, load_average  # noqa: E402
+from benchmark_common import (ROOT, cpu_model, data_file, load_average, progress_printer,  # noqa: E402
+                              result_records, write_report)
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
-RESULT_TAG = "bench-result: "
-
-
-def progress(message):
-    print("regression: " + message, flush=True)
+progress = progress_printer("regression")
 
 
 def parse_args(argv):
@@ -84,8 +78,7 @@ def run(binary, name, args):
                "--methods", args.methods, "--zoom", str(args.zoom)]
     env = dict(os.environ, VTK_SMP_BACKEND_IN_USE="STDThread")
     out = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
-    records = [json.loads(line[len(RESULT_TAG):]) for line in out.stdout.splitlines()
-               if line.startswith(RESULT_TAG)]
+    records = result_records(out.stdout)
     if out.returncode != 0:
         progress("%s %s exited %d:\n%s" % (binary, name, out.returncode, out.stdout[-2000:]))
     return records
@@ -148,11 +141,7 @@ def main(argv):
             statistics.median(entry["old"]), med, min(ratios), max(ratios)))
     lines += ["", "Largest median ratio (rotation and change+frame): %.3f (target: at most 1.05)"
               % worst]
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if args.out:
-        with open(args.out, "w") as f:
-            f.write(text)
+    write_report(lines, args.out)
     return 0
 
 

@@ -23,17 +23,14 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from benchmark_common import cpu_model, data_dir, free_port, load_average  # noqa: E402
+from benchmark_common import (ROOT, cpu_model, data_dir, free_port, load_average,  # noqa: E402
+                              progress_printer, write_report)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
+progress = progress_printer("web-bench")
 WEB = os.path.join(ROOT, "Testing", "Web")
 TYPES = {"MET_CHAR": "int8", "MET_UCHAR": "uint8", "MET_SHORT": "int16", "MET_USHORT": "uint16",
          "MET_INT": "int32", "MET_UINT": "uint32", "MET_FLOAT": "float32", "MET_DOUBLE": "float64"}
-
-
-def progress(message):
-    print("web-bench: " + message, flush=True)
 
 
 def parse_args(argv):
@@ -202,11 +199,7 @@ def main(argv):
         during = (gpu["bytesSentAfter"] - gpu["bytesSent"]) + (gpu["bytesReceivedAfter"] - gpu["bytesReceived"])
         lines.append("| %s | %d | %d | %.2fx | %d |" % (
             name, r["raw_bytes"], gpu["bytesReceived"], gpu["bytesReceived"] / r["raw_bytes"], during))
-    text = "\n".join(lines) + "\n"
-    print(text)
-    if args.out:
-        with open(args.out, "w") as f:
-            f.write(text)
+    write_report(lines, args.out)
     return 0
 
 

@@ -3,7 +3,8 @@
  * @file MedicalTestUtilities.h
  * @brief Small helpers shared by the project's C++ tests (standard C++ only,
  * so the VTK-free core tests can use them too): checks that count failures
- * instead of stopping at the first, and the location of the cached real data.
+ * instead of stopping at the first, and the location of the cached real data
+ * (a test skips when it is not there).
  */
 #ifndef MedicalTestUtilities_h
 #define MedicalTestUtilities_h
@@ -62,6 +63,25 @@ inline std::string DataDirectory()
 inline std::string DataFile(const std::string& name)
 {
   return DataDirectory() + "/" + name;
+}
+
+/// The exit code ctest reads as "skipped" (the tests' SKIP_RETURN_CODE).
+inline constexpr int SkipReturnCode = 125;
+
+/// Path of a file in the real-data folder when it is there; otherwise prints
+/// the SKIP line that says how to fetch it (naming it as `what`) and returns "",
+/// and the test returns SkipReturnCode: a test of real data cannot pass without it.
+inline std::string CachedDataFile(const std::string& name, const char* what)
+{
+  const std::string path = DataFile(name);
+  if (std::FILE* file = std::fopen(path.c_str(), "rb"))
+  {
+    std::fclose(file);
+    return path;
+  }
+  std::printf(
+    "SKIP: %s is not cached (%s); run python3 Python/fetch_data.py\n", what, path.c_str());
+  return std::string();
 }
 } // namespace medical_test
 

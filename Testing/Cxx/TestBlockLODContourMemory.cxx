@@ -12,6 +12,7 @@
 //   made, with one warning saying what limited it.
 // Only the allowance's megabytes vary from run to run: every other word and
 // number of the message is checked.
+#include "AddressSpaceLimit.h"
 #include "vtkBlockLODContour.h"
 #include "vtkMedicalPhantomSource.h"
 
@@ -25,8 +26,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
-
-#include <sys/resource.h>
 
 namespace
 {
@@ -54,39 +53,6 @@ double OutputBytes(vtkImageData* image, double isovalue, int level)
   lod->SetLOD(level);
   lod->Update();
   return lod->GetEstimatedMegabytes()[level] * 1.0e6;
-}
-
-// The address-space limit before the test set its own.
-rlimit Original{};
-
-// Limits the address space to what the process maps now plus `headroom` bytes.
-bool LimitAddressSpace(double headroom)
-{
-  unsigned long long vmKB = 0;
-  if (std::FILE* status = std::fopen("/proc/self/status", "r"))
-  {
-    char line[256];
-    while (std::fgets(line, sizeof(line), status))
-    {
-      std::sscanf(line, "VmSize: %llu kB", &vmKB);
-    }
-    std::fclose(status);
-  }
-  rlimit limit{};
-  if (vmKB == 0 || getrlimit(RLIMIT_AS, &limit) != 0)
-  {
-    return false;
-  }
-  Original = limit;
-  limit.rlim_cur = static_cast<rlim_t>(vmKB * 1024 + headroom);
-  return setrlimit(RLIMIT_AS, &limit) == 0;
-}
-
-// Gives the address space back once the filter has run: the checks, and
-// AddressSanitizer's leak check at exit, need room of their own.
-void RestoreAddressSpace()
-{
-  Check(setrlimit(RLIMIT_AS, &Original) == 0, "address-space limit restored");
 }
 
 // The text of a message after VTK's "ERROR: In file, line N\nclass (address): ".
@@ -144,10 +110,12 @@ int TestBlockLODContourMemory(int argc, char* argv[])
   {
     const double surface = OutputBytes(image, 400.0, 3);
     std::printf("level 3's surface: %s MB\n", MB(surface).c_str());
-    Check(LimitAddressSpace(0.5 * surface), "address-space limit set");
+    medical_test::AddressSpaceLimit space(static_cast<unsigned long long>(0.5 * surface));
+    Check(space.IsSet(), "address-space limit set");
     lod->SetLOD(3);
     lod->Update();
-    RestoreAddressSpace();
+    // Given back once the filter has run: the checks need room of their own.
+    Check(space.Restore(), "address-space limit restored");
     Check(observer->GetError() && !observer->GetWarning(), "one error, no warning");
     CheckMessage(Body(observer->GetErrorMessage()),
       "Level 3's surface of isovalue 400 (" + MB(surface) + " MB) does not fit in the ",
@@ -162,11 +130,13 @@ int TestBlockLODContourMemory(int argc, char* argv[])
     const double both = first + second;
     std::printf("level 2's surfaces: %s + %s MB\n", MB(first).c_str(), MB(second).c_str());
     // The two surfaces fit, a second copy of both (the merged output) does not.
-    Check(LimitAddressSpace(1.8 * both), "address-space limit set");
+    medical_test::AddressSpaceLimit space(static_cast<unsigned long long>(1.8 * both));
+    Check(space.IsSet(), "address-space limit set");
     lod->SetLOD(2);
     lod->SetValue(1, -500.0);
     lod->Update();
-    RestoreAddressSpace();
+    // Given back once the filter has run: the checks need room of their own.
+    Check(space.Restore(), "address-space limit restored");
     Check(observer->GetError() && !observer->GetWarning(), "one error, no warning");
     CheckMessage(Body(observer->GetErrorMessage()),
       "The output (" + MB(both) + " MB) does not fit in the ",
@@ -181,11 +151,13 @@ int TestBlockLODContourMemory(int argc, char* argv[])
     std::printf("levels 3 and 2: %s and %s MB\n", MB(level3).c_str(), MB(level2).c_str());
     Check(4 * level2 < 3 * level3, "level 2 needs well under level 3's bytes");
     // Level 3 fits the budget, not the process; level 2 fits both.
-    Check(LimitAddressSpace(0.75 * level3), "address-space limit set");
+    medical_test::AddressSpaceLimit space(static_cast<unsigned long long>(0.75 * level3));
+    Check(space.IsSet(), "address-space limit set");
     lod->AutoLODOn();
     lod->SetMemoryBudget(256.0);
     lod->Update();
-    RestoreAddressSpace();
+    // Given back once the filter has run: the checks need room of their own.
+    Check(space.Restore(), "address-space limit restored");
     Check(observer->GetWarning() && !observer->GetError(), "one warning, no error");
     CheckMessage(Body(observer->GetWarningMessage()),
       "Level 3 fits the MemoryBudget of 256 MB but not the ",

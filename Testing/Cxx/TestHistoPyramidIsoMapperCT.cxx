@@ -5,25 +5,21 @@
 // (Python/fetch_data.py) or the GL lacks what the GPU path needs.
 #include "IsoMapperTestScenes.h"
 #include "MedicalTestUtilities.h"
+#include "RenderTestUtilities.h"
 
 #include "vtkCamera.h"
 #include "vtkMetaImageReader.h"
-#include "vtkRegressionTestImage.h"
-#include "vtkRenderWindowInteractor.h"
 #include "vtkRenderer.h"
-#include <vtksys/SystemTools.hxx>
 
 #include <cstdio>
 #include <string>
 
 int TestHistoPyramidIsoMapperCT(int argc, char* argv[])
 {
-  const std::string ct = medical_test::DataFile("ct_head.mha");
-  if (!vtksys::SystemTools::FileExists(ct))
+  const std::string ct = medical_test::CachedDataFile("ct_head.mha", "the real CT");
+  if (ct.empty())
   {
-    std::printf("SKIP: the real CT is not cached (%s); run python3 Python/fetch_data.py\n",
-      ct.c_str());
-    return 125;
+    return medical_test::SkipReturnCode;
   }
   vtkNew<vtkRenderWindow> renWin;
   renWin->SetSize(800, 400);
@@ -67,13 +63,7 @@ int TestHistoPyramidIsoMapperCT(int argc, char* argv[])
     medical_test::Check(
       mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath, "drawn by the GPU path");
   }
-  const int result = vtkRegressionTestImage(renWin);
-  if (result == vtkRegressionTester::DO_INTERACTOR)
-  {
-    vtkNew<vtkRenderWindowInteractor> iren;
-    iren->SetRenderWindow(renWin);
-    iren->Start();
-  }
+  const int result = medical_test::CompareWithBaseline(argc, argv, renWin);
   medical_test::Check(result != vtkRegressionTester::FAILED, "image matches the baseline");
   return medical_test::Finish("TestHistoPyramidIsoMapperCT");
 }

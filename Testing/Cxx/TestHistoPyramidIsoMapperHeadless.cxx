@@ -217,12 +217,10 @@ int TestHistoPyramidIsoMapperHeadless(int argc, char* argv[])
   }
   else if (which == "CT")
   {
-    const std::string ct = medical_test::DataFile("ct_head.mha");
-    if (!vtksys::SystemTools::FileExists(ct))
+    const std::string ct = medical_test::CachedDataFile("ct_head.mha", "the real CT");
+    if (ct.empty())
     {
-      std::printf("SKIP: the real CT is not cached (%s); run python3 Python/fetch_data.py\n",
-        ct.c_str());
-      return 125;
+      return medical_test::SkipReturnCode;
     }
     vtkNew<vtkMetaImageReader> reader;
     reader->SetFileName(ct.c_str());

@@ -9,12 +9,11 @@
 // features skips, 125).
 #include "IsoMapperTestScenes.h"
 #include "MedicalTestUtilities.h"
+#include "RenderTestUtilities.h"
 #include "vtkMedicalGLCapabilities.h"
 
 #include "vtkCamera.h"
-#include "vtkRegressionTestImage.h"
 #include "vtkRenderWindow.h"
-#include "vtkRenderWindowInteractor.h"
 #include "vtkRenderer.h"
 
 #include "vtkMath.h"
@@ -114,13 +113,7 @@ int TestHistoPyramidIsoMapperRender(int argc, char* argv[])
       "view " + std::to_string(i) + " drawn with the expected footprint");
   }
 
-  const int result = vtkRegressionTestImage(renWin);
-  if (result == vtkRegressionTester::DO_INTERACTOR)
-  {
-    vtkNew<vtkRenderWindowInteractor> iren;
-    iren->SetRenderWindow(renWin);
-    iren->Start();
-  }
+  const int result = medical_test::CompareWithBaseline(argc, argv, renWin);
   medical_test::Check(result != vtkRegressionTester::FAILED, "image matches the baseline");
   return medical_test::Finish("TestHistoPyramidIsoMapperRender");
 }

@@ -8,6 +8,7 @@
 // exact error and an empty output, never a crash or a partly filled volume.
 // The test observes the reader's errors and warnings itself, so nothing
 // reaches the output window (and ctest's fail pattern) unless unexpected.
+#include "AddressSpaceLimit.h"
 #include "MedicalTestUtilities.h"
 #include "vtkMedicalNIfTIReader.h"
 
@@ -32,8 +33,6 @@
 #include <map>
 #include <string>
 #include <vector>
-
-#include <sys/resource.h>
 
 namespace
 {
@@ -617,21 +616,8 @@ std::map<std::string, std::function<void(const std::string&)>> Cases()
     f.Slope = 0.5;
     const std::string path = dir + "/large.nii";
     WritePlain(path, Int16File(f));
-    std::FILE* status = std::fopen("/proc/self/status", "r");
-    unsigned long long vmKB = 0;
-    char line[256];
-    while (status && std::fgets(line, sizeof(line), status))
-    {
-      std::sscanf(line, "VmSize: %llu kB", &vmKB);
-    }
-    if (status)
-    {
-      std::fclose(status);
-    }
-    rlimit limit{};
-    getrlimit(RLIMIT_AS, &limit);
-    limit.rlim_cur = vmKB * 1024 + (48ULL << 20);
-    Check(vmKB > 0 && setrlimit(RLIMIT_AS, &limit) == 0, "address-space limit set");
+    const medical_test::AddressSpaceLimit limit(48ULL << 20);
+    Check(limit.IsSet(), "address-space limit set");
     Messages messages;
     auto reader = Read(path, messages);
     const std::string start = "Cannot read " + path +

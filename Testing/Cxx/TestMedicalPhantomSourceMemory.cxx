@@ -4,6 +4,7 @@
 // is refused with one error naming that limit and an empty output, whatever
 // MemoryLimit says above it; a MemoryLimit below it still binds; a small
 // phantom is still generated, value for value as without the limit.
+#include "AddressSpaceLimit.h"
 #include "MedicalTestUtilities.h"
 #include "vtkMedicalPhantomSource.h"
 
@@ -18,8 +19,6 @@
 #include <cstring>
 #include <string>
 #include <vector>
-
-#include <sys/resource.h>
 
 namespace
 {
@@ -85,21 +84,8 @@ int TestMedicalPhantomSourceMemory(int, char*[])
     "without a limit, a 24^3 phantom is generated");
 
   // Limit the address space to what is mapped now plus 64 MiB.
-  std::FILE* status = std::fopen("/proc/self/status", "r");
-  unsigned long long vmKB = 0;
-  char line[256];
-  while (status && std::fgets(line, sizeof(line), status))
-  {
-    std::sscanf(line, "VmSize: %llu kB", &vmKB);
-  }
-  if (status)
-  {
-    std::fclose(status);
-  }
-  rlimit limit{};
-  getrlimit(RLIMIT_AS, &limit);
-  limit.rlim_cur = vmKB * 1024 + (64ULL << 20);
-  Check(vmKB > 0 && setrlimit(RLIMIT_AS, &limit) == 0, "address-space limit set");
+  const medical_test::AddressSpaceLimit limit(64ULL << 20);
+  Check(limit.IsSet(), "address-space limit set");
 
   // 512^3 int16 points are 268.4 MB: more than the process may allocate.
   const std::string addressSpace =

@@ -2,12 +2,11 @@
 // ProcessMemoryAllowance() against limits the test sets on itself: an
 // address-space limit (as `ulimit -v` sets it) binds below physical memory,
 // and FitsInProcessMemory() refuses what exceeds it with a message naming it.
+#include "AddressSpaceLimit.h"
 #include "ProcessMemory.h"
 
 #include <cstdio>
 #include <string>
-
-#include <sys/resource.h>
 
 namespace
 {
@@ -29,23 +28,10 @@ int main()
   Check(mediso::FitsInProcessMemory(1 << 20, "one megabyte", message), "one megabyte fits");
 
   // Limit the address space to what is mapped now plus 64 MiB.
-  rlimit limit{};
-  getrlimit(RLIMIT_AS, &limit);
-  std::FILE* status = std::fopen("/proc/self/status", "r");
-  unsigned long long vmKB = 0;
-  char line[256];
-  while (status && std::fgets(line, sizeof(line), status))
-  {
-    std::sscanf(line, "VmSize: %llu kB", &vmKB);
-  }
-  if (status)
-  {
-    std::fclose(status);
-  }
-  Check(vmKB > 0, "VmSize read");
   const unsigned long long headroom = 64ULL << 20;
-  limit.rlim_cur = vmKB * 1024 + headroom;
-  Check(setrlimit(RLIMIT_AS, &limit) == 0, "address-space limit set");
+  const medical_test::AddressSpaceLimit limit(headroom);
+  Check(limit.GetMappedKB() > 0, "VmSize read");
+  Check(limit.IsSet(), "address-space limit set");
 
   const mediso::MemoryAllowance after = mediso::ProcessMemoryAllowance();
   Check(after.Limit == "the process's address-space limit (ulimit -v)",

@@ -24,7 +24,6 @@ checked, so it cannot pass without it); RenderPath "fallback" with that reason;
 triangles drawn; the image is not empty; an isovalue change re-renders with no
 further warning.
 """
-import argparse
 import os
 import sys
 
@@ -32,11 +31,7 @@ from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 
 import HistoPyramidRepresentationChecks as hp
 
-parser = argparse.ArgumentParser()
-parser.add_argument("--plugin", default=os.environ.get("MEDISO_PLUGIN"))
-parser.add_argument("--out", required=True)
-parser.add_argument("--expect-fallback", action="store_true")
-args = parser.parse_args()
+args = hp.parse_args(expect_fallback=True)
 check = hp.Checker()
 
 LoadPlugin(args.plugin, ns=globals())

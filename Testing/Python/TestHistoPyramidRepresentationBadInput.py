@@ -16,7 +16,6 @@ captured and checked (so a passing run prints no VTK error or warning):
 Runs on the GPU path, or on the fallback where the GL lacks it (its one
 warning is then allowed on the first render of each display).
 """
-import argparse
 import os
 import sys
 
@@ -24,10 +23,7 @@ from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 
 import HistoPyramidRepresentationChecks as hp
 
-parser = argparse.ArgumentParser()
-parser.add_argument("--plugin", default=os.environ.get("MEDISO_PLUGIN"))
-parser.add_argument("--out", required=True)
-args = parser.parse_args()
+args = hp.parse_args()
 check = hp.Checker()
 LoadPlugin(args.plugin, ns=globals())
 

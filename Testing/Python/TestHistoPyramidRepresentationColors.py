@@ -18,7 +18,6 @@ MEDISO_DISABLE_GPU_PATH=1; its one warning is captured and checked): both
 paths take their colours from the same place. A machine whose GL lacks what
 the GPU path needs skips the GPU run (exit 125).
 """
-import argparse
 import os
 import sys
 
@@ -26,11 +25,7 @@ from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 
 import HistoPyramidRepresentationChecks as hp
 
-parser = argparse.ArgumentParser()
-parser.add_argument("--plugin", default=os.environ.get("MEDISO_PLUGIN"))
-parser.add_argument("--out", required=True)
-parser.add_argument("--expect-fallback", action="store_true")
-args = parser.parse_args()
+args = hp.parse_args(expect_fallback=True)
 check = hp.Checker()
 expected_path = "fallback" if args.expect_fallback else "gpu"
 name = "TestHistoPyramidRepresentationColors" + ("Fallback" if args.expect_fallback else "")

@@ -18,9 +18,8 @@ import tempfile
 
 from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 from paraview import servermanager
-from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow, vtkStringOutputWindow
 from vtkmodules.util.numpy_support import vtk_to_numpy
-from checks import Checks  # Testing/Python/checks.py
+from checks import Checks, captured  # Testing/Python/checks.py
 
 check = Checks()
 
@@ -107,23 +106,20 @@ Delete(series)
 path = os.path.join(folder, "truncated.nii")
 with open(path, "wb") as out:
     out.write(nifti1(dims, slope=1.0, intercept=-1024.0) + data[: len(data) // 2])
-capture = vtkStringOutputWindow()
-previous = vtkOutputWindow.GetInstance()
-verbosity = vtkLogger.GetCurrentVerbosityCutoff()
-vtkOutputWindow.SetInstance(capture)
-vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
-try:
+
+
+def read_truncated():
     bad = MedicalNIfTIReader(FileName=path)
     contour = BlockLODContour(Input=bad, Isosurfaces=[0.0], LOD=0)
     contour.UpdatePipeline()
-    points = bad.GetDataInformation().GetNumberOfPoints()
-    triangles = contour.GetDataInformation().GetNumberOfCells()
+    counts = (bad.GetDataInformation().GetNumberOfPoints(),
+              contour.GetDataInformation().GetNumberOfCells())
     Delete(contour)
     Delete(bad)
-finally:
-    vtkOutputWindow.SetInstance(previous)
-    vtkLogger.SetStderrVerbosity(verbosity)
-text = capture.GetOutput()
+    return counts
+
+
+(points, triangles), text = captured(read_truncated)
 expected = ("Cannot read %s: the header describes 8 x 6 x 5 INT16 voxels (480 bytes from byte 352), "
             "but the file holds only 592 bytes. The output is empty." % path)
 # Block LOD Contour may say of its own that its input is empty; the reader says one thing.

@@ -12,10 +12,9 @@ import sys
 
 from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 from paraview import servermanager
-from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow, vtkStringOutputWindow
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
+from checks import Checks, captured  # noqa: E402  (Testing/Python/checks.py)
 
 check = Checks()
 
@@ -96,21 +95,14 @@ cases = [
     ("row scratch", dict(Dimensions=[2147483647, 2, 2], MemoryLimit=20000), "a row of 2147483647 doubles"),
 ]
 for label, props, needle in cases:
-    capture = vtkStringOutputWindow()
-    previous = vtkOutputWindow.GetInstance()
-    verbosity = vtkLogger.GetCurrentVerbosityCutoff()
-    # Errors reach both the output window and the logger's stderr sink.
-    vtkOutputWindow.SetInstance(capture)
-    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
-    try:
+    def generate():
         bad = MedicalPhantom(**props)
         bad.UpdatePipeline()
         points = bad.GetDataInformation().GetNumberOfPoints()
         Delete(bad)
-    finally:
-        vtkOutputWindow.SetInstance(previous)
-        vtkLogger.SetStderrVerbosity(verbosity)
-    text = capture.GetOutput()
+        return points
+
+    points, text = captured(generate)
     check("Cannot generate the phantom" in text and needle in text,
           "%s: clear error (got %r)" % (label, text.strip()[:200]))
     check(points == 0, "%s: empty output" % label)

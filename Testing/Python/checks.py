@@ -8,6 +8,11 @@ A failing check prints "FAILED: what" at once (ctest's FAIL_REGULAR_EXPRESSION t
 test whatever its exit status); finish() prints "N check(s) failed" and exits 1 when any failed,
 else prints the message and returns. The client/server and web server tests extend finish()
 (clientserver.Checks disconnects first; webserver.Checks stops its servers first).
+
+    result, text = captured(lambda: reader.UpdatePipeline())   # pvpython only
+
+captured() runs a step that must emit a known VTK error or warning with them captured instead of
+printed, so that the test checks the text instead of failing on it (FAIL_REGULAR_EXPRESSION).
 """
 import sys
 
@@ -34,3 +39,27 @@ class Checks:
             exit(1)
         print(passed_message)
         sys.stdout.flush()
+
+
+def captured(function):
+    """Run function with VTK errors and warnings captured instead of printed.
+
+    Returns (result, captured text). Used only around a step that must emit a
+    known message, so that the test checks it instead of failing on it. VTK's
+    errors reach both the output window and the logger's stderr sink: both are
+    redirected, and given back afterwards whatever the step raised.
+    """
+    # Imported here, so that plain python3 tests import this module without VTK.
+    from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow, vtkStringOutputWindow
+
+    capture = vtkStringOutputWindow()
+    previous = vtkOutputWindow.GetInstance()
+    verbosity = vtkLogger.GetCurrentVerbosityCutoff()
+    vtkOutputWindow.SetInstance(capture)
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
+    try:
+        result = function()
+    finally:
+        vtkOutputWindow.SetInstance(previous)
+        vtkLogger.SetStderrVerbosity(verbosity)
+    return result, capture.GetOutput()
