@@ -56,15 +56,14 @@
 class vtkHistoPyramidIsoMapper;
 
 class MEDICALISOSURFACESREPRESENTATIONS_EXPORT vtkHistoPyramidIsoRepresentation
-  : public vtkImageVolumeRepresentation
-{
+    : public vtkImageVolumeRepresentation {
 public:
-  static vtkHistoPyramidIsoRepresentation* New();
+  static vtkHistoPyramidIsoRepresentation *New();
   vtkTypeMacro(vtkHistoPyramidIsoRepresentation, vtkImageVolumeRepresentation);
-  void PrintSelf(ostream& os, vtkIndent indent) override;
+  void PrintSelf(ostream &os, vtkIndent indent) override;
 
   /// The mapper that draws the isosurfaces (owned by the representation).
-  vtkHistoPyramidIsoMapper* GetIsoMapper();
+  vtkHistoPyramidIsoMapper *GetIsoMapper();
 
   ///@{
   /**
@@ -124,9 +123,9 @@ public:
    * GPU one).
    * Counts are doubles for the ServerManager's information helpers.
    */
-  const char* GetRenderPath();
-  const char* GetFootprint();
-  const char* GetFallbackReason();
+  const char *GetRenderPath();
+  const char *GetFootprint();
+  const char *GetFallbackReason();
   double GetNumberOfPrimitives();
   double GetNumberOfFallbackTriangles();
   double GetNumberOfPyramidBuilds();
@@ -144,7 +143,11 @@ protected:
    * The base class's settings (array, scalar mode, cropping, transfer
    * function mode; its vtkSmartVolumeMapper/vtkMultiBlockVolumeMapper-only
    * settings find no such mapper and do nothing), then the active point
-   * scalars when no colour array is chosen.
+   * scalars when no colour array is chosen. An isovalue outside the range of
+   * the contoured array draws nothing: one warning says so, with the values
+   * and the range, each time the values, the array or its range change (not
+   * on every render); not in a parallel run, where a piece's range is not
+   * the data's.
    */
   void UpdateMapperParameters() override;
 
@@ -152,15 +155,22 @@ protected:
    * The base class's data cache, with a rectilinear grid replaced by the
    * image data it describes (resampled when its spacing is uneven).
    */
-  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestData(vtkInformation *, vtkInformationVector **,
+                  vtkInformationVector *) override;
 
 private:
-  vtkHistoPyramidIsoRepresentation(const vtkHistoPyramidIsoRepresentation&) = delete;
-  void operator=(const vtkHistoPyramidIsoRepresentation&) = delete;
+  vtkHistoPyramidIsoRepresentation(const vtkHistoPyramidIsoRepresentation &) =
+      delete;
+  void operator=(const vtkHistoPyramidIsoRepresentation &) = delete;
+
+  /// The warning for isovalues outside the contoured array's range ("" when
+  /// none).
+  std::string IsovaluesOutsideRange();
 
   vtkNew<vtkHistoPyramidIsoMapper> IsoMapper;
   bool ColorEachSurface = false;
   std::string LastResampleMessage;
+  std::string LastRangeMessage;
 };
 
 #endif
