@@ -28,57 +28,61 @@
 #include <algorithm>
 #include <cmath>
 
-namespace {
-enum Column { ValueColumn = 0, ColorColumn = 1, OpacityColumn = 2 };
+namespace
+{
+enum Column
+{
+  ValueColumn = 0,
+  ColorColumn = 1,
+  OpacityColumn = 2
+};
 
-QString FormatNumber(double value) { return QString::number(value, 'g', 8); }
+QString FormatNumber(double value)
+{
+  return QString::number(value, 'g', 8);
+}
 
 // Tissues in Hounsfield units, as a CT shows them; colours from the list's
 // palette (skin and bone first), skin and soft tissue see-through so what
 // lies inside shows.
-struct TissuePreset {
-  const char *Name;
+struct TissuePreset
+{
+  const char* Name;
   double Value;
   double Color[3];
   double Opacity;
 };
 const TissuePreset TissuePresets[] = {
-    {QT_TRANSLATE_NOOP("pqMedicalIsosurfaceListWidget", "Skin"),
-     -500.0,
-     {0.93, 0.75, 0.62},
-     0.35},
-    {QT_TRANSLATE_NOOP("pqMedicalIsosurfaceListWidget", "Soft tissue"),
-     40.0,
-     {0.80, 0.30, 0.28},
-     0.5},
-    {QT_TRANSLATE_NOOP("pqMedicalIsosurfaceListWidget", "Contrast vessels"),
-     200.0,
-     {0.85, 0.15, 0.15},
-     1.0},
-    {QT_TRANSLATE_NOOP("pqMedicalIsosurfaceListWidget", "Bone"),
-     400.0,
-     {0.96, 0.94, 0.86},
-     1.0},
+  { QT_TRANSLATE_NOOP("pqMedicalIsosurfaceListWidget", "Skin"), -500.0, { 0.93, 0.75, 0.62 },
+    0.35 },
+  { QT_TRANSLATE_NOOP("pqMedicalIsosurfaceListWidget", "Soft tissue"), 40.0, { 0.80, 0.30, 0.28 },
+    0.5 },
+  { QT_TRANSLATE_NOOP("pqMedicalIsosurfaceListWidget", "Contrast vessels"), 200.0,
+    { 0.85, 0.15, 0.15 }, 1.0 },
+  { QT_TRANSLATE_NOOP("pqMedicalIsosurfaceListWidget", "Bone"), 400.0, { 0.96, 0.94, 0.86 }, 1.0 },
 };
 
 // A swatch drawn as the colour cell's icon: unlike the cell's background, an
 // icon stays visible in a selected row.
-QPixmap Swatch(const QColor &color) {
+QPixmap Swatch(const QColor& color)
+{
   QPixmap swatch(36, 12);
   swatch.fill(color);
   return swatch;
 }
-} // namespace
+}
 
 //------------------------------------------------------------------------------
 pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
-    vtkSMProxy *smproxy, vtkSMPropertyGroup *smgroup, QWidget *parentObject)
-    : Superclass(smproxy, smgroup, parentObject),
-      Table(new QTableWidget(0, 3, this)), RangeLabel(new QLabel(this)),
-      AddButton(new QToolButton(this)),
-      RemoveButton(new QPushButton(tr("Remove"), this)),
-      ColorEachSurface(new QCheckBox(tr("Color Each Surface"), this)),
-      Connections(vtkEventQtSlotConnect::New()) {
+  vtkSMProxy* smproxy, vtkSMPropertyGroup* smgroup, QWidget* parentObject)
+  : Superclass(smproxy, smgroup, parentObject)
+  , Table(new QTableWidget(0, 3, this))
+  , RangeLabel(new QLabel(this))
+  , AddButton(new QToolButton(this))
+  , RemoveButton(new QPushButton(tr("Remove"), this))
+  , ColorEachSurface(new QCheckBox(tr("Color Each Surface"), this))
+  , Connections(vtkEventQtSlotConnect::New())
+{
   this->setObjectName("MedicalIsosurfaceList");
   this->Table->setObjectName("Isosurfaces");
   this->RangeLabel->setObjectName("DataRange");
@@ -86,166 +90,162 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   this->RemoveButton->setObjectName("Remove");
   this->ColorEachSurface->setObjectName("ColorEachSurface");
 
-  this->Table->setHorizontalHeaderLabels(
-      {tr("Isovalue"), tr("Color"), tr("Opacity")});
-  this->Table->horizontalHeader()->setSectionResizeMode(ValueColumn,
-                                                        QHeaderView::Stretch);
-  this->Table->horizontalHeader()->setSectionResizeMode(ColorColumn,
-                                                        QHeaderView::Fixed);
-  this->Table->horizontalHeader()->setSectionResizeMode(OpacityColumn,
-                                                        QHeaderView::Stretch);
+  this->Table->setHorizontalHeaderLabels({ tr("Isovalue"), tr("Color"), tr("Opacity") });
+  this->Table->horizontalHeader()->setSectionResizeMode(ValueColumn, QHeaderView::Stretch);
+  this->Table->horizontalHeader()->setSectionResizeMode(ColorColumn, QHeaderView::Fixed);
+  this->Table->horizontalHeader()->setSectionResizeMode(OpacityColumn, QHeaderView::Stretch);
   this->Table->setColumnWidth(ColorColumn, 70);
   this->Table->verticalHeader()->setVisible(false);
   this->Table->setSelectionBehavior(QAbstractItemView::SelectRows);
   this->Table->setMinimumHeight(110);
   this->Table->setMaximumHeight(180);
-  this->Table->setToolTip(
-      tr("One row per isosurface. Double-click a value or an opacity to "
-         "edit it, a colour to choose it (with Color Each Surface checked)."));
-  this->RangeLabel->setToolTip(tr("Range of the array the surfaces are drawn "
-                                  "from: the coloring array, or the active "
-                                  "point scalars with Solid Color."));
+  this->Table->setToolTip(tr("One row per isosurface. Double-click a value or an opacity to "
+                             "edit it, a colour to choose it (with Color Each Surface checked)."));
+  this->RangeLabel->setToolTip(
+    tr("Range of the array the surfaces are drawn from: the coloring array, or the active "
+       "point scalars with Solid Color."));
   // Add: tissue presets, or a value of one's own.
   this->AddButton->setText(tr("Add"));
   this->AddButton->setPopupMode(QToolButton::InstantPopup);
-  this->AddButton->setToolTip(tr("Add a surface: a tissue preset in Hounsfield "
-                                 "units (for a CT) with its color and "
-                                 "opacity, or another value (the middle of the "
-                                 "data range for the first row, else a "
-                                 "tenth of the range above the last row). "
-                                 "Double-click the new value to edit it."));
-  auto *presets = new QMenu(this->AddButton);
+  this->AddButton->setToolTip(
+    tr("Add a surface: a tissue preset in Hounsfield units (for a CT) with its color and "
+       "opacity, or another value (the middle of the data range for the first row, else a "
+       "tenth of the range above the last row). Double-click the new value to edit it."));
+  auto* presets = new QMenu(this->AddButton);
   presets->setObjectName("Presets");
-  for (int i = 0;
-       i < static_cast<int>(sizeof(TissuePresets) / sizeof(TissuePresets[0]));
-       ++i) {
-    const TissuePreset &preset = TissuePresets[i];
-    QAction *action = presets->addAction(
-        QIcon(Swatch(QColor::fromRgbF(preset.Color[0], preset.Color[1],
-                                      preset.Color[2]))),
-        tr("%1 (%2 HU)").arg(tr(preset.Name)).arg(preset.Value));
+  for (int i = 0; i < static_cast<int>(sizeof(TissuePresets) / sizeof(TissuePresets[0])); ++i)
+  {
+    const TissuePreset& preset = TissuePresets[i];
+    QAction* action = presets->addAction(
+      QIcon(Swatch(QColor::fromRgbF(preset.Color[0], preset.Color[1], preset.Color[2]))),
+      tr("%1 (%2 HU)").arg(tr(preset.Name)).arg(preset.Value));
     action->setObjectName(QString("Preset%1").arg(i));
-    QObject::connect(action, &QAction::triggered, this,
-                     [this, i]() { this->addPreset(i); });
+    QObject::connect(action, &QAction::triggered, this, [this, i]() { this->addPreset(i); });
   }
   presets->addSeparator();
-  QAction *other = presets->addAction(tr("Other value"));
+  QAction* other = presets->addAction(tr("Other value"));
   other->setObjectName("OtherValue");
-  QObject::connect(other, &QAction::triggered, this,
-                   &pqMedicalIsosurfaceListWidget::addRow);
+  QObject::connect(other, &QAction::triggered, this, &pqMedicalIsosurfaceListWidget::addRow);
   this->AddButton->setMenu(presets);
   this->RemoveButton->setToolTip(
-      tr("Remove the selected rows (the last row when none is selected)."));
+    tr("Remove the selected rows (the last row when none is selected)."));
   this->ColorEachSurface->setToolTip(
-      tr("Draw each surface in its own color. Unchecked: Solid Color, or the "
-         "color map at the "
-         "isovalue when coloring by an array."));
+    tr("Draw each surface in its own color. Unchecked: Solid Color, or the color map at the "
+       "isovalue when coloring by an array."));
 
-  auto *buttons = new QHBoxLayout;
+  auto* buttons = new QHBoxLayout;
   buttons->setContentsMargins(0, 0, 0, 0);
   buttons->addWidget(this->AddButton);
   buttons->addWidget(this->RemoveButton);
   buttons->addStretch(1);
   buttons->addWidget(this->ColorEachSurface);
 
-  auto *layout = new QVBoxLayout(this);
+  auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
   layout->addWidget(this->RangeLabel);
   layout->addWidget(this->Table);
   layout->addLayout(buttons);
 
-  QObject::connect(this->RemoveButton, &QPushButton::clicked, this,
-                   &pqMedicalIsosurfaceListWidget::removeRows);
-  QObject::connect(this->Table, &QTableWidget::cellChanged, this,
-                   &pqMedicalIsosurfaceListWidget::cellEdited);
+  QObject::connect(
+    this->RemoveButton, &QPushButton::clicked, this, &pqMedicalIsosurfaceListWidget::removeRows);
+  QObject::connect(
+    this->Table, &QTableWidget::cellChanged, this, &pqMedicalIsosurfaceListWidget::cellEdited);
   QObject::connect(this->Table, &QTableWidget::cellDoubleClicked, this,
-                   &pqMedicalIsosurfaceListWidget::cellDoubleClicked);
+    &pqMedicalIsosurfaceListWidget::cellDoubleClicked);
   // Checking the box (the user, not a property update) makes the colours
   // shown the colours drawn.
   QObject::connect(this->ColorEachSurface, &QCheckBox::toggled, this,
-                   &pqMedicalIsosurfaceListWidget::updateTable);
+    &pqMedicalIsosurfaceListWidget::updateTable);
   QObject::connect(this->ColorEachSurface, &QCheckBox::clicked, this,
-                   &pqMedicalIsosurfaceListWidget::colorsChanged);
+    &pqMedicalIsosurfaceListWidget::colorsChanged);
 
-  vtkSMProperty *isovalues = smproxy->GetProperty("IsosurfaceValues");
+  vtkSMProperty* isovalues = smproxy->GetProperty("IsosurfaceValues");
   this->addPropertyLink(this, "values", SIGNAL(valuesChanged()), isovalues);
-  this->addPropertyLink(this, "colors", SIGNAL(colorsChanged()),
-                        smgroup->GetProperty("Colors"));
-  this->addPropertyLink(this, "opacities", SIGNAL(opacitiesChanged()),
-                        smgroup->GetProperty("Opacities"));
+  this->addPropertyLink(this, "colors", SIGNAL(colorsChanged()), smgroup->GetProperty("Colors"));
+  this->addPropertyLink(
+    this, "opacities", SIGNAL(opacitiesChanged()), smgroup->GetProperty("Opacities"));
   this->addPropertyLink(this->ColorEachSurface, "ColorEachSurface");
 
   // The range follows the data and the colouring.
   vtkSMPropertyHelper input(smproxy, "Input", /*quiet=*/true);
-  if (auto *source = vtkSMSourceProxy::SafeDownCast(input.GetAsProxy())) {
-    this->Connections->Connect(source, vtkCommand::UpdateDataEvent, this,
-                               SLOT(updateRange()));
+  if (auto* source = vtkSMSourceProxy::SafeDownCast(input.GetAsProxy()))
+  {
+    this->Connections->Connect(source, vtkCommand::UpdateDataEvent, this, SLOT(updateRange()));
   }
-  if (vtkSMProperty *colorArray = smproxy->GetProperty("ColorArrayName")) {
-    this->Connections->Connect(colorArray, vtkCommand::ModifiedEvent, this,
-                               SLOT(updateRange()));
-    this->Connections->Connect(colorArray, vtkCommand::ModifiedEvent, this,
-                               SLOT(updateTable()));
+  if (vtkSMProperty* colorArray = smproxy->GetProperty("ColorArrayName"))
+  {
+    this->Connections->Connect(colorArray, vtkCommand::ModifiedEvent, this, SLOT(updateRange()));
+    this->Connections->Connect(colorArray, vtkCommand::ModifiedEvent, this, SLOT(updateTable()));
   }
   this->updateRange();
   this->updateTable();
 
   // The list edits values, colours and opacities together: it takes the
   // display's start over, so that editing skin's value keeps skin's look.
-  smproxy->RemoveAnnotation(
-      vtkSMMedicalIsosurfaceInitializationHelper::StartAnnotation());
+  smproxy->RemoveAnnotation(vtkSMMedicalIsosurfaceInitializationHelper::StartAnnotation());
 }
 
 //------------------------------------------------------------------------------
-pqMedicalIsosurfaceListWidget::~pqMedicalIsosurfaceListWidget() {
+pqMedicalIsosurfaceListWidget::~pqMedicalIsosurfaceListWidget()
+{
   this->Connections->Disconnect();
   this->Connections->Delete();
 }
 
 //------------------------------------------------------------------------------
-QColor pqMedicalIsosurfaceListWidget::defaultColor(int row) {
-  static const QColor palette[] = {
-      QColor::fromRgbF(0.93, 0.75, 0.62), QColor::fromRgbF(0.96, 0.94, 0.86),
-      QColor::fromRgbF(0.80, 0.30, 0.28), QColor::fromRgbF(0.35, 0.55, 0.85),
-      QColor::fromRgbF(0.45, 0.75, 0.40), QColor::fromRgbF(0.90, 0.75, 0.25),
-      QColor::fromRgbF(0.65, 0.45, 0.80), QColor::fromRgbF(0.40, 0.80, 0.80)};
+QColor pqMedicalIsosurfaceListWidget::defaultColor(int row)
+{
+  static const QColor palette[] = { QColor::fromRgbF(0.93, 0.75, 0.62),
+    QColor::fromRgbF(0.96, 0.94, 0.86), QColor::fromRgbF(0.80, 0.30, 0.28),
+    QColor::fromRgbF(0.35, 0.55, 0.85), QColor::fromRgbF(0.45, 0.75, 0.40),
+    QColor::fromRgbF(0.90, 0.75, 0.25), QColor::fromRgbF(0.65, 0.45, 0.80),
+    QColor::fromRgbF(0.40, 0.80, 0.80) };
   return palette[row % (sizeof(palette) / sizeof(palette[0]))];
 }
 
 //------------------------------------------------------------------------------
-QList<QVariant> pqMedicalIsosurfaceListWidget::values() const {
+QList<QVariant> pqMedicalIsosurfaceListWidget::values() const
+{
   QList<QVariant> list;
-  for (const Row &row : this->Rows) {
+  for (const Row& row : this->Rows)
+  {
     list.push_back(row.Value);
   }
   return list;
 }
 
 //------------------------------------------------------------------------------
-QList<QVariant> pqMedicalIsosurfaceListWidget::colors() const {
+QList<QVariant> pqMedicalIsosurfaceListWidget::colors() const
+{
   QList<QVariant> list;
-  for (const Row &row : this->Rows) {
+  for (const Row& row : this->Rows)
+  {
     list << row.Color.redF() << row.Color.greenF() << row.Color.blueF();
   }
   return list;
 }
 
 //------------------------------------------------------------------------------
-QList<QVariant> pqMedicalIsosurfaceListWidget::opacities() const {
+QList<QVariant> pqMedicalIsosurfaceListWidget::opacities() const
+{
   QList<QVariant> list;
-  for (const Row &row : this->Rows) {
+  for (const Row& row : this->Rows)
+  {
     list.push_back(row.Opacity);
   }
   return list;
 }
 
 //------------------------------------------------------------------------------
-void pqMedicalIsosurfaceListWidget::setValues(const QList<QVariant> &values) {
+void pqMedicalIsosurfaceListWidget::setValues(const QList<QVariant>& values)
+{
   const std::size_t old = this->Rows.size();
   this->Rows.resize(static_cast<std::size_t>(values.size()));
-  for (std::size_t i = 0; i < this->Rows.size(); ++i) {
+  for (std::size_t i = 0; i < this->Rows.size(); ++i)
+  {
     this->Rows[i].Value = values[static_cast<int>(i)].toDouble();
-    if (i >= old) {
+    if (i >= old)
+    {
       this->Rows[i].Color = defaultColor(static_cast<int>(i));
       this->Rows[i].Opacity = 1.0;
     }
@@ -254,62 +254,64 @@ void pqMedicalIsosurfaceListWidget::setValues(const QList<QVariant> &values) {
 }
 
 //------------------------------------------------------------------------------
-void pqMedicalIsosurfaceListWidget::setColors(const QList<QVariant> &colors) {
-  for (std::size_t i = 0; i < this->Rows.size(); ++i) {
+void pqMedicalIsosurfaceListWidget::setColors(const QList<QVariant>& colors)
+{
+  for (std::size_t i = 0; i < this->Rows.size(); ++i)
+  {
     const int at = 3 * static_cast<int>(i);
-    this->Rows[i].Color =
-        at + 2 < colors.size()
-            ? QColor::fromRgbF(
-                  std::min(1.0, std::max(0.0, colors[at].toDouble())),
-                  std::min(1.0, std::max(0.0, colors[at + 1].toDouble())),
-                  std::min(1.0, std::max(0.0, colors[at + 2].toDouble())))
-            : defaultColor(static_cast<int>(i));
+    this->Rows[i].Color = at + 2 < colors.size()
+      ? QColor::fromRgbF(std::min(1.0, std::max(0.0, colors[at].toDouble())),
+          std::min(1.0, std::max(0.0, colors[at + 1].toDouble())),
+          std::min(1.0, std::max(0.0, colors[at + 2].toDouble())))
+      : defaultColor(static_cast<int>(i));
   }
   this->updateTable();
 }
 
 //------------------------------------------------------------------------------
-void pqMedicalIsosurfaceListWidget::setOpacities(
-    const QList<QVariant> &opacities) {
-  for (std::size_t i = 0; i < this->Rows.size(); ++i) {
-    this->Rows[i].Opacity = static_cast<int>(i) < opacities.size()
-                                ? opacities[static_cast<int>(i)].toDouble()
-                                : 1.0;
+void pqMedicalIsosurfaceListWidget::setOpacities(const QList<QVariant>& opacities)
+{
+  for (std::size_t i = 0; i < this->Rows.size(); ++i)
+  {
+    this->Rows[i].Opacity =
+      static_cast<int>(i) < opacities.size() ? opacities[static_cast<int>(i)].toDouble() : 1.0;
   }
   this->updateTable();
 }
 
 //------------------------------------------------------------------------------
-void pqMedicalIsosurfaceListWidget::updateTable() {
+void pqMedicalIsosurfaceListWidget::updateTable()
+{
   this->Updating = true;
   const bool colorEach = this->ColorEachSurface->isChecked();
   this->Table->setRowCount(static_cast<int>(this->Rows.size()));
-  for (int i = 0; i < static_cast<int>(this->Rows.size()); ++i) {
-    const Row &row = this->Rows[static_cast<std::size_t>(i)];
-    auto *value = new QTableWidgetItem(FormatNumber(row.Value));
+  for (int i = 0; i < static_cast<int>(this->Rows.size()); ++i)
+  {
+    const Row& row = this->Rows[static_cast<std::size_t>(i)];
+    auto* value = new QTableWidgetItem(FormatNumber(row.Value));
     value->setTextAlignment(Qt::AlignRight | Qt::AlignVCenter);
     this->Table->setItem(i, ValueColumn, value);
-    auto *color = new QTableWidgetItem();
+    auto* color = new QTableWidgetItem();
     color->setFlags(Qt::ItemIsSelectable | Qt::ItemIsEnabled);
-    if (colorEach) {
+    if (colorEach)
+    {
       color->setBackground(row.Color);
       color->setData(Qt::DecorationRole, Swatch(row.Color));
       color->setToolTip(tr("Double-click to choose this surface's color"));
-    } else {
+    }
+    else
+    {
       // Drawn in the solid colour or the colour map's colour at the value.
-      vtkSMPropertyHelper colorArray(this->proxy(), "ColorArrayName",
-                                     /*quiet=*/true);
-      const char *name = colorArray.GetInputArrayNameToProcess();
+      vtkSMPropertyHelper colorArray(this->proxy(), "ColorArrayName", /*quiet=*/true);
+      const char* name = colorArray.GetInputArrayNameToProcess();
       color->setText((name && name[0]) ? tr("map") : tr("solid"));
       color->setTextAlignment(Qt::AlignCenter);
-      color->setToolTip(
-          tr("Double-click (or check Color Each Surface) to give this surface "
-             "its own color"));
-      color->setForeground(
-          this->palette().color(QPalette::Disabled, QPalette::Text));
+      color->setToolTip(tr("Double-click (or check Color Each Surface) to give this surface "
+                           "its own color"));
+      color->setForeground(this->palette().color(QPalette::Disabled, QPalette::Text));
     }
     this->Table->setItem(i, ColorColumn, color);
-    auto *opacity = new QTableWidgetItem(FormatNumber(row.Opacity));
+    auto* opacity = new QTableWidgetItem(FormatNumber(row.Opacity));
     opacity->setTextAlignment(Qt::AlignRight | Qt::AlignVCenter);
     this->Table->setItem(i, OpacityColumn, opacity);
   }
@@ -318,7 +320,8 @@ void pqMedicalIsosurfaceListWidget::updateTable() {
 }
 
 //------------------------------------------------------------------------------
-void pqMedicalIsosurfaceListWidget::rowsEdited() {
+void pqMedicalIsosurfaceListWidget::rowsEdited()
+{
   this->updateTable();
   Q_EMIT this->valuesChanged();
   Q_EMIT this->colorsChanged();
@@ -326,15 +329,20 @@ void pqMedicalIsosurfaceListWidget::rowsEdited() {
 }
 
 //------------------------------------------------------------------------------
-void pqMedicalIsosurfaceListWidget::addRow() {
+void pqMedicalIsosurfaceListWidget::addRow()
+{
   Row row;
   const double span = this->HasRange ? this->Range[1] - this->Range[0] : 0.0;
-  if (this->Rows.empty()) {
+  if (this->Rows.empty())
+  {
     row.Value = this->HasRange ? this->Range[0] + 0.5 * span : 0.0;
-  } else {
+  }
+  else
+  {
     // A tenth of the range above the last value, kept inside the range.
     row.Value = this->Rows.back().Value + (span > 0.0 ? 0.1 * span : 1.0);
-    if (this->HasRange && row.Value > this->Range[1]) {
+    if (this->HasRange && row.Value > this->Range[1])
+    {
       row.Value = this->Range[0] + 0.5 * span;
     }
   }
@@ -343,12 +351,12 @@ void pqMedicalIsosurfaceListWidget::addRow() {
 }
 
 //------------------------------------------------------------------------------
-void pqMedicalIsosurfaceListWidget::addPreset(int index) {
-  const TissuePreset &preset = TissuePresets[index];
+void pqMedicalIsosurfaceListWidget::addPreset(int index)
+{
+  const TissuePreset& preset = TissuePresets[index];
   Row row;
   row.Value = preset.Value;
-  row.Color =
-      QColor::fromRgbF(preset.Color[0], preset.Color[1], preset.Color[2]);
+  row.Color = QColor::fromRgbF(preset.Color[0], preset.Color[1], preset.Color[2]);
   row.Opacity = preset.Opacity;
   // A tissue's colour is part of the preset: draw it.
   this->ColorEachSurface->setChecked(true);
@@ -356,39 +364,48 @@ void pqMedicalIsosurfaceListWidget::addPreset(int index) {
 }
 
 //------------------------------------------------------------------------------
-void pqMedicalIsosurfaceListWidget::appendRow(const Row &row) {
+void pqMedicalIsosurfaceListWidget::appendRow(const Row& row)
+{
   this->Rows.push_back(row);
   this->rowsEdited();
 }
 
 //------------------------------------------------------------------------------
-void pqMedicalIsosurfaceListWidget::removeRows() {
+void pqMedicalIsosurfaceListWidget::removeRows()
+{
   std::vector<int> selected;
-  for (const QModelIndex &index :
-       this->Table->selectionModel()->selectedRows()) {
+  for (const QModelIndex& index : this->Table->selectionModel()->selectedRows())
+  {
     selected.push_back(index.row());
   }
-  if (selected.empty() && !this->Rows.empty()) {
+  if (selected.empty() && !this->Rows.empty())
+  {
     selected.push_back(static_cast<int>(this->Rows.size()) - 1);
   }
   std::sort(selected.rbegin(), selected.rend());
-  for (int row : selected) {
+  for (int row : selected)
+  {
     this->Rows.erase(this->Rows.begin() + row);
   }
   this->rowsEdited();
 }
 
 //------------------------------------------------------------------------------
-void pqMedicalIsosurfaceListWidget::cellEdited(int row, int column) {
-  if (this->Updating || row < 0 || row >= static_cast<int>(this->Rows.size())) {
+void pqMedicalIsosurfaceListWidget::cellEdited(int row, int column)
+{
+  if (this->Updating || row < 0 || row >= static_cast<int>(this->Rows.size()))
+  {
     return;
   }
-  Row &edited = this->Rows[static_cast<std::size_t>(row)];
+  Row& edited = this->Rows[static_cast<std::size_t>(row)];
   bool ok = false;
   const double number = this->Table->item(row, column)->text().toDouble(&ok);
-  if (column == ValueColumn && ok) {
+  if (column == ValueColumn && ok)
+  {
     edited.Value = number;
-  } else if (column == OpacityColumn && ok && std::isfinite(number)) {
+  }
+  else if (column == OpacityColumn && ok && std::isfinite(number))
+  {
     edited.Opacity = std::min(1.0, std::max(0.0, number));
   }
   // Text that is not a number puts the old value back.
@@ -396,54 +413,57 @@ void pqMedicalIsosurfaceListWidget::cellEdited(int row, int column) {
 }
 
 //------------------------------------------------------------------------------
-void pqMedicalIsosurfaceListWidget::cellDoubleClicked(int row, int column) {
-  if (column != ColorColumn || row < 0 ||
-      row >= static_cast<int>(this->Rows.size())) {
+void pqMedicalIsosurfaceListWidget::cellDoubleClicked(int row, int column)
+{
+  if (column != ColorColumn || row < 0 || row >= static_cast<int>(this->Rows.size()))
+  {
     return;
   }
-  if (!this->ColorEachSurface->isChecked()) {
+  if (!this->ColorEachSurface->isChecked())
+  {
     // Choosing a colour means wanting colours per surface.
     this->ColorEachSurface->setChecked(true);
   }
-  Row &edited = this->Rows[static_cast<std::size_t>(row)];
-  const QColor chosen = QColorDialog::getColor(
-      edited.Color, this, tr("Surface %1 color").arg(row + 1));
-  if (chosen.isValid()) {
+  Row& edited = this->Rows[static_cast<std::size_t>(row)];
+  const QColor chosen =
+    QColorDialog::getColor(edited.Color, this, tr("Surface %1 color").arg(row + 1));
+  if (chosen.isValid())
+  {
     edited.Color = chosen;
     this->rowsEdited();
   }
 }
 
 //------------------------------------------------------------------------------
-void pqMedicalIsosurfaceListWidget::updateRange() {
+void pqMedicalIsosurfaceListWidget::updateRange()
+{
   this->HasRange = false;
   vtkSMPropertyHelper input(this->proxy(), "Input", /*quiet=*/true);
-  auto *source = vtkSMSourceProxy::SafeDownCast(input.GetAsProxy());
-  vtkPVArrayInformation *array = nullptr;
-  if (source) {
-    vtkPVDataSetAttributesInformation *points =
-        source->GetDataInformation(input.GetOutputPort())
-            ->GetPointDataInformation();
-    vtkSMPropertyHelper colorArray(this->proxy(), "ColorArrayName",
-                                   /*quiet=*/true);
-    const char *name = colorArray.GetInputArrayNameToProcess();
-    array =
-        (name && name[0])
-            ? points->GetArrayInformation(name)
-            : points->GetAttributeInformation(vtkDataSetAttributes::SCALARS);
+  auto* source = vtkSMSourceProxy::SafeDownCast(input.GetAsProxy());
+  vtkPVArrayInformation* array = nullptr;
+  if (source)
+  {
+    vtkPVDataSetAttributesInformation* points =
+      source->GetDataInformation(input.GetOutputPort())->GetPointDataInformation();
+    vtkSMPropertyHelper colorArray(this->proxy(), "ColorArrayName", /*quiet=*/true);
+    const char* name = colorArray.GetInputArrayNameToProcess();
+    array = (name && name[0]) ? points->GetArrayInformation(name)
+                              : points->GetAttributeInformation(vtkDataSetAttributes::SCALARS);
   }
-  if (array && array->GetNumberOfComponents() == 1) {
+  if (array && array->GetNumberOfComponents() == 1)
+  {
     array->GetComponentRange(0, this->Range);
     this->HasRange = this->Range[0] <= this->Range[1];
   }
-  if (this->HasRange) {
-    this->RangeLabel->setText(
-        tr("Data range: [%1, %2] (%3)")
-            .arg(FormatNumber(this->Range[0]))
-            .arg(FormatNumber(this->Range[1]))
-            .arg(array->GetName() ? array->GetName() : "scalars"));
-  } else {
-    this->RangeLabel->setText(
-        tr("Data range: unknown (no one-component point array)"));
+  if (this->HasRange)
+  {
+    this->RangeLabel->setText(tr("Data range: [%1, %2] (%3)")
+                                .arg(FormatNumber(this->Range[0]))
+                                .arg(FormatNumber(this->Range[1]))
+                                .arg(array->GetName() ? array->GetName() : "scalars"));
+  }
+  else
+  {
+    this->RangeLabel->setText(tr("Data range: unknown (no one-component point array)"));
   }
 }

@@ -45,7 +45,8 @@ class QToolButton;
 class QTableWidget;
 class vtkEventQtSlotConnect;
 
-class pqMedicalIsosurfaceListWidget : public pqPropertyGroupWidget {
+class pqMedicalIsosurfaceListWidget : public pqPropertyGroupWidget
+{
   Q_OBJECT
   Q_PROPERTY(QList<QVariant> values READ values WRITE setValues)
   Q_PROPERTY(QList<QVariant> colors READ colors WRITE setColors)
@@ -53,8 +54,8 @@ class pqMedicalIsosurfaceListWidget : public pqPropertyGroupWidget {
   typedef pqPropertyGroupWidget Superclass;
 
 public:
-  pqMedicalIsosurfaceListWidget(vtkSMProxy *proxy, vtkSMPropertyGroup *group,
-                                QWidget *parent = nullptr);
+  pqMedicalIsosurfaceListWidget(
+    vtkSMProxy* proxy, vtkSMPropertyGroup* group, QWidget* parent = nullptr);
   ~pqMedicalIsosurfaceListWidget() override;
 
   ///@{
@@ -62,9 +63,9 @@ public:
   QList<QVariant> values() const;
   QList<QVariant> colors() const;
   QList<QVariant> opacities() const;
-  void setValues(const QList<QVariant> &values);
-  void setColors(const QList<QVariant> &colors);
-  void setOpacities(const QList<QVariant> &opacities);
+  void setValues(const QList<QVariant>& values);
+  void setColors(const QList<QVariant>& colors);
+  void setOpacities(const QList<QVariant>& opacities);
   ///@}
 
 Q_SIGNALS:
@@ -88,7 +89,8 @@ private Q_SLOTS:
 private:
   Q_DISABLE_COPY(pqMedicalIsosurfaceListWidget)
 
-  struct Row {
+  struct Row
+  {
     double Value = 0.0;
     QColor Color;
     double Opacity = 1.0;
@@ -99,18 +101,18 @@ private:
   /// The colour a new row starts with (a fixed palette, skin and bone first).
   static QColor defaultColor(int row);
 
-  void appendRow(const Row &row);
+  void appendRow(const Row& row);
 
   std::vector<Row> Rows;
-  double Range[2] = {0.0, 0.0};
+  double Range[2] = { 0.0, 0.0 };
   bool HasRange = false;
   bool Updating = false;
-  QTableWidget *Table;
-  QLabel *RangeLabel;
-  QToolButton *AddButton;
-  QPushButton *RemoveButton;
-  QCheckBox *ColorEachSurface;
-  vtkEventQtSlotConnect *Connections;
+  QTableWidget* Table;
+  QLabel* RangeLabel;
+  QToolButton* AddButton;
+  QPushButton* RemoveButton;
+  QCheckBox* ColorEachSurface;
+  vtkEventQtSlotConnect* Connections;
 };
 
 #endif

@@ -24,12 +24,15 @@
 #include <new>
 #include <sstream>
 
-namespace {
+namespace
+{
 // Whether the coordinates are evenly spaced (relative tolerance 1e-6 of the
 // axis' extent), and their spacing then.
-bool EvenSpacing(vtkDataArray *coordinates, double &spacing) {
+bool EvenSpacing(vtkDataArray* coordinates, double& spacing)
+{
   const vtkIdType n = coordinates->GetNumberOfTuples();
-  if (n < 2) {
+  if (n < 2)
+  {
     spacing = 1.0;
     return true;
   }
@@ -37,20 +40,22 @@ bool EvenSpacing(vtkDataArray *coordinates, double &spacing) {
   const double last = coordinates->GetComponent(n - 1, 0);
   spacing = (last - first) / static_cast<double>(n - 1);
   const double tolerance = 1e-6 * std::abs(last - first);
-  for (vtkIdType i = 1; i < n - 1; ++i) {
-    if (std::abs(coordinates->GetComponent(i, 0) - (first + spacing * i)) >
-        tolerance) {
+  for (vtkIdType i = 1; i < n - 1; ++i)
+  {
+    if (std::abs(coordinates->GetComponent(i, 0) - (first + spacing * i)) > tolerance)
+    {
       return false;
     }
   }
   return true;
 }
-} // namespace
+}
 
 vtkStandardNewMacro(vtkHistoPyramidIsoRepresentation);
 
 //------------------------------------------------------------------------------
-vtkHistoPyramidIsoRepresentation::vtkHistoPyramidIsoRepresentation() {
+vtkHistoPyramidIsoRepresentation::vtkHistoPyramidIsoRepresentation()
+{
   // The base class made a vtkMultiBlockVolumeMapper; nothing has used it yet
   // (inputs and parameters reach the mapper in RequestData and at render time).
   this->VolumeMapper = this->IsoMapper.GetPointer();
@@ -60,211 +65,234 @@ vtkHistoPyramidIsoRepresentation::vtkHistoPyramidIsoRepresentation() {
 vtkHistoPyramidIsoRepresentation::~vtkHistoPyramidIsoRepresentation() = default;
 
 //------------------------------------------------------------------------------
-vtkHistoPyramidIsoMapper *vtkHistoPyramidIsoRepresentation::GetIsoMapper() {
+vtkHistoPyramidIsoMapper* vtkHistoPyramidIsoRepresentation::GetIsoMapper()
+{
   return this->IsoMapper;
 }
 
 //------------------------------------------------------------------------------
-void vtkHistoPyramidIsoRepresentation::SetForceCPUFallback(bool force) {
+void vtkHistoPyramidIsoRepresentation::SetForceCPUFallback(bool force)
+{
   this->IsoMapper->SetForceCPUFallback(force);
 }
 
 //------------------------------------------------------------------------------
-bool vtkHistoPyramidIsoRepresentation::GetForceCPUFallback() {
+bool vtkHistoPyramidIsoRepresentation::GetForceCPUFallback()
+{
   return this->IsoMapper->GetForceCPUFallback();
 }
 
 //------------------------------------------------------------------------------
-void vtkHistoPyramidIsoRepresentation::SetAllowPointFootprint(bool allow) {
+void vtkHistoPyramidIsoRepresentation::SetAllowPointFootprint(bool allow)
+{
   this->IsoMapper->SetAllowPointFootprint(allow);
 }
 
 //------------------------------------------------------------------------------
-bool vtkHistoPyramidIsoRepresentation::GetAllowPointFootprint() {
+bool vtkHistoPyramidIsoRepresentation::GetAllowPointFootprint()
+{
   return this->IsoMapper->GetAllowPointFootprint();
 }
 
 //------------------------------------------------------------------------------
-void vtkHistoPyramidIsoRepresentation::SetFirstHitPass(bool use) {
+void vtkHistoPyramidIsoRepresentation::SetFirstHitPass(bool use)
+{
   this->IsoMapper->SetFirstHitPass(use);
 }
 
 //------------------------------------------------------------------------------
-bool vtkHistoPyramidIsoRepresentation::GetFirstHitPass() {
+bool vtkHistoPyramidIsoRepresentation::GetFirstHitPass()
+{
   return this->IsoMapper->GetFirstHitPass();
 }
 
 //------------------------------------------------------------------------------
-void vtkHistoPyramidIsoRepresentation::SetDiffuseColor(double r, double g,
-                                                       double b) {
+void vtkHistoPyramidIsoRepresentation::SetDiffuseColor(double r, double g, double b)
+{
   this->IsoMapper->SetSolidColor(r, g, b);
 }
 
 //------------------------------------------------------------------------------
-void vtkHistoPyramidIsoRepresentation::SetOpacity(double opacity) {
+void vtkHistoPyramidIsoRepresentation::SetOpacity(double opacity)
+{
   this->IsoMapper->SetOpacity(opacity);
 }
 
 //------------------------------------------------------------------------------
-void vtkHistoPyramidIsoRepresentation::SetColorEachSurface(bool each) {
-  if (this->ColorEachSurface != each) {
+void vtkHistoPyramidIsoRepresentation::SetColorEachSurface(bool each)
+{
+  if (this->ColorEachSurface != each)
+  {
     this->ColorEachSurface = each;
     this->Modified();
   }
 }
 
 //------------------------------------------------------------------------------
-void vtkHistoPyramidIsoRepresentation::SetNumberOfSurfaceColors(int number) {
+void vtkHistoPyramidIsoRepresentation::SetNumberOfSurfaceColors(int number)
+{
   this->IsoMapper->SetNumberOfSurfaceColors(number);
 }
 
 //------------------------------------------------------------------------------
-void vtkHistoPyramidIsoRepresentation::SetSurfaceColor(int i, double r,
-                                                       double g, double b) {
+void vtkHistoPyramidIsoRepresentation::SetSurfaceColor(int i, double r, double g, double b)
+{
   this->IsoMapper->SetSurfaceColor(i, r, g, b);
 }
 
 //------------------------------------------------------------------------------
-void vtkHistoPyramidIsoRepresentation::SetNumberOfSurfaceOpacities(int number) {
+void vtkHistoPyramidIsoRepresentation::SetNumberOfSurfaceOpacities(int number)
+{
   this->IsoMapper->SetNumberOfSurfaceOpacities(number);
 }
 
 //------------------------------------------------------------------------------
-void vtkHistoPyramidIsoRepresentation::SetSurfaceOpacity(int i,
-                                                         double opacity) {
+void vtkHistoPyramidIsoRepresentation::SetSurfaceOpacity(int i, double opacity)
+{
   this->IsoMapper->SetSurfaceOpacity(i, opacity);
 }
 
 //------------------------------------------------------------------------------
-const char *vtkHistoPyramidIsoRepresentation::GetFootprint() {
-  return this->IsoMapper->GetLastRenderPath() ==
-                 vtkHistoPyramidIsoMapper::GPUPath
-             ? this->IsoMapper->GetLastFootprintAsString()
-             : "none";
+const char* vtkHistoPyramidIsoRepresentation::GetFootprint()
+{
+  return this->IsoMapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath
+    ? this->IsoMapper->GetLastFootprintAsString()
+    : "none";
 }
 
 //------------------------------------------------------------------------------
-const char *vtkHistoPyramidIsoRepresentation::GetRenderPath() {
+const char* vtkHistoPyramidIsoRepresentation::GetRenderPath()
+{
   return this->IsoMapper->GetLastRenderPathAsString();
 }
 
 //------------------------------------------------------------------------------
-const char *vtkHistoPyramidIsoRepresentation::GetFallbackReason() {
+const char* vtkHistoPyramidIsoRepresentation::GetFallbackReason()
+{
   return this->IsoMapper->GetFallbackReason().c_str();
 }
 
 //------------------------------------------------------------------------------
-double vtkHistoPyramidIsoRepresentation::GetNumberOfPrimitives() {
+double vtkHistoPyramidIsoRepresentation::GetNumberOfPrimitives()
+{
   return static_cast<double>(this->IsoMapper->GetNumberOfPrimitives());
 }
 
 //------------------------------------------------------------------------------
-double vtkHistoPyramidIsoRepresentation::GetNumberOfFallbackTriangles() {
+double vtkHistoPyramidIsoRepresentation::GetNumberOfFallbackTriangles()
+{
   return static_cast<double>(this->IsoMapper->GetNumberOfFallbackTriangles());
 }
 
 //------------------------------------------------------------------------------
-double vtkHistoPyramidIsoRepresentation::GetNumberOfPyramidBuilds() {
+double vtkHistoPyramidIsoRepresentation::GetNumberOfPyramidBuilds()
+{
   return static_cast<double>(this->IsoMapper->GetNumberOfPyramidBuilds());
 }
 
 //------------------------------------------------------------------------------
-double vtkHistoPyramidIsoRepresentation::GetGPUMemoryBytes() {
+double vtkHistoPyramidIsoRepresentation::GetGPUMemoryBytes()
+{
   return static_cast<double>(this->IsoMapper->GetGPUMemoryBytes());
 }
 
 //------------------------------------------------------------------------------
-double vtkHistoPyramidIsoRepresentation::GetFrameBufferBytes() {
+double vtkHistoPyramidIsoRepresentation::GetFrameBufferBytes()
+{
   return static_cast<double>(this->IsoMapper->GetFrameBufferBytes());
 }
 
 //------------------------------------------------------------------------------
 int vtkHistoPyramidIsoRepresentation::RequestData(
-    vtkInformation *request, vtkInformationVector **inputVector,
-    vtkInformationVector *outputVector) {
-  if (!this->Superclass::RequestData(request, inputVector, outputVector)) {
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (!this->Superclass::RequestData(request, inputVector, outputVector))
+  {
     return 0;
   }
-  if (auto *image = vtkImageData::SafeDownCast(this->Cache)) {
+  if (auto* image = vtkImageData::SafeDownCast(this->Cache))
+  {
     // Points at one place along an axis (or nowhere) have no surface between
     // them; said here, once per update, since such data may never reach the
-    // mapper (a non-finite spacing makes non-finite bounds, which the view
-    // culls).
-    const std::string spacingProblem =
-        vtkHistoPyramidIsoMapper::CheckSpacing(image->GetSpacing());
-    if (!spacingProblem.empty()) {
+    // mapper (a non-finite spacing makes non-finite bounds, which the view culls).
+    const std::string spacingProblem = vtkHistoPyramidIsoMapper::CheckSpacing(image->GetSpacing());
+    if (!spacingProblem.empty())
+    {
       vtkErrorMacro(<< spacingProblem);
       this->Cache = nullptr;
       this->IsoMapper->RemoveAllInputConnections(0);
     }
     return 1;
   }
-  auto *grid = vtkRectilinearGrid::SafeDownCast(this->Cache);
-  if (!grid) {
+  auto* grid = vtkRectilinearGrid::SafeDownCast(this->Cache);
+  if (!grid)
+  {
     return 1;
   }
   int extent[6];
   grid->GetExtent(extent);
-  vtkDataArray *axes[3] = {grid->GetXCoordinates(), grid->GetYCoordinates(),
-                           grid->GetZCoordinates()};
+  vtkDataArray* axes[3] = { grid->GetXCoordinates(), grid->GetYCoordinates(),
+    grid->GetZCoordinates() };
   double spacing[3];
   bool even = true;
-  for (int a = 0; a < 3; ++a) {
+  for (int a = 0; a < 3; ++a)
+  {
     even = axes[a] && EvenSpacing(axes[a], spacing[a]) && even;
   }
   vtkNew<vtkImageData> image;
-  if (even) {
+  if (even)
+  {
     // The same points and data, described by origin and spacing.
     image->SetExtent(extent);
     image->SetSpacing(spacing);
     image->SetOrigin(axes[0]->GetComponent(0, 0) - spacing[0] * extent[0],
-                     axes[1]->GetComponent(0, 0) - spacing[1] * extent[2],
-                     axes[2]->GetComponent(0, 0) - spacing[2] * extent[4]);
+      axes[1]->GetComponent(0, 0) - spacing[1] * extent[2],
+      axes[2]->GetComponent(0, 0) - spacing[2] * extent[4]);
     image->GetPointData()->ShallowCopy(grid->GetPointData());
     image->GetCellData()->ShallowCopy(grid->GetCellData());
     image->GetFieldData()->ShallowCopy(grid->GetFieldData());
-  } else {
+  }
+  else
+  {
     // Uneven coordinates: sample onto an even grid as fine as the finest
     // spacing along each axis, at most 4 times the axis' points and 1024.
     int dimensions[3];
-    for (int a = 0; a < 3; ++a) {
+    for (int a = 0; a < 3; ++a)
+    {
       const vtkIdType n = axes[a] ? axes[a]->GetNumberOfTuples() : 1;
       double finest = VTK_DOUBLE_MAX;
-      for (vtkIdType i = 1; i < n; ++i) {
-        finest = std::min(finest, std::abs(axes[a]->GetComponent(i, 0) -
-                                           axes[a]->GetComponent(i - 1, 0)));
+      for (vtkIdType i = 1; i < n; ++i)
+      {
+        finest = std::min(
+          finest, std::abs(axes[a]->GetComponent(i, 0) - axes[a]->GetComponent(i - 1, 0)));
       }
-      const double length = n > 1 ? std::abs(axes[a]->GetComponent(n - 1, 0) -
-                                             axes[a]->GetComponent(0, 0))
-                                  : 0.0;
-      double wanted = finest > 0.0 ? std::ceil(length / finest) + 1.0
-                                   : static_cast<double>(n);
-      wanted = std::min({wanted, 4.0 * static_cast<double>(n), 1024.0});
+      const double length =
+        n > 1 ? std::abs(axes[a]->GetComponent(n - 1, 0) - axes[a]->GetComponent(0, 0)) : 0.0;
+      double wanted = finest > 0.0 ? std::ceil(length / finest) + 1.0 : static_cast<double>(n);
+      wanted = std::min({ wanted, 4.0 * static_cast<double>(n), 1024.0 });
       dimensions[a] = std::max(static_cast<int>(n), static_cast<int>(wanted));
     }
     // The resampled copy of every point and cell array, and the mask
     // vtkResampleToImage adds, must fit in what the process may allocate.
     std::uint64_t bytesPerPoint = 1;
-    for (vtkDataSetAttributes *arrays :
-         {static_cast<vtkDataSetAttributes *>(grid->GetPointData()),
-          static_cast<vtkDataSetAttributes *>(grid->GetCellData())}) {
-      for (int i = 0; i < arrays->GetNumberOfArrays(); ++i) {
-        vtkDataArray *array = arrays->GetArray(i);
-        bytesPerPoint +=
-            array ? static_cast<std::uint64_t>(array->GetDataTypeSize()) *
-                        array->GetNumberOfComponents()
-                  : 0;
+    for (vtkDataSetAttributes* arrays : { static_cast<vtkDataSetAttributes*>(grid->GetPointData()),
+           static_cast<vtkDataSetAttributes*>(grid->GetCellData()) })
+    {
+      for (int i = 0; i < arrays->GetNumberOfArrays(); ++i)
+      {
+        vtkDataArray* array = arrays->GetArray(i);
+        bytesPerPoint += array
+          ? static_cast<std::uint64_t>(array->GetDataTypeSize()) * array->GetNumberOfComponents()
+          : 0;
       }
     }
     std::string memoryProblem;
     if (!mediso::FitsInProcessMemory(
-            static_cast<std::uint64_t>(dimensions[0]) * dimensions[1] *
-                dimensions[2] * bytesPerPoint,
-            "the rectilinear grid resampled onto an even grid",
-            memoryProblem)) {
-      vtkErrorMacro(
-          << "HistoPyramid Isosurface cannot draw this rectilinear grid: "
-          << memoryProblem << ".");
+          static_cast<std::uint64_t>(dimensions[0]) * dimensions[1] * dimensions[2] * bytesPerPoint,
+          "the rectilinear grid resampled onto an even grid", memoryProblem))
+    {
+      vtkErrorMacro(<< "HistoPyramid Isosurface cannot draw this rectilinear grid: "
+                    << memoryProblem << ".");
       this->Cache = nullptr;
       this->IsoMapper->RemoveAllInputConnections(0);
       return 1;
@@ -272,11 +300,13 @@ int vtkHistoPyramidIsoRepresentation::RequestData(
     vtkNew<vtkResampleToImage> resample;
     resample->SetInputDataObject(grid);
     resample->SetSamplingDimensions(dimensions);
-    try {
+    try
+    {
       resample->Update();
-    } catch (const std::bad_alloc &) {
-      vtkErrorMacro(<< "HistoPyramid Isosurface cannot draw this rectilinear "
-                       "grid: memory ran "
+    }
+    catch (const std::bad_alloc&)
+    {
+      vtkErrorMacro(<< "HistoPyramid Isosurface cannot draw this rectilinear grid: memory ran "
                        "out while resampling it onto an even grid.");
       this->Cache = nullptr;
       this->IsoMapper->RemoveAllInputConnections(0);
@@ -287,14 +317,13 @@ int vtkHistoPyramidIsoRepresentation::RequestData(
     // of a rectilinear grid's box can be, so the mask carries nothing.
     image->GetPointData()->RemoveArray("vtkValidPointMask");
     std::ostringstream msg;
-    msg << "HistoPyramid Isosurface draws image data: this rectilinear grid's "
-           "coordinates are "
+    msg << "HistoPyramid Isosurface draws image data: this rectilinear grid's coordinates are "
            "not evenly spaced, so it was resampled onto an even "
         << dimensions[0] << "x" << dimensions[1] << "x" << dimensions[2]
-        << " grid (the surfaces are those of the resampled data; Resample To "
-           "Image "
+        << " grid (the surfaces are those of the resampled data; Resample To Image "
            "chooses the grid yourself).";
-    if (msg.str() != this->LastResampleMessage) {
+    if (msg.str() != this->LastResampleMessage)
+    {
       this->LastResampleMessage = msg.str();
       vtkWarningMacro(<< msg.str());
     }
@@ -305,7 +334,8 @@ int vtkHistoPyramidIsoRepresentation::RequestData(
 }
 
 //------------------------------------------------------------------------------
-void vtkHistoPyramidIsoRepresentation::UpdateMapperParameters() {
+void vtkHistoPyramidIsoRepresentation::UpdateMapperParameters()
+{
   this->Superclass::UpdateMapperParameters();
 
   // The base class hides the volume when no colour array is chosen (volume
@@ -313,79 +343,79 @@ void vtkHistoPyramidIsoRepresentation::UpdateMapperParameters() {
   // in the solid colour. This runs only for a visible representation, so
   // showing the actor here never overrides the user's Visibility.
   const bool solid = !this->Actor->GetVisibility();
-  if (solid) {
+  if (solid)
+  {
     this->IsoMapper->SetScalarModeToUsePointData();
-    this->IsoMapper->SelectScalarArray(static_cast<const char *>(nullptr));
+    this->IsoMapper->SelectScalarArray(static_cast<const char*>(nullptr));
     this->Actor->SetVisibility(true);
   }
   // Said once per change of values, array or range, not per render.
   const std::string outside = this->IsovaluesOutsideRange();
-  if (outside != this->LastRangeMessage) {
+  if (outside != this->LastRangeMessage)
+  {
     this->LastRangeMessage = outside;
-    if (!outside.empty()) {
+    if (!outside.empty())
+    {
       vtkWarningMacro(<< outside);
     }
   }
-  this->IsoMapper->SetColorSource(
-      this->ColorEachSurface
-          ? vtkHistoPyramidIsoMapper::SurfaceColors
-          : (solid ? vtkHistoPyramidIsoMapper::SolidColors
-                   : vtkHistoPyramidIsoMapper::TransferFunctionColors));
+  this->IsoMapper->SetColorSource(this->ColorEachSurface
+      ? vtkHistoPyramidIsoMapper::SurfaceColors
+      : (solid ? vtkHistoPyramidIsoMapper::SolidColors
+               : vtkHistoPyramidIsoMapper::TransferFunctionColors));
 }
 
 //------------------------------------------------------------------------------
-std::string vtkHistoPyramidIsoRepresentation::IsovaluesOutsideRange() {
-  auto *controller = vtkMultiProcessController::GetGlobalController();
-  auto *input =
-      vtkDataSet::SafeDownCast(this->IsoMapper->GetInputDataObject(0, 0));
-  if ((controller && controller->GetNumberOfProcesses() > 1) || !input) {
+std::string vtkHistoPyramidIsoRepresentation::IsovaluesOutsideRange()
+{
+  auto* controller = vtkMultiProcessController::GetGlobalController();
+  auto* input = vtkDataSet::SafeDownCast(this->IsoMapper->GetInputDataObject(0, 0));
+  if ((controller && controller->GetNumberOfProcesses() > 1) || !input)
+  {
     return std::string();
   }
   int cellFlag = 0;
-  vtkDataArray *array =
-      vtkDataArray::SafeDownCast(vtkAbstractMapper::GetScalars(
-          input, this->IsoMapper->GetScalarMode(),
-          this->IsoMapper->GetArrayAccessMode(), this->IsoMapper->GetArrayId(),
-          this->IsoMapper->GetArrayName(), cellFlag));
+  vtkDataArray* array = vtkDataArray::SafeDownCast(vtkAbstractMapper::GetScalars(input,
+    this->IsoMapper->GetScalarMode(), this->IsoMapper->GetArrayAccessMode(),
+    this->IsoMapper->GetArrayId(), this->IsoMapper->GetArrayName(), cellFlag));
   if (!array || cellFlag != 0 || array->GetNumberOfComponents() != 1 ||
-      array->GetNumberOfTuples() == 0) {
+    array->GetNumberOfTuples() == 0)
+  {
     return std::string();
   }
   double range[2];
   array->GetRange(range, 0);
   std::ostringstream outside;
-  const int count =
-      this->Property->GetIsoSurfaceValues()->GetNumberOfContours();
+  const int count = this->Property->GetIsoSurfaceValues()->GetNumberOfContours();
   int n = 0;
-  for (int i = 0; i < count; ++i) {
+  for (int i = 0; i < count; ++i)
+  {
     const double value = this->Property->GetIsoSurfaceValues()->GetValue(i);
-    if (value < range[0] || value > range[1]) {
+    if (value < range[0] || value > range[1])
+    {
       outside << (n++ ? ", " : "") << value;
     }
   }
-  if (n == 0) {
+  if (n == 0)
+  {
     return std::string();
   }
   std::ostringstream message;
-  message << "HistoPyramid Isosurface: isovalue" << (n > 1 ? "s " : " ")
-          << outside.str() << (n > 1 ? " are" : " is") << " outside the range ["
-          << range[0] << ", " << range[1] << "] of the array \""
-          << (array->GetName() ? array->GetName() : "")
+  message << "HistoPyramid Isosurface: isovalue" << (n > 1 ? "s " : " ") << outside.str()
+          << (n > 1 ? " are" : " is") << " outside the range [" << range[0] << ", " << range[1]
+          << "] of the array \"" << (array->GetName() ? array->GetName() : "")
           << "\": no surface is drawn for " << (n > 1 ? "them" : "it") << ".";
   return message.str();
 }
 
 //------------------------------------------------------------------------------
-void vtkHistoPyramidIsoRepresentation::PrintSelf(ostream &os,
-                                                 vtkIndent indent) {
+void vtkHistoPyramidIsoRepresentation::PrintSelf(ostream& os, vtkIndent indent)
+{
   this->Superclass::PrintSelf(os, indent);
   os << indent << "RenderPath: " << this->GetRenderPath() << "\n";
   os << indent << "Footprint: " << this->GetFootprint() << "\n";
-  os << indent << "FallbackReason: " << this->IsoMapper->GetFallbackReason()
-     << "\n";
-  os << indent
-     << "NumberOfPrimitives: " << this->IsoMapper->GetNumberOfPrimitives()
-     << "\n";
+  os << indent << "FallbackReason: " << this->IsoMapper->GetFallbackReason() << "\n";
+  os << indent << "NumberOfPrimitives: " << this->IsoMapper->GetNumberOfPrimitives() << "\n";
   os << indent << "IsoMapper:\n";
   this->IsoMapper->PrintSelf(os, indent.GetNextIndent());
 }

@@ -56,14 +56,15 @@
 class vtkHistoPyramidIsoMapper;
 
 class MEDICALISOSURFACESREPRESENTATIONS_EXPORT vtkHistoPyramidIsoRepresentation
-    : public vtkImageVolumeRepresentation {
+  : public vtkImageVolumeRepresentation
+{
 public:
-  static vtkHistoPyramidIsoRepresentation *New();
+  static vtkHistoPyramidIsoRepresentation* New();
   vtkTypeMacro(vtkHistoPyramidIsoRepresentation, vtkImageVolumeRepresentation);
-  void PrintSelf(ostream &os, vtkIndent indent) override;
+  void PrintSelf(ostream& os, vtkIndent indent) override;
 
   /// The mapper that draws the isosurfaces (owned by the representation).
-  vtkHistoPyramidIsoMapper *GetIsoMapper();
+  vtkHistoPyramidIsoMapper* GetIsoMapper();
 
   ///@{
   /**
@@ -123,9 +124,9 @@ public:
    * GPU one).
    * Counts are doubles for the ServerManager's information helpers.
    */
-  const char *GetRenderPath();
-  const char *GetFootprint();
-  const char *GetFallbackReason();
+  const char* GetRenderPath();
+  const char* GetFootprint();
+  const char* GetFallbackReason();
   double GetNumberOfPrimitives();
   double GetNumberOfFallbackTriangles();
   double GetNumberOfPyramidBuilds();
@@ -155,13 +156,11 @@ protected:
    * The base class's data cache, with a rectilinear grid replaced by the
    * image data it describes (resampled when its spacing is uneven).
    */
-  int RequestData(vtkInformation *, vtkInformationVector **,
-                  vtkInformationVector *) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
 private:
-  vtkHistoPyramidIsoRepresentation(const vtkHistoPyramidIsoRepresentation &) =
-      delete;
-  void operator=(const vtkHistoPyramidIsoRepresentation &) = delete;
+  vtkHistoPyramidIsoRepresentation(const vtkHistoPyramidIsoRepresentation&) = delete;
+  void operator=(const vtkHistoPyramidIsoRepresentation&) = delete;
 
   /// The warning for isovalues outside the contoured array's range ("" when
   /// none).

@@ -31,19 +31,20 @@
 class vtkDataObject;
 
 class MEDICALISOSURFACESREPRESENTATIONS_EXPORT vtkPVMedicalHistogramInformation
-    : public vtkPVInformation {
+  : public vtkPVInformation
+{
 public:
-  static vtkPVMedicalHistogramInformation *New();
+  static vtkPVMedicalHistogramInformation* New();
   vtkTypeMacro(vtkPVMedicalHistogramInformation, vtkPVInformation);
-  void PrintSelf(ostream &os, vtkIndent indent) override;
+  void PrintSelf(ostream& os, vtkIndent indent) override;
 
   ///@{
   /// The output port, the point array (empty: the active scalars) and the bins
   /// (the first at [low, low + width), `count` of them) to count in.
   vtkSetMacro(PortNumber, int);
   vtkGetMacro(PortNumber, int);
-  void SetArrayName(const char *name) { this->ArrayName = name ? name : ""; }
-  const char *GetArrayName() const { return this->ArrayName.c_str(); }
+  void SetArrayName(const char* name) { this->ArrayName = name ? name : ""; }
+  const char* GetArrayName() const { return this->ArrayName.c_str(); }
   void SetBins(double low, double width, int count);
   ///@}
 
@@ -53,24 +54,23 @@ public:
   double GetCount(int bin) const;
   ///@}
 
-  void CopyFromObject(vtkObject *object) override;
-  void AddInformation(vtkPVInformation *other) override;
-  void CopyToStream(vtkClientServerStream *stream) override;
-  void CopyFromStream(const vtkClientServerStream *stream) override;
-  void CopyParametersToStream(vtkMultiProcessStream &stream) override;
-  void CopyParametersFromStream(vtkMultiProcessStream &stream) override;
+  void CopyFromObject(vtkObject* object) override;
+  void AddInformation(vtkPVInformation* other) override;
+  void CopyToStream(vtkClientServerStream* stream) override;
+  void CopyFromStream(const vtkClientServerStream* stream) override;
+  void CopyParametersToStream(vtkMultiProcessStream& stream) override;
+  void CopyParametersFromStream(vtkMultiProcessStream& stream) override;
 
 protected:
   vtkPVMedicalHistogramInformation();
   ~vtkPVMedicalHistogramInformation() override;
 
 private:
-  vtkPVMedicalHistogramInformation(const vtkPVMedicalHistogramInformation &) =
-      delete;
-  void operator=(const vtkPVMedicalHistogramInformation &) = delete;
+  vtkPVMedicalHistogramInformation(const vtkPVMedicalHistogramInformation&) = delete;
+  void operator=(const vtkPVMedicalHistogramInformation&) = delete;
 
   /// Adds a leaf's values; false when it has no such array.
-  bool CountLeaf(vtkDataObject *leaf);
+  bool CountLeaf(vtkDataObject* leaf);
 
   int PortNumber = 0;
   std::string ArrayName;

@@ -15,17 +15,18 @@
 
 #include <vector>
 
-namespace {
-const char *const ColorsName = "HistoPyramidSurfaceColors";
-const char *const OpacitiesName = "HistoPyramidSurfaceOpacities";
-const char *const ColorEachName = "HistoPyramidColorEachSurface";
+namespace
+{
+const char* const ColorsName = "HistoPyramidSurfaceColors";
+const char* const OpacitiesName = "HistoPyramidSurfaceOpacities";
+const char* const ColorEachName = "HistoPyramidColorEachSurface";
 
 // Skin and bone, as the isosurface list's palette starts.
-const double SkinAndBoneColors[] = {0.93, 0.75, 0.62, 0.96, 0.94, 0.86};
-const double SkinAndBoneOpacities[] = {0.35, 1.0};
+const double SkinAndBoneColors[] = { 0.93, 0.75, 0.62, 0.96, 0.94, 0.86 };
+const double SkinAndBoneOpacities[] = { 0.35, 1.0 };
 
-bool Equals(vtkSMProxy *display, const char *name,
-            const std::vector<double> &expected) {
+bool Equals(vtkSMProxy* display, const char* name, const std::vector<double>& expected)
+{
   vtkSMPropertyHelper helper(display, name, /*quiet=*/true);
   return helper.GetArray<double>() == expected;
 }
@@ -35,83 +36,86 @@ bool Equals(vtkSMProxy *display, const char *name,
  * change to other values (by a script) takes the start's colours and
  * opacities away, if nobody changed them, and stops watching.
  */
-class StartObserver : public vtkCommand {
+class StartObserver : public vtkCommand
+{
 public:
-  static StartObserver *New() { return new StartObserver; }
+  static StartObserver* New() { return new StartObserver; }
 
   vtkWeakPointer<vtkSMProxy> Display;
   std::vector<double> Values;
   std::vector<double> Colors;
   std::vector<double> Opacities;
 
-  void Execute(vtkObject *caller, unsigned long, void *) override {
-    vtkSMProxy *display = this->Display;
-    auto *property = vtkSMProperty::SafeDownCast(caller);
-    if (!display || !property) {
+  void Execute(vtkObject* caller, unsigned long, void*) override
+  {
+    vtkSMProxy* display = this->Display;
+    auto* property = vtkSMProperty::SafeDownCast(caller);
+    if (!display || !property)
+    {
       return;
     }
-    if (!display->HasAnnotation(
-            vtkSMMedicalIsosurfaceInitializationHelper::StartAnnotation())) {
+    if (!display->HasAnnotation(vtkSMMedicalIsosurfaceInitializationHelper::StartAnnotation()))
+    {
       property->RemoveObserver(this);
       return;
     }
-    if (Equals(display, "IsosurfaceValues", this->Values)) {
+    if (Equals(display, "IsosurfaceValues", this->Values))
+    {
       return;
     }
     if (Equals(display, ColorsName, this->Colors) &&
-        Equals(display, OpacitiesName, this->Opacities) &&
-        vtkSMPropertyHelper(display, ColorEachName, true).GetAsInt() == 1) {
-      for (const char *name : {ColorsName, OpacitiesName, ColorEachName}) {
-        if (vtkSMProperty *owned = display->GetProperty(name)) {
+      Equals(display, OpacitiesName, this->Opacities) &&
+      vtkSMPropertyHelper(display, ColorEachName, true).GetAsInt() == 1)
+    {
+      for (const char* name : { ColorsName, OpacitiesName, ColorEachName })
+      {
+        if (vtkSMProperty* owned = display->GetProperty(name))
+        {
           owned->ResetToXMLDefaults();
         }
       }
       display->UpdateVTKObjects();
     }
-    display->RemoveAnnotation(
-        vtkSMMedicalIsosurfaceInitializationHelper::StartAnnotation());
+    display->RemoveAnnotation(vtkSMMedicalIsosurfaceInitializationHelper::StartAnnotation());
     property->RemoveObserver(this);
   }
 };
-} // namespace
+}
 
 vtkStandardNewMacro(vtkSMMedicalIsosurfaceInitializationHelper);
 
 //------------------------------------------------------------------------------
-vtkSMMedicalIsosurfaceInitializationHelper::
-    vtkSMMedicalIsosurfaceInitializationHelper() = default;
+vtkSMMedicalIsosurfaceInitializationHelper::vtkSMMedicalIsosurfaceInitializationHelper() = default;
 
 //------------------------------------------------------------------------------
-vtkSMMedicalIsosurfaceInitializationHelper::
-    ~vtkSMMedicalIsosurfaceInitializationHelper() = default;
+vtkSMMedicalIsosurfaceInitializationHelper::~vtkSMMedicalIsosurfaceInitializationHelper() = default;
 
 //------------------------------------------------------------------------------
 void vtkSMMedicalIsosurfaceInitializationHelper::PostInitializeProxy(
-    vtkSMProxy *display, vtkPVXMLElement *,
-    vtkMTimeType initializationTimeStamp) {
-  vtkSMProperty *isovalues =
-      display ? display->GetProperty("IsosurfaceValues") : nullptr;
-  if (!isovalues || isovalues->GetMTime() > initializationTimeStamp) {
+  vtkSMProxy* display, vtkPVXMLElement*, vtkMTimeType initializationTimeStamp)
+{
+  vtkSMProperty* isovalues = display ? display->GetProperty("IsosurfaceValues") : nullptr;
+  if (!isovalues || isovalues->GetMTime() > initializationTimeStamp)
+  {
     return;
   }
   vtkSMPropertyHelper input(display, "Input", /*quiet=*/true);
-  auto *source = vtkSMSourceProxy::SafeDownCast(input.GetAsProxy());
+  auto* source = vtkSMSourceProxy::SafeDownCast(input.GetAsProxy());
   // ColorArrayName is not chosen yet: the array is the active point scalars,
   // the one the representation contours while coloured by Solid Color.
-  const std::vector<double> hounsfield = {mediso::SkinHounsfield,
-                                          mediso::BoneHounsfield};
+  const std::vector<double> hounsfield = { mediso::SkinHounsfield, mediso::BoneHounsfield };
   std::vector<double> values;
   bool isHounsfield = false;
-  if (!source || !vtkSMMedicalIsovaluesDomain::StartValues(
-                     source, input.GetOutputPort(), nullptr, hounsfield, values,
-                     &isHounsfield)) {
+  if (!source ||
+    !vtkSMMedicalIsovaluesDomain::StartValues(
+      source, input.GetOutputPort(), nullptr, hounsfield, values, &isHounsfield))
+  {
     return;
   }
-  vtkSMPropertyHelper(isovalues).Set(values.data(),
-                                     static_cast<unsigned int>(values.size()));
-  if (isHounsfield && display->GetProperty(ColorsName) &&
-      display->GetProperty(OpacitiesName) &&
-      display->GetProperty(ColorEachName)) {
+  vtkSMPropertyHelper(isovalues).Set(values.data(), static_cast<unsigned int>(values.size()));
+  if (isHounsfield && display->GetProperty(ColorsName) && display->GetProperty(OpacitiesName) &&
+    display->GetProperty(ColorEachName))
+  {
     vtkSMPropertyHelper(display, ColorsName).Set(SkinAndBoneColors, 6);
     vtkSMPropertyHelper(display, OpacitiesName).Set(SkinAndBoneOpacities, 2);
     vtkSMPropertyHelper(display, ColorEachName).Set(1);
@@ -127,7 +131,7 @@ void vtkSMMedicalIsosurfaceInitializationHelper::PostInitializeProxy(
 }
 
 //------------------------------------------------------------------------------
-void vtkSMMedicalIsosurfaceInitializationHelper::PrintSelf(ostream &os,
-                                                           vtkIndent indent) {
+void vtkSMMedicalIsosurfaceInitializationHelper::PrintSelf(ostream& os, vtkIndent indent)
+{
   this->Superclass::PrintSelf(os, indent);
 }

@@ -35,21 +35,20 @@
 #include "MedicalIsosurfacesRepresentationsModule.h" // for export macro
 #include "vtkSMProxyInitializationHelper.h"
 
-class MEDICALISOSURFACESREPRESENTATIONS_EXPORT
-    vtkSMMedicalIsosurfaceInitializationHelper
-    : public vtkSMProxyInitializationHelper {
+class MEDICALISOSURFACESREPRESENTATIONS_EXPORT vtkSMMedicalIsosurfaceInitializationHelper
+  : public vtkSMProxyInitializationHelper
+{
 public:
-  static vtkSMMedicalIsosurfaceInitializationHelper *New();
-  vtkTypeMacro(vtkSMMedicalIsosurfaceInitializationHelper,
-               vtkSMProxyInitializationHelper);
-  void PrintSelf(ostream &os, vtkIndent indent) override;
+  static vtkSMMedicalIsosurfaceInitializationHelper* New();
+  vtkTypeMacro(vtkSMMedicalIsosurfaceInitializationHelper, vtkSMProxyInitializationHelper);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
 
-  void PostInitializeProxy(vtkSMProxy *proxy, vtkPVXMLElement *xml,
-                           vtkMTimeType initializationTimeStamp) override;
+  void PostInitializeProxy(
+    vtkSMProxy* proxy, vtkPVXMLElement* xml, vtkMTimeType initializationTimeStamp) override;
 
   /// The display annotation that keeps the start's colours and opacities
   /// attached to the start's values (see the class comment).
-  static const char *StartAnnotation() { return "MedicalIsosurfaceStart"; }
+  static const char* StartAnnotation() { return "MedicalIsosurfaceStart"; }
 
 protected:
   vtkSMMedicalIsosurfaceInitializationHelper();
@@ -57,8 +56,8 @@ protected:
 
 private:
   vtkSMMedicalIsosurfaceInitializationHelper(
-      const vtkSMMedicalIsosurfaceInitializationHelper &) = delete;
-  void operator=(const vtkSMMedicalIsosurfaceInitializationHelper &) = delete;
+    const vtkSMMedicalIsosurfaceInitializationHelper&) = delete;
+  void operator=(const vtkSMMedicalIsosurfaceInitializationHelper&) = delete;
 };
 
 #endif

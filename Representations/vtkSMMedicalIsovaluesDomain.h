@@ -43,14 +43,14 @@
 class vtkSMSourceProxy;
 
 class MEDICALISOSURFACESREPRESENTATIONS_EXPORT vtkSMMedicalIsovaluesDomain
-    : public vtkSMArrayRangeDomain {
+  : public vtkSMArrayRangeDomain
+{
 public:
-  static vtkSMMedicalIsovaluesDomain *New();
+  static vtkSMMedicalIsovaluesDomain* New();
   vtkTypeMacro(vtkSMMedicalIsovaluesDomain, vtkSMArrayRangeDomain);
-  void PrintSelf(ostream &os, vtkIndent indent) override;
+  void PrintSelf(ostream& os, vtkIndent indent) override;
 
-  int SetDefaultValues(vtkSMProperty *property,
-                       bool useUncheckedValues) override;
+  int SetDefaultValues(vtkSMProperty* property, bool useUncheckedValues) override;
 
   /**
    * The first isovalues of a point array of `source`'s output `port` (the
@@ -59,21 +59,18 @@ public:
    * there is no one-component point array or its values cannot be split.
    * `isHounsfield` (may be null) says which applied.
    */
-  static bool StartValues(vtkSMSourceProxy *source, unsigned int port,
-                          const char *arrayName,
-                          const std::vector<double> &hounsfield,
-                          std::vector<double> &values, bool *isHounsfield);
+  static bool StartValues(vtkSMSourceProxy* source, unsigned int port, const char* arrayName,
+    const std::vector<double>& hounsfield, std::vector<double>& values, bool* isHounsfield);
 
 protected:
   vtkSMMedicalIsovaluesDomain();
   ~vtkSMMedicalIsovaluesDomain() override;
 
-  int ReadXMLAttributes(vtkSMProperty *property,
-                        vtkPVXMLElement *element) override;
+  int ReadXMLAttributes(vtkSMProperty* property, vtkPVXMLElement* element) override;
 
 private:
-  vtkSMMedicalIsovaluesDomain(const vtkSMMedicalIsovaluesDomain &) = delete;
-  void operator=(const vtkSMMedicalIsovaluesDomain &) = delete;
+  vtkSMMedicalIsovaluesDomain(const vtkSMMedicalIsovaluesDomain&) = delete;
+  void operator=(const vtkSMMedicalIsovaluesDomain&) = delete;
 
   std::vector<double> HounsfieldValues;
 };

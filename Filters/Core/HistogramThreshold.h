@@ -35,7 +35,8 @@
 #include <cstdint>
 #include <vector>
 
-namespace mediso {
+namespace mediso
+{
 
 /// Skin and bone in Hounsfield units: the surfaces a CT starts with.
 constexpr double SkinHounsfield = -500.0;
@@ -47,36 +48,39 @@ bool LooksLikeHounsfieldUnits(double min, double max);
 
 /// Equal bins over the values: bin i holds [Low + i Width, Low + (i + 1)
 /// Width).
-struct HistogramBins {
+struct HistogramBins
+{
   double Low = 0.0;
   double Width = 1.0;
   std::size_t Count = 0;
 
   /// Bins for values in [min, max] (integral: the values are integers). No bins
   /// (Count 0) for a range that is not finite or is reversed.
-  static HistogramBins For(double min, double max, bool integral,
-                           std::size_t maxBins = 256);
+  static HistogramBins For(double min, double max, bool integral, std::size_t maxBins = 256);
 
   /// The bin of a value, values past either end clamped into the end bins.
-  std::size_t BinOf(double value) const {
+  std::size_t BinOf(double value) const
+  {
     const double at = std::floor((value - this->Low) / this->Width);
-    if (!(at > 0.0)) {
+    if (!(at > 0.0))
+    {
       return 0;
     }
-    return at >= static_cast<double>(this->Count)
-               ? this->Count - 1
-               : static_cast<std::size_t>(at);
+    return at >= static_cast<double>(this->Count) ? this->Count - 1 : static_cast<std::size_t>(at);
   }
 };
 
 /// Adds `n` values, `stride` apart, to `counts` (bins.Count entries). NaNs are
 /// skipped.
 template <typename T>
-void AccumulateHistogram(const T *values, std::size_t n, std::size_t stride,
-                         const HistogramBins &bins, std::uint64_t *counts) {
-  for (std::size_t i = 0; i < n; ++i) {
+void AccumulateHistogram(const T* values, std::size_t n, std::size_t stride,
+  const HistogramBins& bins, std::uint64_t* counts)
+{
+  for (std::size_t i = 0; i < n; ++i)
+  {
     const double value = static_cast<double>(values[i * stride]);
-    if (value == value) {
+    if (value == value)
+    {
       ++counts[bins.BinOf(value)];
     }
   }
@@ -89,9 +93,9 @@ void AccumulateHistogram(const T *values, std::size_t n, std::size_t stride,
  * modes leave several). Returns false, leaving `threshold` alone, when the
  * histogram has fewer than two non-empty bins (nothing to split).
  */
-bool OtsuThreshold(const std::vector<std::uint64_t> &counts,
-                   const HistogramBins &bins, double &threshold);
+bool OtsuThreshold(
+  const std::vector<std::uint64_t>& counts, const HistogramBins& bins, double& threshold);
 
-} // namespace mediso
+}
 
 #endif
