@@ -180,9 +180,32 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   this->updateRange();
   this->updateTable();
 
-  // The list edits values, colours and opacities together: it takes the
-  // display's start over, so that editing skin's value keeps skin's look.
-  smproxy->RemoveAnnotation(vtkSMMedicalIsosurfaceInitializationHelper::StartAnnotation());
+  // A display still at its HU start (skin and bone, nothing else set) gets
+  // skin's and bone's look, once: skin over bone as soon as the type is chosen.
+  const char* start = vtkSMMedicalIsosurfaceInitializationHelper::StartAnnotation();
+  if (smproxy->HasAnnotation(start))
+  {
+    smproxy->RemoveAnnotation(start);
+    vtkSMProperty* colorsProperty = smgroup->GetProperty("Colors");
+    vtkSMProperty* opacitiesProperty = smgroup->GetProperty("Opacities");
+    vtkSMProperty* colorEachProperty = smgroup->GetProperty("ColorEachSurface");
+    double values[2];
+    double colors[6];
+    double opacities[2];
+    vtkSMMedicalIsosurfaceInitializationHelper::GetSkinAndBone(values, colors, opacities);
+    if (colorsProperty && opacitiesProperty && colorEachProperty &&
+      vtkSMPropertyHelper(isovalues).GetArray<double>() ==
+        std::vector<double>(values, values + 2) &&
+      vtkSMPropertyHelper(colorsProperty).GetNumberOfElements() == 0 &&
+      vtkSMPropertyHelper(opacitiesProperty).GetNumberOfElements() == 0 &&
+      vtkSMPropertyHelper(colorEachProperty).GetAsInt() == 0)
+    {
+      vtkSMPropertyHelper(colorsProperty).Set(colors, 6);
+      vtkSMPropertyHelper(opacitiesProperty).Set(opacities, 2);
+      vtkSMPropertyHelper(colorEachProperty).Set(1);
+      smproxy->UpdateVTKObjects();
+    }
+  }
 }
 
 //------------------------------------------------------------------------------

@@ -13,21 +13,19 @@
  * initialises a new image display (Show in pvpython, Apply in the GUI) and,
  * unless IsosurfaceValues was set during that initialisation, sets:
  *
- * - for an array in Hounsfield units: skin (-500 HU, skin colour, opacity
- *   0.35) over bone (400 HU, bone colour, opaque), Color Each Surface on;
+ * - for an array in Hounsfield units: skin (-500 HU) and bone (400 HU);
  * - otherwise: one surface at Otsu's threshold of the array's histogram;
  *
  * (vtkSMMedicalIsovaluesDomain::StartValues chooses). Where neither applies
- * ParaView's default stays.
+ * ParaView's default stays. Only the values: colours and opacities stay as
+ * they were, so a script that sets IsosurfaceValues draws what it drew before.
  *
- * The skin's colour and translucency belong to the start, not to whatever
- * values come next: the first time a script sets IsosurfaceValues to other
- * values, the colours, opacities and Color Each Surface the start set (if
- * still as set) return to their defaults, so a script that sets its own
- * isovalues draws exactly what it drew before the start existed. The
- * isosurface list in the GUI edits values, colours and opacities together and
- * so takes the start over (it removes the display's "MedicalIsosurfaceStart"
- * annotation, which keeps the start's look attached).
+ * The HU start is marked with the display annotation StartAnnotation(). The
+ * isosurface list in the GUI (pqMedicalIsosurfaceListWidget) finds it on a
+ * display still at the start and gives skin and bone their look
+ * (GetSkinAndBone(): skin colour at opacity 0.35 over opaque bone, Color
+ * Each Surface on), so that opening a CT and choosing the representation
+ * shows skin over bone.
  */
 #ifndef vtkSMMedicalIsosurfaceInitializationHelper_h
 #define vtkSMMedicalIsosurfaceInitializationHelper_h
@@ -46,9 +44,11 @@ public:
   void PostInitializeProxy(
     vtkSMProxy* proxy, vtkPVXMLElement* xml, vtkMTimeType initializationTimeStamp) override;
 
-  /// The display annotation that keeps the start's colours and opacities
-  /// attached to the start's values (see the class comment).
+  /// The display annotation that marks a display started at skin and bone.
   static const char* StartAnnotation() { return "MedicalIsosurfaceStart"; }
+
+  /// Skin's and bone's values (HU), colours (r, g, b each) and opacities, as the start shows them.
+  static void GetSkinAndBone(double values[2], double colors[6], double opacities[2]);
 
 protected:
   vtkSMMedicalIsosurfaceInitializationHelper();
