@@ -6,7 +6,7 @@
  *
  * The client knows a point array's range (vtkPVArrayInformation) but not how
  * its values are spread; the first isovalue chosen by Otsu's threshold
- * (vtkSMMedicalIsovaluesDomain) needs the spread. This information object
+ * (vtkSMMedicalIsosurfaceInitializationHelper) needs the spread. This information object
  * counts, where the data lives, the values of one point array (by name, or the
  * active scalars when the name is empty) in the bins the client sets
  * (mediso::HistogramBins: SetBins), and sums the counts of every process.
@@ -17,7 +17,7 @@
  * Gathered with vtkSMSourceProxy::GatherInformation, like vtkPVDataInformation,
  * from the output port set with SetPortNumber.
  *
- * @sa vtkSMMedicalIsovaluesDomain, HistogramThreshold.h
+ * @sa vtkSMMedicalIsosurfaceInitializationHelper, HistogramThreshold.h
  */
 #ifndef vtkPVMedicalHistogramInformation_h
 #define vtkPVMedicalHistogramInformation_h
