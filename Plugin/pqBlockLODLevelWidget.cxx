@@ -65,8 +65,20 @@ pqBlockLODLevelWidget::pqBlockLODLevelWidget(
   this->MemoryBudget->setToolTip(tr("Memory the output surface may take with Auto LOD, in MB "
                                     "(10^6 bytes), all isovalues together."));
 
+  // Which numbers are estimates: the status column says it row by row (the
+  // level used and cached levels are exact counts), the seconds always are.
   this->Table->setHorizontalHeaderLabels(
-    { tr("Level"), tr("Triangles"), tr("MB"), tr("Seconds"), QString() });
+    { tr("Level"), tr("Triangles"), tr("MB"), tr("Est. Seconds"), tr("Status") });
+  const QString countsTip = tr("Estimated before extraction for the first isovalue, except on "
+                               "rows marked exact (the level used, and cached levels).");
+  this->Table->horizontalHeaderItem(TrianglesColumn)->setToolTip(countsTip);
+  this->Table->horizontalHeaderItem(MegabytesColumn)->setToolTip(countsTip);
+  this->Table->horizontalHeaderItem(SecondsColumn)
+    ->setToolTip(tr("Estimated extraction time, from a cost model fitted to this filter's runs: "
+                    "it changes between Applies as the model learns. Cached: no extraction."));
+  this->Table->horizontalHeaderItem(UsedColumn)
+    ->setToolTip(tr("used: the level the last Apply extracted (exact counts); cached: extracted "
+                    "before (exact counts); estimated: not extracted."));
   this->Table->verticalHeader()->setVisible(false);
   this->Table->setEditTriggers(QAbstractItemView::NoEditTriggers);
   this->Table->setSelectionMode(QAbstractItemView::NoSelection);
@@ -198,7 +210,11 @@ void pqBlockLODLevelWidget::updateEstimates()
     {
       cells << QString("-") << QString("-") << QString("-");
     }
-    cells << (level == chosen ? tr("\u25c0 used") : QString());
+    const bool cached =
+      known && seconds.GetAsDouble(level) == 0.0 && triangles.GetAsDouble(level) > 0.0;
+    cells << (level == chosen
+        ? tr("\u25c0 used, exact")
+        : (cached ? tr("cached, exact") : (known ? tr("estimated") : QString())));
     for (int column = 0; column < cells.size(); ++column)
     {
       auto* item = new QTableWidgetItem(cells[column]);

@@ -7,6 +7,7 @@
 #include "vtkPVArrayInformation.h"
 #include "vtkPVDataInformation.h"
 #include "vtkPVDataSetAttributesInformation.h"
+#include "vtkSMMedicalIsosurfaceInitializationHelper.h"
 #include "vtkSMPropertyGroup.h"
 #include "vtkSMPropertyHelper.h"
 #include "vtkSMProxy.h"
@@ -17,8 +18,11 @@
 #include <QHBoxLayout>
 #include <QHeaderView>
 #include <QLabel>
+#include <QMenu>
+#include <QPixmap>
 #include <QPushButton>
 #include <QTableWidget>
+#include <QToolButton>
 #include <QVBoxLayout>
 
 #include <algorithm>
@@ -37,6 +41,35 @@ QString FormatNumber(double value)
 {
   return QString::number(value, 'g', 8);
 }
+
+// Tissues in Hounsfield units, as a CT shows them; colours from the list's
+// palette (skin and bone first), skin and soft tissue see-through so what
+// lies inside shows.
+struct TissuePreset
+{
+  const char* Name;
+  double Value;
+  double Color[3];
+  double Opacity;
+};
+const TissuePreset TissuePresets[] = {
+  { QT_TRANSLATE_NOOP("pqMedicalIsosurfaceListWidget", "Skin"), -500.0, { 0.93, 0.75, 0.62 },
+    0.35 },
+  { QT_TRANSLATE_NOOP("pqMedicalIsosurfaceListWidget", "Soft tissue"), 40.0, { 0.80, 0.30, 0.28 },
+    0.5 },
+  { QT_TRANSLATE_NOOP("pqMedicalIsosurfaceListWidget", "Contrast vessels"), 200.0,
+    { 0.85, 0.15, 0.15 }, 1.0 },
+  { QT_TRANSLATE_NOOP("pqMedicalIsosurfaceListWidget", "Bone"), 400.0, { 0.96, 0.94, 0.86 }, 1.0 },
+};
+
+// A swatch drawn as the colour cell's icon: unlike the cell's background, an
+// icon stays visible in a selected row.
+QPixmap Swatch(const QColor& color)
+{
+  QPixmap swatch(36, 12);
+  swatch.fill(color);
+  return swatch;
+}
 }
 
 //------------------------------------------------------------------------------
@@ -45,7 +78,7 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   : Superclass(smproxy, smgroup, parentObject)
   , Table(new QTableWidget(0, 3, this))
   , RangeLabel(new QLabel(this))
-  , AddButton(new QPushButton(tr("Add"), this))
+  , AddButton(new QToolButton(this))
   , RemoveButton(new QPushButton(tr("Remove"), this))
   , ColorEachSurface(new QCheckBox(tr("Color Each Surface"), this))
   , Connections(vtkEventQtSlotConnect::New())
@@ -71,6 +104,31 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   this->RangeLabel->setToolTip(
     tr("Range of the array the surfaces are drawn from: the coloring array, or the active "
        "point scalars with Solid Color."));
+  // Add: tissue presets, or a value of one's own.
+  this->AddButton->setText(tr("Add"));
+  this->AddButton->setPopupMode(QToolButton::InstantPopup);
+  this->AddButton->setToolTip(
+    tr("Add a surface: a tissue preset in Hounsfield units (for a CT) with its color and "
+       "opacity, or another value (the middle of the data range for the first row, else a "
+       "tenth of the range above the last row). Double-click the new value to edit it."));
+  auto* presets = new QMenu(this->AddButton);
+  presets->setObjectName("Presets");
+  for (int i = 0; i < static_cast<int>(sizeof(TissuePresets) / sizeof(TissuePresets[0])); ++i)
+  {
+    const TissuePreset& preset = TissuePresets[i];
+    QAction* action = presets->addAction(
+      QIcon(Swatch(QColor::fromRgbF(preset.Color[0], preset.Color[1], preset.Color[2]))),
+      tr("%1 (%2 HU)").arg(tr(preset.Name)).arg(preset.Value));
+    action->setObjectName(QString("Preset%1").arg(i));
+    QObject::connect(action, &QAction::triggered, this, [this, i]() { this->addPreset(i); });
+  }
+  presets->addSeparator();
+  QAction* other = presets->addAction(tr("Other value"));
+  other->setObjectName("OtherValue");
+  QObject::connect(other, &QAction::triggered, this, &pqMedicalIsosurfaceListWidget::addRow);
+  this->AddButton->setMenu(presets);
+  this->RemoveButton->setToolTip(
+    tr("Remove the selected rows (the last row when none is selected)."));
   this->ColorEachSurface->setToolTip(
     tr("Draw each surface in its own color. Unchecked: Solid Color, or the color map at the "
        "isovalue when coloring by an array."));
@@ -88,7 +146,6 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   layout->addWidget(this->Table);
   layout->addLayout(buttons);
 
-  QObject::connect(this->AddButton, &QPushButton::clicked, this, &pqMedicalIsosurfaceListWidget::addRow);
   QObject::connect(
     this->RemoveButton, &QPushButton::clicked, this, &pqMedicalIsosurfaceListWidget::removeRows);
   QObject::connect(
@@ -122,6 +179,33 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   }
   this->updateRange();
   this->updateTable();
+
+  // A display still at its HU start (skin and bone, nothing else set) gets
+  // skin's and bone's look, once: skin over bone as soon as the type is chosen.
+  const char* start = vtkSMMedicalIsosurfaceInitializationHelper::StartAnnotation();
+  if (smproxy->HasAnnotation(start))
+  {
+    smproxy->RemoveAnnotation(start);
+    vtkSMProperty* colorsProperty = smgroup->GetProperty("Colors");
+    vtkSMProperty* opacitiesProperty = smgroup->GetProperty("Opacities");
+    vtkSMProperty* colorEachProperty = smgroup->GetProperty("ColorEachSurface");
+    double values[2];
+    double colors[6];
+    double opacities[2];
+    vtkSMMedicalIsosurfaceInitializationHelper::GetSkinAndBone(values, colors, opacities);
+    if (colorsProperty && opacitiesProperty && colorEachProperty &&
+      vtkSMPropertyHelper(isovalues).GetArray<double>() ==
+        std::vector<double>(values, values + 2) &&
+      vtkSMPropertyHelper(colorsProperty).GetNumberOfElements() == 0 &&
+      vtkSMPropertyHelper(opacitiesProperty).GetNumberOfElements() == 0 &&
+      vtkSMPropertyHelper(colorEachProperty).GetAsInt() == 0)
+    {
+      vtkSMPropertyHelper(colorsProperty).Set(colors, 6);
+      vtkSMPropertyHelper(opacitiesProperty).Set(opacities, 2);
+      vtkSMPropertyHelper(colorEachProperty).Set(1);
+      smproxy->UpdateVTKObjects();
+    }
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -235,6 +319,7 @@ void pqMedicalIsosurfaceListWidget::updateTable()
     if (colorEach)
     {
       color->setBackground(row.Color);
+      color->setData(Qt::DecorationRole, Swatch(row.Color));
       color->setToolTip(tr("Double-click to choose this surface's color"));
     }
     else
@@ -285,6 +370,25 @@ void pqMedicalIsosurfaceListWidget::addRow()
     }
   }
   row.Color = defaultColor(static_cast<int>(this->Rows.size()));
+  this->appendRow(row);
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::addPreset(int index)
+{
+  const TissuePreset& preset = TissuePresets[index];
+  Row row;
+  row.Value = preset.Value;
+  row.Color = QColor::fromRgbF(preset.Color[0], preset.Color[1], preset.Color[2]);
+  row.Opacity = preset.Opacity;
+  // A tissue's colour is part of the preset: draw it.
+  this->ColorEachSurface->setChecked(true);
+  this->appendRow(row);
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::appendRow(const Row& row)
+{
   this->Rows.push_back(row);
   this->rowsEdited();
 }

@@ -19,6 +19,14 @@
  * The range is the one of the array the representation contours: the
  * colouring array when one is chosen, else the input's active point
  * scalars; it is refreshed when the data or the colouring changes.
+ *
+ * *Add* opens a menu of tissue presets in Hounsfield units (skin -500, soft
+ * tissue 40, contrast-filled vessels 200, bone 400), each adding a row with
+ * its colour and opacity (and turning Color Each Surface on, so the colour is
+ * drawn), and "Other value", a row a tenth of the range above the last one.
+ * A preset's value is a start: edit it in the row. The list also takes over
+ * the display's start (vtkSMMedicalIsosurfaceInitializationHelper): its
+ * colours and opacities stay with the rows whatever values are typed.
  */
 #ifndef pqMedicalIsosurfaceListWidget_h
 #define pqMedicalIsosurfaceListWidget_h
@@ -33,6 +41,7 @@
 class QCheckBox;
 class QLabel;
 class QPushButton;
+class QToolButton;
 class QTableWidget;
 class vtkEventQtSlotConnect;
 
@@ -65,7 +74,11 @@ Q_SIGNALS:
   void opacitiesChanged();
 
 private Q_SLOTS:
+  /// Adds a row a tenth of the range above the last (the middle of the range
+  /// for the first).
   void addRow();
+  /// Adds a tissue preset's row (index into the presets).
+  void addPreset(int preset);
   void removeRows();
   void cellEdited(int row, int column);
   void cellDoubleClicked(int row, int column);
@@ -88,13 +101,15 @@ private:
   /// The colour a new row starts with (a fixed palette, skin and bone first).
   static QColor defaultColor(int row);
 
+  void appendRow(const Row& row);
+
   std::vector<Row> Rows;
   double Range[2] = { 0.0, 0.0 };
   bool HasRange = false;
   bool Updating = false;
   QTableWidget* Table;
   QLabel* RangeLabel;
-  QPushButton* AddButton;
+  QToolButton* AddButton;
   QPushButton* RemoveButton;
   QCheckBox* ColorEachSurface;
   vtkEventQtSlotConnect* Connections;

@@ -2,16 +2,19 @@
 #include "vtkHistoPyramidIsoRepresentation.h"
 
 #include "vtkCellData.h"
+#include "vtkContourValues.h"
 #include "vtkDataArray.h"
 #include "vtkFieldData.h"
 #include "vtkHistoPyramidIsoMapper.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkMultiProcessController.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVLODVolume.h"
 #include "vtkPointData.h"
 #include "vtkRectilinearGrid.h"
 #include "vtkResampleToImage.h"
+#include "vtkVolumeProperty.h"
 
 #include "ProcessMemory.h"
 
@@ -346,10 +349,63 @@ void vtkHistoPyramidIsoRepresentation::UpdateMapperParameters()
     this->IsoMapper->SelectScalarArray(static_cast<const char*>(nullptr));
     this->Actor->SetVisibility(true);
   }
+  // Said once per change of values, array or range, not per render.
+  const std::string outside = this->IsovaluesOutsideRange();
+  if (outside != this->LastRangeMessage)
+  {
+    this->LastRangeMessage = outside;
+    if (!outside.empty())
+    {
+      vtkWarningMacro(<< outside);
+    }
+  }
   this->IsoMapper->SetColorSource(this->ColorEachSurface
       ? vtkHistoPyramidIsoMapper::SurfaceColors
       : (solid ? vtkHistoPyramidIsoMapper::SolidColors
                : vtkHistoPyramidIsoMapper::TransferFunctionColors));
+}
+
+//------------------------------------------------------------------------------
+std::string vtkHistoPyramidIsoRepresentation::IsovaluesOutsideRange()
+{
+  auto* controller = vtkMultiProcessController::GetGlobalController();
+  auto* input = vtkDataSet::SafeDownCast(this->IsoMapper->GetInputDataObject(0, 0));
+  if ((controller && controller->GetNumberOfProcesses() > 1) || !input)
+  {
+    return std::string();
+  }
+  int cellFlag = 0;
+  vtkDataArray* array = vtkDataArray::SafeDownCast(vtkAbstractMapper::GetScalars(input,
+    this->IsoMapper->GetScalarMode(), this->IsoMapper->GetArrayAccessMode(),
+    this->IsoMapper->GetArrayId(), this->IsoMapper->GetArrayName(), cellFlag));
+  if (!array || cellFlag != 0 || array->GetNumberOfComponents() != 1 ||
+    array->GetNumberOfTuples() == 0)
+  {
+    return std::string();
+  }
+  double range[2];
+  array->GetRange(range, 0);
+  std::ostringstream outside;
+  const int count = this->Property->GetIsoSurfaceValues()->GetNumberOfContours();
+  int n = 0;
+  for (int i = 0; i < count; ++i)
+  {
+    const double value = this->Property->GetIsoSurfaceValues()->GetValue(i);
+    if (value < range[0] || value > range[1])
+    {
+      outside << (n++ ? ", " : "") << value;
+    }
+  }
+  if (n == 0)
+  {
+    return std::string();
+  }
+  std::ostringstream message;
+  message << "HistoPyramid Isosurface: isovalue" << (n > 1 ? "s " : " ") << outside.str()
+          << (n > 1 ? " are" : " is") << " outside the range [" << range[0] << ", " << range[1]
+          << "] of the array \"" << (array->GetName() ? array->GetName() : "")
+          << "\": no surface is drawn for " << (n > 1 ? "them" : "it") << ".";
+  return message.str();
 }
 
 //------------------------------------------------------------------------------

@@ -144,7 +144,11 @@ protected:
    * The base class's settings (array, scalar mode, cropping, transfer
    * function mode; its vtkSmartVolumeMapper/vtkMultiBlockVolumeMapper-only
    * settings find no such mapper and do nothing), then the active point
-   * scalars when no colour array is chosen.
+   * scalars when no colour array is chosen. An isovalue outside the range of
+   * the contoured array draws nothing: one warning says so, with the values
+   * and the range, each time the values, the array or its range change (not
+   * on every render); not in a parallel run, where a piece's range is not
+   * the data's.
    */
   void UpdateMapperParameters() override;
 
@@ -158,9 +162,14 @@ private:
   vtkHistoPyramidIsoRepresentation(const vtkHistoPyramidIsoRepresentation&) = delete;
   void operator=(const vtkHistoPyramidIsoRepresentation&) = delete;
 
+  /// The warning for isovalues outside the contoured array's range ("" when
+  /// none).
+  std::string IsovaluesOutsideRange();
+
   vtkNew<vtkHistoPyramidIsoMapper> IsoMapper;
   bool ColorEachSurface = false;
   std::string LastResampleMessage;
+  std::string LastRangeMessage;
 };
 
 #endif

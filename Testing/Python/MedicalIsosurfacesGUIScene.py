@@ -6,6 +6,11 @@ Environment (set by the driver, Testing/Python/TestMedicalIsosurfacesGUI.py):
                        (skin 0.4 opaque over bone, a colour each);
                        "blocklod": Block LOD Contour with Auto LOD applied,
                        selected, its panel showing the estimator's table
+                       "start": the phantom shown as HistoPyramid Isosurface
+                       with nothing else set (the start: skin over bone);
+                       "apply": the phantom shown as HistoPyramid Isosurface,
+                       skin in pure red, selected: the driver's events add a
+                       Block LOD Contour from the Filters menu and click Apply
     MEDISO_GUI_STATUS  where to write what the proxies say, as JSON, once the
                        scene is set up (the driver waits for this file)
 
@@ -51,6 +56,28 @@ if panel == "representation":
         "primitives": display.GetProperty("HistoPyramidPrimitives")[0],
         "triangles": display.GetProperty("HistoPyramidFallbackTriangles")[0],
     })
+    SetActiveSource(head)
+elif panel == "start":
+    display.SetRepresentationType("HistoPyramid Isosurface")
+    view.CameraPosition = [94.5, -300.0, 94.5]
+    view.CameraFocalPoint = [94.5, 94.5, 94.5]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
+    view.ResetCamera()
+    Render(view)
+    status.update({"isovalues": list(display.IsosurfaceValues)})
+    SetActiveSource(head)
+elif panel == "apply":
+    display.SetRepresentationType("HistoPyramid Isosurface")
+    display.IsosurfaceValues = [-500.0]
+    display.HistoPyramidColorEachSurface = 1
+    display.HistoPyramidSurfaceColors = [1.0, 0.0, 0.0]
+    display.HistoPyramidSurfaceOpacities = [1.0]
+    view.CameraPosition = [94.5, -300.0, 94.5]
+    view.CameraFocalPoint = [94.5, 94.5, 94.5]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
+    view.ResetCamera()
+    Render(view)
+    status.update({"head_visible": display.Visibility})
     SetActiveSource(head)
 else:
     Hide(head, view)

@@ -11,7 +11,9 @@ server: checked too):
   while the client's copy drew nothing ("none"): the frame was the server's;
 - the screenshot taken by the client is not empty;
 - an isovalue change (only the value travels) rebuilds the pyramid on the
-  server and changes the image that comes back.
+  server and changes the image that comes back;
+- a new display and a new Block LOD Contour start at Otsu's threshold counted
+  on the server (the phantom shifted positive), and the phantom at skin and bone.
 Skips (125) when the server's GL lacks what the GPU path needs.
 """
 import argparse
@@ -93,6 +95,24 @@ check(after["path"] == "gpu" and after["builds"] == builds and client_after["pat
       "the client draws nothing (%s / %s)" % (after, client_after))
 third = hp.screenshot(view, os.path.join(out, "TestHistoPyramidRepresentationClientServerLocal.png"))
 check(hp.foreground_fraction(third) > 0.05, "the image still shows the surface")
+
+# Where a new display and a new Block LOD Contour start when the histogram
+# lives on the server: the phantom shifted positive (not HU) starts at Otsu's
+# threshold, counted there (vtkPVMedicalHistogramInformation), the same value
+# as in a builtin session (TestMedicalIsosurfacesDefaults: 633.78125 for this
+# phantom); the phantom itself at skin and bone.
+start_phantom = MedicalPhantom(Dimensions=[48, 48, 48], Spacing=[3.0, 3.0, 3.0])  # noqa: F405
+shifted = Calculator(Input=start_phantom, Function="HU+1024", ResultArrayName="Shifted")  # noqa: F405
+shifted_display = Show(shifted, view)
+shifted_contour = BlockLODContour(Input=shifted)  # noqa: F405
+phantom_display = Show(start_phantom, view)
+check(list(shifted_display.IsosurfaceValues) == [633.78125]
+      and list(shifted_contour.Isosurfaces) == [633.78125]
+      and list(phantom_display.IsosurfaceValues) == [-500.0, 400.0],
+      "the start with the data on the server: Otsu's threshold 633.78125 for the shifted "
+      "phantom (display %s, filter %s), skin and bone for the phantom (%s)"
+      % (list(shifted_display.IsosurfaceValues), list(shifted_contour.Isosurfaces),
+         list(phantom_display.IsosurfaceValues)))
 
 Disconnect()
 if check.failures:

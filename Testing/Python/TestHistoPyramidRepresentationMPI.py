@@ -13,7 +13,8 @@ by either and the mean colour difference over pixels covered by both is
 <= 12 of 255 (the thresholds of TestHistoPyramidIsoMapperChecks_Reference).
 Rank 0 must have drawn part of the surface and not all of it (its primitives
 against the one-process count), so a run where one rank drew everything cannot
-pass.
+pass. A new display of the phantom shifted positive starts at the Otsu
+threshold of the whole volume, its histogram summed over the ranks.
 """
 import argparse
 import json
@@ -78,6 +79,18 @@ for case, skin_opacity in (("opaque", 1.0), ("translucent", 0.35)):
         check(either > 5000, "%s: the surface covers a good part of the image" % case)
         check(agreement >= 0.985, "%s: covered pixels match the one-process image" % case)
         check(diff <= 12.0, "%s: colours match the one-process image" % case)
+
+# The start of a new display when the histogram is split across the ranks
+# (vtkPVMedicalHistogramInformation sums the ranks' counts): the phantom
+# shifted positive starts at the Otsu threshold of the whole volume, the value
+# a single process finds (TestMedicalIsosurfacesDefaults: 633.78125).
+start_phantom = ns["MedicalPhantom"](Dimensions=[48, 48, 48], Spacing=[3.0, 3.0, 3.0])
+shifted = simple.Calculator(Input=start_phantom, Function="HU+1024", ResultArrayName="Shifted")
+shifted_display = simple.Show(shifted, view)
+check(list(shifted_display.IsosurfaceValues) == [633.78125],
+      "%d rank(s): the shifted phantom starts at the whole volume's Otsu threshold 633.78125 (got %s)"
+      % (ranks, list(shifted_display.IsosurfaceValues)))
+simple.Hide(shifted, view)
 
 if args.out and rank == 0:
     with open(args.out, "w") as f:

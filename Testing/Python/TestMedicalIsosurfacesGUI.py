@@ -12,6 +12,12 @@ as its --script:
    Properties panel down to the representation's isovalue list;
 2. "blocklod": Block LOD Contour with Auto LOD and a 1 MB budget applied: its
    panel shows the estimator's table with the level used marked;
+1b. "start": the phantom as HistoPyramid Isosurface, nothing else set: the
+   display starts at -500 and 400 and the list gives skin its colour (warm
+   pixels in the view);
+2b. "apply": the phantom as HistoPyramid Isosurface (pure red skin); recorded
+   events add Block LOD Contour from the Filters menu and click Apply: the
+   phantom's display must be hidden (no red left on the screen);
 3. "help": as 2, then recorded events: with Auto LOD the level control is
    disabled and shows the level used, the budget enabled; Auto LOD unchecked,
    the level is enabled and shows its setting, the budget disabled (QtTesting
@@ -190,6 +196,48 @@ if check(status is not None, "blocklod: the scene script ran (status written)"):
     check(status["chosen_level"] == 2 and megabytes[2] <= 1.0 < megabytes[3],
           "blocklod: the budget of 1 MB chose level 2, the highest that fits (%s, %s MB)"
           % (status["chosen_level"], megabytes))
+
+# --- 1b. the start: skin over bone without a number typed -----------------------
+# The phantom shown as HistoPyramid Isosurface, nothing else set: the display
+# starts at -500 and 400 (pvpython sees that too), and the isosurface list, once
+# the panel shows it, gives skin its colour and translucency over bone: warm
+# (skin-coloured) pixels in the view, where the values alone draw grey-white.
+process, status_path, log = start_paraview("start")
+status = wait_for(status_path, process, 120)
+time.sleep(3.0)
+start_screen = stable_screen() if status else None
+stop_paraview("start", process, log)
+if check(status is not None and start_screen is not None, "start: the scene script ran (status written)"):
+    check(status["isovalues"] == [-500.0, 400.0],
+          "start: the phantom's display starts at skin and bone (%s)" % status["isovalues"])
+    pixels = start_screen[210:1010, 570:1390].astype(int)
+    warm = (pixels[:, :, 0] - pixels[:, :, 2] > 40) & (pixels[:, :, 0] > 100)
+    write_png(os.path.join(args.out, NAME + "-start.png"), start_screen)
+    check(int(warm.sum()) > 5000,
+          "start: skin is drawn in skin colour (%d warm pixels in the view)" % int(warm.sum()))
+
+# --- 2b. Apply on Block LOD Contour hides its input ---------------------------
+# The phantom is drawn as HistoPyramid Isosurface with pure red skin; the
+# events add a Block LOD Contour from the Filters menu (it starts at bone, 400)
+# and click Apply, which (pqApplyBehavior, the filter's Visibility hint) shows
+# the contour and must hide the phantom: no red left on the screen.
+accept = ('<pqevent object="pqClientMainWindow/menubar/menuFilters/Alphabetical" '
+          'command="activate" arguments="BlockLODContour" />\n'
+          '<pqevent object="pqClientMainWindow/propertiesDock/propertiesPanel/Accept" '
+          'command="activate" arguments="" />')
+process, status_path, log = start_paraview("apply", accept)
+status = wait_for(status_path, process, 120)
+time.sleep(3.0)
+apply_screen = stable_screen() if status else None
+stop_paraview("apply", process, log)
+if check(status is not None and apply_screen is not None, "apply: the scene script ran (status written)"):
+    check(status["head_visible"] == 1, "apply: the phantom was shown before Apply")
+    # The render view's area (the panels have red icons: Delete, clear).
+    pixels = apply_screen[210:1010, 570:1390].astype(int)
+    red = (pixels[:, :, 0] > 120) & (pixels[:, :, 1] < 60) & (pixels[:, :, 2] < 60)
+    write_png(os.path.join(args.out, NAME + "-apply.png"), apply_screen)
+    check(int(red.sum()) < 50,
+          "apply: after Apply the phantom's red skin is hidden (%d red pixels in the view)" % int(red.sum()))
 
 # --- 3. the "?" button opens the plugin's documentation ----------------------
 # Before the click, the level-of-detail controls: with Auto LOD the level is
