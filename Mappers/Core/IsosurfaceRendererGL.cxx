@@ -3,6 +3,7 @@
 
 #include "GLObjects.h"
 #include "HistoPyramidGL.h"
+#include "Lighting.h"
 #include "Matrix4.h"
 #include "MedisoShaders.h"
 
@@ -217,17 +218,6 @@ std::string ChooseVariant(
 }
 } // namespace
 
-void SetLightingUniforms(Program& program, const IsosurfaceFrame& frame)
-{
-  program.Set("ambient", frame.Ambient);
-  program.Set("diffuse", frame.Diffuse);
-  program.Set("specular", frame.Specular);
-  program.Set("specularPower", frame.SpecularPower);
-  program.Set3fv("lightDirections", MaximumLights, &frame.LightDirections[0][0]);
-  program.Set3fv("lightColors", MaximumLights, &frame.LightColors[0][0]);
-}
-
-//------------------------------------------------------------------------------
 struct IsosurfaceRendererGL::Internals
 {
   std::shared_ptr<const GLApi> GL;

@@ -67,11 +67,6 @@ namespace glcore
 class Program;
 }
 
-/// Sets a lit program's material and light uniforms (ambient, diffuse, specular,
-/// specularPower, lightDirections, lightColors) from the frame: the isosurface and the mesh
-/// programs shade alike.
-void SetLightingUniforms(glcore::Program& program, const IsosurfaceFrame& frame);
-
 /// What a frame did.
 struct IsosurfaceFrameStats
 {

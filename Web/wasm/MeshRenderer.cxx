@@ -2,6 +2,7 @@
 #include "MeshRenderer.h"
 
 #include "GLObjects.h"
+#include "Lighting.h"
 #include "WebShaders.h"
 
 #include <algorithm>

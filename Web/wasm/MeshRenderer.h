@@ -13,7 +13,7 @@
 #ifndef MedicalIsosurfaces_MeshRenderer_h
 #define MedicalIsosurfaces_MeshRenderer_h
 
-#include "IsosurfaceRendererGL.h"
+#include "IsosurfaceFrame.h"
 #include "Matrix4.h"
 
 #include <cstdint>
