@@ -85,6 +85,13 @@
  * @warning With AutoLOD each piece picks its level from its own estimate: in
  * a parallel run set LOD explicitly for one seamless surface. In a piece an
  * isovalue outside that piece's range is not a warning (the piece is empty).
+ * @warning The triangle offsets (0, 3, 6, ...) of every output are views of
+ * one read-only run that all of the process's outputs share (no output writes
+ * or faults in its own). Appending cells (InsertNextCell, Append) copies them
+ * first, but writing into an output's offsets in place (SetValue on
+ * GetOffsetsArray(), or Reset() and then new cells) would change every
+ * output's: DeepCopy an output before editing its cells in place (editing
+ * it in place would change the filter's cached surface as well).
  *
  * Inputs: vtkImageData with a one-component point array of type char, signed
  * char, unsigned char, short, unsigned short, int, unsigned int, float or

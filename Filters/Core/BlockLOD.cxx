@@ -10,6 +10,10 @@
 #include <mutex>
 #include <type_traits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace mediso
 {
 namespace
@@ -187,6 +191,9 @@ public:
       this->Threshold = static_cast<std::int64_t>(c == c ? std::min(hi, std::max(lo, c)) : hi);
     }
   }
+  /// For integer types: v >= IntegerThreshold() (ceil(isovalue), clamped to
+  /// [lowest, max + 1]).
+  std::int64_t IntegerThreshold() const { return this->Threshold; }
   bool operator()(T v) const
   {
     if constexpr (std::is_integral<T>::value)
@@ -212,6 +219,60 @@ struct BlockRows
   std::uint16_t Missing[BlockCells + 1][BlockCells + 1]; // [k][j]: NaN or infinite
 };
 
+// The "above" bits of a full row of a block at full resolution (9 samples)
+// in a few vector instructions, for the types of the scans (8-bit MRI, 16-bit
+// CT): it reads 16 samples, so only where `left` samples remain from `r` on.
+// False when it did not classify the row (the caller's scalar loop does).
+template <typename T>
+inline bool AboveRow9(
+  const T* r, int count, std::int64_t left, const AboveIsovalue<T>& above, std::uint16_t& bits)
+{
+#if defined(__SSE2__)
+  if constexpr (std::is_same<T, std::uint8_t>::value || std::is_same<T, std::int16_t>::value)
+  {
+    if (count != BlockCells + 1 || left < 16)
+    {
+      return false;
+    }
+    const std::int64_t threshold = above.IntegerThreshold();
+    if (threshold <= std::numeric_limits<T>::lowest())
+    {
+      bits = 0x1FF;
+      return true;
+    }
+    if (threshold > std::numeric_limits<T>::max())
+    {
+      bits = 0;
+      return true;
+    }
+    int mask;
+    if constexpr (std::is_same<T, std::uint8_t>::value)
+    {
+      // v >= t exactly when max(v, t) == v (unsigned bytes).
+      const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r));
+      const __m128i t = _mm_set1_epi8(static_cast<char>(threshold));
+      mask = _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(x, t), x));
+    }
+    else
+    {
+      // v >= t exactly when v > t - 1 (t - 1 is a 16-bit value here).
+      const __m128i t = _mm_set1_epi16(static_cast<short>(threshold - 1));
+      const __m128i lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r));
+      const __m128i hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r + 8));
+      mask = _mm_movemask_epi8(_mm_packs_epi16(_mm_cmpgt_epi16(lo, t), _mm_cmpgt_epi16(hi, t)));
+    }
+    bits = static_cast<std::uint16_t>(mask & 0x1FF);
+    return true;
+  }
+#endif
+  (void)r;
+  (void)count;
+  (void)left;
+  (void)above;
+  (void)bits;
+  return false;
+}
+
 // Classifies a block's samples straight from the data (no copy of the values).
 template <typename T>
 void ClassifyRows(
@@ -219,6 +280,7 @@ void ClassifyRows(
 {
   const std::int64_t sx = v.Dims[0];
   const std::int64_t sxy = sx * v.Dims[1];
+  const std::int64_t readable = sxy * v.Dims[2]; // samples in the volume
   int xs[BlockCells + 1];
   for (int i = 0; i < s.Count[0]; ++i)
   {
@@ -234,6 +296,11 @@ void ClassifyRows(
       if (s.Stride == 1)
       {
         const T* r = row + xs[0];
+        if (AboveRow9(r, s.Count[0], readable - (r - v.Data), above, rows.Above[k][j]))
+        {
+          rows.Missing[k][j] = 0; // integer samples
+          continue;
+        }
         for (int i = 0; i < s.Count[0]; ++i)
         {
           a |= static_cast<std::uint32_t>(above(r[i])) << i;
@@ -728,6 +795,26 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
     bitCoords[bit] = static_cast<std::uint16_t>((cell % layout) | ((cell / layout) % layout) << 4 |
       (cell / (layout * layout)) << 8 | (bit / layoutCube) << 12);
   }
+  // Per set of axes (bit d: axis d), the edge bits whose origin is sample 0
+  // along each of those axes: the edges a neighbour across them may own on
+  // this block's upper faces.
+  std::vector<std::uint64_t> faceMasks(8 * static_cast<std::size_t>(words), 0);
+  for (int bit = 0; bit < 3 * layoutCube; ++bit)
+  {
+    const int l[3] = { bitCoords[bit] & 15, (bitCoords[bit] >> 4) & 15, (bitCoords[bit] >> 8) & 15 };
+    for (int across = 1; across < 8; ++across)
+    {
+      bool onFace = true;
+      for (int d = 0; d < 3; ++d)
+      {
+        onFace = onFace && !(((across >> d) & 1) && l[d] != 0);
+      }
+      if (onFace)
+      {
+        faceMasks[across * words + (bit >> 6)] |= std::uint64_t(1) << (bit & 63);
+      }
+    }
+  }
   // Each cube edge's origin (relative to the cube's lower corner), axis, and
   // bit relative to the cube's lower corner's bit.
   int edgeOrigin[12][3];
@@ -852,12 +939,59 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
         }
       }
 
-      // Triangles of every cut cube. A vertex's edge is owned by this block
-      // (its id is in ownIds) unless its origin lies on the block's upper face.
-      std::int64_t tid = plan.TriangleOffset[a];
+      // The ids of the cut edges on the block's upper faces that a neighbour
+      // owns (its edges at local sample 0 along each axis it is a neighbour
+      // along), written into the free entries of ownIds (no own edge has
+      // its origin on an upper face a neighbour owns): then every vertex of
+      // every cube is one load, and a neighbour's edge is ranked once, not
+      // once per triangle corner.
       const std::int64_t bxyz[3] = { block % ranges.Blocks[0],
         (block / ranges.Blocks[0]) % ranges.Blocks[1],
         block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]) };
+      for (int across = 1; across < 8; ++across)
+      {
+        bool exists = true;
+        std::int64_t owner[3];
+        for (int d = 0; d < 3; ++d)
+        {
+          const bool along = (across >> d) & 1;
+          exists = exists && !(along && s.LastBlock[d]);
+          owner[d] = bxyz[d] + (along ? 1 : 0);
+        }
+        if (!exists)
+        {
+          continue;
+        }
+        const std::int64_t oa =
+          plan.ActiveIndex[(owner[2] * ranges.Blocks[1] + owner[1]) * ranges.Blocks[0] + owner[0]];
+        if (oa < 0)
+        {
+          continue; // no cut edge there
+        }
+        const std::uint64_t* wordBits = plan.EdgeBits.data() + oa * words;
+        const std::uint32_t* wordRank = plan.EdgeRank.data() + oa * words;
+        const std::uint64_t* face = faceMasks.data() + across * words;
+        const IdType first = static_cast<IdType>(out.FirstPointId + plan.PointOffset[oa]);
+        for (int w = 0; w < words; ++w)
+        {
+          for (std::uint64_t m = wordBits[w] & face[w]; m; m &= m - 1)
+          {
+            const int bit = w * 64 + __builtin_ctzll(m);
+            const std::uint64_t below = wordBits[w] & ((std::uint64_t(1) << (bit & 63)) - 1);
+            // The same edge in this block's layout: sample n - 1 instead of 0
+            // along each axis the neighbour is across.
+            const int packed = bitCoords[bit];
+            const int l[3] = { (across & 1) ? n[0] - 1 : (packed & 15),
+              (across & 2) ? n[1] - 1 : ((packed >> 4) & 15),
+              (across & 4) ? n[2] - 1 : ((packed >> 8) & 15) };
+            ownIds[s.Bit(l[0], l[1], l[2], packed >> 12)] =
+              first + static_cast<IdType>(wordRank[w] + PopCount64(below));
+          }
+        }
+      }
+
+      // Triangles of every cut cube, every vertex from ownIds.
+      std::int64_t tid = plan.TriangleOffset[a];
       const std::uint8_t* cubeCase = plan.CubeCases.data() + a * plan.CubesPerBlock;
       const std::uint64_t* cutCubes = plan.CutCubes.data() + a * plan.CubeWordsPerBlock;
       // Block ids on the whole volume's grid for a piece (extraction runs at
@@ -880,35 +1014,6 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
           (volume.GlobalOffset[2] + s.First[2] + k) / BlockCells };
         return static_cast<std::int32_t>((g[2] * globalBlocks[1] + g[1]) * globalBlocks[0] + g[0]);
       };
-      // The id of a vertex on a neighbour's edge: that block's first point
-      // plus the rank of the edge's bit among its owned cut edges.
-      auto neighbourId = [&](int i, int j, int k, int edge) -> IdType {
-        int l[3] = { i + edgeOrigin[edge][0], j + edgeOrigin[edge][1], k + edgeOrigin[edge][2] };
-        std::int64_t owner[3] = { bxyz[0], bxyz[1], bxyz[2] };
-        for (int d = 0; d < 3; ++d)
-        {
-          if (l[d] == n[d] - 1 && !s.LastBlock[d])
-          {
-            ++owner[d];
-            l[d] = 0;
-          }
-        }
-        if (owner[0] == bxyz[0] && owner[1] == bxyz[1] && owner[2] == bxyz[2])
-        {
-          return ownIds[s.Bit(l[0], l[1], l[2], edgeAxis[edge])];
-        }
-        const std::int64_t oa = plan.ActiveIndex[(owner[2] * ranges.Blocks[1] + owner[1]) *
-            ranges.Blocks[0] + owner[0]];
-        const std::uint64_t* wordBits = plan.EdgeBits.data() + oa * words;
-        const std::uint32_t* wordRank = plan.EdgeRank.data() + oa * words;
-        const IdType first = static_cast<IdType>(out.FirstPointId + plan.PointOffset[oa]);
-        const int bit = s.Bit(l[0], l[1], l[2], edgeAxis[edge]);
-        const std::uint64_t below = wordBits[bit >> 6] & ((std::uint64_t(1) << (bit & 63)) - 1);
-        return first + static_cast<IdType>(wordRank[bit >> 6] + PopCount64(below));
-      };
-      // Cubes whose upper corner lies on an upper face that a neighbour owns.
-      const int lastOwned[3] = { s.LastBlock[0] ? n[0] : n[0] - 2,
-        s.LastBlock[1] ? n[1] : n[1] - 2, s.LastBlock[2] ? n[2] : n[2] - 2 };
       const int cubeMask = (1 << s.CubeShift) - 1;
       for (int w = 0; w < plan.CubeWordsPerBlock; ++w)
       {
@@ -919,29 +1024,15 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
           const int j = (cube >> s.CubeShift) & cubeMask;
           const int k = cube >> (2 * s.CubeShift);
           const int c = cubeCase[cube];
-          const int* edges = cases[c];
           const std::int64_t firstTriangle = tid;
           IdType* tri = out.Connectivity + 3 * tid;
-          if (i < lastOwned[0] && j < lastOwned[1] && k < lastOwned[2])
+          const IdType* ids = ownIds.data() + (k * layout + j) * layout + i;
+          const std::int16_t* vertexBits = caseBits[c];
+          for (int v = 0; v < caseVertices[c]; v += 3, ++tid, tri += 3)
           {
-            // Every vertex on one of this block's own edges.
-            const IdType* ids = ownIds.data() + (k * layout + j) * layout + i;
-            const std::int16_t* vertexBits = caseBits[c];
-            for (int v = 0; v < caseVertices[c]; v += 3, ++tid, tri += 3)
-            {
-              tri[0] = ids[vertexBits[v]];
-              tri[1] = ids[vertexBits[v + 1]];
-              tri[2] = ids[vertexBits[v + 2]];
-            }
-          }
-          else
-          {
-            for (int e = 0; e < 15 && edges[e] >= 0; e += 3, ++tid, tri += 3)
-            {
-              tri[0] = neighbourId(i, j, k, edges[e]);
-              tri[1] = neighbourId(i, j, k, edges[e + 1]);
-              tri[2] = neighbourId(i, j, k, edges[e + 2]);
-            }
+            tri[0] = ids[vertexBits[v]];
+            tri[1] = ids[vertexBits[v + 1]];
+            tri[2] = ids[vertexBits[v + 2]];
           }
           if (out.BlockIds)
           {

@@ -6,7 +6,9 @@
 // - the points', normals' and scalars' value ranges are in VTK's range cache
 //   (per component, finite or not, and of the length) and equal ranges
 //   computed afresh from the values, for one isovalue, for two merged into one
-//   output, and for a surface served from the cache.
+//   output, and for a surface served from the cache;
+// - the triangle offsets (one run shared by every surface) are 0, 3, 6, ...,
+//   and a cell added to one output leaves every other surface's offsets alone.
 #include "MedicalTestUtilities.h"
 #include "vtkBlockLODContour.h"
 #include "vtkMedicalPhantomSource.h"
@@ -79,6 +81,20 @@ void CheckOutput(vtkPolyData* pd, const std::string& label)
   CheckRanges(pd->GetPointData()->GetNormals(), label + ", normals");
   CheckRanges(pd->GetPointData()->GetScalars(), label + ", scalars");
 }
+
+// Offsets 0, 3, 6, ... of a triangle surface.
+bool TriangleOffsets(vtkCellArray* polys)
+{
+  vtkDataArray* offsets = polys->GetOffsetsArray();
+  for (vtkIdType i = 0; i < offsets->GetNumberOfValues(); ++i)
+  {
+    if (offsets->GetComponent(i, 0) != 3.0 * i)
+    {
+      return false;
+    }
+  }
+  return offsets->GetNumberOfValues() == polys->GetNumberOfCells() + 1;
+}
 } // namespace
 
 int TestBlockLODContourOutput(int, char*[])
@@ -114,6 +130,25 @@ int TestBlockLODContourOutput(int, char*[])
       b->GetConnectivityArray()->GetComponent(i, 0);
   }
   Check(same, "CompactIds: the same triangles");
+  Check(TriangleOffsets(a) && TriangleOffsets(b), "offsets 0, 3, 6, ... (64- and 32-bit)");
+
+  // A quad appended to another filter's output: its offsets grow into memory
+  // of their own, the shared ones stay those of triangles.
+  {
+    vtkNew<vtkBlockLODContour> other;
+    other->SetInputConnection(phantom->GetOutputPort());
+    other->SetValue(0, -500.0);
+    other->Update();
+    vtkPolyData* edited = other->GetOutput();
+    const vtkIdType quad[4] = { 0, 1, 2, 3 };
+    const vtkIdType cells = edited->GetPolys()->GetNumberOfCells();
+    edited->GetPolys()->InsertNextCell(4, quad);
+    vtkDataArray* offsets = edited->GetPolys()->GetOffsetsArray();
+    Check(edited->GetPolys()->GetNumberOfCells() == cells + 1 &&
+        offsets->GetComponent(cells + 1, 0) == 3.0 * cells + 4,
+      "a cell appended to an output is its own");
+    Check(TriangleOffsets(a) && TriangleOffsets(b), "the other surfaces' offsets are unchanged");
+  }
 
   // Two isovalues merged into one output, then served from the cache.
   lod->SetNumberOfContours(2);
