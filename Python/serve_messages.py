@@ -102,7 +102,8 @@ class Field:
 # Level k of a volume samples the points at multiples of LEVEL_STRIDES[k] along each axis: the
 # strides of the C++ BlockLOD core, mediso::LevelStride(k) = BlockCells >> k = 8 >> k
 # (Filters/Core/BlockLOD.h), which TestWebServerLevels checks against BlockLODContour at each
-# level. The one difference: the C++'s coarse copy (MakeCoarseCopy) also takes the last point of
+# level and TestWebPage_budget against the strides the WebAssembly module reports. The one
+# difference: the C++'s coarse copy (MakeCoarseCopy) also takes the last point of
 # an axis whose length minus one is not a multiple of the stride; the levels sent to the page
 # leave that partial layer out (docs/web.md, "The server").
 LEVEL_STRIDES = (8, 4, 2, 1)

@@ -139,7 +139,8 @@ def image_of(source, name):
     return image, array
 
 
-# The scalar types the page reads (numpy's names, as /api/datasets states them).
+# The scalar types the page reads (numpy's names, as /api/datasets states them): the cores'
+# types, which the WebAssembly module hands the page (TestWebPage_budget checks the two agree).
 SCALAR_TYPES = ("int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64")
 
 

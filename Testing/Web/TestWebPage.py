@@ -222,6 +222,15 @@ if args.case == "budget":
     types = {t["name"]: t for t in facts["scalarTypes"]}
     check(described["type"] in types, "the server's type %s is one of the module's %s"
           % (described["type"], sorted(types)))
+    # The server states two of the cores' facts itself (it cannot load the module): they must be
+    # the ones the module hands the page.
+    sys.path.insert(0, os.path.join(ROOT, "Python"))
+    from serve_messages import LEVEL_STRIDES  # noqa: E402
+    from serve_operations import SCALAR_TYPES  # noqa: E402
+    check(list(LEVEL_STRIDES) == strides, "the server's LEVEL_STRIDES %s are the module's strides %s"
+          % (list(LEVEL_STRIDES), strides))
+    check(sorted(SCALAR_TYPES) == sorted(types), "the server's SCALAR_TYPES %s are the module's %s"
+          % (sorted(SCALAR_TYPES), sorted(types)))
     size = types.get(described["type"], {}).get("bytes", 0)
     for k, (stride, level) in enumerate(zip(strides, described["levels"])):
         d = level["dims"]
