@@ -3,19 +3,17 @@
 // dataset's range), the "Add a surface" button, and the server panel's choice of surface. Every
 // change draws at once (viewer.js's change: change + frame, timed).
 
+import { countHistogram } from "./histogram.js";
+import { BONE, firstSurfaces } from "./presets.js";
 import { $, state } from "./state.js";
 import { change } from "./viewer.js";
 
-const SKIN = [0.93, 0.75, 0.62];
-const BONE = [0.97, 0.95, 0.88];
-
-/** The surfaces a dataset opens with: skin and bone for a CT in Hounsfield units. */
+/**
+ * The surfaces a dataset opens with (presets.js): skin and bone for a CT in Hounsfield units,
+ * else Otsu's threshold of the fetched volume's histogram.
+ */
 export function defaultSurfaces(d) {
-  if (d.range[0] <= -900 && d.range[1] >= 400) { // a CT in Hounsfield units
-    return [{ value: -500, color: SKIN, opacity: 0.35 }, { value: 400, color: BONE, opacity: 1 }];
-  }
-  const v = d.range[0] + 0.3 * (d.range[1] - d.range[0]);
-  return [{ value: Number(v.toPrecision(4)), color: SKIN, opacity: 1 }];
+  return firstSurfaces(d, countHistogram());
 }
 
 function hex(color) {

@@ -57,6 +57,16 @@ function unshuffle(shuffled, size) {
   return out;
 }
 
+// The values as JavaScript reads them (little-endian, as the server sends them and every browser
+// stores them): the page's own view of the fetched level, for the slices and the histogram.
+const TYPED_ARRAYS = { int8: Int8Array, uint8: Uint8Array, int16: Int16Array, uint16: Uint16Array,
+  int32: Int32Array, uint32: Uint32Array, float32: Float32Array, float64: Float64Array };
+function typedValues(bytes, typeName) {
+  const Typed = TYPED_ARRAYS[typeName];
+  const copy = bytes.byteOffset % Typed.BYTES_PER_ELEMENT === 0 ? bytes : bytes.slice();
+  return new Typed(copy.buffer, copy.byteOffset, copy.length / Typed.BYTES_PER_ELEMENT);
+}
+
 /** Fetches level `level` of the dataset and gives it to the viewer (the module's memory). */
 export async function loadVolume(level) {
   const d = state.dataset;
@@ -70,6 +80,8 @@ export async function loadVolume(level) {
   const spacing = response.headers.get("X-Mediso-Spacing").split(",").map(Number);
   const origin = response.headers.get("X-Mediso-Origin").split(",").map(Number);
   const bytes = unshuffle(new Uint8Array(body), type.bytes);
+  state.values = typedValues(bytes, typeName);
+  state.grid = { dims, spacing, origin };
   const M = state.module;
   const pointerBefore = state.volumePointer;
   if (state.volumePointer) {
