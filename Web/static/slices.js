@@ -242,9 +242,9 @@ function drawView(view) {
   g.fillText(labelOf(vec.scale(def.right, -1)), 4, mid);
   g.textAlign = "right";
   g.fillText(labelOf(def.right), width - 4, mid);
-  g.textAlign = "center";
-  g.fillText(labelOf(vec.scale(def.down, -1)), width / 2, 10);
-  g.fillText(labelOf(def.down), width / 2, height - 9);
+  g.textAlign = "center"; // under the title's line, over the window's
+  g.fillText(labelOf(vec.scale(def.down, -1)), width / 2, 24);
+  g.fillText(labelOf(def.down), width / 2, height - 30);
   g.font = "11px system-ui, sans-serif";
   g.fillStyle = "#b8c0cc";
   g.textAlign = "left";
@@ -394,12 +394,11 @@ export function setupSlices(histogram) {
     canvas.tabIndex = 0;
     const select = document.createElement("select");
     select.append(...choices.map((c, i) => Object.assign(document.createElement("option"),
-      { value: String(i), textContent: c.name + " (W " + round(c.width) + " L " + round(c.level) + ")" })),
+      { value: String(i), textContent: c.name, title: "W " + round(c.width) + " L " + round(c.level) })),
     Object.assign(document.createElement("option"), { value: "custom", textContent: "dragged", disabled: true }));
-    const label = Object.assign(document.createElement("label"), { className: "window" });
-    label.append("Window ", select);
-    select.setAttribute("aria-label", def.title + " window");
-    panel.append(canvas, label);
+    select.className = "window";
+    select.setAttribute("aria-label", def.title + " window (width and level)");
+    panel.append(canvas, select);
     box.append(panel);
     const view = { def, canvas, select, choices, picture: document.createElement("canvas"),
       index: 0, window: Object.assign({}, choices[0]), axes: null, place: null, contours: [] };
