@@ -204,6 +204,13 @@ const browser = await launchBrowser();
   checks.check(after.s[2].index === Math.round(indexOf(after.c)[0]) && after.s[2].index !== before.s[2].index &&
     after.s[0].index === before.s[0].index && after.s[1].index === before.s[1].index,
     "the sagittal slice follows (" + before.s[2].index + " -> " + after.s[2].index + "), the axial and coronal stay");
+  // The clicked view has the focus: the up key steps its slice (superior), the 3D view stays.
+  const viewBefore = await page.evaluate(() => window.mediso.getView().world.direction);
+  await page.keyboard.press("ArrowUp");
+  const stepped = await page.evaluate(() => ({ s: window.mediso.slices(), d: window.mediso.getView().world.direction }));
+  checks.check(stepped.s[0].index === after.s[0].index + 1 && stepped.d.every((x, i) => x === viewBefore[i]),
+    "the up key on the focused axial view steps its slice " + after.s[0].index + " -> " + stepped.s[0].index +
+    ", the 3D view not turned");
 
   // Window: a right-drag on the coronal view widens its window only; presets set it.
   const coronal = after.s[1];

@@ -390,7 +390,7 @@ export function setupSlices(histogram) {
     panel.dataset.view = def.name;
     const canvas = document.createElement("canvas");
     canvas.setAttribute("aria-label", def.title + " slice: click or drag to move the crosshair, " +
-      "right- or shift-drag for the window (horizontal) and level (vertical), wheel to step");
+      "right- or shift-drag for the window (horizontal) and level (vertical), wheel or arrow keys to step");
     canvas.tabIndex = 0;
     const select = document.createElement("select");
     select.append(...choices.map((c, i) => Object.assign(document.createElement("option"),
@@ -436,7 +436,8 @@ export function setupSlices(histogram) {
 }
 
 // Mouse on a slice: left-click or drag moves the crosshair; right- or shift-drag sets the window
-// (right: wider) and the level (up: higher); the wheel steps through the slices.
+// (right: wider) and the level (up: higher); the wheel, and the up and down keys while the view
+// has the focus, step through the slices.
 function attach(view) {
   const canvas = view.canvas;
   let dragging = null;
@@ -450,6 +451,7 @@ function attach(view) {
   canvas.addEventListener("contextmenu", (e) => e.preventDefault());
   canvas.addEventListener("pointerdown", (e) => {
     canvas.setPointerCapture(e.pointerId);
+    canvas.focus({ preventScroll: true });
     if (e.button === 2 || e.shiftKey) {
       dragging = { window: true, x: e.clientX, y: e.clientY, start: Object.assign({}, view.window) };
     } else if (e.button === 0) {
@@ -473,12 +475,24 @@ function attach(view) {
   const end = () => { dragging = null; };
   canvas.addEventListener("pointerup", end);
   canvas.addEventListener("pointercancel", end);
+  const step = (by) => {
+    const idx = indexOf(crosshair);
+    idx[view.axes.n] = Math.round(idx[view.axes.n]) + by;
+    setCrosshair(pointOf(idx));
+  };
   canvas.addEventListener("wheel", (e) => {
     e.preventDefault();
-    const idx = indexOf(crosshair);
-    idx[view.axes.n] = Math.round(idx[view.axes.n]) + Math.sign(e.deltaY);
-    setCrosshair(pointOf(idx));
+    step(Math.sign(e.deltaY));
   }, { passive: false });
+  // A focused view keeps the arrow keys (not the 3D view's turns): up and down step its slices.
+  canvas.addEventListener("keydown", (e) => {
+    const by = { ArrowUp: 1, ArrowDown: -1, PageUp: 10, PageDown: -10 }[e.key];
+    if (by !== undefined) {
+      e.preventDefault();
+      e.stopPropagation();
+      step(by);
+    }
+  });
 }
 
 // ---------------------------------------------------------------------------- automation
