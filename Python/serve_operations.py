@@ -250,6 +250,28 @@ def source_modified(spec):
     return os.path.getmtime(spec)
 
 
+def metaimage_direction(spec):
+    """The direction matrix a MetaImage header states (TransformMatrix, row-major, columns =
+    axes), or None. VTK's and ParaView's MetaImage readers leave it out (their images have the
+    identity), as ITK and 3D Slicer do not: the server states it to the page, which places the
+    volume in patient space by it; the worker's image keeps VTK's identity, so that its surfaces
+    are in the frame the page draws in."""
+    try:
+        with open(spec, "rb") as f:
+            for _ in range(64):
+                key, sep, value = f.readline().decode("ascii", "replace").partition("=")
+                key = key.strip()
+                if not sep or key == "ElementDataFile":
+                    return None
+                if key in ("TransformMatrix", "Rotation", "Orientation"):
+                    # row by row, the axes as columns (as Headless/MetaImage.cxx reads it)
+                    t = [float(v) for v in value.split()]
+                    return t if len(t) == 9 else None
+    except (OSError, ValueError):
+        return None
+    return None
+
+
 def describe(spec, name, image, array):
     """What the server needs of a volume, besides its values: its geometry, type and range."""
     import math
@@ -257,9 +279,11 @@ def describe(spec, name, image, array):
     if not (math.isfinite(lo) and math.isfinite(hi)) or lo >= hi:
         raise ValueError("%s: its values span no range (%g..%g)" % (spec, lo, hi))
     matrix = image.GetDirectionMatrix()
+    direction = [matrix.GetElement(r, c) for r in range(3) for c in range(3)]
+    if source_format(spec)["name"] == "MetaImage":
+        direction = metaimage_direction(spec) or direction
     return {"name": name, "dims": list(image.GetDimensions()), "spacing": list(image.GetSpacing()),
-            "origin": list(image.GetOrigin()),
-            "direction": [matrix.GetElement(r, c) for r in range(3) for c in range(3)],
+            "origin": list(image.GetOrigin()), "direction": direction,
             "range": [float(lo), float(hi)], "format": source_format(spec),
             "modified": source_modified(spec)}
 
