@@ -118,6 +118,9 @@ async function start() {
       countBytes(sent, received);
       updateReadout();
     },
+    showSurface(surface, shown) {
+      change(() => { surface.hidden = !shown; });
+    },
   });
 }
 
