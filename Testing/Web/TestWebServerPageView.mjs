@@ -103,6 +103,7 @@ const browser = await launchBrowser();
   const marker = await page.evaluate(() => window.mediso.orientation());
   const space = marker.space;
   checks.check(/LPS/.test(space) && /NIfTI/.test(space), "the page says the space: " + space);
+  checks.check(!/guessed/.test(space), "... from the format the server states, not the name");
   checks.check(near(view.world.direction, [0, 1, 0], 1e-6) && near(view.world.viewUp, [0, 0, 1], 1e-6),
     "anterior view in patient space: looking " + fmt(view.world.direction) + " (posterior: 0, 1, 0), up " +
     fmt(view.world.viewUp) + " (superior: 0, 0, 1)");
