@@ -76,12 +76,13 @@ MRI_EXPECTED_DIMS = (181, 217, 181)
 MRI_EXPECTED_SPACING = (1.0, 1.0, 1.0)
 
 # The volumes' direction matrices in patient space (LPS, as DICOM and ITK), row-major with the
-# voxel axes as columns, as the TransformMatrix is written (and Headless/MetaImage.cxx reads
-# it; both matrices here are diagonal, so a reader taking the rows as the axes agrees). The head CT: InVesalius' reader (vtkGDCMImageReader,
-# rows flipped to VTK's lower-left origin) leaves x along the series' rows, the patient's left in
-# an axial series, y towards the face (anterior: -y in LPS) and z up the slices (superior). The
-# file keeps no DICOM header, so x's sense is the reader's and cannot be checked from it; y and z
-# are what the volume shows (face at +j, crown at +k). The MRI's comes from ch2.nii.gz's sform.
+# voxel axes as columns, as the TransformMatrix is written (and Headless/MetaImage.cxx reads it;
+# both matrices here are diagonal, so a reader taking the rows as the axes agrees).
+# The head CT: InVesalius' reader (vtkGDCMImageReader, rows flipped to VTK's lower-left origin)
+# leaves x along the series' rows, the patient's left in an axial series, y towards the face
+# (anterior: -y in LPS) and z up the slices (superior). The file keeps no DICOM header, so x's
+# sense is the reader's and cannot be checked from it; y and z are what the volume shows (face
+# at +j, crown at +k). The MRI's comes from ch2.nii.gz's sform.
 CT_DIRECTION = ((1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, 1.0))
 IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
@@ -148,8 +149,9 @@ def save_manifest(cache_dir, manifest):
     manifest["format_version"] = MANIFEST_FORMAT
     manifest["generator"] = "MedicalIsosurfaces Python/fetch_data.py"
     manifest["note"] = ("Fetched from Debian packages on demand; never commit these files. "
-                        "Offsets are 0 0 0; axes are the stored voxel axes (x fastest), their directions "
-                        "in patient space (LPS) in each file's TransformMatrix and 'axes'.")
+                        "Offsets are 0 0 0; axes are the stored voxel axes (x fastest), their "
+                        "directions in patient space (LPS) in each file's TransformMatrix and "
+                        "'axes'.")
     path = cache_dir / MANIFEST_NAME
     tmp = path.with_name(path.name + ".tmp")
     with open(tmp, "w", encoding="utf-8") as f:
