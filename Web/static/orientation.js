@@ -96,6 +96,14 @@ export function setDataset(d) {
   // LPS = F * world, F = diag(-1, -1, 1) for a RAS world.
   const f = world === "RAS" ? [-1, -1, 1] : [1, 1, 1];
   const rows = [0, 1, 2].map((r) => [0, 1, 2].map((c) => f[r] * m[3 * r + c]));
+  // Axes that are a mirror image of patient space (determinant -1: a series read with its rows
+  // flipped, as the cached ct_head.mha, or a NIfTI stored left to right) cannot be turned into
+  // it: the module draws the grid as it is, so the views face the right way with left and right
+  // swapped in the picture. Said, not hidden.
+  if (!note && dot(rows[0], cross(rows[1], rows[2])) < 0) {
+    note = "the volume's axes are a mirror image of patient space: the views face the right way, " +
+      "with left and right swapped in the picture";
+  }
   frame = { origin: d.origin.map(Number), rows, flip: f, world, source };
   return { space: "patient space (LPS) from " + source, note };
 }
