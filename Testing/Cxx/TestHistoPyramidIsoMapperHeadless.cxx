@@ -27,6 +27,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -36,6 +37,39 @@
 namespace
 {
 using medical_test::Check;
+
+// A MetaImage header's TransformMatrix (row-major, the axes as columns, as
+// Headless/MetaImage.cxx reads it); the identity without one.
+std::vector<double> MetaImageDirection(const std::string& path)
+{
+  std::vector<double> m = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int i = 0; i < 64 && std::getline(in, line); ++i)
+  {
+    const auto equals = line.find('=');
+    std::string key;
+    std::istringstream(line.substr(0, equals)) >> key;
+    if (key == "ElementDataFile" || equals == std::string::npos)
+    {
+      break;
+    }
+    if (key == "TransformMatrix")
+    {
+      std::istringstream values(line.substr(equals + 1));
+      std::vector<double> read(9);
+      for (double& v : read)
+      {
+        values >> v;
+      }
+      if (values)
+      {
+        m = read;
+      }
+    }
+  }
+  return m;
+}
 
 struct Scene
 {
@@ -227,6 +261,10 @@ int TestHistoPyramidIsoMapperHeadless(int argc, char* argv[])
     reader->Update();
     Scene s;
     s.Image = reader->GetOutput();
+    // mediso-render places the file by its TransformMatrix (Python/fetch_data.py writes the
+    // CT's direction in patient space), which VTK's reader leaves out: the same direction on
+    // VTK's image, so that both draw the same scene.
+    s.Image->SetDirectionMatrix(MetaImageDirection(ct).data());
     s.Volume = ct;
     s.Size[0] = 480;
     s.Size[1] = 360;

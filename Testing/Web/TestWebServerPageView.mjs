@@ -6,7 +6,9 @@
 //   along -i (the file's i axis points anterior); the marker puts S up and L right (components
 //   above 0.99); and in the picture the cube is drawn up and right of the centre (anterior view)
 //   and left of it (left view: anterior is on the left). The phantom (RAS, nose at +y) opens the
-//   same way.
+//   same way. A MetaImage with a mirroring TransformMatrix (diag(1, -1, 1), as the cached
+//   ct_head.mha's) opens in the anterior view by the matrix the server states, and the page says
+//   that its left and right are swapped in the picture.
 // - navigation: a right-drag and a shift-drag of 120 px move the focal point by 120 px of the
 //   focal plane (within 5%) across the view, and turn it by less than 0.001 degree; a left-drag
 //   does turn it (more than 10 degrees); a wheel step 100 px off the centre dollies 1.1x nearer
@@ -23,7 +25,7 @@
 //   values applied and the bad ones left out.
 // - a bad isovalue (outside the range, or empty) is refused with a message beside its box and
 //   the surface keeps its value; a good one clears the message and is drawn.
-import { mkdtempSync, writeFileSync } from "node:fs";
+import { mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
 import { Checks, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
@@ -104,6 +106,7 @@ const browser = await launchBrowser();
   const marker = await page.evaluate(() => window.mediso.orientation());
   const space = marker.space;
   checks.check(/LPS/.test(space) && /NIfTI/.test(space), "the page says the space: " + space);
+  checks.check(!/guessed/.test(space), "... from the format the server states, not the name");
   checks.check(near(view.world.direction, [0, 1, 0], 1e-6) && near(view.world.viewUp, [0, 0, 1], 1e-6),
     "anterior view in patient space: looking " + fmt(view.world.direction) + " (posterior: 0, 1, 0), up " +
     fmt(view.world.viewUp) + " (superior: 0, 0, 1)");
@@ -122,6 +125,33 @@ const browser = await launchBrowser();
   const side = await drawnCentroid(page);
   checks.check(side.n > 200 && side.x < -20 && side.y > 20,
     "left view: the anterior-superior cube is drawn up and left of the centre: " + JSON.stringify(side));
+  await context.close();
+}
+
+// --- a MetaImage whose TransformMatrix is a mirror (as the cached ct_head.mha's) -----------------
+// The server states the header's matrix; the page places the volume by it and says that left
+// and right are swapped, since its module draws the grid unmirrored.
+const mirrored = path.join(folder, "mirrored.mha");
+let mirrorServer;
+{
+  const values = readFileSync(nifti).subarray(352);
+  writeFileSync(mirrored, Buffer.concat([Buffer.from(["ObjectType = Image", "NDims = 3",
+    "BinaryData = True", "BinaryDataByteOrderMSB = False", "CompressedData = False",
+    "TransformMatrix = 1 0 0 0 -1 0 0 0 1", "Offset = 0 0 0", "ElementSpacing = 2 2 2",
+    "DimSize = " + [N, N, N].join(" "), "ElementType = MET_SHORT", "ElementDataFile = LOCAL", ""].join("\n")),
+    values]));
+  mirrorServer = await startServer([mirrored]);
+  const context = await browser.newContext({ viewport: { width: 1200, height: 800 } });
+  const page = await context.newPage();
+  await openPage(page, mirrorServer);
+  const space = (await page.evaluate(() => window.mediso.orientation())).space;
+  const view = await page.evaluate(() => window.mediso.getView());
+  const forward = sub(view.focalPoint, view.position).map((x) => x / len(sub(view.focalPoint, view.position)));
+  checks.check(/MetaImage \(LPS\)/.test(space) && /mirror image/.test(space),
+    "a mirrored MetaImage: " + space);
+  checks.check(near(view.world.direction, [0, 1, 0], 1e-6) && near(forward, [0, -1, 0], 1e-6),
+    "... opens in the anterior view, in the module's frame looking along -j " + fmt(forward) +
+    " (the header puts +j anterior)");
   await context.close();
 }
 
@@ -297,4 +327,4 @@ for (const [width, height, ratio] of [[1920, 1080, 1], [800, 600, 2]]) {
   await context.close();
 }
 
-await checks.finish(browser, server, phantomServer);
+await checks.finish(browser, server, phantomServer, mirrorServer);

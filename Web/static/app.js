@@ -139,6 +139,9 @@ async function start() {
       countBytes(sent, received);
       updateReadout();
     },
+    showSurface(surface, shown) {
+      change(() => { surface.hidden = !shown; });
+    },
   });
 }
 

@@ -43,7 +43,8 @@ export const state = Object.seal({
   levelNote: "",
 
   // surfaces.js (and app.js's automation, through surfaces.js): the isosurfaces
-  // [{value, color: [r, g, b], opacity}].
+  // [{value, color: [r, g, b], opacity}], and hidden: true on the source of a server result
+  // while the result is shown (operations.js, through app.js).
   surfaces: [],
 
   // viewer.js, at each frame: its times and what it drew.

@@ -71,13 +71,17 @@ export function buildSurfaceList() {
       const x = checked(value, message, "isovalue", d.range[0], d.range[1]);
       if (x !== null) {
         change(() => { s.value = x; slider.value = String(x); });
+        updateServerChoice();
       }
     };
-    slider.oninput = () => change(() => {
-      s.value = Number(slider.value);
-      value.value = slider.value;
-      checked(value, message, "isovalue", d.range[0], d.range[1]);
-    });
+    slider.oninput = () => {
+      change(() => {
+        s.value = Number(slider.value);
+        value.value = slider.value;
+        checked(value, message, "isovalue", d.range[0], d.range[1]);
+      });
+      updateServerChoice();
+    };
     color.oninput = () => change(() => { s.color = fromHex(color.value); });
     opacity.oninput = () => {
       const x = checked(opacity, message, "opacity", 0, 1);
@@ -90,9 +94,21 @@ export function buildSurfaceList() {
       remove, slider, message);
     box.append(row);
   });
+  updateServerChoice();
+}
+
+/**
+ * The server panel's surface choice: one option per surface, its current isovalue, the choice
+ * kept where the surface still is (an isovalue changed in its box or slider shows here at once).
+ */
+function updateServerChoice() {
   const pick = $("op-surface");
+  const chosen = pick.value;
   pick.replaceChildren(...state.surfaces.map((s, i) =>
     Object.assign(document.createElement("option"), { value: i, textContent: String(s.value) })));
+  if (chosen !== "" && Number(chosen) < state.surfaces.length) {
+    pick.value = chosen;
+  }
 }
 
 /** The dataset's default surfaces in the list, and the "Add a surface" button. */

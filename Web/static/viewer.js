@@ -113,7 +113,8 @@ export const afterFrame = [];
 /** Draws now and waits for the GPU: the time of a change + frame. */
 export function renderNow() {
   const viewer = state.viewer;
-  viewer.setSurfaces(state.surfaces);
+  // A surface hidden (the source of a server result shown, operations.js) is not drawn.
+  viewer.setSurfaces(state.surfaces.filter((s) => !s.hidden));
   const start = performance.now();
   if (!viewer.render()) {
     throw new Error("render failed: " + viewer.stats().error);
