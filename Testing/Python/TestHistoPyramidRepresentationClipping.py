@@ -1,6 +1,6 @@
-"""pvpython test: the 'HistoPyramid Isosurface' representation honours ParaView's cropping.
+"""pvpython test: the 'HistoPyramid Isosurface' representation's cropping and clipping plane.
 
-    pvpython TestHistoPyramidRepresentationCropping.py --plugin PATH --out DIR [--expect-fallback]
+    pvpython TestHistoPyramidRepresentationClipping.py --plugin PATH --out DIR [--expect-fallback]
 
 ParaView 5.11's image volume displays crop with UseCropping, CroppingOrigin and
 CroppingScale (vtkImageVolumeRepresentation: region planes = origin + data
@@ -12,7 +12,11 @@ MedicalPhantom (skin -500 HU over bone 400 HU, opaque, solid white):
   (level 3) of ExtractSubset of the same box shown as a Surface: covered pixels
   agree on >= 98.5% of those covered by either, mean colour difference <= 12
   (of 255) where both cover; and differs from the uncropped image;
-- UseCropping off again gives the uncropped image back.
+- UseCropping off again gives the uncropped image back;
+- the clipping plane (HistoPyramidClipPlane, ...Origin, ...Normal, ...Invert;
+  its widget group shown for this type) gives the image of Block LOD Contour
+  + Clip with the same plane, with Invert on and off (same thresholds), and
+  differs from the unclipped image; off again, the unclipped image.
 Run twice: on the GPU path, and on the CPU fallback (--expect-fallback, under
 MEDISO_DISABLE_GPU_PATH=1; its one warning is captured and checked). A machine
 whose GL lacks what the GPU path needs skips the GPU run (exit 125).
@@ -27,7 +31,7 @@ import HistoPyramidRepresentationChecks as hp
 args = hp.parse_args(expect_fallback=True)
 check = hp.Checker()
 expected_path = "fallback" if args.expect_fallback else "gpu"
-name = "TestHistoPyramidRepresentationCropping" + ("Fallback" if args.expect_fallback else "")
+name = "TestHistoPyramidRepresentationClipping" + ("Fallback" if args.expect_fallback else "")
 
 LoadPlugin(args.plugin, ns=globals())
 phantom = MedicalPhantom(Dimensions=[64, 64, 64], Spacing=[3.0, 3.0, 3.0])
@@ -138,7 +142,54 @@ check(hp.changed_fraction(whole, again) < 0.001,
       "UseCropping off: the uncropped image again (%.2f%% differ)"
       % (100 * hp.changed_fraction(whole, again)))
 
+# 5. The clipping plane, against Block LOD Contour + Clip with the same plane.
+clip_group = groups.get("HistoPyramidClipPlaneOrigin", [None])[-1]
+check(clip_group is not None and clip_group.GetPanelWidget() == "InteractivePlane"
+      and hp.REPRESENTATION in decorator_values(clip_group.GetHints()),
+      "the clipping plane is edited with the plane widget, shown for this type")
+full = BlockLODContour(Input=phantom, Isosurfaces=[hp.SKIN, hp.BONE], LOD=3, AutoLOD=0,
+                       ComputeNormals=1)
+plane_origin = [centre[0] + 6.0, centre[1], centre[2]]
+plane_normal = [1.0, 0.25, 0.2]
+for invert in (1, 0):
+    display.HistoPyramidClipPlane = 1
+    display.HistoPyramidClipPlaneOrigin = plane_origin
+    display.HistoPyramidClipPlaneNormal = plane_normal
+    display.HistoPyramidClipPlaneInvert = invert
+    _, clip_output = hp.captured(lambda: Render(view))
+    check(clip_output.strip() == "", "clip plane: no warning or error (got %r)" % clip_output.strip()[:300])
+    clipped = shot("clip_plane_invert%d" % invert)
+    check(hp.render_info(display)["path"] == expected_path, "clip plane: path %r" % expected_path)
+    check(hp.changed_fraction(whole, clipped) > 0.05,
+          "Invert %d: the plane changes the image (%.1f%% of the pixels)"
+          % (invert, 100 * hp.changed_fraction(whole, clipped)))
+    cut = Clip(Input=full, ClipType="Plane", Invert=invert)
+    cut.ClipType.Origin = plane_origin
+    cut.ClipType.Normal = plane_normal
+    camera = [list(view.CameraPosition), list(view.CameraFocalPoint), list(view.CameraViewUp)]
+    Hide(phantom, view)
+    surface = Show(cut, view)
+    surface.SetRepresentationType("Surface")
+    surface.ColorArrayName = ["POINTS", ""]
+    for prop in ("Ambient", "Diffuse", "Specular", "SpecularPower"):
+        surface.SetPropertyWithName(prop, display.GetPropertyValue(prop))
+    view.CameraPosition, view.CameraFocalPoint, view.CameraViewUp = camera
+    reference = shot("clip_reference_invert%d" % invert)
+    agreement, difference, either = hp.compare_images(clipped, reference)
+    print("clip plane (Invert %d) vs Block LOD Contour + Clip: %d pixels covered by either, masks "
+          "agree on %.2f%%, mean colour difference %.2f" % (invert, either, 100 * agreement, difference))
+    check(either > 5000, "Invert %d: the clipped surfaces cover a good part of the image" % invert)
+    check(agreement >= 0.985, "Invert %d: covered pixels agree with Block LOD Contour + Clip" % invert)
+    check(difference <= 12.0, "Invert %d: colours agree with Block LOD Contour + Clip" % invert)
+    Hide(cut, view)
+    display = Show(phantom, view)
+display.HistoPyramidClipPlane = 0
+again = shot("unclipped_again")
+check(hp.changed_fraction(whole, again) < 0.001,
+      "clip plane off: the unclipped image again (%.2f%% differ)"
+      % (100 * hp.changed_fraction(whole, again)))
+
 if check.failures:
     print("%d check(s) failed" % len(check.failures))
     sys.exit(1)
-print("HistoPyramid representation cropping (%s): all checks passed" % expected_path)
+print("HistoPyramid representation cropping and clipping (%s): all checks passed" % expected_path)
