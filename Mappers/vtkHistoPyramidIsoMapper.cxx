@@ -7,10 +7,13 @@
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkMatrix4x4.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLHistoPyramidIsosurfaces.h"
 #include "vtkPiecewiseFunction.h"
+#include "vtkPlane.h"
+#include "vtkPlaneCollection.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkVolume.h"
@@ -259,7 +262,69 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
 
-  // 3. The GPU path, or the fallback when it cannot run (said once, with the reason).
+  // 3. The clipping planes and the cropping box's faces, in world
+  //    coordinates (the cropping planes are in the volume's own, as for
+  //    VTK's volume mappers: moved by the volume's matrix).
+  using Plane = vtkOpenGLHistoPyramidIsosurfaces::Plane;
+  std::vector<Plane> planes;
+  if (this->ClippingPlanes)
+  {
+    const int count = this->ClippingPlanes->GetNumberOfItems();
+    if (count > 6)
+    {
+      sayOnce(false,
+        "more than 6 clipping planes (" + std::to_string(count) + "): only the first 6 are used.");
+    }
+    for (int i = 0; i < std::min(count, 6); ++i)
+    {
+      vtkPlane* plane = this->ClippingPlanes->GetItem(i);
+      const double* n = plane->GetNormal();
+      const double* o = plane->GetOrigin();
+      const Plane p = { n[0], n[1], n[2], -(n[0] * o[0] + n[1] * o[1] + n[2] * o[2]) };
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]) ||
+        !std::isfinite(p[3]) || (p[0] == 0.0 && p[1] == 0.0 && p[2] == 0.0))
+      {
+        sayOnce(
+          false, "a clipping plane has a zero or non-finite normal or origin: it is ignored.");
+        continue;
+      }
+      planes.push_back(p);
+    }
+  }
+  if (this->Cropping)
+  {
+    if (this->CroppingRegionFlags != VTK_CROP_SUBVOLUME)
+    {
+      std::ostringstream msg;
+      msg << "cropping region flags 0x" << std::hex << this->CroppingRegionFlags
+          << " are not supported (only the subvolume, 0x" << VTK_CROP_SUBVOLUME
+          << "): the volume is drawn uncropped.";
+      sayOnce(false, msg.str());
+    }
+    else
+    {
+      std::vector<Plane> box;
+      for (int a = 0; a < 3; ++a)
+      {
+        Plane low = { 0.0, 0.0, 0.0, -this->CroppingRegionPlanes[2 * a] };
+        low[a] = 1.0;
+        Plane high = { 0.0, 0.0, 0.0, this->CroppingRegionPlanes[2 * a + 1] };
+        high[a] = -1.0;
+        box.push_back(low);
+        box.push_back(high);
+      }
+      vtkNew<vtkMatrix4x4> worldToModel;
+      vtkMatrix4x4::Invert(vol->GetMatrix(), worldToModel);
+      for (const Plane& p : vtkOpenGLHistoPyramidIsosurfaces::PullBackPlanes(box, worldToModel))
+      {
+        planes.push_back(p);
+      }
+    }
+  }
+  impl.GPU->SetClipPlanes(planes);
+  impl.Fallback->SetClipPlanes(planes);
+
+  // 4. The GPU path, or the fallback when it cannot run (said once, with the reason).
   vtkOpenGLHistoPyramidIsosurfaces* gpu = impl.GPU;
   std::string reason;
   if (this->ForceCPUFallback)

@@ -44,6 +44,18 @@
  * matrix are honoured. Surfaces are always shaded (an unshaded isosurface
  * shows no shape), regardless of vtkVolumeProperty::GetShade().
  *
+ * Clipping and cropping: the mapper's clipping planes
+ * (vtkAbstractMapper::AddClippingPlane(), world coordinates, at most 6; the
+ * normal points to the side that is kept) and vtkVolumeMapper's cropping
+ * (SetCropping(), SetCroppingRegionPlanes() in the volume's own coordinates,
+ * as for VTK's volume mappers) cut the surfaces exactly, on both paths: the
+ * GPU path cuts each fragment's ray (a surface behind a removed one shows
+ * through) and skips cells wholly removed; the CPU path cuts its triangles
+ * (vtkClipPolyData). Cut faces are left open (not capped). Of the cropping
+ * region flags, only the subvolume (VTK_CROP_SUBVOLUME, the default: keep the
+ * box) is supported; other flags are warned about once and the volume is
+ * drawn uncropped. Planes beyond the sixth are warned about once and ignored.
+ *
  * Capability check and fallback: the first render in a window runs
  * vtkMedicalGLCapabilities::Probe(); if the context lacks OpenGL 3.2 or
  * working integer textures, a shader does not build, the volume exceeds the

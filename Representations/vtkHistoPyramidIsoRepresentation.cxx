@@ -8,9 +8,11 @@
 #include "vtkHistoPyramidIsoMapper.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkMatrix4x4.h"
 #include "vtkMultiProcessController.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVLODVolume.h"
+#include "vtkPlaneCollection.h"
 #include "vtkPointData.h"
 #include "vtkRectilinearGrid.h"
 #include "vtkResampleToImage.h"
@@ -23,6 +25,7 @@
 #include <cstdint>
 #include <new>
 #include <sstream>
+#include <vector>
 
 namespace
 {
@@ -334,9 +337,86 @@ int vtkHistoPyramidIsoRepresentation::RequestData(
 }
 
 //------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetClipPlane(bool use)
+{
+  if (use != this->ClipPlane)
+  {
+    this->ClipPlane = use;
+    this->Modified(); // read at render time (UpdateMapperParameters)
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetClipPlaneOrigin(double x, double y, double z)
+{
+  this->ClipPlaneOrigin[0] = x;
+  this->ClipPlaneOrigin[1] = y;
+  this->ClipPlaneOrigin[2] = z;
+  this->Modified(); // read at render time (UpdateMapperParameters)
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetClipPlaneNormal(double x, double y, double z)
+{
+  this->ClipPlaneNormal[0] = x;
+  this->ClipPlaneNormal[1] = y;
+  this->ClipPlaneNormal[2] = z;
+  this->Modified(); // read at render time (UpdateMapperParameters)
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetClipPlaneInvert(bool invert)
+{
+  if (invert != this->ClipPlaneInvert)
+  {
+    this->ClipPlaneInvert = invert;
+    this->Modified(); // read at render time (UpdateMapperParameters)
+  }
+}
+
+//------------------------------------------------------------------------------
 void vtkHistoPyramidIsoRepresentation::UpdateMapperParameters()
 {
   this->Superclass::UpdateMapperParameters();
+
+  // The clipping plane, in world coordinates (the display's transform moves
+  // the data), with its normal towards the kept side as the mapper takes it.
+  if (this->ClipPlane)
+  {
+    const double sign = this->ClipPlaneInvert ? -1.0 : 1.0;
+    const double* n = this->ClipPlaneNormal;
+    const double* o = this->ClipPlaneOrigin;
+    vtkMatrix4x4* dataToWorld = this->Actor->GetMatrix();
+    vtkNew<vtkMatrix4x4> worldToData;
+    vtkMatrix4x4::Invert(dataToWorld, worldToData);
+    const std::vector<vtkOpenGLHistoPyramidIsosurfaces::Plane> world =
+      vtkOpenGLHistoPyramidIsosurfaces::PullBackPlanes(
+        { { sign * n[0], sign * n[1], sign * n[2],
+          -sign * (n[0] * o[0] + n[1] * o[1] + n[2] * o[2]) } },
+        worldToData);
+    const auto& p = world[0];
+    const double norm2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+    if (norm2 > 0.0 && std::isfinite(norm2) && std::isfinite(p[3]))
+    {
+      this->MapperClipPlane->SetNormal(p[0], p[1], p[2]);
+      this->MapperClipPlane->SetOrigin(
+        -p[3] * p[0] / norm2, -p[3] * p[1] / norm2, -p[3] * p[2] / norm2);
+    }
+    else
+    {
+      this->MapperClipPlane->SetNormal(0.0, 0.0, 0.0); // the mapper says it is ignored
+    }
+    vtkPlaneCollection* planes = this->IsoMapper->GetClippingPlanes();
+    if (!planes || !planes->IsItemPresent(this->MapperClipPlane))
+    {
+      this->IsoMapper->AddClippingPlane(this->MapperClipPlane);
+    }
+  }
+  else if (this->IsoMapper->GetClippingPlanes() &&
+    this->IsoMapper->GetClippingPlanes()->IsItemPresent(this->MapperClipPlane))
+  {
+    this->IsoMapper->RemoveClippingPlane(this->MapperClipPlane);
+  }
 
   // The base class hides the volume when no colour array is chosen (volume
   // mappers need one). An isosurface needs only scalars: use the active ones,

@@ -49,7 +49,8 @@
 
 #include "MedicalIsosurfacesRepresentationsModule.h" // For export macro
 #include "vtkImageVolumeRepresentation.h"
-#include "vtkNew.h" // For vtkNew
+#include "vtkNew.h"   // For vtkNew
+#include "vtkPlane.h" // For vtkPlane
 
 #include <string> // For std::string
 
@@ -94,6 +95,23 @@ public:
    */
   void SetFirstHitPass(bool use);
   bool GetFirstHitPass();
+  ///@}
+
+  ///@{
+  /**
+   * A clipping plane, the representation's counterpart of ParaView's Clip
+   * filter with a Plane: on (ClipPlane), the surfaces are cut at the plane
+   * through ClipPlaneOrigin with ClipPlaneNormal (data coordinates, moved with
+   * the display's transform) and left open at the cut. As Clip does, the side
+   * the normal points to is removed while ClipPlaneInvert is on (the default)
+   * and kept when it is off. Both paths honour it (the mapper's clipping
+   * planes), together with cropping (UseCropping). Default off, origin 0,
+   * normal +x.
+   */
+  void SetClipPlane(bool use);
+  void SetClipPlaneOrigin(double x, double y, double z);
+  void SetClipPlaneNormal(double x, double y, double z);
+  void SetClipPlaneInvert(bool invert);
   ///@}
 
   ///@{
@@ -168,6 +186,11 @@ private:
 
   vtkNew<vtkHistoPyramidIsoMapper> IsoMapper;
   bool ColorEachSurface = false;
+  bool ClipPlane = false;
+  double ClipPlaneOrigin[3] = { 0.0, 0.0, 0.0 };
+  double ClipPlaneNormal[3] = { 1.0, 0.0, 0.0 };
+  bool ClipPlaneInvert = true;
+  vtkNew<vtkPlane> MapperClipPlane; // the plane as the mapper takes it (world, kept side)
   std::string LastResampleMessage;
   std::string LastRangeMessage;
 };
