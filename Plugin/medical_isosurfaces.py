@@ -53,7 +53,8 @@ def MakeMeshFromView(display=None, view=None, level=None, names=None, show=True)
     ``view``); ``view``: its view (default: the active view), rendered once so that the colours
     are those drawn; ``level``: 0-3, or None for Auto LOD; ``names``: one name per isovalue
     (default: the array's name and the value, e.g. "HU 400"); ``show``: show the mesh in ``view``
-    coloured by its SurfaceColor and hide the display, as a filter's Apply replaces its input.
+    coloured by surface (a categorical colour map of its own: the surfaces' names, colours and
+    opacities) and hide the display, as a filter's Apply replaces its input.
     Surfaces the display does not draw (opacity 0, values that are not numbers) are left out.
     """
     if view is None:
@@ -110,8 +111,37 @@ def MakeMeshFromView(display=None, view=None, level=None, names=None, show=True)
     mesh.UpdatePipeline()
     if show and view is not None:
         shown = simple.Show(mesh, view)
-        simple.ColorBy(shown, ("CELLS", "SurfaceColor"))
-        shown.MapScalars = 0
+        _color_by_surface(shown, labels, colors)
         simple.Hide(source, view)
         simple.Render(view)
     return mesh
+
+
+def _color_by_surface(shown, labels, colors):
+    """Colours the mesh's display by SurfaceIndex through a colour map of its own: categorical,
+    one annotation (the name), one colour and one opacity per surface (opacity mapping enabled
+    where one is below 1). ParaView's PLY writer maps colours through the display's colour map
+    (Save Data: Enable Coloring, SurfaceIndex), so this map also writes each surface's colour
+    (and opacity, with Enable Alpha) to a PLY file."""
+    simple.ColorBy(shown, ("CELLS", "SurfaceIndex"), True)
+    lut = simple.GetColorTransferFunction("SurfaceIndex", shown, True)
+    lut.InterpretValuesAsCategories = 1
+    annotations, indexed = [], []
+    for i, name in enumerate(labels):
+        annotations += [str(i), name]
+        indexed += colors[4 * i:4 * i + 3]
+    lut.Annotations = annotations
+    lut.IndexedColors = indexed
+    lut.IndexedOpacities = colors[3::4]
+    lut.EnableOpacityMapping = 1 if min(colors[3::4]) < 1.0 else 0
+
+
+def _make_mesh_for_panel(display_id, view_id):
+    """The panel's Make Mesh button: MakeMeshFromView on proxies given by their global ids."""
+    session = servermanager.ActiveConnection.Session
+
+    def proxy(global_id):
+        found = session.GetRemoteObject(global_id) if global_id else None
+        return servermanager._getPyProxy(found) if found is not None else None
+
+    return MakeMeshFromView(proxy(display_id), proxy(view_id))
