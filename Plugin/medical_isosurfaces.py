@@ -33,13 +33,15 @@ def _display_proxy(display, view):
 
 
 def _contoured_array(display, source, port):
-    """The array the display contours: its colouring array, else the input's active point scalars."""
-    name = display.ColorArrayName[1] if display.ColorArrayName[0] in ("POINTS", "") else ""
-    if name:
-        return name
+    """The array the display contours (its colouring array, else the input's active point
+    scalars) and its range ((name, None) when the data information has no such array)."""
     info = source.GetDataInformation(port).DataInformation.GetPointDataInformation()
-    scalars = info.GetAttributeInformation(vtkDataSetAttributes.SCALARS)
-    return scalars.GetName() if scalars is not None else ""
+    name = display.ColorArrayName[1] if display.ColorArrayName[0] in ("POINTS", "") else ""
+    array = info.GetArrayInformation(name) if name else \
+        info.GetAttributeInformation(vtkDataSetAttributes.SCALARS)
+    if array is None:
+        return name, None
+    return array.GetName(), array.GetComponentRange(0)
 
 
 def _format(value):
@@ -55,7 +57,8 @@ def MakeMeshFromView(display=None, view=None, level=None, names=None, show=True)
     (default: the array's name and the value, e.g. "HU 400"); ``show``: show the mesh in ``view``
     coloured by surface (a categorical colour map of its own: the surfaces' names, colours and
     opacities) and hide the display, as a filter's Apply replaces its input.
-    Surfaces the display does not draw (opacity 0, values that are not numbers) are left out.
+    Surfaces the display does not draw (opacity 0, values outside the array's range or not
+    numbers) are left out.
     """
     if view is None:
         view = simple.GetActiveView()
@@ -68,7 +71,7 @@ def MakeMeshFromView(display=None, view=None, level=None, names=None, show=True)
     input_property = display.GetProperty("Input")
     source = servermanager._getPyProxy(input_property.GetProxy(0))
     port = input_property.GetOutputPortForConnection(0)
-    array = _contoured_array(display, source, port)
+    array, data_range = _contoured_array(display, source, port)
 
     # The colour and opacity each isovalue is drawn with, as of a render.
     if view is not None:
@@ -81,7 +84,8 @@ def MakeMeshFromView(display=None, view=None, level=None, names=None, show=True)
     values, colors, labels = [], [], []
     for i, value in enumerate(isovalues):
         look = looks[4 * i:4 * i + 4] if len(looks) >= 4 * (i + 1) else [1.0, 1.0, 1.0, 1.0]
-        if math.isnan(value) or look[3] <= 0.0 or value in values:
+        outside = data_range is not None and not data_range[0] <= value <= data_range[1]
+        if math.isnan(value) or outside or look[3] <= 0.0 or value in values:
             continue
         values.append(value)
         colors.extend(look)

@@ -4,6 +4,7 @@
 #include "vtkCellData.h"
 #include "vtkContourValues.h"
 #include "vtkDataArray.h"
+#include "vtkDataObject.h"
 #include "vtkFieldData.h"
 #include "vtkHistoPyramidIsoMapper.h"
 #include "vtkImageData.h"
@@ -410,14 +411,25 @@ std::string vtkHistoPyramidIsoRepresentation::OutsideRangeMessage(
   std::ostringstream message;
   message << "HistoPyramid Isosurface: isovalue" << (n > 1 ? "s " : " ") << outside.str()
           << (n > 1 ? " are" : " is") << " outside the range [" << range[0] << ", " << range[1]
-          << "] of the array \"" << (arrayName ? arrayName : "")
-          << "\": no surface is drawn for " << (n > 1 ? "them" : "it") << ".";
+          << "] of the array \"" << (arrayName ? arrayName : "") << "\": no surface is drawn for "
+          << (n > 1 ? "them" : "it") << ".";
   return message.str();
 }
 
 //------------------------------------------------------------------------------
 vtkDoubleArray* vtkHistoPyramidIsoRepresentation::GetSurfaceLooks()
 {
+  // The colouring as UpdateMapperParameters() sets it, from the properties
+  // alone: in client/server mode the client's copy, which ParaView reads
+  // information from, never renders.
+  vtkInformation* array = this->GetInputArrayInformation(0);
+  const char* name = array && array->Has(vtkDataObject::FIELD_NAME())
+    ? array->Get(vtkDataObject::FIELD_NAME())
+    : nullptr;
+  this->IsoMapper->SetColorSource(this->ColorEachSurface
+      ? vtkHistoPyramidIsoMapper::SurfaceColors
+      : ((name && name[0]) ? vtkHistoPyramidIsoMapper::TransferFunctionColors
+                           : vtkHistoPyramidIsoMapper::SolidColors));
   vtkContourValues* values = this->Property->GetIsoSurfaceValues();
   const int count = values->GetNumberOfContours();
   this->SurfaceLooks->SetNumberOfComponents(4);

@@ -48,9 +48,9 @@
 #define vtkHistoPyramidIsoRepresentation_h
 
 #include "MedicalIsosurfacesRepresentationsModule.h" // For export macro
+#include "vtkDoubleArray.h"                          // For vtkNew<vtkDoubleArray>
 #include "vtkImageVolumeRepresentation.h"
-#include "vtkDoubleArray.h" // For vtkNew<vtkDoubleArray>
-#include "vtkNew.h"         // For vtkNew
+#include "vtkNew.h" // For vtkNew
 
 #include <string> // For std::string
 

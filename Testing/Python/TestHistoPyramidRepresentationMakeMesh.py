@@ -13,8 +13,8 @@ bone 400, a colour each:
   and opacity the view draws that surface with (the representation's SurfaceLooks); field
   data names each surface, counts its triangles (those of a one-isovalue Block LOD Contour);
 - coloured by the HU colour map instead, the mesh takes the map's colours at the values,
-  opaque while the map's opacity mapping is off; a surface the view does not draw
-  (opacity 0) is left out;
+  opaque while the map's opacity mapping is off; surfaces the view does not draw
+  (opacity 0, a value outside the data range) are left out;
 - the display is hidden and the mesh shown in its colours;
 - saved as STL, PLY (with its colours) and VTP and read back: the same triangles,
   colours and names;
@@ -224,11 +224,14 @@ check(surface_colors.round(6).tolist() == [[0.0, 1.0, 0.0, 1.0], [0.0, 0.0, 1.0,
 Delete(mesh_proxy)
 Delete(contour)
 Show(phantom, view)
-display.HistoPyramidSurfaceOpacities = [0.0, 1.0]
+display.HistoPyramidSurfaceOpacities = [0.0, 1.0, 1.0]
+display.IsosurfaceValues = [hp.SKIN, hp.BONE, 1.0e6]
+_, warned = hp.captured(lambda: Render(view))
+check("outside the range" in warned, "1e6: the representation's warning (%r)" % warned.strip()[:200])
 mesh_proxy = medical_isosurfaces.MakeMeshFromView(display, view, level=1, show=False)
 mesh = fetch(mesh_proxy)
 check(list(servermanager._getPyProxy(contour_of(mesh_proxy)).GetPropertyValue("ContourValues"))
-      == [hp.BONE], "a surface the view does not draw (opacity 0) is left out")
+      == [hp.BONE], "surfaces the view does not draw (opacity 0, outside the range) are left out")
 same_triangles(mesh, reference_contour([hp.BONE], level=1), "bone only")
 
 # --- 4. bad calls -------------------------------------------------------------------
