@@ -110,8 +110,8 @@ elif panel == "mesh":
         contour.UpdatePropertyInformation()
         mesh_status = {
             "triangles": mesh.GetDataInformation().GetNumberOfCells(),
-            "contour_values": list(contour.ContourValues),
-            "auto_lod": contour.AutoLOD,
+            "contour_values": list(contour.GetPropertyValue("ContourValues")),
+            "auto_lod": contour.GetPropertyValue("AutoLOD"),
             "chosen_level": contour.GetProperty("ChosenLevel")[0],
             "surface_names": list(mesh.SurfaceNames),
             "surface_colors": list(mesh.SurfaceColors),

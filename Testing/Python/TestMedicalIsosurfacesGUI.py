@@ -178,6 +178,9 @@ scroll = ('<pqevent object="pqClientMainWindow/propertiesDock/propertiesPanel/sc
           'qt_scrollarea_vcontainer/1QScrollBar0" command="set_int" arguments="285" />')
 process, status_path, log = start_paraview("representation", scroll)
 status = wait_for(status_path, process, 120)
+# As for 1b and 2b: the window may not be painted yet when the status is
+# written (a black screen was captured twice a second apart under load).
+time.sleep(3.0)
 representation_screen = stable_screen() if status else None
 stop_paraview("representation", process, log)
 if check(status is not None, "representation: the scene script ran (status written)"):
