@@ -3,7 +3,7 @@
     pvpython TestMedicalIsosurfacesGUI.py --paraview PATH --plugin-dir DIR --settings INI
                                           --baseline PNG --out DIR [--qch FILE]
 
-Starts the `paraview` executable three times, each with a fresh home holding
+Starts the `paraview` executable six times, each with a fresh home holding
 Testing/Data/GUI/ParaView5.11.0.ini (no welcome dialog, a left dock wide enough
 to read), the plugin on PV_PLUGIN_PATH, and Testing/Python/MedicalIsosurfacesGUIScene.py
 as its --script:
@@ -18,6 +18,12 @@ as its --script:
 2b. "apply": the phantom as HistoPyramid Isosurface (pure red skin); recorded
    events add Block LOD Contour from the Filters menu and click Apply: the
    phantom's display must be hidden (no red left on the screen);
+2c. "mesh": the phantom as HistoPyramid Isosurface at -500, 400 and 5000
+   (outside the range); recorded events check that the panel shows the range
+   warning and click Make Mesh; the scene reports the mesh: the triangles of a
+   Block LOD Contour of the drawn values at Auto LOD's level, each surface's
+   name, colour and opacity, the phantom hidden (the representation's one
+   warning about 5000 is expected in the log);
 3. "help": as 2, then recorded events: with Auto LOD the level control is
    disabled and shows the level used, the budget enabled; Auto LOD unchecked,
    the level is enabled and shows its setting, the budget disabled (QtTesting
