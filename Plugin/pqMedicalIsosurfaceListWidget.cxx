@@ -406,7 +406,12 @@ void pqMedicalIsosurfaceListWidget::updateTable()
     this->Table->setItem(i, ColorColumn, color);
     auto* opacity = new QTableWidgetItem(FormatNumber(row.Opacity));
     opacity->setTextAlignment(Qt::AlignRight | Qt::AlignVCenter);
-    if (static_cast<std::size_t>(i) < this->DrawnOpacities.size() &&
+    if (this->HasRange && !(row.Value >= this->Range[0] && row.Value <= this->Range[1]))
+    {
+      opacity->setData(Qt::UserRole, 0.0);
+      opacity->setToolTip(tr("Outside the data range: not drawn."));
+    }
+    else if (static_cast<std::size_t>(i) < this->DrawnOpacities.size() &&
       std::abs(this->DrawnOpacities[static_cast<std::size_t>(i)] - row.Opacity) > 1e-6)
     {
       opacity->setData(Qt::UserRole, this->DrawnOpacities[static_cast<std::size_t>(i)]);
@@ -570,7 +575,8 @@ void pqMedicalIsosurfaceListWidget::updateRange()
     this->RangeLabel->setText(tr("Data range: unknown (no one-component point array)"));
   }
   this->RangeName = this->HasRange && array->GetName() ? array->GetName() : "";
-  this->updateWarning();
+  // The rows outside the range and the warning follow the range.
+  this->updateTable();
 }
 
 //------------------------------------------------------------------------------
