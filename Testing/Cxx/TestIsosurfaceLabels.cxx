@@ -61,8 +61,8 @@ void ExpectError(vtkPolyData* input, int surfaces, const char* needle, const std
   Check(!observer->GetWarning() && at != std::string::npos &&
       message.find("ERROR", message.find("ERROR") + 1) == std::string::npos,
     what + ": one error mentioning '" + needle + "'");
-  Check(labels->GetOutput()->GetNumberOfCells() == 0 &&
-      labels->GetOutput()->GetNumberOfPoints() == 0,
+  Check(
+    labels->GetOutput()->GetNumberOfCells() == 0 && labels->GetOutput()->GetNumberOfPoints() == 0,
     what + ": an empty output");
 }
 }
@@ -97,8 +97,7 @@ int TestIsosurfaceLabels(int, char*[])
     "the input's points and cells themselves (a shallow copy)");
 
   auto* index = vtkIntArray::SafeDownCast(output->GetCellData()->GetArray("SurfaceIndex"));
-  auto* color =
-    vtkUnsignedCharArray::SafeDownCast(output->GetCellData()->GetArray("SurfaceColor"));
+  auto* color = vtkUnsignedCharArray::SafeDownCast(output->GetCellData()->GetArray("SurfaceColor"));
   vtkDataArray* isovalue = input->GetPointData()->GetScalars();
   const bool arrays = index && color && color->GetNumberOfComponents() == 4 && isovalue;
   Check(arrays, "SurfaceIndex (int) and SurfaceColor (RGBA) per cell");
@@ -149,8 +148,8 @@ int TestIsosurfaceLabels(int, char*[])
   quiet->AddObserver(vtkCommand::WarningEvent, observer);
   quiet->SetInputData(empty);
   quiet->Update();
-  Check(!observer->GetError() && !observer->GetWarning() &&
-      quiet->GetOutput()->GetNumberOfCells() == 0,
+  Check(
+    !observer->GetError() && !observer->GetWarning() && quiet->GetOutput()->GetNumberOfCells() == 0,
     "an empty input: an empty output, no message");
 
   return medical_test::Finish("vtkIsosurfaceLabels: all checks passed");
