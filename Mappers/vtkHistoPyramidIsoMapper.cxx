@@ -5,6 +5,7 @@
 #include "vtkColorTransferFunction.h"
 #include "vtkContourValues.h"
 #include "vtkDataArray.h"
+#include "vtkDiscretizableColorTransferFunction.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkMatrix4x4.h"
@@ -116,6 +117,58 @@ void vtkHistoPyramidIsoMapper::ReleaseGraphicsResources(vtkWindow* win)
 }
 
 //------------------------------------------------------------------------------
+bool vtkHistoPyramidIsoMapper::MapsScalarOpacity(vtkVolumeProperty* property) const
+{
+  if (this->ColorSource != TransferFunctionColors || !property)
+  {
+    return false;
+  }
+  // ParaView's colour maps are vtkDiscretizableColorTransferFunctions; like
+  // its Surface representation's mapper, apply their opacity function only
+  // when the map says so (a plain vtkColorTransferFunction has no such switch).
+  auto* map = vtkDiscretizableColorTransferFunction::SafeDownCast(
+    property->GetColorChannels(0) == 1 ? nullptr : property->GetRGBTransferFunction(0));
+  return !map || map->GetEnableOpacityMapping();
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoMapper::GetSurfaceLook(
+  vtkVolumeProperty* property, int index, double value, double color[3], double& opacity) const
+{
+  const std::size_t i = static_cast<std::size_t>(std::max(0, index));
+  opacity = 1.0;
+  if (this->ColorSource == TransferFunctionColors && property)
+  {
+    if (property->GetColorChannels(0) == 1)
+    {
+      color[0] = color[1] = color[2] = property->GetGrayTransferFunction(0)->GetValue(value);
+    }
+    else
+    {
+      property->GetRGBTransferFunction(0)->GetColor(value, color);
+    }
+    vtkPiecewiseFunction* map = property->GetScalarOpacity(0);
+    if (map && this->MapsScalarOpacity(property))
+    {
+      opacity = map->GetValue(value);
+    }
+  }
+  else if (this->ColorSource == SurfaceColors && 3 * i < this->SurfaceColorValues.size())
+  {
+    std::copy_n(&this->SurfaceColorValues[3 * i], 3, color);
+  }
+  else
+  {
+    std::copy_n(this->SolidColor, 3, color);
+  }
+  if (i < this->SurfaceOpacityValues.size())
+  {
+    opacity *= this->SurfaceOpacityValues[i];
+  }
+  opacity = std::min(1.0, std::max(0.0, opacity * this->Opacity));
+}
+
+//------------------------------------------------------------------------------
 void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
   Internals& impl = *this->Impl;
@@ -217,40 +270,11 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
   std::vector<Surface> surfaces;
-  vtkPiecewiseFunction* opacity = property->GetScalarOpacity(0);
   for (std::size_t k = 0; k < requested.Surfaces.size(); ++k)
   {
-    const double v = requested.Surfaces[k].Value;
-    const std::size_t index = static_cast<std::size_t>(requested.Sources[k]);
     Surface s;
-    s.Value = v;
-    s.Opacity = 1.0;
-    if (this->ColorSource == TransferFunctionColors)
-    {
-      if (property->GetColorChannels(0) == 1)
-      {
-        const double gray = property->GetGrayTransferFunction(0)->GetValue(v);
-        s.Color[0] = s.Color[1] = s.Color[2] = gray;
-      }
-      else
-      {
-        property->GetRGBTransferFunction(0)->GetColor(v, s.Color);
-      }
-      s.Opacity = opacity ? opacity->GetValue(v) : 1.0;
-    }
-    else if (this->ColorSource == SurfaceColors && 3 * index < this->SurfaceColorValues.size())
-    {
-      std::copy_n(&this->SurfaceColorValues[3 * index], 3, s.Color);
-    }
-    else
-    {
-      std::copy_n(this->SolidColor, 3, s.Color);
-    }
-    if (index < this->SurfaceOpacityValues.size())
-    {
-      s.Opacity *= this->SurfaceOpacityValues[index];
-    }
-    s.Opacity = std::min(1.0, std::max(0.0, s.Opacity * this->Opacity));
+    s.Value = requested.Surfaces[k].Value;
+    this->GetSurfaceLook(property, requested.Sources[k], s.Value, s.Color, s.Opacity);
     if (s.Opacity > 0.0)
     {
       surfaces.push_back(s);

@@ -92,6 +92,7 @@
 #include <string>  // For std::string
 #include <vector>  // For std::vector
 
+class vtkVolumeProperty;
 
 class MEDICALISOSURFACESMAPPERS_EXPORT vtkHistoPyramidIsoMapper : public vtkVolumeMapper
 {
@@ -245,6 +246,13 @@ public:
    * SurfaceOpacity(i) (1 where none is set) and by Opacity: an application
    * can give each surface its own colour and opacity without editing
    * transfer functions. A surface of opacity 0 is not drawn.
+   *
+   * The scalar opacity function applies only with TransferFunctionColors,
+   * and, when the colour function is a vtkDiscretizableColorTransferFunction
+   * (ParaView's colour maps), only while its EnableOpacityMapping is on: the
+   * rule of VTK's surface mappers and of ParaView's Surface representation
+   * (whose colour map editor calls it "Enable opacity mapping for surfaces"),
+   * so colouring by an array does not make a surface translucent unasked.
    */
   vtkSetClampMacro(ColorSource, int, TransferFunctionColors, SurfaceColors);
   vtkGetMacro(ColorSource, int);
@@ -259,6 +267,18 @@ public:
   vtkSetClampMacro(Opacity, double, 0.0, 1.0);
   vtkGetMacro(Opacity, double);
   ///@}
+
+  /**
+   * The colour and opacity the isovalue `value`, the `index`-th of
+   * `property`'s isovalues, is drawn with under the rules above (an opacity
+   * of 0: not drawn). Render() takes every surface's look from here; a host
+   * reads it to show or export what the view draws.
+   */
+  void GetSurfaceLook(
+    vtkVolumeProperty* property, int index, double value, double color[3], double& opacity) const;
+
+  /// Whether `property`'s scalar opacity function applies (see SetColorSource()).
+  bool MapsScalarOpacity(vtkVolumeProperty* property) const;
 
   /**
    * Why an image of this spacing holds no surface (a zero or non-finite

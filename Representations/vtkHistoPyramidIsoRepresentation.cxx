@@ -4,6 +4,7 @@
 #include "vtkCellData.h"
 #include "vtkContourValues.h"
 #include "vtkDataArray.h"
+#include "vtkDataObject.h"
 #include "vtkFieldData.h"
 #include "vtkHistoPyramidIsoMapper.h"
 #include "vtkImageData.h"
@@ -465,15 +466,22 @@ std::string vtkHistoPyramidIsoRepresentation::IsovaluesOutsideRange()
   }
   double range[2];
   array->GetRange(range, 0);
+  vtkContourValues* values = this->Property->GetIsoSurfaceValues();
+  return OutsideRangeMessage(
+    values->GetValues(), values->GetNumberOfContours(), range, array->GetName());
+}
+
+//------------------------------------------------------------------------------
+std::string vtkHistoPyramidIsoRepresentation::OutsideRangeMessage(
+  const double* values, int count, const double range[2], const char* arrayName)
+{
   std::ostringstream outside;
-  const int count = this->Property->GetIsoSurfaceValues()->GetNumberOfContours();
   int n = 0;
   for (int i = 0; i < count; ++i)
   {
-    const double value = this->Property->GetIsoSurfaceValues()->GetValue(i);
-    if (value < range[0] || value > range[1])
+    if (values[i] < range[0] || values[i] > range[1])
     {
-      outside << (n++ ? ", " : "") << value;
+      outside << (n++ ? ", " : "") << values[i];
     }
   }
   if (n == 0)
@@ -483,9 +491,36 @@ std::string vtkHistoPyramidIsoRepresentation::IsovaluesOutsideRange()
   std::ostringstream message;
   message << "HistoPyramid Isosurface: isovalue" << (n > 1 ? "s " : " ") << outside.str()
           << (n > 1 ? " are" : " is") << " outside the range [" << range[0] << ", " << range[1]
-          << "] of the array \"" << (array->GetName() ? array->GetName() : "")
-          << "\": no surface is drawn for " << (n > 1 ? "them" : "it") << ".";
+          << "] of the array \"" << (arrayName ? arrayName : "") << "\": no surface is drawn for "
+          << (n > 1 ? "them" : "it") << ".";
   return message.str();
+}
+
+//------------------------------------------------------------------------------
+vtkDoubleArray* vtkHistoPyramidIsoRepresentation::GetSurfaceLooks()
+{
+  // The colouring as UpdateMapperParameters() sets it, from the properties
+  // alone: in client/server mode the client's copy, which ParaView reads
+  // information from, never renders.
+  vtkInformation* array = this->GetInputArrayInformation(0);
+  const char* name = array && array->Has(vtkDataObject::FIELD_NAME())
+    ? array->Get(vtkDataObject::FIELD_NAME())
+    : nullptr;
+  this->IsoMapper->SetColorSource(this->ColorEachSurface
+      ? vtkHistoPyramidIsoMapper::SurfaceColors
+      : ((name && name[0]) ? vtkHistoPyramidIsoMapper::TransferFunctionColors
+                           : vtkHistoPyramidIsoMapper::SolidColors));
+  vtkContourValues* values = this->Property->GetIsoSurfaceValues();
+  const int count = values->GetNumberOfContours();
+  this->SurfaceLooks->SetNumberOfComponents(4);
+  this->SurfaceLooks->SetNumberOfTuples(count);
+  for (int i = 0; i < count; ++i)
+  {
+    double look[4];
+    this->IsoMapper->GetSurfaceLook(this->Property, i, values->GetValue(i), look, look[3]);
+    this->SurfaceLooks->SetTypedTuple(i, look);
+  }
+  return this->SurfaceLooks;
 }
 
 //------------------------------------------------------------------------------

@@ -48,12 +48,14 @@
 #define vtkHistoPyramidIsoRepresentation_h
 
 #include "MedicalIsosurfacesRepresentationsModule.h" // For export macro
+#include "vtkDoubleArray.h"                          // For vtkNew<vtkDoubleArray>
 #include "vtkImageVolumeRepresentation.h"
 #include "vtkNew.h"   // For vtkNew
 #include "vtkPlane.h" // For vtkPlane
 
 #include <string> // For std::string
 
+class vtkDoubleArray;
 class vtkHistoPyramidIsoMapper;
 
 class MEDICALISOSURFACESREPRESENTATIONS_EXPORT vtkHistoPyramidIsoRepresentation
@@ -154,6 +156,23 @@ public:
   double GetFrameBufferMB() { return this->GetFrameBufferBytes() / 1.0e6; }
   ///@}
 
+  /**
+   * What each isovalue, in the order of IsosurfaceValues, is drawn with:
+   * red, green, blue and opacity per isovalue (vtkHistoPyramidIsoMapper::
+   * GetSurfaceLook() under the colouring of the last update; opacity 0: not
+   * drawn). The panel's Opacity column and the mesh made from the view read
+   * it, so both show what the view draws.
+   */
+  vtkDoubleArray* GetSurfaceLooks();
+
+  /**
+   * The warning for `count` isovalues `values` outside `range` of the array
+   * `arrayName` ("" when all are inside): the one text the representation
+   * gives in Output Messages and the panel shows above the list.
+   */
+  static std::string OutsideRangeMessage(
+    const double* values, int count, const double range[2], const char* arrayName);
+
 protected:
   vtkHistoPyramidIsoRepresentation();
   ~vtkHistoPyramidIsoRepresentation() override;
@@ -185,6 +204,7 @@ private:
   std::string IsovaluesOutsideRange();
 
   vtkNew<vtkHistoPyramidIsoMapper> IsoMapper;
+  vtkNew<vtkDoubleArray> SurfaceLooks;
   bool ColorEachSurface = false;
   bool ClipPlane = false;
   double ClipPlaneOrigin[3] = { 0.0, 0.0, 0.0 };
