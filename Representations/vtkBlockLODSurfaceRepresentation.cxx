@@ -1,0 +1,323 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkBlockLODSurfaceRepresentation.h"
+
+#include "vtkBlockLODContour.h"
+#include "vtkCommunicator.h"
+#include "vtkCompositeDataIterator.h"
+#include "vtkCompositeDataSet.h"
+#include "vtkDataArray.h"
+#include "vtkFieldData.h"
+#include "vtkInformation.h"
+#include "vtkIntArray.h"
+#include "vtkMultiProcessController.h"
+#include "vtkObjectFactory.h"
+#include "vtkPVRenderView.h"
+#include "vtkPVView.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+
+#include <algorithm>
+#include <array>
+
+vtkStandardNewMacro(vtkBlockLODSurfaceRepresentation);
+
+namespace
+{
+constexpr int Levels = 4;
+
+// The first vtkPolyData of a delivered piece (a vtkPolyData, or a composite
+// dataset around one).
+vtkPolyData* FirstSurface(vtkDataObject* data)
+{
+  if (auto* surface = vtkPolyData::SafeDownCast(data))
+  {
+    return surface;
+  }
+  if (auto* composite = vtkCompositeDataSet::SafeDownCast(data))
+  {
+    vtkSmartPointer<vtkCompositeDataIterator> it;
+    it.TakeReference(composite->NewIterator());
+    for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+    {
+      if (auto* surface = vtkPolyData::SafeDownCast(it->GetCurrentDataObject()))
+      {
+        return surface;
+      }
+    }
+  }
+  return nullptr;
+}
+
+// The field that marks LOD geometry made here, with its level (a decimated
+// copy may carry the output's own "BlockLODLevel" along).
+const char* const LevelMark = "BlockLODInteractiveLevel";
+
+// Triangles and level of a delivered LOD piece (-1 when it is not marked as
+// a Block LOD level: the decimated copy).
+void DescribeLOD(vtkDataObject* data, int& level, double& triangles)
+{
+  level = -1;
+  triangles = 0.0;
+  if (auto* composite = vtkCompositeDataSet::SafeDownCast(data))
+  {
+    vtkSmartPointer<vtkCompositeDataIterator> it;
+    it.TakeReference(composite->NewIterator());
+    for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+    {
+      if (auto* surface = vtkPolyData::SafeDownCast(it->GetCurrentDataObject()))
+      {
+        triangles += static_cast<double>(surface->GetNumberOfPolys());
+      }
+    }
+  }
+  else if (auto* surface = vtkPolyData::SafeDownCast(data))
+  {
+    triangles = static_cast<double>(surface->GetNumberOfPolys());
+  }
+  vtkPolyData* first = FirstSurface(data);
+  vtkDataArray* field = first ? first->GetFieldData()->GetArray(LevelMark) : nullptr;
+  if (field && field->GetNumberOfTuples() == 1)
+  {
+    level = static_cast<int>(field->GetTuple1(0));
+  }
+}
+}
+
+//------------------------------------------------------------------------------
+vtkBlockLODSurfaceRepresentation::vtkBlockLODSurfaceRepresentation() = default;
+vtkBlockLODSurfaceRepresentation::~vtkBlockLODSurfaceRepresentation() = default;
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::SetInteractiveLevels(bool use)
+{
+  if (use != this->InteractiveLevels)
+  {
+    this->InteractiveLevels = use;
+    // The LOD geometry is remade by the next update's REQUEST_UPDATE_LOD.
+    this->MarkModified();
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::SetInteractiveTriangleBudget(double triangles)
+{
+  triangles = std::max(0.0, triangles);
+  if (triangles != this->InteractiveTriangleBudget)
+  {
+    this->InteractiveTriangleBudget = triangles;
+    this->MarkModified();
+  }
+}
+
+//------------------------------------------------------------------------------
+vtkBlockLODContour* vtkBlockLODSurfaceRepresentation::FindContour()
+{
+  if (this->GetNumberOfInputPorts() < 1 || this->GetNumberOfInputConnections(0) != 1)
+  {
+    return nullptr; // the client's copy, in client/server
+  }
+  // ParaView's own pass-through filters between a source and its displays
+  // (vtkPVPostFilter) are skipped; any other filter ends the search.
+  vtkAlgorithm* producer = this->GetInputAlgorithm(0, 0);
+  while (producer && producer->IsA("vtkPVPostFilter") && producer->GetNumberOfInputPorts() == 1 &&
+    producer->GetNumberOfInputConnections(0) == 1)
+  {
+    producer = producer->GetInputAlgorithm(0, 0);
+  }
+  auto* contour = vtkBlockLODContour::SafeDownCast(producer);
+  if (!contour)
+  {
+    return nullptr;
+  }
+  // The filter's output must be the data shown here: shallow copies along
+  // the way share its points array.
+  auto* shown = vtkPolyData::SafeDownCast(this->GetInputDataObject(0, 0));
+  vtkPolyData* made = contour->GetOutput();
+  if (!shown || !made || !shown->GetPoints() || !made->GetPoints() ||
+    shown->GetPoints()->GetData() != made->GetPoints()->GetData())
+  {
+    return nullptr;
+  }
+  return contour;
+}
+
+//------------------------------------------------------------------------------
+bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
+{
+  this->ChosenInteractiveLevel = -1;
+  this->LevelSurface->Initialize();
+  vtkBlockLODContour* contour = this->FindContour();
+  const int still = contour ? contour->GetChosenLevel() : -1;
+
+  // Triangles per level, this process's (unknown: -1), then summed over the
+  // processes so that every piece picks the same level. Every data process
+  // runs this pass, with or without a piece.
+  std::array<double, Levels> triangles;
+  triangles.fill(-1.0);
+  if (still >= 0 && still < Levels)
+  {
+    auto* shown = vtkPolyData::SafeDownCast(this->GetInputDataObject(0, 0));
+    triangles[still] = static_cast<double>(shown->GetNumberOfPolys());
+    for (int level = still - 1; level >= 0; --level)
+    {
+      triangles[level] = contour->EstimateLevelTriangles(level);
+    }
+  }
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  if (controller && controller->GetNumberOfProcesses() > 1)
+  {
+    // Unknown counts are summed as a large negative number, so that a level
+    // unknown on any process stays unknown.
+    std::array<double, Levels> local, global;
+    for (int level = 0; level < Levels; ++level)
+    {
+      local[level] = triangles[level] < 0 ? -1e300 : triangles[level];
+    }
+    // A process without a Block LOD piece (an empty piece) adds nothing.
+    if (!contour)
+    {
+      local.fill(0.0);
+    }
+    controller->AllReduce(local.data(), global.data(), Levels, vtkCommunicator::SUM_OP);
+    triangles = global;
+    std::array<int, 1> have = { { contour ? 1 : 0 } }, anyHave = { { 0 } };
+    controller->AllReduce(have.data(), anyHave.data(), 1, vtkCommunicator::MAX_OP);
+    if (anyHave[0] == 0)
+    {
+      return false;
+    }
+  }
+  if (!contour || still < 0 || still >= Levels)
+  {
+    return false;
+  }
+
+  // The finest level, from the output's down, within the budget; else the
+  // coarsest known.
+  int chosen = -1;
+  for (int level = still; level >= 0; --level)
+  {
+    if (triangles[level] < 0)
+    {
+      continue;
+    }
+    chosen = level;
+    if (triangles[level] <= this->InteractiveTriangleBudget)
+    {
+      break;
+    }
+  }
+  if (chosen < 0)
+  {
+    return false;
+  }
+  if (chosen == still)
+  {
+    // Within the budget already: the shown surface is its own LOD.
+    this->LevelSurface->ShallowCopy(this->GetInputDataObject(0, 0));
+  }
+  else if (!contour->GenerateLevel(chosen, this->LevelSurface))
+  {
+    return false;
+  }
+  // Marked in field data of its own (a shallow copy shares the source's).
+  vtkNew<vtkFieldData> fields;
+  fields->ShallowCopy(this->LevelSurface->GetFieldData());
+  vtkNew<vtkIntArray> mark;
+  mark->SetName(LevelMark);
+  mark->InsertNextValue(chosen);
+  fields->AddArray(mark);
+  this->LevelSurface->SetFieldData(fields);
+  this->ChosenInteractiveLevel = chosen;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+vtkDataObject* vtkBlockLODSurfaceRepresentation::WrapLikePiece(vtkDataObject* piece)
+{
+  // The view moves LOD geometry between processes as data of the piece's
+  // type (the client's placeholder is an empty piece of that type): the level
+  // takes the place of the piece's surface in a copy of its structure.
+  auto* composite = vtkCompositeDataSet::SafeDownCast(piece);
+  if (!composite)
+  {
+    return this->LevelSurface;
+  }
+  this->LevelPiece.TakeReference(composite->NewInstance());
+  this->LevelPiece->CopyStructure(composite);
+  vtkSmartPointer<vtkCompositeDataIterator> it;
+  it.TakeReference(composite->NewIterator());
+  for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+  {
+    if (vtkPolyData::SafeDownCast(it->GetCurrentDataObject()))
+    {
+      this->LevelPiece->SetDataSet(it, this->LevelSurface);
+      break;
+    }
+  }
+  return this->LevelPiece;
+}
+
+//------------------------------------------------------------------------------
+int vtkBlockLODSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKey* request_type,
+  vtkInformation* inInfo,
+  vtkInformation* outInfo)
+{
+  if (request_type == vtkPVView::REQUEST_UPDATE_LOD() && this->InteractiveLevels &&
+    !this->SuppressLOD && !inInfo->Has(vtkPVRenderView::USE_OUTLINE_FOR_LOD()))
+  {
+    // vtkGeometryRepresentation's pass would decimate the data; the surfaces
+    // base class adds nothing to this pass, so only the data
+    // representation's bookkeeping runs before the level replaces it.
+    if (!this->vtkPVDataRepresentation::ProcessViewRequest(request_type, inInfo, outInfo))
+    {
+      return 0;
+    }
+    // Run on every data process (a parallel run reduces counts in it).
+    const bool made = this->MakeLevelLOD();
+    vtkDataObject* piece = vtkPVView::GetPiece(inInfo, this);
+    if (made && piece != nullptr)
+    {
+      vtkPVView::SetPieceLOD(inInfo, this, this->WrapLikePiece(piece));
+      return 1;
+    }
+  }
+  else if (request_type == vtkPVView::REQUEST_UPDATE_LOD())
+  {
+    this->ChosenInteractiveLevel = -1;
+  }
+
+  if (!this->Superclass::ProcessViewRequest(request_type, inInfo, outInfo))
+  {
+    return 0;
+  }
+  if (request_type == vtkPVView::REQUEST_RENDER())
+  {
+    vtkDataObject* lod = vtkPVView::GetDeliveredPieceLOD(inInfo, this);
+    this->LastRenderUsedLOD =
+      !this->SuppressLOD && inInfo->Has(vtkPVRenderView::USE_LOD()) == 1 && lod != nullptr;
+    if (lod)
+    {
+      DescribeLOD(lod, this->InteractiveLevel, this->InteractiveTriangles);
+    }
+    else
+    {
+      this->InteractiveLevel = -1;
+      this->InteractiveTriangles = 0.0;
+    }
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "InteractiveLevels: " << this->InteractiveLevels << "\n";
+  os << indent << "InteractiveTriangleBudget: " << this->InteractiveTriangleBudget << "\n";
+  os << indent << "InteractiveLevel: " << this->InteractiveLevel << "\n";
+  os << indent << "InteractiveTriangles: " << this->InteractiveTriangles << "\n";
+  os << indent << "LastRenderUsedLOD: " << this->LastRenderUsedLOD << "\n";
+  os << indent << "ChosenInteractiveLevel: " << this->ChosenInteractiveLevel << "\n";
+}

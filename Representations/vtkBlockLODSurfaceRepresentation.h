@@ -1,0 +1,143 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @class   vtkBlockLODSurfaceRepresentation
+ * @brief   ParaView's Surface representation of a vtkBlockLODContour output,
+ *          whose interactive frames draw a coarser Block LOD level.
+ *
+ * ParaView's render view keeps a second, lighter copy of large geometry for
+ * interactive renders (while the camera moves): when the shown geometry
+ * exceeds the view's LODThreshold (MB), each vtkGeometryRepresentation is
+ * asked, in the REQUEST_UPDATE_LOD pass, for a decimated copy of its data
+ * (vtkQuadricClustering), which the view delivers to the rendering processes
+ * like the full data (the client in client/server with local rendering) and
+ * draws through the actor's LOD mapper during interaction. The still render
+ * draws the full data.
+ *
+ * An isosurface from vtkBlockLODContour has better copies than a decimated
+ * one: the method's own coarser levels (cube edges of 8, 4, 2 voxels), every
+ * one watertight and with normals from the volume, and cached by the filter,
+ * so switching between them costs no extraction. This representation is the
+ * Surface representation (vtkGeometryRepresentationWithFaces, every property
+ * unchanged) with one difference: in REQUEST_UPDATE_LOD it supplies, as the
+ * LOD, the finest level at or below the output's whose triangles fit the
+ * interactive budget, made by the filter (vtkBlockLODContour::GenerateLevel),
+ * instead of the decimated copy. The view's decision to use the LOD at all
+ * (LODThreshold), its delivery and the still render are ParaView's and
+ * unchanged.
+ *
+ * How the filter is found: ParaView connects a representation to its
+ * source's output through a pass-through filter of its own (vtkPVPostFilter);
+ * the representation looks upstream through those for a vtkBlockLODContour,
+ * on the data processes, and uses its level only when the filter's current
+ * output is the data the representation received (the same points array).
+ * Anything else (another source, an output not current, the view asking for
+ * outlines as LOD, InteractiveLevels off) gets ParaView's decimated copy.
+ *
+ * Level choice: the candidates are the output's level and every coarser one,
+ * finest first, with their triangles (the output's exactly, the others from
+ * the filter's estimator: exact for cached or planned levels and for levels
+ * 0 and 1 almost always, predicted otherwise). The first whose triangles are
+ * at most InteractiveTriangleBudget is chosen, else level 0. In a parallel
+ * run the counts are summed over the processes first, so every piece draws
+ * the same level.
+ *
+ * What interactive frames draw is readable on the rendering process:
+ * GetInteractiveLevel() (the level of the LOD geometry, -1 when it is not a
+ * Block LOD level), GetInteractiveTriangles() and GetLastRenderUsedLOD().
+ *
+ * @sa vtkBlockLODContour vtkGeometryRepresentation vtkPVRenderView
+ */
+#ifndef vtkBlockLODSurfaceRepresentation_h
+#define vtkBlockLODSurfaceRepresentation_h
+
+#include "MedicalIsosurfacesRepresentationsModule.h" // For export macro
+#include "vtkGeometryRepresentationWithFaces.h"
+#include "vtkNew.h"          // For vtkNew
+#include "vtkSmartPointer.h" // For vtkSmartPointer
+
+class vtkBlockLODContour;
+class vtkCompositeDataSet;
+class vtkPolyData;
+
+class MEDICALISOSURFACESREPRESENTATIONS_EXPORT vtkBlockLODSurfaceRepresentation
+  : public vtkGeometryRepresentationWithFaces
+{
+public:
+  static vtkBlockLODSurfaceRepresentation* New();
+  vtkTypeMacro(vtkBlockLODSurfaceRepresentation, vtkGeometryRepresentationWithFaces);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  int ProcessViewRequest(vtkInformationRequestKey* request_type,
+    vtkInformation* inInfo,
+    vtkInformation* outInfo) override;
+
+  ///@{
+  /**
+   * Draw a coarser Block LOD level during interaction (when the view uses its
+   * LOD at all) instead of ParaView's decimated copy. Default on.
+   */
+  void SetInteractiveLevels(bool use);
+  vtkGetMacro(InteractiveLevels, bool);
+  ///@}
+
+  ///@{
+  /**
+   * The most triangles (all isovalues, all processes together) an
+   * interactive frame should draw: the finest level within it is chosen, else
+   * level 0. Default 300000.
+   */
+  void SetInteractiveTriangleBudget(double triangles);
+  vtkGetMacro(InteractiveTriangleBudget, double);
+  ///@}
+
+  ///@{
+  /**
+   * What the LOD geometry on this process is: its Block LOD level (-1 when
+   * there is none, or it is ParaView's decimated copy) and its triangles.
+   * Set by the last render that had LOD geometry delivered, so on the
+   * rendering process (the client with local rendering).
+   */
+  vtkGetMacro(InteractiveLevel, int);
+  vtkGetMacro(InteractiveTriangles, double);
+  ///@}
+
+  /**
+   * Whether the last render on this process drew the LOD geometry (an
+   * interactive render with the view's LOD in use).
+   */
+  vtkGetMacro(LastRenderUsedLOD, bool);
+
+  /**
+   * The level chosen by the last REQUEST_UPDATE_LOD pass on this (data)
+   * process, -1 when the decimated copy was used.
+   */
+  vtkGetMacro(ChosenInteractiveLevel, int);
+
+protected:
+  vtkBlockLODSurfaceRepresentation();
+  ~vtkBlockLODSurfaceRepresentation() override;
+
+  // The vtkBlockLODContour whose current output this representation shows,
+  // or null.
+  vtkBlockLODContour* FindContour();
+  // The LOD geometry of REQUEST_UPDATE_LOD: the chosen level, or false (the
+  // decimated copy is used).
+  bool MakeLevelLOD();
+  // The LOD geometry in the shape of the view's piece.
+  vtkDataObject* WrapLikePiece(vtkDataObject* piece);
+
+  bool InteractiveLevels = true;
+  double InteractiveTriangleBudget = 300000.0;
+  int InteractiveLevel = -1;
+  double InteractiveTriangles = 0.0;
+  bool LastRenderUsedLOD = false;
+  int ChosenInteractiveLevel = -1;
+  vtkNew<vtkPolyData> LevelSurface;
+  vtkSmartPointer<vtkCompositeDataSet> LevelPiece;
+
+private:
+  vtkBlockLODSurfaceRepresentation(const vtkBlockLODSurfaceRepresentation&) = delete;
+  void operator=(const vtkBlockLODSurfaceRepresentation&) = delete;
+};
+
+#endif
