@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkBlockLODSurfaceRepresentation.h"
 
+#include "FrameTimeModel.h"
 #include "vtkBlockLODContour.h"
+#include "vtkCallbackCommand.h"
+#include "vtkCommand.h"
 #include "vtkCommunicator.h"
 #include "vtkCompositeDataIterator.h"
 #include "vtkCompositeDataSet.h"
@@ -15,16 +18,39 @@
 #include "vtkPVView.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkProperty.h"
+#include "vtkRenderer.h"
 #include "vtkSmartPointer.h"
 
 #include <algorithm>
 #include <array>
+#include <chrono>
+#include <mutex>
+#include <vector>
 
 vtkStandardNewMacro(vtkBlockLODSurfaceRepresentation);
 
 namespace
 {
 constexpr int Levels = 4;
+
+// The frames of this process, for every Block LOD display in it: the model
+// describes the renderer and the machine, not one display.
+struct ProcessFrames
+{
+  std::mutex Mutex;
+  mediso::FrameTimeModel Model;
+};
+ProcessFrames& Frames()
+{
+  static ProcessFrames frames;
+  return frames;
+}
+
+double Now()
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 // The first vtkPolyData of a delivered piece (a vtkPolyData, or a composite
 // dataset around one).
@@ -100,6 +126,17 @@ void vtkBlockLODSurfaceRepresentation::SetInteractiveLevels(bool use)
 }
 
 //------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::SetInteractiveFrameBudget(double seconds)
+{
+  seconds = std::max(0.0, seconds);
+  if (seconds != this->InteractiveFrameBudget)
+  {
+    this->InteractiveFrameBudget = seconds;
+    this->MarkModified();
+  }
+}
+
+//------------------------------------------------------------------------------
 void vtkBlockLODSurfaceRepresentation::SetInteractiveTriangleBudget(double triangles)
 {
   triangles = std::max(0.0, triangles);
@@ -146,6 +183,7 @@ vtkBlockLODContour* vtkBlockLODSurfaceRepresentation::FindContour()
 bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
 {
   this->ChosenInteractiveLevel = -1;
+  this->PredictedInteractiveSeconds = 0.0;
   this->LevelSurface->Initialize();
   vtkBlockLODContour* contour = this->FindContour();
   const int still = contour ? contour->GetChosenLevel() : -1;
@@ -193,25 +231,46 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
     return false;
   }
 
-  // The finest level, from the output's down, within the budget; else the
-  // coarsest known.
-  int chosen = -1;
+  // The finest level, from the output's down, within the triangle budget (when
+  // set) and predicted within the frame budget (when set); else the coarsest.
+  mediso::FrameWork work;
+  work.Method = mediso::FrameMethod::Triangles;
+  work.Translucent = this->Property->GetOpacity() < 1.0;
+  if (auto* view = vtkPVRenderView::SafeDownCast(this->GetView()))
+  {
+    const int* size = view->GetSize();
+    work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
+      static_cast<std::uint64_t>(std::max(0, size[1]));
+  }
+  std::vector<mediso::FrameTimeModel::Candidate> candidates;
   for (int level = still; level >= 0; --level)
   {
-    if (triangles[level] < 0)
+    const bool allowed =
+      this->InteractiveTriangleBudget <= 0 || triangles[level] <= this->InteractiveTriangleBudget;
+    if (triangles[level] >= 0 && (allowed || level == 0))
     {
-      continue;
-    }
-    chosen = level;
-    if (triangles[level] <= this->InteractiveTriangleBudget)
-    {
-      break;
+      mediso::FrameTimeModel::Candidate candidate;
+      candidate.Level = level;
+      candidate.Work = work;
+      candidate.Work.Primitives = static_cast<std::uint64_t>(triangles[level]);
+      candidates.push_back(candidate);
     }
   }
-  if (chosen < 0)
+  if (candidates.empty())
   {
     return false;
   }
+  std::size_t pick = 0;
+  double predicted = 0.0;
+  {
+    std::lock_guard<std::mutex> lock(Frames().Mutex);
+    if (this->InteractiveFrameBudget > 0)
+    {
+      pick = Frames().Model.Choose(candidates, this->InteractiveFrameBudget);
+    }
+    predicted = Frames().Model.Predict(candidates[pick].Work);
+  }
+  const int chosen = candidates[pick].Level;
   if (chosen == still)
   {
     // Within the budget already: the shown surface is its own LOD.
@@ -230,6 +289,7 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
   fields->AddArray(mark);
   this->LevelSurface->SetFieldData(fields);
   this->ChosenInteractiveLevel = chosen;
+  this->PredictedInteractiveSeconds = predicted;
   return true;
 }
 
@@ -306,8 +366,81 @@ int vtkBlockLODSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKe
       this->InteractiveLevel = -1;
       this->InteractiveTriangles = 0.0;
     }
+    // What the coming frame draws, for the frame-time model: the LOD's
+    // triangles or the full data's, unless that data is new here (its upload
+    // is not a frame's cost).
+    vtkDataObject* drawn =
+      this->LastRenderUsedLOD ? lod : vtkPVView::GetDeliveredPiece(inInfo, this);
+    this->FrameTriangles = -1.0;
+    if (drawn && this->GetVisibility())
+    {
+      int level = -1;
+      double triangles = 0.0;
+      DescribeLOD(drawn, level, triangles);
+      if (drawn->GetMTime() == this->DrawnDataTime && triangles > 0)
+      {
+        this->FrameTriangles = triangles;
+      }
+      this->DrawnDataTime = drawn->GetMTime();
+    }
   }
   return 1;
+}
+
+//------------------------------------------------------------------------------
+bool vtkBlockLODSurfaceRepresentation::AddToView(vtkView* view)
+{
+  if (!this->Superclass::AddToView(view))
+  {
+    return false;
+  }
+  if (auto* renderView = vtkPVRenderView::SafeDownCast(view))
+  {
+    this->ObservedRenderer = renderView->GetRenderer();
+    this->StartObserver = this->ObservedRenderer->AddObserver(
+      vtkCommand::StartEvent, this, &vtkBlockLODSurfaceRepresentation::OnRenderStart);
+    this->EndObserver = this->ObservedRenderer->AddObserver(
+      vtkCommand::EndEvent, this, &vtkBlockLODSurfaceRepresentation::OnRenderEnd);
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkBlockLODSurfaceRepresentation::RemoveFromView(vtkView* view)
+{
+  if (this->ObservedRenderer)
+  {
+    this->ObservedRenderer->RemoveObserver(this->StartObserver);
+    this->ObservedRenderer->RemoveObserver(this->EndObserver);
+    this->ObservedRenderer = nullptr;
+  }
+  return this->Superclass::RemoveFromView(view);
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::OnRenderStart()
+{
+  this->FrameStart = Now();
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::OnRenderEnd()
+{
+  if (this->FrameTriangles <= 0 || !this->ObservedRenderer)
+  {
+    return;
+  }
+  mediso::FrameWork work;
+  work.Method = mediso::FrameMethod::Triangles;
+  work.Primitives = static_cast<std::uint64_t>(this->FrameTriangles);
+  const int* size = this->ObservedRenderer->GetSize();
+  work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
+    static_cast<std::uint64_t>(std::max(0, size[1]));
+  work.Translucent = this->Property->GetOpacity() < 1.0;
+  const double seconds = Now() - this->FrameStart;
+  this->FrameTriangles = -1.0; // one observation per prepared frame
+  std::lock_guard<std::mutex> lock(Frames().Mutex);
+  Frames().Model.Observe(work, seconds);
 }
 
 //------------------------------------------------------------------------------
@@ -315,6 +448,8 @@ void vtkBlockLODSurfaceRepresentation::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "InteractiveLevels: " << this->InteractiveLevels << "\n";
+  os << indent << "InteractiveFrameBudget: " << this->InteractiveFrameBudget << " s\n";
+  os << indent << "PredictedInteractiveSeconds: " << this->PredictedInteractiveSeconds << "\n";
   os << indent << "InteractiveTriangleBudget: " << this->InteractiveTriangleBudget << "\n";
   os << indent << "InteractiveLevel: " << this->InteractiveLevel << "\n";
   os << indent << "InteractiveTriangles: " << this->InteractiveTriangles << "\n";

@@ -36,10 +36,22 @@
  * Level choice: the candidates are the output's level and every coarser one,
  * finest first, with their triangles (the output's exactly, the others from
  * the filter's estimator: exact for cached or planned levels and for levels
- * 0 and 1 almost always, predicted otherwise). The first whose triangles are
- * at most InteractiveTriangleBudget is chosen, else level 0. In a parallel
- * run the counts are summed over the processes first, so every piece draws
- * the same level.
+ * 0 and 1 almost always, predicted otherwise). The first one predicted to
+ * draw within InteractiveFrameBudget seconds, and with at most
+ * InteractiveTriangleBudget triangles when that is set, is chosen, else the
+ * coarsest allowed. The seconds come from a frame-time model
+ * (mediso::FrameTimeModel, Mappers/Core/FrameTimeModel.h: seconds = a + b *
+ * triangles + c * pixels, fitted per opaque/translucent), which this
+ * representation feeds with the frames it draws in this process: each
+ * frame's renderer time, with the triangles it drew, the view's pixels and
+ * whether it was translucent. Before any frame the model's prior is
+ * conservative (a software renderer), so the first interactive level errs on
+ * the coarse side. The frame's time is the renderer's, whatever else it
+ * drew: with several large displays a frame's cost is charged to each, which
+ * errs on the coarse side as well. In a parallel run the counts are summed
+ * over the processes first, so every piece draws the same level; in
+ * client/server the level is chosen on the server, which renders no frame to
+ * learn from when the client renders: there the prior decides.
  *
  * What interactive frames draw is readable on the rendering process:
  * GetInteractiveLevel() (the level of the LOD geometry, -1 when it is not a
@@ -54,9 +66,11 @@
 #include "vtkGeometryRepresentationWithFaces.h"
 #include "vtkNew.h"          // For vtkNew
 #include "vtkSmartPointer.h" // For vtkSmartPointer
+#include "vtkWeakPointer.h"  // For vtkWeakPointer
 
 class vtkBlockLODContour;
 class vtkCompositeDataSet;
+class vtkRenderer;
 class vtkPolyData;
 
 class MEDICALISOSURFACESREPRESENTATIONS_EXPORT vtkBlockLODSurfaceRepresentation
@@ -82,13 +96,29 @@ public:
 
   ///@{
   /**
+   * The seconds an interactive frame should take, as the frame-time model
+   * predicts them: the finest level within it is chosen, else level 0. 0
+   * leaves the choice to InteractiveTriangleBudget alone. Default 0.1.
+   */
+  void SetInteractiveFrameBudget(double seconds);
+  vtkGetMacro(InteractiveFrameBudget, double);
+  ///@}
+
+  ///@{
+  /**
    * The most triangles (all isovalues, all processes together) an
-   * interactive frame should draw: the finest level within it is chosen, else
-   * level 0. Default 300000.
+   * interactive frame may draw, on top of the frame budget; 0 for no such
+   * limit. Default 0.
    */
   void SetInteractiveTriangleBudget(double triangles);
   vtkGetMacro(InteractiveTriangleBudget, double);
   ///@}
+
+  /**
+   * The seconds the frame-time model predicted, when the level was chosen
+   * (on this data process), for a frame drawing that level (0 when none was).
+   */
+  vtkGetMacro(PredictedInteractiveSeconds, double);
 
   ///@{
   /**
@@ -126,8 +156,26 @@ protected:
   // The LOD geometry in the shape of the view's piece.
   vtkDataObject* WrapLikePiece(vtkDataObject* piece);
 
+  // Frames drawn here, for the frame-time model: a renderer's StartEvent and
+  // EndEvent around the render that REQUEST_RENDER prepared.
+  void OnRenderStart();
+  void OnRenderEnd();
+  bool AddToView(vtkView* view) override;
+  bool RemoveFromView(vtkView* view) override;
+
   bool InteractiveLevels = true;
-  double InteractiveTriangleBudget = 300000.0;
+  double InteractiveFrameBudget = 0.1;
+  double InteractiveTriangleBudget = 0.0;
+  double PredictedInteractiveSeconds = 0.0;
+  // The frame being drawn: its triangles (-1: nothing to learn from) and start.
+  double FrameTriangles = -1.0;
+  double FrameStart = 0.0;
+  unsigned long StartObserver = 0;
+  unsigned long EndObserver = 0;
+  vtkWeakPointer<vtkRenderer> ObservedRenderer;
+  // The data drawn by the last frame, so that its first frame (uploads) is
+  // not learnt from.
+  vtkMTimeType DrawnDataTime = 0;
   int InteractiveLevel = -1;
   double InteractiveTriangles = 0.0;
   bool LastRenderUsedLOD = false;

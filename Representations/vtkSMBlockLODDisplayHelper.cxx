@@ -15,8 +15,9 @@ vtkSMBlockLODDisplayHelper::vtkSMBlockLODDisplayHelper() = default;
 vtkSMBlockLODDisplayHelper::~vtkSMBlockLODDisplayHelper() = default;
 
 //------------------------------------------------------------------------------
-void vtkSMBlockLODDisplayHelper::PostInitializeProxy(
-  vtkSMProxy* proxy, vtkPVXMLElement* xml, vtkMTimeType)
+void vtkSMBlockLODDisplayHelper::PostInitializeProxy(vtkSMProxy* proxy,
+  vtkPVXMLElement* xml,
+  vtkMTimeType)
 {
   const char* view = xml ? xml->GetAttribute("view") : nullptr;
   const char* type = xml ? xml->GetAttribute("type") : nullptr;

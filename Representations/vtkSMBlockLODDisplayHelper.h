@@ -42,8 +42,9 @@ public:
    * attributes) to the proxy's hints, unless they already name a
    * representation for that view.
    */
-  void PostInitializeProxy(
-    vtkSMProxy* proxy, vtkPVXMLElement* xml, vtkMTimeType initializationTimeStamp) override;
+  void PostInitializeProxy(vtkSMProxy* proxy,
+    vtkPVXMLElement* xml,
+    vtkMTimeType initializationTimeStamp) override;
 
 protected:
   vtkSMBlockLODDisplayHelper();
