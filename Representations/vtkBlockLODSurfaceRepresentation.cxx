@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <map>
 #include <mutex>
 #include <vector>
 
@@ -35,11 +36,34 @@ namespace
 constexpr int Levels = 4;
 
 // The frames of this process, for every Block LOD display in it: the model
-// describes the renderer and the machine, not one display.
+// describes the renderer and the machine, not one display. A frame is
+// observed once, with the triangles of every Block LOD display it drew
+// together, and a display's candidate level is predicted with the other
+// displays' last triangles added (what the frame will draw besides it).
 struct ProcessFrames
 {
+  struct Frame
+  {
+    double Triangles = 0.0;
+    bool Learn = true; // false when a display drew new data (its upload)
+    bool Translucent = false;
+    double Start = 0.0;
+  };
   std::mutex Mutex;
   mediso::FrameTimeModel Model;
+  // Per renderer: the frame being drawn, and each display's last triangles.
+  std::map<const void*, Frame> Pending;
+  std::map<const void*, std::map<const void*, double>> Drawn;
+
+  double OthersDrawn(const void* renderer, const void* display)
+  {
+    double sum = 0.0;
+    for (const auto& entry : this->Drawn[renderer])
+    {
+      sum += entry.first == display ? 0.0 : entry.second;
+    }
+    return sum;
+  }
 };
 ProcessFrames& Frames()
 {
@@ -243,6 +267,12 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
       static_cast<std::uint64_t>(std::max(0, size[1]));
   }
   std::vector<mediso::FrameTimeModel::Candidate> candidates;
+  double others = 0.0;
+  if (this->ObservedRenderer)
+  {
+    std::lock_guard<std::mutex> lock(Frames().Mutex);
+    others = Frames().OthersDrawn(this->ObservedRenderer.GetPointer(), this);
+  }
   for (int level = still; level >= 0; --level)
   {
     const bool allowed =
@@ -252,7 +282,7 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
       mediso::FrameTimeModel::Candidate candidate;
       candidate.Level = level;
       candidate.Work = work;
-      candidate.Work.Primitives = static_cast<std::uint64_t>(triangles[level]);
+      candidate.Work.Primitives = static_cast<std::uint64_t>(triangles[level] + others);
       candidates.push_back(candidate);
     }
   }
@@ -371,16 +401,17 @@ int vtkBlockLODSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKe
     // is not a frame's cost).
     vtkDataObject* drawn =
       this->LastRenderUsedLOD ? lod : vtkPVView::GetDeliveredPiece(inInfo, this);
-    this->FrameTriangles = -1.0;
-    if (drawn && this->GetVisibility())
+    if (drawn && this->GetVisibility() && this->ObservedRenderer)
     {
       int level = -1;
       double triangles = 0.0;
       DescribeLOD(drawn, level, triangles);
-      if (drawn->GetMTime() == this->DrawnDataTime && triangles > 0)
-      {
-        this->FrameTriangles = triangles;
-      }
+      std::lock_guard<std::mutex> lock(Frames().Mutex);
+      ProcessFrames::Frame& frame = Frames().Pending[this->ObservedRenderer.GetPointer()];
+      frame.Triangles += triangles;
+      frame.Learn = frame.Learn && drawn->GetMTime() == this->DrawnDataTime;
+      frame.Translucent = frame.Translucent || this->Property->GetOpacity() < 1.0;
+      Frames().Drawn[this->ObservedRenderer.GetPointer()][this] = triangles;
       this->DrawnDataTime = drawn->GetMTime();
     }
   }
@@ -410,6 +441,15 @@ bool vtkBlockLODSurfaceRepresentation::RemoveFromView(vtkView* view)
 {
   if (this->ObservedRenderer)
   {
+    {
+      std::lock_guard<std::mutex> lock(Frames().Mutex);
+      Frames().Drawn[this->ObservedRenderer.GetPointer()].erase(this);
+      if (Frames().Drawn[this->ObservedRenderer.GetPointer()].empty())
+      {
+        Frames().Drawn.erase(this->ObservedRenderer.GetPointer());
+        Frames().Pending.erase(this->ObservedRenderer.GetPointer());
+      }
+    }
     this->ObservedRenderer->RemoveObserver(this->StartObserver);
     this->ObservedRenderer->RemoveObserver(this->EndObserver);
     this->ObservedRenderer = nullptr;
@@ -420,27 +460,52 @@ bool vtkBlockLODSurfaceRepresentation::RemoveFromView(vtkView* view)
 //------------------------------------------------------------------------------
 void vtkBlockLODSurfaceRepresentation::OnRenderStart()
 {
-  this->FrameStart = Now();
+  // Every Block LOD display observes the renderer; the first one to hear of
+  // a prepared frame starts its clock.
+  std::lock_guard<std::mutex> lock(Frames().Mutex);
+  auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
+  if (frame != Frames().Pending.end() && frame->second.Start == 0.0)
+  {
+    frame->second.Start = Now();
+  }
 }
 
 //------------------------------------------------------------------------------
 void vtkBlockLODSurfaceRepresentation::OnRenderEnd()
 {
-  if (this->FrameTriangles <= 0 || !this->ObservedRenderer)
+  // The first display to hear of the frame's end records it, once.
+  const double end = Now();
+  std::lock_guard<std::mutex> lock(Frames().Mutex);
+  auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
+  if (frame == Frames().Pending.end())
+  {
+    return;
+  }
+  const ProcessFrames::Frame drawn = frame->second;
+  Frames().Pending.erase(frame);
+  if (!drawn.Learn || drawn.Triangles <= 0 || drawn.Start == 0.0)
   {
     return;
   }
   mediso::FrameWork work;
   work.Method = mediso::FrameMethod::Triangles;
-  work.Primitives = static_cast<std::uint64_t>(this->FrameTriangles);
+  work.Primitives = static_cast<std::uint64_t>(drawn.Triangles);
   const int* size = this->ObservedRenderer->GetSize();
   work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
     static_cast<std::uint64_t>(std::max(0, size[1]));
-  work.Translucent = this->Property->GetOpacity() < 1.0;
-  const double seconds = Now() - this->FrameStart;
-  this->FrameTriangles = -1.0; // one observation per prepared frame
-  std::lock_guard<std::mutex> lock(Frames().Mutex);
-  Frames().Model.Observe(work, seconds);
+  work.Translucent = drawn.Translucent;
+  Frames().Model.Observe(work, end - drawn.Start);
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::SetVisibility(bool visible)
+{
+  if (!visible && this->ObservedRenderer)
+  {
+    std::lock_guard<std::mutex> lock(Frames().Mutex);
+    Frames().Drawn[this->ObservedRenderer.GetPointer()].erase(this);
+  }
+  this->Superclass::SetVisibility(visible);
 }
 
 //------------------------------------------------------------------------------

@@ -43,13 +43,15 @@
  * (mediso::FrameTimeModel, Mappers/Core/FrameTimeModel.h: seconds = a + b *
  * triangles + c * pixels, fitted per opaque/translucent), which this
  * representation feeds with the frames it draws in this process: each
- * frame's renderer time, with the triangles it drew, the view's pixels and
- * whether it was translucent. Before any frame the model's prior is
+ * frame's renderer time, with the triangles every Block LOD display drew in
+ * it together, the view's pixels and whether any was translucent (a frame
+ * that drew new data, i.e. uploaded it, is not learnt from). A display's
+ * candidate is predicted with the other Block LOD displays' last triangles
+ * added, the frame it will share. Before any frame the model's prior is
  * conservative (a software renderer), so the first interactive level errs on
- * the coarse side. The frame's time is the renderer's, whatever else it
- * drew: with several large displays a frame's cost is charged to each, which
- * errs on the coarse side as well. In a parallel run the counts are summed
- * over the processes first, so every piece draws the same level; in
+ * the coarse side. Other displays in the view (not Block LOD's) are part of
+ * the frame's time but not of its counted work. In a parallel run the counts
+ * are summed over the processes first, so every piece draws the same level; in
  * client/server the level is chosen on the server, which renders no frame to
  * learn from when the client renders: there the prior decides.
  *
@@ -84,6 +86,12 @@ public:
   int ProcessViewRequest(vtkInformationRequestKey* request_type,
     vtkInformation* inInfo,
     vtkInformation* outInfo) override;
+
+  /**
+   * As the base class's; a hidden display also stops counting in the frames
+   * the other Block LOD displays predict.
+   */
+  void SetVisibility(bool visible) override;
 
   ///@{
   /**
@@ -167,9 +175,6 @@ protected:
   double InteractiveFrameBudget = 0.1;
   double InteractiveTriangleBudget = 0.0;
   double PredictedInteractiveSeconds = 0.0;
-  // The frame being drawn: its triangles (-1: nothing to learn from) and start.
-  double FrameTriangles = -1.0;
-  double FrameStart = 0.0;
   unsigned long StartObserver = 0;
   unsigned long EndObserver = 0;
   vtkWeakPointer<vtkRenderer> ObservedRenderer;
