@@ -227,80 +227,88 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
     }
   }
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
-  if (controller && controller->GetNumberOfProcesses() > 1)
+  const bool parallel = controller && controller->GetNumberOfProcesses() > 1;
+  if (parallel)
   {
     // Unknown counts are summed as a large negative number, so that a level
-    // unknown on any process stays unknown.
+    // unknown on any process stays unknown; a process without a Block LOD
+    // piece (an empty piece) adds nothing.
     std::array<double, Levels> local, global;
     for (int level = 0; level < Levels; ++level)
     {
-      local[level] = triangles[level] < 0 ? -1e300 : triangles[level];
-    }
-    // A process without a Block LOD piece (an empty piece) adds nothing.
-    if (!contour)
-    {
-      local.fill(0.0);
+      local[level] = !contour ? 0.0 : (triangles[level] < 0 ? -1e300 : triangles[level]);
     }
     controller->AllReduce(local.data(), global.data(), Levels, vtkCommunicator::SUM_OP);
     triangles = global;
-    std::array<int, 1> have = { { contour ? 1 : 0 } }, anyHave = { { 0 } };
-    controller->AllReduce(have.data(), anyHave.data(), 1, vtkCommunicator::MAX_OP);
-    if (anyHave[0] == 0)
-    {
-      return false;
-    }
-  }
-  if (!contour || still < 0 || still >= Levels)
-  {
-    return false;
   }
 
   // The finest level, from the output's down, within the triangle budget (when
   // set) and predicted within the frame budget (when set); else the coarsest.
-  mediso::FrameWork work;
-  work.Method = mediso::FrameMethod::Triangles;
-  work.Translucent = this->Property->GetOpacity() < 1.0;
-  if (auto* view = vtkPVRenderView::SafeDownCast(this->GetView()))
-  {
-    const int* size = view->GetSize();
-    work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
-      static_cast<std::uint64_t>(std::max(0, size[1]));
-  }
+  // Levels stands for none.
+  int chosen = Levels;
   std::vector<mediso::FrameTimeModel::Candidate> candidates;
-  double others = 0.0;
-  if (this->ObservedRenderer)
+  if (contour && still >= 0 && still < Levels)
   {
-    std::lock_guard<std::mutex> lock(Frames().Mutex);
-    others = Frames().OthersDrawn(this->ObservedRenderer.GetPointer(), this);
-  }
-  for (int level = still; level >= 0; --level)
-  {
-    const bool allowed =
-      this->InteractiveTriangleBudget <= 0 || triangles[level] <= this->InteractiveTriangleBudget;
-    if (triangles[level] >= 0 && (allowed || level == 0))
+    mediso::FrameWork work;
+    work.Method = mediso::FrameMethod::Triangles;
+    work.Translucent = this->Property->GetOpacity() < 1.0;
+    if (auto* view = vtkPVRenderView::SafeDownCast(this->GetView()))
     {
-      mediso::FrameTimeModel::Candidate candidate;
-      candidate.Level = level;
-      candidate.Work = work;
-      candidate.Work.Primitives = static_cast<std::uint64_t>(triangles[level] + others);
-      candidates.push_back(candidate);
+      const int* size = view->GetSize();
+      work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
+        static_cast<std::uint64_t>(std::max(0, size[1]));
+    }
+    double others = 0.0;
+    if (this->ObservedRenderer)
+    {
+      std::lock_guard<std::mutex> lock(Frames().Mutex);
+      others = Frames().OthersDrawn(this->ObservedRenderer.GetPointer(), this);
+    }
+    for (int level = still; level >= 0; --level)
+    {
+      const bool allowed =
+        this->InteractiveTriangleBudget <= 0 || triangles[level] <= this->InteractiveTriangleBudget;
+      if (triangles[level] >= 0 && (allowed || level == 0))
+      {
+        mediso::FrameTimeModel::Candidate candidate;
+        candidate.Level = level;
+        candidate.Work = work;
+        candidate.Work.Primitives = static_cast<std::uint64_t>(triangles[level] + others);
+        candidates.push_back(candidate);
+      }
+    }
+    if (!candidates.empty())
+    {
+      std::size_t pick = 0;
+      if (this->InteractiveFrameBudget > 0)
+      {
+        std::lock_guard<std::mutex> lock(Frames().Mutex);
+        pick = Frames().Model.Choose(candidates, this->InteractiveFrameBudget);
+      }
+      chosen = candidates[pick].Level;
     }
   }
-  if (candidates.empty())
+  if (parallel)
+  {
+    // Every piece draws the same level: the coarsest any process chose (each
+    // process's frame-time model learnt from its own frames).
+    int local = chosen, agreed = Levels;
+    controller->AllReduce(&local, &agreed, 1, vtkCommunicator::MIN_OP);
+    chosen = agreed;
+  }
+  if (!contour || chosen >= Levels || chosen > still)
   {
     return false;
   }
-  std::size_t pick = 0;
   double predicted = 0.0;
+  for (const auto& candidate : candidates)
   {
-    std::lock_guard<std::mutex> lock(Frames().Mutex);
-    if (this->InteractiveFrameBudget > 0)
+    if (candidate.Level == chosen)
     {
-      pick = Frames().Model.Choose(candidates, this->InteractiveFrameBudget);
+      std::lock_guard<std::mutex> lock(Frames().Mutex);
+      predicted = Frames().Model.Predict(candidate.Work);
     }
-    predicted = Frames().Model.Predict(candidates[pick].Work);
   }
-  const int chosen = candidates[pick].Level;
   if (chosen == still)
   {
     // Within the budget already: the shown surface is its own LOD.

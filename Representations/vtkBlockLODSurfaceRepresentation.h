@@ -51,7 +51,9 @@
  * conservative (a software renderer), so the first interactive level errs on
  * the coarse side. Other displays in the view (not Block LOD's) are part of
  * the frame's time but not of its counted work. In a parallel run the counts
- * are summed over the processes first, so every piece draws the same level; in
+ * are summed over the processes first, and every piece draws the coarsest
+ * level any process chose (each learnt from its own frames), so that the
+ * pieces meet at one level; in
  * client/server the level is chosen on the server, which renders no frame to
  * learn from when the client renders: there the prior decides.
  *
