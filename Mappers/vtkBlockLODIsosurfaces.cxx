@@ -66,6 +66,18 @@ vtkBlockLODIsosurfaces::vtkBlockLODIsosurfaces()
 vtkBlockLODIsosurfaces::~vtkBlockLODIsosurfaces() = default;
 
 //------------------------------------------------------------------------------
+void vtkBlockLODIsosurfaces::SetLevel(int level)
+{
+  this->Impl->Contour->SetLOD(level);
+}
+
+//------------------------------------------------------------------------------
+int vtkBlockLODIsosurfaces::GetLevel() const
+{
+  return this->Impl->Contour->GetLOD();
+}
+
+//------------------------------------------------------------------------------
 void vtkBlockLODIsosurfaces::ReleaseGraphicsResources(vtkWindow* win)
 {
   this->Impl->PolyMapper->ReleaseGraphicsResources(win);
@@ -126,8 +138,10 @@ void vtkBlockLODIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol,
       impl.Contour->SetValue(static_cast<int>(i), surfaces[i].Value);
     }
   }
+  const vtkMTimeType extractedBefore = impl.Contour->GetOutput()->GetMTime();
   impl.Contour->Update();
   vtkPolyData* surface = impl.Contour->GetOutput();
+  this->LastFrameExtracted = surface->GetMTime() != extractedBefore;
 
   // Colour every point by its isovalue (RGBA, opacity in alpha).
   // Recoloured only when the surface or the looks change (not every frame).

@@ -12,7 +12,10 @@
  * isovalue (RGBA), recoloured only when the surface or the looks change.
  * Translucent surfaces are drawn sorted back to front (vtkDepthSortPolyData)
  * with blending: the renderer's depth peeling does not reach geometry a
- * volume mapper draws.
+ * volume mapper draws. SetLevel() picks a coarser level (vtkBlockLODContour's
+ * LOD 0..2, cube edges of 8, 4, 2 voxels): vtkHistoPyramidIsoMapper's
+ * interactive frames; the filter's cache keeps each level's surfaces, so
+ * switching back and forth extracts nothing again.
  *
  * @sa vtkHistoPyramidIsoMapper vtkOpenGLHistoPyramidIsosurfaces vtkBlockLODContour
  */
@@ -49,6 +52,16 @@ public:
   /// Triangles of the last frame.
   vtkGetMacro(NumberOfTriangles, std::uint64_t);
 
+  ///@{
+  /// The level drawn (vtkBlockLODContour's LOD, 0..3; default 3, full resolution).
+  void SetLevel(int level);
+  int GetLevel() const;
+  ///@}
+
+  /// Whether the last frame extracted its surfaces (a new level, values or input) rather than
+  /// drawing ones already extracted: such a frame's time is not a drawing time.
+  vtkGetMacro(LastFrameExtracted, bool);
+
   void ReleaseGraphicsResources(vtkWindow* win);
 
 protected:
@@ -60,6 +73,7 @@ private:
   void operator=(const vtkBlockLODIsosurfaces&) = delete;
 
   std::uint64_t NumberOfTriangles = 0;
+  bool LastFrameExtracted = false;
   struct Internals;
   std::unique_ptr<Internals> Impl;
 };

@@ -15,10 +15,13 @@
 #include "vtkRenderer.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
+#include "vtk_glew.h"
 
 #include "IsosurfaceScene.h"
 
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -46,6 +49,14 @@ bool SupportedType(int type)
       return false;
   }
 }
+
+// Image sample distances an interactive GPU frame chooses from, finest first.
+constexpr float SampleDistances[] = { 1.0f, 1.5f, 2.0f, 2.5f, 3.0f, 4.0f, 5.0f, 6.0f, 8.0f };
+
+// The full-resolution Block LOD level (vtkBlockLODContour's LOD 3: cubes of one voxel).
+constexpr int FullLevel = 3;
+
+using Clock = std::chrono::steady_clock;
 } // anonymous namespace
 
 //------------------------------------------------------------------------------
@@ -55,6 +66,34 @@ struct vtkHistoPyramidIsoMapper::Internals
   vtkNew<vtkOpenGLHistoPyramidIsosurfaces> GPU;
   vtkNew<vtkBlockLODIsosurfaces> Fallback;
   std::set<std::string> Said;
+
+  // The frame-time model and what it is fed: the first frame of each sample
+  // distance and translucency pays for shader builds and buffers, so it is
+  // not observed (Warm says which were seen).
+  mediso::FrameTimeModel Model;
+  std::set<std::pair<int, bool>> Warm;
+  // The fallback's triangles per level for the current values and input
+  // (-1: not drawn yet), which its interactive choice predicts from.
+  std::array<double, 4> LevelTriangles = { { -1.0, -1.0, -1.0, -1.0 } };
+  std::vector<double> CountedValues;
+  vtkMTimeType CountedStamp = 0;
+
+  // Triangles of `level`: drawn, or scaled from the nearest level drawn
+  // (a surface's triangles grow about 4x per finer level); 0 when none was.
+  double TrianglesAt(int level) const
+  {
+    for (int distance = 0; distance < 4; ++distance)
+    {
+      for (int other : { level + distance, level - distance })
+      {
+        if (other >= 0 && other < 4 && this->LevelTriangles[other] >= 0.0)
+        {
+          return this->LevelTriangles[other] * std::pow(4.0, level - other);
+        }
+      }
+    }
+    return 0.0;
+  }
 };
 
 //------------------------------------------------------------------------------
@@ -94,6 +133,12 @@ const char* vtkHistoPyramidIsoMapper::GetLastRenderPathAsString() const
 }
 
 //------------------------------------------------------------------------------
+const mediso::FrameTimeModel& vtkHistoPyramidIsoMapper::GetFrameTimeModel() const
+{
+  return this->Impl->Model;
+}
+
+//------------------------------------------------------------------------------
 std::uint64_t vtkHistoPyramidIsoMapper::GetGPUMemoryBytes() const
 {
   return this->Impl->GPU->GetGPUMemoryBytes();
@@ -110,6 +155,7 @@ void vtkHistoPyramidIsoMapper::ReleaseGraphicsResources(vtkWindow* win)
 {
   this->Impl->GPU->ReleaseGraphicsResources(win);
   this->Impl->Fallback->ReleaseGraphicsResources(win);
+  this->Impl->Warm.clear();
 }
 
 //------------------------------------------------------------------------------
@@ -119,6 +165,11 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   this->LastRenderPath = NoPath;
   this->GPUStats.Primitives = 0;
   this->NumberOfFallbackTriangles = 0;
+  this->LastInteractive = false;
+  this->LastSampleDistance = 1.0;
+  this->LastLevel = FullLevel;
+  this->LastPredictedSeconds = 0.0;
+  this->LastMeasuredSeconds = 0.0;
 
   // Say a message once (per distinct text), as an error or a warning.
   auto sayOnce = [&](bool error, const std::string& text)
@@ -259,22 +310,84 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
 
-  // 3. The GPU path, or the fallback when it cannot run (said once, with the reason).
+  // 3. Interactive or still (VTK's rule: less than a second allocated to
+  //    the prop), the budget, and what the frame-time model is told.
+  const double allocated = vol->GetAllocatedRenderTime();
+  const bool adjust = this->InteractiveAdjust;
+  const bool interactive = adjust && allocated < 1.0;
+  const double budget = this->InteractiveFrameBudget > 0.0 ? this->InteractiveFrameBudget : allocated;
+  int width = 0, height = 0;
+  ren->GetTiledSize(&width, &height);
+  bool translucent = false;
+  for (const Surface& s : surfaces)
+  {
+    translucent = translucent || s.Opacity < 1.0;
+  }
+  this->LastInteractive = interactive;
+  mediso::FrameWork chosenWork;
+
+  // 4. The GPU path, or the fallback when it cannot run (said once, with the reason).
   vtkOpenGLHistoPyramidIsosurfaces* gpu = impl.GPU;
   std::string reason;
+  vtkOpenGLHistoPyramidIsosurfaces::SampleDistanceChooser chooser;
+  if (adjust)
+  {
+    chooser = [&](std::uint64_t primitives)
+    {
+      std::vector<mediso::FrameTimeModel::Candidate> candidates;
+      for (float distance : SampleDistances)
+      {
+        mediso::FrameTimeModel::Candidate candidate;
+        candidate.Level = FullLevel;
+        candidate.SampleDistance = distance;
+        candidate.Work.Method = mediso::FrameMethod::CellRasterisation;
+        candidate.Work.Primitives = primitives;
+        candidate.Work.Pixels = mediso::FrameTimeModel::ShadedPixels(width, height, distance);
+        candidate.Work.Translucent = translucent;
+        candidates.push_back(candidate);
+      }
+      const std::size_t chosen = interactive ? impl.Model.Choose(candidates, budget) : 0;
+      chosenWork = candidates[chosen].Work;
+      this->LastPredictedSeconds = impl.Model.Predict(chosenWork);
+      return candidates[chosen].SampleDistance;
+    };
+  }
+  const std::uint64_t buildsBefore = gpu->GetStats().PyramidBuilds;
+  const std::uint64_t uploadsBefore = gpu->GetStats().VolumeUploads;
+  const Clock::time_point gpuStart = Clock::now();
   if (this->ForceCPUFallback)
   {
     reason = "ForceCPUFallback is on";
   }
   else if (gpu->RenderIsosurfaces(ren, vol, image, scalars, surfaces, this->AllowPointFootprint,
-             this->FirstHitPass, reason))
+             this->FirstHitPass, chooser, reason))
   {
     this->LastRenderPath = GPUPath;
     this->FallbackReason.clear();
     this->GPUStats = gpu->GetStats();
     this->LastFootprint = this->GPUStats.PointFootprint ? PointFootprint : BoxFootprint;
+    this->LastSampleDistance = this->GPUStats.SampleDistance;
+    if (adjust && this->GPUStats.Primitives > 0)
+    {
+      // Timed to the frame's end: a GL frame's calls return before its work is done.
+      glFinish();
+      this->LastMeasuredSeconds = std::chrono::duration<double>(Clock::now() - gpuStart).count();
+      const bool rebuilt = this->GPUStats.PyramidBuilds != buildsBefore ||
+        this->GPUStats.VolumeUploads != uploadsBefore;
+      const std::pair<int, bool> key(
+        static_cast<int>(std::lround(100.0 * this->LastSampleDistance)), chosenWork.Translucent);
+      if (!rebuilt && !impl.Warm.insert(key).second)
+      {
+        impl.Model.Observe(chosenWork, this->LastMeasuredSeconds);
+      }
+    }
+    else
+    {
+      this->LastPredictedSeconds = 0.0;
+    }
     return;
   }
+  this->LastPredictedSeconds = 0.0;
   if (!this->ForceCPUFallback)
   {
     sayOnce(false,
@@ -282,9 +395,59 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         "); rendering with vtkBlockLODContour and vtkPolyDataMapper instead.");
   }
   this->FallbackReason = reason;
+
+  // The fallback's level: the finest predicted within the budget while
+  // interactive, from the triangles each level had for these values.
+  std::vector<double> drawnValues;
+  for (const Surface& s : surfaces)
+  {
+    drawnValues.push_back(s.Value);
+  }
+  if (drawnValues != impl.CountedValues || scalars->GetMTime() != impl.CountedStamp)
+  {
+    impl.LevelTriangles.fill(-1.0);
+    impl.CountedValues = drawnValues;
+    impl.CountedStamp = scalars->GetMTime();
+  }
+  int level = FullLevel;
+  if (interactive)
+  {
+    std::vector<mediso::FrameTimeModel::Candidate> candidates;
+    for (int l = FullLevel; l >= 0; --l)
+    {
+      mediso::FrameTimeModel::Candidate candidate;
+      candidate.Level = l;
+      candidate.Work.Method = mediso::FrameMethod::Triangles;
+      candidate.Work.Primitives = static_cast<std::uint64_t>(impl.TrianglesAt(l));
+      candidate.Work.Pixels = mediso::FrameTimeModel::ShadedPixels(width, height, 1.0);
+      candidate.Work.Translucent = translucent;
+      candidates.push_back(candidate);
+    }
+    level = candidates[impl.Model.Choose(candidates, budget)].Level;
+  }
+  impl.Fallback->SetLevel(level);
+  const Clock::time_point fallbackStart = Clock::now();
   impl.Fallback->RenderIsosurfaces(ren, vol, image, scalars, surfaces);
   this->NumberOfFallbackTriangles = impl.Fallback->GetNumberOfTriangles();
   this->LastRenderPath = FallbackPath;
+  this->LastLevel = level;
+  impl.LevelTriangles[static_cast<std::size_t>(level)] =
+    static_cast<double>(this->NumberOfFallbackTriangles);
+  if (adjust)
+  {
+    chosenWork.Method = mediso::FrameMethod::Triangles;
+    chosenWork.Primitives = this->NumberOfFallbackTriangles;
+    chosenWork.Pixels = mediso::FrameTimeModel::ShadedPixels(width, height, 1.0);
+    chosenWork.Translucent = translucent;
+    this->LastPredictedSeconds = impl.Model.Predict(chosenWork);
+    glFinish();
+    this->LastMeasuredSeconds =
+      std::chrono::duration<double>(Clock::now() - fallbackStart).count();
+    if (!impl.Fallback->GetLastFrameExtracted())
+    {
+      impl.Model.Observe(chosenWork, this->LastMeasuredSeconds);
+    }
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -298,4 +461,11 @@ void vtkHistoPyramidIsoMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfPyramidBuilds: " << this->GPUStats.PyramidBuilds << "\n";
   os << indent << "NumberOfVolumeUploads: " << this->GPUStats.VolumeUploads << "\n";
   os << indent << "GPUMemoryBytes: " << this->GetGPUMemoryBytes() << "\n";
+  os << indent << "InteractiveAdjust: " << this->InteractiveAdjust << "\n";
+  os << indent << "InteractiveFrameBudget: " << this->InteractiveFrameBudget << "\n";
+  os << indent << "LastInteractive: " << this->LastInteractive << "\n";
+  os << indent << "LastSampleDistance: " << this->LastSampleDistance << "\n";
+  os << indent << "LastLevel: " << this->LastLevel << "\n";
+  os << indent << "LastPredictedSeconds: " << this->LastPredictedSeconds << "\n";
+  os << indent << "LastMeasuredSeconds: " << this->LastMeasuredSeconds << "\n";
 }

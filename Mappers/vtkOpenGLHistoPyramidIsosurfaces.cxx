@@ -138,7 +138,8 @@ std::uint64_t vtkOpenGLHistoPyramidIsosurfaces::GetFrameBufferBytes() const
 //------------------------------------------------------------------------------
 bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol,
   vtkImageData* image, vtkDataArray* scalars, const std::vector<Surface>& surfaces,
-  bool allowPointFootprint, bool firstHitPass, std::string& reason)
+  bool allowPointFootprint, bool firstHitPass, const SampleDistanceChooser& sampleDistance,
+  std::string& reason)
 {
   Internals& impl = *this->Impl;
   auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
@@ -256,6 +257,10 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
   }
   frame.AllowPointFootprint = allowPointFootprint;
   frame.FirstHitPass = firstHitPass;
+  if (sampleDistance)
+  {
+    frame.SampleDistance = sampleDistance(impl.Scene.GetActivePairs());
+  }
 
   // 4. Draw.
   if (!impl.Scene.Render(frame, reason))

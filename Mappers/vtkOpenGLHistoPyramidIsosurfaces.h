@@ -33,7 +33,8 @@
 #include "MedicalIsosurfacesMappersModule.h" // For export macro
 #include "vtkObject.h"
 
-#include <cstdint> // For std::uint64_t
+#include <cstdint>    // For std::uint64_t
+#include <functional> // For std::function
 #include <memory>  // For std::unique_ptr
 #include <string>  // For std::string
 #include <vector>  // For std::vector
@@ -59,14 +60,20 @@ public:
     double Opacity;
   };
 
+  /// The image sample distance of a frame, from the primitives it will draw (see RenderIsosurfaces).
+  using SampleDistanceChooser = std::function<float(std::uint64_t primitives)>;
+
   /**
    * Draw `surfaces` (increasing values, at most 8) of the single-component
    * point array `scalars` of `image` for `vol` into `ren`. False, with the
    * reason, when the GPU path cannot draw them (the caller falls back).
+   * `sampleDistance`, when set, is asked for the frame's image sample
+   * distance once the pyramid is up to date (its argument: the active
+   * cell-isovalue pairs the frame draws); unset, the frame draws every pixel.
    */
   bool RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image,
     vtkDataArray* scalars, const std::vector<Surface>& surfaces, bool allowPointFootprint,
-    bool firstHitPass, std::string& reason);
+    bool firstHitPass, const SampleDistanceChooser& sampleDistance, std::string& reason);
 
   /**
    * What the GPU path did (the scene's stats: the last frame drawn, the last
