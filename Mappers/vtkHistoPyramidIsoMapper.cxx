@@ -77,6 +77,8 @@ struct vtkHistoPyramidIsoMapper::Internals
   std::array<double, 4> LevelTriangles = { { -1.0, -1.0, -1.0, -1.0 } };
   std::vector<double> CountedValues;
   vtkMTimeType CountedStamp = 0;
+  // Active pairs of the last GPU frame of these values and input (0: none yet).
+  std::uint64_t Primitives = 0;
 
   // Triangles of `level`: drawn, or scaled from the nearest level drawn
   // (a surface's triangles grow about 4x per finer level); 0 when none was.
@@ -311,7 +313,8 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   }
 
   // 3. Interactive or still (VTK's rule: less than a second allocated to
-  //    the prop), the budget, and what the frame-time model is told.
+  //    the prop), the budget, and the counts the frame-time model predicts
+  //    from (known for these values and this input once drawn).
   const double allocated = vol->GetAllocatedRenderTime();
   const bool adjust = this->InteractiveAdjust;
   const bool interactive = adjust && allocated < 1.0;
@@ -319,16 +322,112 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   int width = 0, height = 0;
   ren->GetTiledSize(&width, &height);
   bool translucent = false;
+  std::vector<double> drawnValues;
   for (const Surface& s : surfaces)
   {
     translucent = translucent || s.Opacity < 1.0;
+    drawnValues.push_back(s.Value);
+  }
+  if (drawnValues != impl.CountedValues || scalars->GetMTime() != impl.CountedStamp)
+  {
+    impl.LevelTriangles.fill(-1.0);
+    impl.Primitives = 0;
+    impl.CountedValues = drawnValues;
+    impl.CountedStamp = scalars->GetMTime();
   }
   this->LastInteractive = interactive;
-  mediso::FrameWork chosenWork;
+  const std::uint64_t fullPixels = mediso::FrameTimeModel::ShadedPixels(width, height, 1.0);
+  // Triangles of a Block LOD level: drawn, scaled from a level drawn, or
+  // (none drawn yet) from the GPU path's active pairs, about two triangles
+  // each at the full level.
+  auto trianglesAt = [&](int level)
+  {
+    const double drawn = impl.TrianglesAt(level);
+    return static_cast<std::uint64_t>(
+      drawn > 0.0 ? drawn : 2.0 * static_cast<double>(impl.Primitives) * std::pow(4.0, level - 3));
+  };
+  auto gpuCandidate = [&](float distance, std::uint64_t primitives)
+  {
+    mediso::FrameTimeModel::Candidate candidate;
+    candidate.Level = FullLevel;
+    candidate.SampleDistance = distance;
+    candidate.Work.Method = mediso::FrameMethod::CellRasterisation;
+    candidate.Work.Primitives = primitives;
+    candidate.Work.Pixels = mediso::FrameTimeModel::ShadedPixels(width, height, distance);
+    candidate.Work.Translucent = translucent;
+    return candidate;
+  };
+  auto triangleCandidate = [&](int level)
+  {
+    mediso::FrameTimeModel::Candidate candidate;
+    candidate.Level = level;
+    candidate.Work.Method = mediso::FrameMethod::Triangles;
+    candidate.Work.Primitives = trianglesAt(level);
+    candidate.Work.Pixels = fullPixels;
+    candidate.Work.Translucent = translucent;
+    return candidate;
+  };
 
-  // 4. The GPU path, or the fallback when it cannot run (said once, with the reason).
+  // The triangles of a Block LOD level (the CPU path: the fallback, or an
+  // interactive frame that even the GPU path's coarsest distance would not
+  // fit in the budget), timed and observed unless it extracted.
+  auto drawTriangles = [&](int level)
+  {
+    impl.Fallback->SetLevel(level);
+    const Clock::time_point start = Clock::now();
+    impl.Fallback->RenderIsosurfaces(ren, vol, image, scalars, surfaces);
+    this->NumberOfFallbackTriangles = impl.Fallback->GetNumberOfTriangles();
+    this->LastRenderPath = FallbackPath;
+    this->LastLevel = level;
+    impl.LevelTriangles[static_cast<std::size_t>(level)] =
+      static_cast<double>(this->NumberOfFallbackTriangles);
+    if (adjust)
+    {
+      mediso::FrameWork work;
+      work.Method = mediso::FrameMethod::Triangles;
+      work.Primitives = this->NumberOfFallbackTriangles;
+      work.Pixels = fullPixels;
+      work.Translucent = translucent;
+      this->LastPredictedSeconds = impl.Model.Predict(work);
+      glFinish();
+      this->LastMeasuredSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+      if (!impl.Fallback->GetLastFrameExtracted())
+      {
+        impl.Model.Observe(work, this->LastMeasuredSeconds);
+      }
+    }
+  };
+
+  // 4. An interactive frame whose GPU distances are all predicted over the
+  //    budget (the primitives dominate: a coarser volume is needed) draws a
+  //    coarser Block LOD level's triangles instead, when one is predicted
+  //    to fit better. Needs the active pairs of a GPU frame of these values.
   vtkOpenGLHistoPyramidIsosurfaces* gpu = impl.GPU;
+  if (interactive && this->InteractiveTriangleLevels && !this->ForceCPUFallback &&
+    impl.Primitives > 0 && this->LastGPUPathWorked)
+  {
+    std::vector<mediso::FrameTimeModel::Candidate> candidates;
+    for (float distance : SampleDistances)
+    {
+      candidates.push_back(gpuCandidate(distance, impl.Primitives));
+    }
+    for (int level = FullLevel - 1; level >= 0; --level)
+    {
+      candidates.push_back(triangleCandidate(level));
+    }
+    const mediso::FrameTimeModel::Candidate& chosen =
+      candidates[impl.Model.Choose(candidates, budget)];
+    if (chosen.Work.Method == mediso::FrameMethod::Triangles)
+    {
+      this->FallbackReason.clear();
+      drawTriangles(chosen.Level);
+      return;
+    }
+  }
+
+  // 5. The GPU path, or the fallback when it cannot run (said once, with the reason).
   std::string reason;
+  mediso::FrameWork chosenWork;
   vtkOpenGLHistoPyramidIsosurfaces::SampleDistanceChooser chooser;
   if (adjust)
   {
@@ -337,14 +436,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       std::vector<mediso::FrameTimeModel::Candidate> candidates;
       for (float distance : SampleDistances)
       {
-        mediso::FrameTimeModel::Candidate candidate;
-        candidate.Level = FullLevel;
-        candidate.SampleDistance = distance;
-        candidate.Work.Method = mediso::FrameMethod::CellRasterisation;
-        candidate.Work.Primitives = primitives;
-        candidate.Work.Pixels = mediso::FrameTimeModel::ShadedPixels(width, height, distance);
-        candidate.Work.Translucent = translucent;
-        candidates.push_back(candidate);
+        candidates.push_back(gpuCandidate(distance, primitives));
       }
       const std::size_t chosen = interactive ? impl.Model.Choose(candidates, budget) : 0;
       chosenWork = candidates[chosen].Work;
@@ -363,10 +455,12 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
              this->FirstHitPass, chooser, reason))
   {
     this->LastRenderPath = GPUPath;
+    this->LastGPUPathWorked = true;
     this->FallbackReason.clear();
     this->GPUStats = gpu->GetStats();
     this->LastFootprint = this->GPUStats.PointFootprint ? PointFootprint : BoxFootprint;
     this->LastSampleDistance = this->GPUStats.SampleDistance;
+    impl.Primitives = this->GPUStats.Primitives;
     if (adjust && this->GPUStats.Primitives > 0)
     {
       // Timed to the frame's end: a GL frame's calls return before its work is done.
@@ -387,6 +481,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     }
     return;
   }
+  this->LastGPUPathWorked = false;
   this->LastPredictedSeconds = 0.0;
   if (!this->ForceCPUFallback)
   {
@@ -398,56 +493,17 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 
   // The fallback's level: the finest predicted within the budget while
   // interactive, from the triangles each level had for these values.
-  std::vector<double> drawnValues;
-  for (const Surface& s : surfaces)
-  {
-    drawnValues.push_back(s.Value);
-  }
-  if (drawnValues != impl.CountedValues || scalars->GetMTime() != impl.CountedStamp)
-  {
-    impl.LevelTriangles.fill(-1.0);
-    impl.CountedValues = drawnValues;
-    impl.CountedStamp = scalars->GetMTime();
-  }
   int level = FullLevel;
   if (interactive)
   {
     std::vector<mediso::FrameTimeModel::Candidate> candidates;
     for (int l = FullLevel; l >= 0; --l)
     {
-      mediso::FrameTimeModel::Candidate candidate;
-      candidate.Level = l;
-      candidate.Work.Method = mediso::FrameMethod::Triangles;
-      candidate.Work.Primitives = static_cast<std::uint64_t>(impl.TrianglesAt(l));
-      candidate.Work.Pixels = mediso::FrameTimeModel::ShadedPixels(width, height, 1.0);
-      candidate.Work.Translucent = translucent;
-      candidates.push_back(candidate);
+      candidates.push_back(triangleCandidate(l));
     }
     level = candidates[impl.Model.Choose(candidates, budget)].Level;
   }
-  impl.Fallback->SetLevel(level);
-  const Clock::time_point fallbackStart = Clock::now();
-  impl.Fallback->RenderIsosurfaces(ren, vol, image, scalars, surfaces);
-  this->NumberOfFallbackTriangles = impl.Fallback->GetNumberOfTriangles();
-  this->LastRenderPath = FallbackPath;
-  this->LastLevel = level;
-  impl.LevelTriangles[static_cast<std::size_t>(level)] =
-    static_cast<double>(this->NumberOfFallbackTriangles);
-  if (adjust)
-  {
-    chosenWork.Method = mediso::FrameMethod::Triangles;
-    chosenWork.Primitives = this->NumberOfFallbackTriangles;
-    chosenWork.Pixels = mediso::FrameTimeModel::ShadedPixels(width, height, 1.0);
-    chosenWork.Translucent = translucent;
-    this->LastPredictedSeconds = impl.Model.Predict(chosenWork);
-    glFinish();
-    this->LastMeasuredSeconds =
-      std::chrono::duration<double>(Clock::now() - fallbackStart).count();
-    if (!impl.Fallback->GetLastFrameExtracted())
-    {
-      impl.Model.Observe(chosenWork, this->LastMeasuredSeconds);
-    }
-  }
+  drawTriangles(level);
 }
 
 //------------------------------------------------------------------------------
@@ -463,6 +519,7 @@ void vtkHistoPyramidIsoMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "GPUMemoryBytes: " << this->GetGPUMemoryBytes() << "\n";
   os << indent << "InteractiveAdjust: " << this->InteractiveAdjust << "\n";
   os << indent << "InteractiveFrameBudget: " << this->InteractiveFrameBudget << "\n";
+  os << indent << "InteractiveTriangleLevels: " << this->InteractiveTriangleLevels << "\n";
   os << indent << "LastInteractive: " << this->LastInteractive << "\n";
   os << indent << "LastSampleDistance: " << this->LastSampleDistance << "\n";
   os << indent << "LastLevel: " << this->LastLevel << "\n";

@@ -63,12 +63,17 @@
  * the GPU path at the finest image sample distance predicted within the
  * budget (the surfaces drawn into a reduced target, then up to the viewport
  * with their depth), the CPU fallback at the finest Block LOD level
- * predicted within it. Other renders are full quality, the same image as
- * with InteractiveAdjust off. GetLastSampleDistance(), GetLastLevel(),
+ * predicted within it. Where even the GPU path's coarsest distance is
+ * predicted over the budget (its per-cell work dominates: the frame needs a
+ * coarser volume), the frame draws the triangles of the finest coarser
+ * Block LOD level predicted within it (level 0 when none is), the CPU
+ * path's cached levels (InteractiveTriangleLevels; such a frame reports the
+ * "fallback" path with an empty FallbackReason). Other renders are full
+ * quality, the same image as with InteractiveAdjust off. GetLastSampleDistance(), GetLastLevel(),
  * GetLastPredictedSeconds() and GetLastMeasuredSeconds() say what the last
  * frame did; frames are timed to their end (glFinish) while InteractiveAdjust
- * is on. Coarser volume levels on the GPU path are not done: its level is
- * always the full one (3).
+ * is on. The GPU path itself draws the full volume (level 3); coarser
+ * volumes reach the screen through the Block LOD triangles.
  *
  * GPU memory: GetGPUMemoryBytes() (the volume texture plus about 0.16 bytes
  * per padded cell for the pyramid) stays the same across isovalue changes;
@@ -214,6 +219,18 @@ public:
 
   ///@{
   /**
+   * Let an interactive GPU frame whose coarsest sample distance is still
+   * predicted over the budget draw a coarser Block LOD level's triangles
+   * instead (see the class description). Off: interactive GPU frames stay
+   * on the GPU path at its coarsest distance. Default on.
+   */
+  vtkSetMacro(InteractiveTriangleLevels, bool);
+  vtkGetMacro(InteractiveTriangleLevels, bool);
+  vtkBooleanMacro(InteractiveTriangleLevels, bool);
+  ///@}
+
+  ///@{
+  /**
    * What the last frame did: whether it was an interactive render, the image
    * sample distance (1: every pixel) and Block LOD level (3: full
    * resolution; the GPU path always draws the full volume) it drew at, the
@@ -336,11 +353,13 @@ private:
   bool FirstHitPass = true;
   bool InteractiveAdjust = true;
   double InteractiveFrameBudget = 0.1;
+  bool InteractiveTriangleLevels = true;
   bool LastInteractive = false;
   double LastSampleDistance = 1.0;
   int LastLevel = 3;
   double LastPredictedSeconds = 0.0;
   double LastMeasuredSeconds = 0.0;
+  bool LastGPUPathWorked = false;
   mediso::IsosurfaceSceneStats GPUStats;
   std::uint64_t NumberOfFallbackTriangles = 0;
   int ColorSource = TransferFunctionColors;

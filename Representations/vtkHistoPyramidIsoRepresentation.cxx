@@ -131,6 +131,18 @@ double vtkHistoPyramidIsoRepresentation::GetInteractiveFrameBudget()
 }
 
 //------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetInteractiveTriangleLevels(bool use)
+{
+  this->IsoMapper->SetInteractiveTriangleLevels(use);
+}
+
+//------------------------------------------------------------------------------
+bool vtkHistoPyramidIsoRepresentation::GetInteractiveTriangleLevels()
+{
+  return this->IsoMapper->GetInteractiveTriangleLevels();
+}
+
+//------------------------------------------------------------------------------
 double vtkHistoPyramidIsoRepresentation::GetLastInteractive()
 {
   return this->IsoMapper->GetLastInteractive() ? 1.0 : 0.0;

@@ -101,13 +101,16 @@ public:
    * Interactive frames (vtkHistoPyramidIsoMapper::SetInteractiveAdjust,
    * SetInteractiveFrameBudget): during the view's interactive renders draw
    * within the budget (seconds; 0: the time the view allocates), at a coarser
-   * image sample distance (GPU) or Block LOD level (fallback). Defaults on,
-   * 0.1 s.
+   * image sample distance (GPU) or Block LOD level (fallback; also the GPU
+   * path's frames that no distance fits, with InteractiveTriangleLevels).
+   * Defaults on, 0.1 s, on.
    */
   void SetInteractiveAdjust(bool adjust);
   bool GetInteractiveAdjust();
   void SetInteractiveFrameBudget(double seconds);
   double GetInteractiveFrameBudget();
+  void SetInteractiveTriangleLevels(bool use);
+  bool GetInteractiveTriangleLevels();
   ///@}
 
   ///@{

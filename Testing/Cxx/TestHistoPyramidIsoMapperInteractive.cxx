@@ -6,12 +6,15 @@
 //    draw every pixel, and a still render after interactive ones is the same
 //    image, pixel for pixel, as the one before them.
 // 2. An interactive render (DesiredUpdateRate 1000: a millisecond for the
-//    window) with a tiny InteractiveFrameBudget draws at an image sample
-//    distance above 1 and says so (GetLastSampleDistance, GetLastInteractive,
+//    window) with a budget between the frame-time model's predictions for
+//    distances 1 and 8 draws at a distance above 1 predicted within it. With
+//    a tiny budget and InteractiveTriangleLevels off it draws at the coarsest
+//    distance (8) and says so (GetLastSampleDistance, GetLastInteractive,
 //    predicted and measured seconds); its image covers about the same pixels
 //    as the still one (the reduced target drawn up to the viewport), differs
 //    from it, and keeps the depth test: an opaque plane in front of the
-//    volume's left part stays unchanged in every frame.
+//    volume's left part stays unchanged. With the triangle levels on (the
+//    default) a tiny budget draws a coarser Block LOD level's triangles.
 // 3. With a budget of 1000 s the interactive render draws every pixel (the
 //    still image); with InteractiveFrameBudget 0 the allocated render time
 //    is the budget; with InteractiveAdjust off interactive renders are the
@@ -32,6 +35,7 @@
 #include "vtkRenderer.h"
 #include "vtkUnsignedCharArray.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -146,17 +150,46 @@ void CheckGPUScene(
   Check(stillCovered > Size * Size / 10 && stillPlane > 1000,
     name + ": the still frame shows the surfaces and the plane");
 
-  // Interactive, a tiny budget: a sample distance above 1.
+  // Interactive, a budget between the model's predictions for distances 1
+  // and 8 (so far it has seen only still frames): a distance above 1, one
+  // predicted within the budget, on the GPU path.
+  const bool translucent = looks.front().Opacity < 1.0;
+  const std::uint64_t primitives = mapper->GetNumberOfPrimitives();
+  auto predict = [&](double distance)
+  {
+    mediso::FrameWork work;
+    work.Method = mediso::FrameMethod::CellRasterisation;
+    work.Primitives = primitives;
+    work.Pixels = mediso::FrameTimeModel::ShadedPixels(Size, Size, distance);
+    work.Translucent = translucent;
+    return mapper->GetFrameTimeModel().Predict(work);
+  };
+  Check(
+    predict(1.0) > predict(8.0), name + ": the model predicts a coarser distance to be cheaper");
+  const double between = std::sqrt(predict(1.0) * predict(8.0));
+  mapper->SetInteractiveFrameBudget(between);
+  scene.Render(InteractiveRate);
+  std::printf(
+    "%s interactive, budget %.4f s: %s\n", name.c_str(), between, Describe(mapper).c_str());
+  Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
+      mapper->GetLastInteractive() && mapper->GetLastSampleDistance() > 1.0 &&
+      mapper->GetGPUStats().SampleDistance > 1.0f && mapper->GetLastPredictedSeconds() <= between,
+    name + ": an interactive render draws at the finest distance predicted within the budget");
+
+  // A tiny budget with the triangle levels off: the GPU path's coarsest
+  // distance, drawn up to the viewport.
   mapper->SetInteractiveFrameBudget(1e-7);
+  mapper->InteractiveTriangleLevelsOff();
   std::vector<unsigned char> interactive;
   for (int frame = 0; frame < 3; ++frame)
   {
     interactive = scene.Render(InteractiveRate);
   }
-  std::printf("%s interactive, tiny budget: %s\n", name.c_str(), Describe(mapper).c_str());
-  Check(mapper->GetLastInteractive() && mapper->GetLastSampleDistance() > 1.0 &&
-      mapper->GetGPUStats().SampleDistance > 1.0f,
-    name + ": an interactive render with a tiny budget draws at a sample distance above 1");
+  std::printf(
+    "%s interactive, tiny budget, GPU only: %s\n", name.c_str(), Describe(mapper).c_str());
+  Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
+      mapper->GetLastInteractive() && mapper->GetLastSampleDistance() == 8.0,
+    name + ": a tiny budget without triangle levels draws the coarsest distance, 8");
   Check(mapper->GetLastPredictedSeconds() > 1e-7 && mapper->GetLastMeasuredSeconds() > 0.0,
     name + ": it says what was predicted and measured");
   Check(interactive != still, name + ": the interactive image differs from the still one");
@@ -167,6 +200,25 @@ void CheckGPUScene(
     name + ": the interactive frame covers the still frame's pixels within 10%");
   Check(PlanePixels(interactive) == stillPlane && PlanePixels(interactive) > 0,
     name + ": the plane in front keeps every pixel (the reduced surfaces' depth is tested)");
+
+  // The same with the triangle levels (the default): a coarser Block LOD
+  // level's triangles, which are what fits a tiny budget best.
+  mapper->InteractiveTriangleLevelsOn();
+  std::vector<unsigned char> triangles;
+  for (int frame = 0; frame < 2; ++frame)
+  {
+    triangles = scene.Render(InteractiveRate);
+  }
+  std::printf("%s interactive, tiny budget: %s, %llu triangles\n", name.c_str(),
+    Describe(mapper).c_str(),
+    static_cast<unsigned long long>(mapper->GetNumberOfFallbackTriangles()));
+  Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::FallbackPath &&
+      mapper->GetFallbackReason().empty() && mapper->GetLastLevel() < 3 &&
+      mapper->GetNumberOfFallbackTriangles() > 0,
+    name + ": a tiny budget draws a coarser Block LOD level's triangles (no fallback reason)");
+  Check(PlanePixels(triangles) == stillPlane &&
+      std::abs(Covered(triangles) - stillCovered) < stillCovered / 10,
+    name + ": they cover the still pixels within 10%, behind the plane");
 
   // A still render after the interactive ones: the same image.
   const std::vector<unsigned char> after = scene.Render(StillRate);
@@ -183,8 +235,9 @@ void CheckGPUScene(
   // window's props) is the budget.
   mapper->SetInteractiveFrameBudget(0.0);
   scene.Render(1.0e6);
-  Check(mapper->GetLastInteractive() && mapper->GetLastSampleDistance() > 1.0,
-    name + ": budget 0 takes the allocated render time (a microsecond: a coarser distance)");
+  Check(mapper->GetLastInteractive() &&
+      (mapper->GetLastSampleDistance() > 1.0 || mapper->GetLastLevel() < 3),
+    name + ": budget 0 takes the allocated render time (a microsecond: a coarser frame)");
 
   // InteractiveAdjust off: interactive renders are the still image, untimed.
   mapper->SetInteractiveFrameBudget(1e-7);

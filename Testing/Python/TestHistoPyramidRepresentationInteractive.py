@@ -32,11 +32,13 @@ view, display = hp.make_scene(phantom)
 
 INFO = ["HistoPyramidLastInteractive", "HistoPyramidLastSampleDistance", "HistoPyramidLastLevel",
         "HistoPyramidLastPredictedSeconds", "HistoPyramidLastMeasuredSeconds"]
-for name in ["HistoPyramidInteractiveAdjust", "HistoPyramidInteractiveFrameBudget"] + INFO:
+for name in ["HistoPyramidInteractiveAdjust", "HistoPyramidInteractiveFrameBudget",
+             "HistoPyramidInteractiveTriangleLevels"] + INFO:
     check(display.GetProperty(name) is not None, "the display has %s" % name)
 check(display.HistoPyramidInteractiveAdjust == 1, "InteractiveAdjust is on by default")
 check(abs(display.HistoPyramidInteractiveFrameBudget - 0.1) < 1e-12,
       "InteractiveFrameBudget is 0.1 s by default")
+check(display.HistoPyramidInteractiveTriangleLevels == 1, "InteractiveTriangleLevels is on by default")
 
 
 def last_frame():
@@ -67,15 +69,25 @@ check(still["measured"] > 0.0 and still["predicted"] > 0.0,
 before = hp.screenshot(view, os.path.join(args.out, "InteractiveStillBefore.png"))
 
 display.HistoPyramidInteractiveFrameBudget = 1e-7
+display.HistoPyramidInteractiveTriangleLevels = 0
 for _ in range(3):
     view.InteractiveRender()
 moving = last_frame()
 print("interactive:", moving)
-check(moving["interactive"] == 1 and moving["distance"] > 1.0 and moving["path"] == "gpu",
-      "an interactive render with a tiny budget draws at a sample distance above 1 (got %r)"
-      % moving)
+check(moving["interactive"] == 1 and moving["distance"] == 8.0 and moving["path"] == "gpu",
+      "an interactive render with a tiny budget, triangle levels off, draws on the GPU path at "
+      "the coarsest sample distance, 8 (got %r)" % moving)
 check(moving["predicted"] > 0.0 and moving["measured"] > 0.0,
       "the interactive frame says what was predicted and measured (got %r)" % moving)
+display.HistoPyramidInteractiveTriangleLevels = 1
+view.InteractiveRender()
+view.InteractiveRender()
+coarse = last_frame()
+print("interactive, triangle levels:", coarse)
+check(coarse["interactive"] == 1 and coarse["path"] == "fallback" and coarse["reason"] == ""
+      and coarse["level"] < 3 and coarse["triangles"] > 0,
+      "with the triangle levels (default) a tiny budget draws a coarser Block LOD level, with "
+      "no fallback reason (got %r)" % coarse)
 
 view.StillRender()
 after_info = last_frame()
