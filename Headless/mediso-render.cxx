@@ -68,6 +68,8 @@ Scene:
                         (default 0.15,0.8,0.25,30)
   --no-points           never draw point footprints (always quads)
   --no-first-hit        draw opaque frames in one pass
+  --sample-distance D   image sample distance (>= 1, default 1): draw into a target of
+                        size / D pixels, then up to the image (interactive frames)
 The camera is VTK's: reset to the volume's bounds (view angle 30 degrees,
 looking down -z), then azimuth, elevation, orthogonalised view up, zoom.
 
@@ -97,6 +99,7 @@ struct Options
   double Background[3] = { 0.1, 0.12, 0.16 };
   double Material[4] = { 0.15, 0.8, 0.25, 30.0 };
   bool Points = true, FirstHit = true;
+  double SampleDistance = 1.0;
   std::string Output;
   int Resample[3] = { 0, 0, 0 };
   std::string WriteVolume;
@@ -252,6 +255,14 @@ Options Parse(int argc, char* argv[])
     else if (arg == "--no-first-hit")
     {
       opt.FirstHit = false;
+    }
+    else if (arg == "--sample-distance")
+    {
+      opt.SampleDistance = Number(value("--sample-distance"), "--sample-distance");
+      if (!(opt.SampleDistance >= 1.0) || !std::isfinite(opt.SampleDistance))
+      {
+        throw UsageError{ "--sample-distance must be a number of at least 1" };
+      }
     }
     else if (arg == "--output")
     {
@@ -475,6 +486,7 @@ public:
     this->Frame.SpecularPower = static_cast<float>(this->Opt.Material[3]);
     this->Frame.AllowPointFootprint = this->Opt.Points;
     this->Frame.FirstHitPass = this->Opt.FirstHit;
+    this->Frame.SampleDistance = static_cast<float>(this->Opt.SampleDistance);
   }
 
   // Builds the pyramid for `surfaces` (ahead of the frame, to time it apart); "" or why not.
@@ -669,7 +681,8 @@ int Run(int argc, char* argv[])
            << ", \"framebuffer_bytes\": " << scene.Scene.GetFrameBufferBytes()
            << ", \"volume_bytes\": " << image.Bytes.size()
            << ", \"footprint\": " << JsonString(stats.PointFootprint ? "points" : "boxes")
-           << ", \"first_hit\": " << (stats.FirstHit ? "true" : "false") << "}";
+           << ", \"first_hit\": " << (stats.FirstHit ? "true" : "false")
+           << ", \"sample_distance\": " << stats.SampleDistance << "}";
       std::printf("%s\n", json.str().c_str());
     }
   }

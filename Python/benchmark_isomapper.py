@@ -226,6 +226,8 @@ def report(args, command, records, failed, started, wall, load_before, load_afte
                          "%.2f" % (r["median_s"] / r["still_median_s"]),
                          "%g (%g..%g)" % (r["distance_median"], r["distance_min"],
                                           r["distance_max"]),
+                         "%d; level median %g, min %g" % (r["triangle_frames"],
+                                                          r["level_median"], r["level_min"]),
                          "%s / %s" % (fmt_s(r["predicted_median_s"]),
                                       fmt_s(r["measured_median_s"])),
                          "%.0f%%" % (100.0 * r["error_median"]),
@@ -237,6 +239,7 @@ def report(args, command, records, failed, started, wall, load_before, load_afte
         lines.extend(table(["input", "window", "isovalues", "frames", "still median s",
                             "interactive median s", "interactive / still",
                             "sample distance median (min..max)",
+                            "frames as Block LOD triangles",
                             "predicted / measured median s", "median |error|",
                             "frames predicted within 25%", "still frame after"], rows))
 

@@ -812,13 +812,17 @@ int main(int argc, char* argv[])
             vtkHistoPyramidIsoMapper* hp = scene.HistoPyramid;
             hp->SetInteractiveFrameBudget(opt.InteractiveBudget);
             scene.Window->SetDesiredUpdateRate(1000.0);
-            std::vector<double> frameTimes, distances, predicted, measured, errors;
+            std::vector<double> frameTimes, distances, predicted, measured, errors, levels;
             int within = 0;
+            int triangleFrames = 0;
             for (int f = 0; f < opt.Frames; ++f)
             {
               scene.Rotate(1.0);
               frameTimes.push_back(scene.Frame());
               distances.push_back(hp->GetLastSampleDistance());
+              levels.push_back(hp->GetLastLevel());
+              triangleFrames +=
+                hp->GetLastRenderPath() == vtkHistoPyramidIsoMapper::FallbackPath ? 1 : 0;
               predicted.push_back(hp->GetLastPredictedSeconds());
               measured.push_back(hp->GetLastMeasuredSeconds());
               const double error = std::abs(predicted.back() - measured.back()) /
@@ -843,6 +847,9 @@ int main(int argc, char* argv[])
               .Add("distance_median", Summarise(distances).Median)
               .Add("distance_min", Summarise(distances).Min)
               .Add("distance_max", *std::max_element(distances.begin(), distances.end()))
+              .Add("level_min", *std::min_element(levels.begin(), levels.end()))
+              .Add("level_median", Summarise(levels).Median)
+              .Add("triangle_frames", static_cast<double>(triangleFrames))
               .Add("predicted_median_s", Summarise(predicted).Median)
               .Add("measured_median_s", Summarise(measured).Median)
               .Add("error_median", Summarise(errors).Median)
