@@ -318,7 +318,8 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   const double allocated = vol->GetAllocatedRenderTime();
   const bool adjust = this->InteractiveAdjust;
   const bool interactive = adjust && allocated < 1.0;
-  const double budget = this->InteractiveFrameBudget > 0.0 ? this->InteractiveFrameBudget : allocated;
+  const double budget =
+    this->InteractiveFrameBudget > 0.0 ? this->InteractiveFrameBudget : allocated;
   int width = 0, height = 0;
   ren->GetTiledSize(&width, &height);
   bool translucent = false;

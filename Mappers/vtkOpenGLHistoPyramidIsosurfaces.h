@@ -60,7 +60,8 @@ public:
     double Opacity;
   };
 
-  /// The image sample distance of a frame, from the primitives it will draw (see RenderIsosurfaces).
+  /// The image sample distance of a frame, from the primitives it will draw (see
+  /// RenderIsosurfaces).
   using SampleDistanceChooser = std::function<float(std::uint64_t primitives)>;
 
   /**

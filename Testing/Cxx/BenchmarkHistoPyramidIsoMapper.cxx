@@ -825,8 +825,8 @@ int main(int argc, char* argv[])
                 hp->GetLastRenderPath() == vtkHistoPyramidIsoMapper::FallbackPath ? 1 : 0;
               predicted.push_back(hp->GetLastPredictedSeconds());
               measured.push_back(hp->GetLastMeasuredSeconds());
-              const double error = std::abs(predicted.back() - measured.back()) /
-                std::max(measured.back(), 1e-9);
+              const double error =
+                std::abs(predicted.back() - measured.back()) / std::max(measured.back(), 1e-9);
               errors.push_back(error);
               within += error <= 0.25 ? 1 : 0;
             }
@@ -861,8 +861,8 @@ int main(int argc, char* argv[])
                         "sample distance median %g, predicted/measured median %.4f/%.4f s, "
                         "%.0f%% of frames predicted within 25%%\n",
               opt.Input.c_str(), windowText.c_str(), opt.InteractiveBudget, is.Median, s.Median,
-              Summarise(distances).Median, Summarise(predicted).Median,
-              Summarise(measured).Median, 100.0 * within / std::max(1, opt.Frames));
+              Summarise(distances).Median, Summarise(predicted).Median, Summarise(measured).Median,
+              100.0 * within / std::max(1, opt.Frames));
           }
           std::printf("%s %s %s iso %g: %d frames, median %.4f s (%.1f fps), min %.4f s, "
                       "total %.1f s, %.0f elements, path %s\n",
