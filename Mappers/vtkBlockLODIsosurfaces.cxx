@@ -47,6 +47,10 @@ vtkBlockLODIsosurfaces::vtkBlockLODIsosurfaces()
 {
   Internals& impl = *this->Impl;
   impl.Contour->SetLOD(3);
+  // Set once: vtkAlgorithm::SetInputArrayToProcess marks the filter modified
+  // on every call, which would extract (and recolour) again on every frame.
+  impl.Contour->SetInputArrayToProcess(
+    0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
   impl.Contour->SetComputeNormals(true);
   impl.Contour->SetComputeScalars(true);
   impl.Sort->SetInputData(impl.Colored);
@@ -123,8 +127,6 @@ void vtkBlockLODIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol,
   }
 
   impl.Contour->SetInputData(impl.IndexImage);
-  impl.Contour->SetInputArrayToProcess(
-    0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
   bool valuesChanged = impl.Contour->GetNumberOfContours() != static_cast<vtkIdType>(surfaces.size());
   for (std::size_t i = 0; i < surfaces.size() && !valuesChanged; ++i)
   {
