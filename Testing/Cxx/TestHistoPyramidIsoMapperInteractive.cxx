@@ -28,7 +28,10 @@
 
 #include "vtkActor.h"
 #include "vtkCamera.h"
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
 #include "vtkPlaneSource.h"
+#include "vtkPointData.h"
 #include "vtkPolyDataMapper.h"
 #include "vtkProperty.h"
 #include "vtkRenderWindow.h"
@@ -259,7 +262,9 @@ int TestHistoPyramidIsoMapperInteractive(int, char*[])
 
   // 4. The CPU fallback: a coarser level while interactive (no GPU needed).
   {
-    Scene scene(phantom, { skinGlass, bone });
+    vtkNew<vtkImageData> own; // changed below
+    own->DeepCopy(phantom);
+    Scene scene(own, { skinGlass, bone });
     vtkHistoPyramidIsoMapper* mapper = scene.Mapper;
     mapper->ForceCPUFallbackOn();
     scene.Render(StillRate);
@@ -282,6 +287,18 @@ int TestHistoPyramidIsoMapperInteractive(int, char*[])
     Check(mapper->GetLastLevel() == 3 && mapper->GetNumberOfFallbackTriangles() == fullTriangles &&
         after == still,
       "fallback: the still render after it draws level 3, the same image");
+    // New values in the same array: the levels kept for the old ones are not drawn.
+    vtkDataArray* values = own->GetPointData()->GetScalars();
+    for (vtkIdType i = 0; i < values->GetNumberOfTuples() / 2; ++i)
+    {
+      values->SetTuple1(i, -1000.0);
+    }
+    values->Modified();
+    scene.Render(InteractiveRate);
+    const std::vector<unsigned char> changed = scene.Render(StillRate);
+    Check(mapper->GetLastLevel() == 3 && mapper->GetNumberOfFallbackTriangles() != fullTriangles &&
+        changed != still,
+      "fallback: new values in the array draw new surfaces (no level kept from the old ones)");
   }
 
   const int skip = ProbeOrSkip();
