@@ -14,8 +14,9 @@
  * with blending: the renderer's depth peeling does not reach geometry a
  * volume mapper draws. SetLevel() picks a coarser level (vtkBlockLODContour's
  * LOD 0..2, cube edges of 8, 4, 2 voxels): vtkHistoPyramidIsoMapper's
- * interactive frames; the filter's cache keeps each level's surfaces, so
- * switching back and forth extracts nothing again.
+ * interactive frames. The coloured surface of each level drawn is kept
+ * for the current input and looks (dropped when either changes), so that
+ * switching back and forth neither runs the filter nor recolours.
  *
  * @sa vtkHistoPyramidIsoMapper vtkOpenGLHistoPyramidIsosurfaces vtkBlockLODContour
  */
