@@ -41,20 +41,21 @@ export function countBytes(sent, received) {
   state.bytesReceived += received;
 }
 
-// The server sends byte b of every value together: values of `size` bytes back in order.
-function unshuffle(shuffled, size) {
+// The server sends byte b of every value together: values of `size` bytes back in order, into
+// `out` (the module's memory: no second copy for the collector to reclaim during the first
+// changes).
+function unshuffle(shuffled, size, out) {
   if (size === 1) {
-    return shuffled;
+    out.set(shuffled);
+    return;
   }
   const n = shuffled.length / size;
-  const out = new Uint8Array(shuffled.length);
   for (let b = 0; b < size; ++b) {
     const plane = shuffled.subarray(b * n, (b + 1) * n);
     for (let i = 0, o = b; i < n; ++i, o += size) {
       out[o] = plane[i];
     }
   }
-  return out;
 }
 
 /** Fetches level `level` of the dataset and gives it to the viewer (the module's memory). */
@@ -69,20 +70,24 @@ export async function loadVolume(level) {
   const dims = response.headers.get("X-Mediso-Dims").split(",").map(Number);
   const spacing = response.headers.get("X-Mediso-Spacing").split(",").map(Number);
   const origin = response.headers.get("X-Mediso-Origin").split(",").map(Number);
-  const bytes = unshuffle(new Uint8Array(body), type.bytes);
+  const shuffled = new Uint8Array(body);
   const M = state.module;
   const pointerBefore = state.volumePointer;
   if (state.volumePointer) {
     M._free(state.volumePointer);
   }
-  state.volumePointer = M._malloc(bytes.length);
-  M.HEAPU8.set(bytes, state.volumePointer);
+  state.volumePointer = M._malloc(shuffled.length);
+  unshuffle(shuffled, type.bytes, M.HEAPU8.subarray(state.volumePointer, state.volumePointer + shuffled.length));
   state.level = level;
   // The module resets its camera with a new volume; another level of the same volume keeps the
   // view the user has.
   const kept = pointerBefore ? state.viewer.getView() : null;
   if (!state.viewer.setVolume(type.value, state.volumePointer, dims, spacing, origin)) {
     throw new Error("the volume cannot be uploaded: " + state.viewer.stats().error);
+  }
+  const refused = state.remote ? await state.viewer.uploaded : ""; // the worker's upload
+  if (refused) {
+    throw new Error("the volume cannot be uploaded: " + refused);
   }
   if (kept) {
     state.viewer.setView(kept);
