@@ -264,6 +264,14 @@ for (const [width, height, ratio] of [[1920, 1080, 1], [800, 600, 2]]) {
     return { width: v.width, height: v.height, css: [b.width, b.height], dpr: devicePixelRatio };
   });
   const fits = (s) => Math.abs(s.width - s.css[0] * s.dpr) <= 1 && Math.abs(s.height - s.css[1] * s.dpr) <= 1;
+  // The viewer may draw in a worker: the backing store follows the box with the worker's next
+  // frame, so the checks below wait for it (up to 10 s) after each change of the window.
+  const settled = () => page.waitForFunction(() => {
+    const v = document.getElementById("view");
+    const b = v.getBoundingClientRect();
+    return Math.abs(v.width - b.width * devicePixelRatio) <= 1 &&
+      Math.abs(v.height - b.height * devicePixelRatio) <= 1;
+  }, null, { timeout: 10000 }).catch(() => {});
   const s = await size();
   checks.check(fits(s) && s.dpr === ratio, width + "x" + height + " at ratio " + ratio + ": backing store " + s.width + "x" +
     s.height + " for " + s.css.join("x") + " CSS pixels");
@@ -271,11 +279,14 @@ for (const [width, height, ratio] of [[1920, 1080, 1], [800, 600, 2]]) {
     width + "x" + height + ": the view takes " + s.css.map(Math.round).join("x") + " CSS pixels");
   await page.setViewportSize({ width: Math.round(width * 0.75), height: Math.round(height * 0.9) });
   await page.waitForTimeout(300);
+  await settled();
   const r = await size();
   checks.check(fits(r) && r.css[1] < s.css[1], "resized window: backing store " + r.width + "x" + r.height + " for " +
     r.css.join("x"));
   await page.click("#toggle-panel");
   await page.waitForTimeout(300);
+  await settled();
+  await page.evaluate(() => window.mediso.setView(window.mediso.getView())); // the frame drawn
   const hidden = await size();
   checks.check(fits(hidden) && Math.abs(hidden.css[0] - Math.round(width * 0.75)) <= 1 &&
     hidden.css[0] * hidden.css[1] > 1.1 * r.css[0] * r.css[1],

@@ -105,6 +105,7 @@ async function start() {
     scheduleLink();
   });
   renderNow();
+  await drawn(); // ready after the first frame (the worker's answer)
   // The "On the server" panel (Web/static/operations.js) is given what it needs here.
   setupOperations({
     dataset: d,
