@@ -60,5 +60,5 @@ export const state = Object.seal({
   lastRefinedMs: 0, // the last change to its full-level frame
   sampleDistance: 1, // the GPU path's image sample distance of the last frame
   frameNote: "", // why the last frame is coarser than the full one ("" when it is not)
-  frameLog: [], // the last 200 frames: [{values, cpuLevel, triangles, primitives, sampleDistance, interactive, settled, ms}]
+  frameLog: [], // the last 200 frames: [{values, cpuLevel, triangles, primitives, sampleDistance, interactive, settled, ms, predictedMs}]
 });

@@ -138,7 +138,7 @@ function recordFrame(ms, stats) {
   state.frameNote = stats.note || "";
   state.frameLog.push({ id: stats.id, values: stats.values, cpuLevel: stats.cpuLevel,
     triangles: stats.triangles, primitives: stats.primitives, sampleDistance: state.sampleDistance,
-    interactive: state.interactive, settled: state.settled, ms });
+    interactive: state.interactive, settled: state.settled, ms, predictedMs: stats.predictedMs || 0 });
   if (state.frameLog.length > 200) {
     state.frameLog.shift();
   }
