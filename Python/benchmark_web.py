@@ -2,7 +2,7 @@
 """The web client against vtk.js in the same browser: isovalue change + frame, first image, bytes.
 
     python3 Python/benchmark_web.py [--inputs ct,ct512] [--sweep 10] [--size 800x600] [--out FILE.md]
-    python3 Python/benchmark_web.py --interactive [--inputs phantom:256,ct] [--before main] [--out FILE.md]
+    python3 Python/benchmark_web.py --interactive [--inputs phantom:256,ct] [--paths cpu,gpu] [--before main]
 
 In one headless Chromium (Debian's, software WebGL2: SwiftShader), on the same volume and canvas
 size: the page's GPU path (the core on WebGL2), its CPU path (the BlockLOD core in WebAssembly at
@@ -54,8 +54,11 @@ def parse_args(argv):
     p.add_argument("--out", default="")
     p.add_argument("--interactive", action="store_true",
                    help="the page before (--before) against this one: first answer, drag, long tasks")
-    p.add_argument("--before", default="main", help="--interactive: the git ref of the page before")
+    p.add_argument("--before", default="",
+                   help="--interactive: the git ref of the page before (default: where this branch "
+                        "left main, whose page takes this tree's WebAssembly module)")
     p.add_argument("--moves", type=int, default=30, help="--interactive: mouse moves of the drag")
+    p.add_argument("--paths", default="cpu,gpu", help="--interactive: the page's paths to run")
     return p.parse_args(argv)
 
 
@@ -183,7 +186,7 @@ def run_interactive(args, name, before_root):
         lo, hi = (-1000, 1100) if name.startswith("phantom:") else (-1000, 2000)
         isovalues = [400, -500, 300, 500, -300, 200, 600]
         isovalues = [v for v in isovalues if lo < v < hi]
-        config = {"pages": {"before": before_url, "after": after_url}, "paths": ["cpu", "gpu"],
+        config = {"pages": {"before": before_url, "after": after_url}, "paths": args.paths.split(","),
                   "size": [int(v) for v in args.size.split("x")], "isovalues": isovalues,
                   "moves": args.moves}
         config_file = os.path.join(work, "config.json")
@@ -205,6 +208,9 @@ def main_interactive(args, argv):
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     load_before = load_average()
     t0 = time.perf_counter()
+    if not args.before:
+        args.before = subprocess.run(["git", "-C", ROOT, "merge-base", "HEAD", "main"], check=True,
+                                     stdout=subprocess.PIPE, text=True).stdout.strip()[:12]
     before_root = os.path.join(args.work, "before-" + args.before.replace("/", "-"))
     shutil.rmtree(before_root, ignore_errors=True)
     os.makedirs(before_root)

@@ -460,6 +460,7 @@ public:
     const GLApi::Functions& f = this->GL->F();
     const double start = emscripten_get_now();
     this->FrameStart = start;
+    this->MeshesUploaded = false;
     std::vector<double> values;
     for (const IsosurfaceLook& s : this->Frame.Surfaces)
     {
@@ -545,15 +546,17 @@ public:
   }
 
   /// Waits for the GPU to finish (a one-pixel read-back): for timings. A
-  /// frame that built nothing is then given to the frame-time model with its
-  /// time to here (a build's one-off work would inflate the fit).
+  /// frame that built nothing (GPU path: no pyramid build; CPU path: no
+  /// surface extracted or uploaded) is then given to the frame-time model
+  /// with its time to here (one-off work would inflate the fit).
   void Finish()
   {
     emscripten_webgl_make_context_current(this->Context);
     unsigned char pixel[4];
     this->GL->F().ReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, pixel);
     const double seconds = (emscripten_get_now() - this->FrameStart) / 1000.0;
-    if (this->FrameDrawn && this->LastBuildMs == 0.0)
+    const bool oneOff = this->CPUPath ? this->MeshesUploaded : this->LastBuildMs > 0.0;
+    if (this->FrameDrawn && !oneOff)
     {
       this->Times.Observe(this->DrawnWork(this->DrawnSampleDistance), seconds);
     }
@@ -821,6 +824,7 @@ private:
       const CPUSurface& surface = *surfaces[slot];
       if (!(this->ShownKeys[slot] == key))
       {
+        this->MeshesUploaded = true;
         this->Meshes->SetMesh(slot, surface.Points.data(), surface.Normals.data(),
           static_cast<std::int64_t>(surface.Points.size() / 3), surface.Triangles.data(),
           static_cast<std::int64_t>(surface.Triangles.size() / 3));
@@ -853,6 +857,7 @@ private:
   FrameTimeModel Times; // this client's frames: the time each level or sample distance takes
   double FrameStart = 0.0;
   bool FrameDrawn = false; // a frame was drawn since the last Finish
+  bool MeshesUploaded = false; // the last frame made or uploaded a CPU path surface
   glcore::Name Sampled, SampledColor, SampledDepth; // a sampled frame's framebuffer
   int SampledSize[2] = { 0, 0 };
 
