@@ -27,6 +27,16 @@
  * A preset's value is a start: edit it in the row. The list also takes over
  * the display's start (vtkSMMedicalIsosurfaceInitializationHelper): its
  * colours and opacities stay with the rows whatever values are typed.
+ *
+ * The Opacity column edits each row's own opacity and shows, after each
+ * render, the opacity the surface is drawn with where that differs (the
+ * colour map's opacity map, when its opacity mapping is on, and the
+ * display's Opacity multiply it: the representation's SurfaceLooks). Below
+ * the list, a warning names isovalues outside the data range (the text the
+ * representation gives in Output Messages). *Make Mesh* runs the plugin's
+ * Python call medical_isosurfaces.MakeMeshFromView() on this display: the
+ * surfaces as a Block LOD Contour + Isosurface Labels mesh to save (hidden
+ * where ParaView has no Python).
  */
 #ifndef pqMedicalIsosurfaceListWidget_h
 #define pqMedicalIsosurfaceListWidget_h
@@ -36,6 +46,7 @@
 #include <QColor>
 #include <QList>
 #include <QVariant>
+#include <string>
 #include <vector>
 
 class QCheckBox;
@@ -83,6 +94,12 @@ private Q_SLOTS:
   void cellEdited(int row, int column);
   void cellDoubleClicked(int row, int column);
   void updateRange();
+  /// Reads the opacities drawn (SurfaceLooks) after a render.
+  void updateLooks();
+  /// Says which isovalues lie outside the data range.
+  void updateWarning();
+  /// The mesh of the surfaces shown (medical_isosurfaces.MakeMeshFromView).
+  void makeMesh();
   /// Rebuilds the table from Rows without signalling an edit.
   void updateTable();
 
@@ -104,7 +121,10 @@ private:
   void appendRow(const Row& row);
 
   std::vector<Row> Rows;
+  std::vector<double> DrawnOpacities;
+  QMetaObject::Connection RenderConnection;
   double Range[2] = { 0.0, 0.0 };
+  std::string RangeName;
   bool HasRange = false;
   bool Updating = false;
   QTableWidget* Table;
@@ -112,6 +132,8 @@ private:
   QToolButton* AddButton;
   QPushButton* RemoveButton;
   QCheckBox* ColorEachSurface;
+  QLabel* RangeWarning;
+  QPushButton* MeshButton;
   vtkEventQtSlotConnect* Connections;
 };
 
