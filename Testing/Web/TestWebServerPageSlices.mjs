@@ -287,6 +287,7 @@ const browser = await launchBrowser();
   checks.check(s.length === 2 && s[0].value === -500 && s[0].opacity < 1 && s[1].value === 400 && s[1].opacity === 1,
     "a CT in Hounsfield units opens with translucent skin at -500 and bone at 400: " + JSON.stringify(s.map((x) => [x.value, x.opacity])));
   await page.click('#presets button[data-preset="Contrast vessels"]');
+  await page.evaluate(() => window.mediso.drawn()); // the slices redraw after the (worker's) frame
   const added = await page.evaluate(() => window.mediso.getSurfaces().map((x) => x.value));
   checks.check(added.join() === "-500,400,200", "the Contrast vessels preset adds 200 HU: " + added.join());
   const windows = await page.evaluate(() => window.mediso.slices().map((v) => v.window));

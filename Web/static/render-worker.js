@@ -213,6 +213,8 @@ self.onmessage = async (event) => {
       schedule();
     }
   } catch (error) {
-    post({ op: "error", message: String(error && error.message || error) });
+    const message = String(error && error.message || error);
+    // A failed start answers the page's wait for "ready" (it then says why it cannot draw).
+    post(m.op === "init" ? { op: "ready", ok: false, error: message } : { op: "error", message });
   }
 };
