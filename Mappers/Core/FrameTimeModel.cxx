@@ -5,8 +5,10 @@
 #include <cmath>
 #include <limits>
 
-namespace mediso {
-namespace {
+namespace mediso
+{
+namespace
+{
 // A floor for the prior's seconds of a frame, the divisor of its relative
 // error (zero work with a zero prior must not give a frame infinite weight).
 constexpr double MinimumSeconds = 1e-6;
@@ -20,96 +22,112 @@ using Matrix3 = std::array<Vector3, 3>;
 
 // Solves the rows and columns of A, b named by `free` (Gaussian elimination
 // with partial pivoting); false when singular. Others stay 0.
-bool SolveSubset(const Matrix3 &a, const Vector3 &b,
-                 const std::array<bool, 3> &free, Vector3 &x) {
+bool SolveSubset(const Matrix3& a, const Vector3& b, const std::array<bool, 3>& free, Vector3& x)
+{
   int index[3];
   int n = 0;
-  for (int j = 0; j < 3; ++j) {
-    if (free[j]) {
+  for (int j = 0; j < 3; ++j)
+  {
+    if (free[j])
+    {
       index[n++] = j;
     }
   }
   double m[3][4];
-  for (int r = 0; r < n; ++r) {
-    for (int c = 0; c < n; ++c) {
+  for (int r = 0; r < n; ++r)
+  {
+    for (int c = 0; c < n; ++c)
+    {
       m[r][c] = a[index[r]][index[c]];
     }
     m[r][n] = b[index[r]];
   }
-  for (int c = 0; c < n; ++c) {
+  for (int c = 0; c < n; ++c)
+  {
     int pivot = c;
-    for (int r = c + 1; r < n; ++r) {
-      if (std::fabs(m[r][c]) > std::fabs(m[pivot][c])) {
+    for (int r = c + 1; r < n; ++r)
+    {
+      if (std::fabs(m[r][c]) > std::fabs(m[pivot][c]))
+      {
         pivot = r;
       }
     }
-    if (!(std::fabs(m[pivot][c]) > 0.0)) {
+    if (!(std::fabs(m[pivot][c]) > 0.0))
+    {
       return false;
     }
-    for (int k = 0; k <= n; ++k) {
+    for (int k = 0; k <= n; ++k)
+    {
       std::swap(m[c][k], m[pivot][k]);
     }
-    for (int r = 0; r < n; ++r) {
-      if (r != c) {
+    for (int r = 0; r < n; ++r)
+    {
+      if (r != c)
+      {
         const double f = m[r][c] / m[c][c];
-        for (int k = c; k <= n; ++k) {
+        for (int k = c; k <= n; ++k)
+        {
           m[r][k] -= f * m[c][k];
         }
       }
     }
   }
-  x = {0.0, 0.0, 0.0};
-  for (int r = 0; r < n; ++r) {
+  x = { 0.0, 0.0, 0.0 };
+  for (int r = 0; r < n; ++r)
+  {
     x[index[r]] = m[r][n] / m[r][r];
   }
   return true;
 }
 
-double Finite(double value, double fallback) {
+double Finite(double value, double fallback)
+{
   return std::isfinite(value) ? value : fallback;
 }
 } // namespace
 
-double FrameTimeModel::Coefficients::Evaluate(const FrameWork &work) const {
-  const double seconds =
-      this->Seconds +
-      this->PerPrimitive * static_cast<double>(work.Primitives) +
-      this->PerPixel * static_cast<double>(work.Pixels);
-  if (!(seconds > 0.0)) {
+double FrameTimeModel::Coefficients::Evaluate(const FrameWork& work) const
+{
+  const double seconds = this->Seconds + this->PerPrimitive * static_cast<double>(work.Primitives) +
+    this->PerPixel * static_cast<double>(work.Pixels);
+  if (!(seconds > 0.0))
+  {
     return 0.0;
   }
   return std::isfinite(seconds) ? seconds : std::numeric_limits<double>::max();
 }
 
-std::uint64_t FrameTimeModel::ShadedPixels(int width, int height,
-                                           double sampleDistance) {
-  if (width <= 0 || height <= 0 || !std::isfinite(sampleDistance) ||
-      !(sampleDistance > 0.0)) {
+std::uint64_t FrameTimeModel::ShadedPixels(int width, int height, double sampleDistance)
+{
+  if (width <= 0 || height <= 0 || !std::isfinite(sampleDistance) || !(sampleDistance > 0.0))
+  {
     return 0;
   }
-  const double pixels = static_cast<double>(width) *
-                        static_cast<double>(height) /
-                        (sampleDistance * sampleDistance);
-  return std::max<std::uint64_t>(
-      1, static_cast<std::uint64_t>(std::floor(pixels)));
+  const double pixels =
+    static_cast<double>(width) * static_cast<double>(height) / (sampleDistance * sampleDistance);
+  return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::floor(pixels)));
 }
 
-FrameTimeModel::Coefficients FrameTimeModel::Prior(FrameMethod method,
-                                                   bool translucent) {
+FrameTimeModel::Coefficients FrameTimeModel::Prior(FrameMethod method, bool translucent)
+{
   // Software rasterisers, pessimistically: a host's first frames without
   // observations should come out coarse rather than late. Translucent frames
   // blend every layer (and the cell rasteriser sorts), hence the factors.
   Coefficients prior;
-  if (method == FrameMethod::CellRasterisation) {
+  if (method == FrameMethod::CellRasterisation)
+  {
     prior.Seconds = 0.005;
     prior.PerPrimitive = 6e-7;
     prior.PerPixel = 4e-7;
-  } else {
+  }
+  else
+  {
     prior.Seconds = 0.005;
     prior.PerPrimitive = 3e-7;
     prior.PerPixel = 1e-7;
   }
-  if (translucent) {
+  if (translucent)
+  {
     const double factor = method == FrameMethod::CellRasterisation ? 3.0 : 4.0;
     prior.Seconds *= factor;
     prior.PerPrimitive *= factor;
@@ -118,29 +136,32 @@ FrameTimeModel::Coefficients FrameTimeModel::Prior(FrameMethod method,
   return prior;
 }
 
-std::size_t FrameTimeModel::Key(FrameMethod method, bool translucent) {
+std::size_t FrameTimeModel::Key(FrameMethod method, bool translucent)
+{
   const std::size_t m = method == FrameMethod::CellRasterisation ? 0 : 1;
   return 2 * m + (translucent ? 1 : 0);
 }
 
-void FrameTimeModel::Observe(const FrameWork &work, double seconds) {
+void FrameTimeModel::Observe(const FrameWork& work, double seconds)
+{
   if (!std::isfinite(seconds) || seconds < 0.0 ||
-      (work.Method != FrameMethod::CellRasterisation &&
-       work.Method != FrameMethod::Triangles)) {
+    (work.Method != FrameMethod::CellRasterisation && work.Method != FrameMethod::Triangles))
+  {
     return;
   }
-  Pair &pair = this->Pairs[Key(work.Method, work.Translucent)];
-  pair.Samples.push_back({static_cast<double>(work.Primitives),
-                          static_cast<double>(work.Pixels), seconds});
-  while (pair.Samples.size() > HistoryLength) {
+  Pair& pair = this->Pairs[Key(work.Method, work.Translucent)];
+  pair.Samples.push_back(
+    { static_cast<double>(work.Primitives), static_cast<double>(work.Pixels), seconds });
+  while (pair.Samples.size() > HistoryLength)
+  {
     pair.Samples.pop_front();
   }
   pair.Fitted = Solve(pair.Samples, Prior(work.Method, work.Translucent));
 }
 
-FrameTimeModel::Coefficients
-FrameTimeModel::Solve(const std::deque<Sample> &samples,
-                      const Coefficients &prior) {
+FrameTimeModel::Coefficients FrameTimeModel::Solve(
+  const std::deque<Sample>& samples, const Coefficients& prior)
+{
   // Rows in relative terms: frame i asks (a, b, c) . (1, P, X) / p_i = t_i /
   // p_i, p_i the prior's seconds for its work, weighted by recency. Dividing by
   // the prior rather than by the measured t_i makes a 10 ms frame count as
@@ -153,27 +174,31 @@ FrameTimeModel::Solve(const std::deque<Sample> &samples,
   std::vector<double> target(n);
   double totalWeight = 0.0;
   double w = 1.0;
-  for (std::size_t k = n; k-- > 0;) {
-    const Sample &s = samples[k];
+  for (std::size_t k = n; k-- > 0;)
+  {
+    const Sample& s = samples[k];
     const double p =
-        std::max(prior.Seconds + prior.PerPrimitive * s.Primitives +
-                     prior.PerPixel * s.Pixels,
-                 MinimumSeconds);
+      std::max(prior.Seconds + prior.PerPrimitive * s.Primitives + prior.PerPixel * s.Pixels,
+        MinimumSeconds);
     weight[k] = w;
-    row[k] = {1.0 / p, s.Primitives / p, s.Pixels / p};
+    row[k] = { 1.0 / p, s.Primitives / p, s.Pixels / p };
     target[k] = s.Seconds / p;
     totalWeight += w;
     w *= RecencyDecay;
   }
-  Vector3 scale = {0.0, 0.0, 0.0};
-  for (std::size_t k = 0; k < n; ++k) {
-    for (int j = 0; j < 3; ++j) {
+  Vector3 scale = { 0.0, 0.0, 0.0 };
+  for (std::size_t k = 0; k < n; ++k)
+  {
+    for (int j = 0; j < 3; ++j)
+    {
       scale[j] += weight[k] * row[k][j] * row[k][j];
     }
   }
-  for (int j = 0; j < 3; ++j) {
+  for (int j = 0; j < 3; ++j)
+  {
     scale[j] = std::sqrt(scale[j] / totalWeight);
-    if (!(scale[j] > 0.0) || !std::isfinite(scale[j])) {
+    if (!(scale[j] > 0.0) || !std::isfinite(scale[j]))
+    {
       scale[j] = 1.0;
     }
   }
@@ -181,31 +206,36 @@ FrameTimeModel::Solve(const std::deque<Sample> &samples,
   // The prior's least-squares scale to these frames: each row of the prior
   // is 1, so it is the frames' weighted mean ratio to the prior.
   double ratio = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
+  for (std::size_t k = 0; k < n; ++k)
+  {
     ratio += weight[k] * target[k];
   }
   const double priorScale = Finite(ratio / totalWeight, 1.0);
-  const Vector3 priorPhi = {priorScale * prior.Seconds * scale[0],
-                            priorScale * prior.PerPrimitive * scale[1],
-                            priorScale * prior.PerPixel * scale[2]};
+  const Vector3 priorPhi = { priorScale * prior.Seconds * scale[0],
+    priorScale * prior.PerPrimitive * scale[1], priorScale * prior.PerPixel * scale[2] };
 
   // Normal equations of the scaled problem with the ridge towards the prior.
   const double ridge = PriorWeight * totalWeight;
   Matrix3 a{};
   Vector3 b{};
-  for (std::size_t k = 0; k < n; ++k) {
+  for (std::size_t k = 0; k < n; ++k)
+  {
     Vector3 z;
-    for (int j = 0; j < 3; ++j) {
+    for (int j = 0; j < 3; ++j)
+    {
       z[j] = row[k][j] / scale[j];
     }
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) {
+    for (int r = 0; r < 3; ++r)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
         a[r][c] += weight[k] * z[r] * z[c];
       }
       b[r] += weight[k] * z[r] * target[k];
     }
   }
-  for (int j = 0; j < 3; ++j) {
+  for (int j = 0; j < 3; ++j)
+  {
     a[j][j] += ridge;
     b[j] += ridge * priorPhi[j];
   }
@@ -216,29 +246,35 @@ FrameTimeModel::Solve(const std::deque<Sample> &samples,
   // objective is it.
   Vector3 best = priorPhi;
   double bestObjective = std::numeric_limits<double>::infinity();
-  for (int mask = 0; mask < 8; ++mask) {
-    const std::array<bool, 3> free = {(mask & 1) != 0, (mask & 2) != 0,
-                                      (mask & 4) != 0};
+  for (int mask = 0; mask < 8; ++mask)
+  {
+    const std::array<bool, 3> free = { (mask & 1) != 0, (mask & 2) != 0, (mask & 4) != 0 };
     Vector3 phi;
-    if (!SolveSubset(a, b, free, phi)) {
+    if (!SolveSubset(a, b, free, phi))
+    {
       continue;
     }
     bool feasible = true;
-    for (int j = 0; j < 3; ++j) {
+    for (int j = 0; j < 3; ++j)
+    {
       feasible = feasible && std::isfinite(phi[j]) && phi[j] >= 0.0;
     }
-    if (!feasible) {
+    if (!feasible)
+    {
       continue;
     }
     double objective = 0.0;
-    for (int r = 0; r < 3; ++r) {
+    for (int r = 0; r < 3; ++r)
+    {
       double ar = 0.0;
-      for (int c = 0; c < 3; ++c) {
+      for (int c = 0; c < 3; ++c)
+      {
         ar += a[r][c] * phi[c];
       }
       objective += phi[r] * ar - 2.0 * b[r] * phi[r];
     }
-    if (objective < bestObjective) {
+    if (objective < bestObjective)
+    {
       bestObjective = objective;
       best = phi;
     }
@@ -251,44 +287,51 @@ FrameTimeModel::Solve(const std::deque<Sample> &samples,
   return fitted;
 }
 
-double FrameTimeModel::Predict(const FrameWork &work) const {
-  if (work.Method != FrameMethod::CellRasterisation &&
-      work.Method != FrameMethod::Triangles) {
+double FrameTimeModel::Predict(const FrameWork& work) const
+{
+  if (work.Method != FrameMethod::CellRasterisation && work.Method != FrameMethod::Triangles)
+  {
     return Prior(FrameMethod::CellRasterisation, true).Evaluate(work);
   }
   return this->Fit(work.Method, work.Translucent).Evaluate(work);
 }
 
-bool FrameTimeModel::HasObservations(FrameMethod method,
-                                     bool translucent) const {
+bool FrameTimeModel::HasObservations(FrameMethod method, bool translucent) const
+{
   return this->ObservationCount(method, translucent) > 0;
 }
 
-std::size_t FrameTimeModel::ObservationCount(FrameMethod method,
-                                             bool translucent) const {
+std::size_t FrameTimeModel::ObservationCount(FrameMethod method, bool translucent) const
+{
   return this->Pairs[Key(method, translucent)].Samples.size();
 }
 
-FrameTimeModel::Coefficients FrameTimeModel::Fit(FrameMethod method,
-                                                 bool translucent) const {
-  const Pair &pair = this->Pairs[Key(method, translucent)];
+FrameTimeModel::Coefficients FrameTimeModel::Fit(FrameMethod method, bool translucent) const
+{
+  const Pair& pair = this->Pairs[Key(method, translucent)];
   return pair.Samples.empty() ? Prior(method, translucent) : pair.Fitted;
 }
 
-void FrameTimeModel::Reset() {
-  for (Pair &pair : this->Pairs) {
+void FrameTimeModel::Reset()
+{
+  for (Pair& pair : this->Pairs)
+  {
     pair.Samples.clear();
     pair.Fitted = Coefficients();
   }
 }
 
-std::size_t FrameTimeModel::Choose(const std::vector<Candidate> &candidates,
-                                   double budgetSeconds) const {
-  if (candidates.empty()) {
+std::size_t FrameTimeModel::Choose(
+  const std::vector<Candidate>& candidates, double budgetSeconds) const
+{
+  if (candidates.empty())
+  {
     return 0;
   }
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    if (this->Predict(candidates[i].Work) <= budgetSeconds) {
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+  {
+    if (this->Predict(candidates[i].Work) <= budgetSeconds)
+    {
       return i;
     }
   }

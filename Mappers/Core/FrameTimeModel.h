@@ -66,26 +66,27 @@
 #include <deque>
 #include <vector>
 
-namespace mediso {
+namespace mediso
+{
 
 /// How a frame draws its surfaces.
-enum class FrameMethod {
-  CellRasterisation =
-      0, ///< the GPU HistoPyramid: one primitive per active cell-isovalue pair
-  Triangles = 1 ///< extracted triangles (Block LOD levels, the CPU fallback)
+enum class FrameMethod
+{
+  CellRasterisation = 0, ///< the GPU HistoPyramid: one primitive per active cell-isovalue pair
+  Triangles = 1          ///< extracted triangles (Block LOD levels, the CPU fallback)
 };
 
 /// The work of one frame, what its cost is modelled from.
-struct FrameWork {
+struct FrameWork
+{
   FrameMethod Method = FrameMethod::Triangles;
-  std::uint64_t Primitives =
-      0; ///< active cell-isovalue pairs drawn, or triangles
-  std::uint64_t Pixels =
-      0; ///< pixels shaded: viewport pixels / (sample distance)^2
+  std::uint64_t Primitives = 0; ///< active cell-isovalue pairs drawn, or triangles
+  std::uint64_t Pixels = 0;     ///< pixels shaded: viewport pixels / (sample distance)^2
   bool Translucent = false;
 };
 
-class FrameTimeModel {
+class FrameTimeModel
+{
 public:
   /// Frames kept per (method, translucent) pair.
   static constexpr std::size_t HistoryLength = 32;
@@ -94,18 +95,18 @@ public:
 
   /// The three coefficients of one pair: seconds = Seconds + PerPrimitive *
   /// primitives + PerPixel * pixels.
-  struct Coefficients {
+  struct Coefficients
+  {
     double Seconds = 0.0;
     double PerPrimitive = 0.0;
     double PerPixel = 0.0;
-    double Evaluate(const FrameWork &work) const;
+    double Evaluate(const FrameWork& work) const;
   };
 
   /// The pixels a viewport shades at an image sample distance (rounded down, at
   /// least 1 for a non-empty viewport; 0 for an empty one or a distance that is
   /// not finite and positive).
-  static std::uint64_t ShadedPixels(int width, int height,
-                                    double sampleDistance);
+  static std::uint64_t ShadedPixels(int width, int height, double sampleDistance);
 
   /// The conservative coefficients used before a pair has frames, and the shape
   /// the fit is anchored to.
@@ -113,10 +114,10 @@ public:
 
   /// A measured frame (seconds of rendering it), folded into the fit for its
   /// method and translucency.
-  void Observe(const FrameWork &work, double seconds);
+  void Observe(const FrameWork& work, double seconds);
   /// Predicted seconds for a frame (a conservative prior before any observation
   /// of that method).
-  double Predict(const FrameWork &work) const;
+  double Predict(const FrameWork& work) const;
   bool HasObservations(FrameMethod method, bool translucent) const;
   /// Frames currently kept for a pair (at most HistoryLength).
   std::size_t ObservationCount(FrameMethod method, bool translucent) const;
@@ -125,29 +126,30 @@ public:
   /// Forgets every frame (another renderer, another window).
   void Reset();
 
-  struct Candidate {
+  struct Candidate
+  {
     int Level = 0;
     float SampleDistance = 1.0f;
     FrameWork Work;
   };
   /// Index of the first candidate (callers order them finest first) predicted
   /// within budgetSeconds, else the last (coarsest).
-  std::size_t Choose(const std::vector<Candidate> &candidates,
-                     double budgetSeconds) const;
+  std::size_t Choose(const std::vector<Candidate>& candidates, double budgetSeconds) const;
 
 private:
-  struct Sample {
+  struct Sample
+  {
     double Primitives = 0.0;
     double Pixels = 0.0;
     double Seconds = 0.0;
   };
-  struct Pair {
+  struct Pair
+  {
     std::deque<Sample> Samples; // oldest first
     Coefficients Fitted;
   };
   static std::size_t Key(FrameMethod method, bool translucent);
-  static Coefficients Solve(const std::deque<Sample> &samples,
-                            const Coefficients &prior);
+  static Coefficients Solve(const std::deque<Sample>& samples, const Coefficients& prior);
 
   std::array<Pair, 4> Pairs;
 };
