@@ -104,7 +104,9 @@ function reference() {
   return { low: lo, width, counts, otsu: lo + (split + 1) * width };
 }
 
-const frame = (page) => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+// Two animation frames, then the viewer's frame of the last change (it may draw in a worker).
+const frame = (page) => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))
+  .then(() => window.mediso.drawn()));
 
 // The centroid of a view's pixels of `color` (within 40 per channel), relative to its crosshair,
 // in CSS pixels (x right, y down), and how many.
