@@ -2,6 +2,7 @@
 """The web client against vtk.js in the same browser: isovalue change + frame, first image, bytes.
 
     python3 Python/benchmark_web.py [--inputs ct,ct512] [--sweep 10] [--size 800x600] [--out FILE.md]
+    python3 Python/benchmark_web.py --interactive [--inputs phantom:256,ct] [--paths cpu,gpu] [--before main]
 
 In one headless Chromium (Debian's, software WebGL2: SwiftShader), on the same volume and canvas
 size: the page's GPU path (the core on WebGL2), its CPU path (the BlockLOD core in WebAssembly at
@@ -12,6 +13,13 @@ time from opening each page to its first image, and the bytes the page received 
 against its raw bytes. The page is served by Python/serve.py (pvpython), vtk.js's page by a static
 server; vtk.js reads the same raw values. ct512 is the CT resampled to 512x512x216
 (BenchmarkHistoPyramidIsoMapper --write-input). Not a test: it prints a table.
+
+--interactive (issue 30): the page before (the page of git ref --before, which draws on the main
+thread, served from an export of that ref with the same WebAssembly module) and this page (the
+viewer in a worker), in one Chromium, on each path: the time from an isovalue change to its first
+visible frame and to the full level, the median frame of a mouse drag with its level or image
+sample distance, and the longest main-thread task (PerformanceObserver longtask) over the changes
+and the drag. Inputs: phantom:N (the plugin's phantom) or ct.
 """
 import argparse
 import json
@@ -44,6 +52,13 @@ def parse_args(argv):
     p.add_argument("--wasm", default=os.path.join(ROOT, "build-web", "bin"))
     p.add_argument("--work", default=os.path.join(ROOT, "build", "bench-web"))
     p.add_argument("--out", default="")
+    p.add_argument("--interactive", action="store_true",
+                   help="the page before (--before) against this one: first answer, drag, long tasks")
+    p.add_argument("--before", default="",
+                   help="--interactive: the git ref of the page before (default: where this branch "
+                        "left main, whose page takes this tree's WebAssembly module)")
+    p.add_argument("--moves", type=int, default=30, help="--interactive: mouse moves of the drag")
+    p.add_argument("--paths", default="cpu,gpu", help="--interactive: the page's paths to run")
     return p.parse_args(argv)
 
 
@@ -143,8 +158,106 @@ def run_input(args, name):
     return result
 
 
+def start_server(root, args, data):
+    """serve.py of the tree `root` on a free port with --data `data`; (process, page URL)."""
+    port = free_port()
+    token = "bench-%d" % port
+    server = subprocess.Popen([shutil.which("pvpython"), "--no-mpi", os.path.join(root, "Python", "serve.py"),
+                               "--plugin", args.plugin, "--wasm", args.wasm, "--data", data,
+                               "--port", str(port), "--token=" + token],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                              env=dict(os.environ, PYTHONDONTWRITEBYTECODE="1"))
+    for line in server.stdout:
+        if "open http" in line:
+            break
+    return server, "http://127.0.0.1:%d/?token=%s" % (port, token)
+
+
+def run_interactive(args, name, before_root):
+    data = volume_path(name) if not name.startswith("phantom:") else name
+    work = os.path.join(args.work, "interactive-" + name.replace(":", "-"))
+    os.makedirs(work, exist_ok=True)
+    servers = []
+    try:
+        before, before_url = start_server(before_root, args, data)
+        servers.append(before)
+        after, after_url = start_server(ROOT, args, data)
+        servers.append(after)
+        lo, hi = (-1000, 1100) if name.startswith("phantom:") else (-1000, 2000)
+        isovalues = [400, -500, 300, 500, -300, 200, 600]
+        isovalues = [v for v in isovalues if lo < v < hi]
+        config = {"pages": {"before": before_url, "after": after_url}, "paths": args.paths.split(","),
+                  "size": [int(v) for v in args.size.split("x")], "isovalues": isovalues,
+                  "moves": args.moves}
+        config_file = os.path.join(work, "config.json")
+        out_file = os.path.join(work, "result.json")
+        with open(config_file, "w") as f:
+            json.dump(config, f)
+        progress("%s: the page before and after, %d changes and a drag of %d moves per path"
+                 % (name, len(isovalues) - 1, args.moves))
+        subprocess.run(["node", os.path.join(WEB, "bench-interactive.mjs"), config_file, out_file],
+                       check=True, cwd=WEB, timeout=3600)
+        with open(out_file) as f:
+            return json.load(f)
+    finally:
+        for server in servers:
+            server.kill()
+
+
+def main_interactive(args, argv):
+    started = time.strftime("%Y-%m-%d %H:%M:%S")
+    load_before = load_average()
+    t0 = time.perf_counter()
+    if not args.before:
+        args.before = subprocess.run(["git", "-C", ROOT, "merge-base", "HEAD", "main"], check=True,
+                                     stdout=subprocess.PIPE, text=True).stdout.strip()[:12]
+    before_root = os.path.join(args.work, "before-" + args.before.replace("/", "-"))
+    shutil.rmtree(before_root, ignore_errors=True)
+    os.makedirs(before_root)
+    archive = subprocess.run(["git", "-C", ROOT, "archive", args.before, "Python", "Web/static"],
+                             check=True, stdout=subprocess.PIPE).stdout
+    subprocess.run(["tar", "-x", "-C", before_root], input=archive, check=True)
+    results = {name: run_interactive(args, name, before_root) for name in args.inputs.split(",")}
+    lines = ["# The page before and after the worker (issue 30)", "",
+             "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv),
+             "- Started %s, %.0f s; load average %s before, %s after" % (
+                 started, time.perf_counter() - t0, load_before, load_average()),
+             "- Machine: nproc %d (%s); Chromium headless, SwiftShader; canvas %s" % (
+                 os.cpu_count() or 0, cpu_model(), args.size),
+             "- before: `%s`'s page (the viewer on the main thread); after: this tree's (the viewer in a "
+             "worker, frame budget 100 ms); the same WebAssembly module" % args.before, "",
+             "| input | path | page | first visible answer ms, median (max) | full level ms, median | "
+             "drag frame ms, median | drag frames/s | drag level / sample distance | longest main-thread task ms |",
+             "|---|---|---|---:|---:|---:|---:|---|---:|"]
+    for name, r in results.items():
+        for run in r["runs"]:
+            firsts = [c["firstMs"] for c in run["changes"]]
+            fulls = [c["fullMs"] for c in run["changes"]]
+            d = run["drag"]
+            how = "-"
+            if d.get("levels") is not None:
+                how = ("levels %s" % d["levels"]) if run["path"] == "cpu" else \
+                    ("distance %s" % ", ".join("%.2g" % s for s in d["sampleDistances"]))
+            lines.append("| %s | %s | %s | %.0f (%.0f) | %.0f | %.0f | %s | %s | %.0f |" % (
+                name, run["path"], run["page"], statistics.median(firsts), max(firsts),
+                statistics.median(fulls), d["frameMs"] or 0,
+                "%.1f" % d["rate"] if d.get("rate") is not None else "-", how, run["longestTaskMs"]))
+    errors = ["%s %s: %.0f%%" % (name, run["path"], 100 * run["drag"]["predictionError"])
+              for name, r in results.items() for run in r["runs"]
+              if run["page"] == "after" and run["drag"].get("predictionError") is not None
+              and run["drag"]["predictionError"] == run["drag"]["predictionError"]]
+    lines += ["", "The frame-time model's median error on the drag frames it chose (after): " +
+              (", ".join(errors) or "none recorded") + "."]
+    write_report(lines, args.out)
+    return 0
+
+
 def main(argv):
     args = parse_args(argv)
+    if args.interactive:
+        if args.inputs == "ct,ct512":
+            args.inputs = "phantom:256,ct"
+        return main_interactive(args, argv)
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     load_before = load_average()
     t0 = time.perf_counter()

@@ -86,12 +86,14 @@ checks.check(report.watertight === "true" && report.fields.length === 7 &&
   report.fields.includes("pieces: 1"),
   "the mesh report is shown: " + report.head + "; " + report.fields.join(", "));
 const drawn = (s) => (s.path === "gpu" ? s.primitives : s.triangles);
-const hidden = await page.evaluate(() => window.mediso.stats());
+// (mediso.drawn(): the stats once the frame of the last change is drawn; the viewer may draw in
+// a worker, whose frames come after the click.)
+const hidden = await page.evaluate(() => window.mediso.drawn());
 const sourceBox = await page.isChecked("#op-show-source");
 await page.click("#op-show-source");
-const shownAgain = await page.evaluate(() => window.mediso.stats());
+const shownAgain = await page.evaluate(() => window.mediso.drawn());
 await page.click("#op-show-source");
-const hiddenAgain = await page.evaluate(() => window.mediso.stats());
+const hiddenAgain = await page.evaluate(() => window.mediso.drawn());
 checks.check(!sourceBox && drawn(hidden) < drawn(stats0) && drawn(shownAgain) === drawn(stats0) &&
   drawn(hiddenAgain) === drawn(hidden),
   "the source is hidden while the result is shown (" + drawn(stats0) + " -> " + drawn(hidden) +

@@ -104,7 +104,9 @@ function reference() {
   return { low: lo, width, counts, otsu: lo + (split + 1) * width };
 }
 
-const frame = (page) => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+// Two animation frames, then the viewer's frame of the last change (it may draw in a worker).
+const frame = (page) => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))
+  .then(() => window.mediso.drawn()));
 
 // The centroid of a view's pixels of `color` (within 40 per channel), relative to its crosshair,
 // in CSS pixels (x right, y down), and how many.
@@ -287,6 +289,7 @@ const browser = await launchBrowser();
   checks.check(s.length === 2 && s[0].value === -500 && s[0].opacity < 1 && s[1].value === 400 && s[1].opacity === 1,
     "a CT in Hounsfield units opens with translucent skin at -500 and bone at 400: " + JSON.stringify(s.map((x) => [x.value, x.opacity])));
   await page.click('#presets button[data-preset="Contrast vessels"]');
+  await page.evaluate(() => window.mediso.drawn()); // the slices redraw after the (worker's) frame
   const added = await page.evaluate(() => window.mediso.getSurfaces().map((x) => x.value));
   checks.check(added.join() === "-500,400,200", "the Contrast vessels preset adds 200 HU: " + added.join());
   const windows = await page.evaluate(() => window.mediso.slices().map((v) => v.window));

@@ -297,13 +297,14 @@ for (const [width, height, ratio] of [[1920, 1080, 1], [800, 600, 2]]) {
     return { width: v.width, height: v.height, css: [b.width, b.height], dpr: devicePixelRatio, beside };
   });
   const fits = (s) => Math.abs(s.width - s.css[0] * s.dpr) <= 1 && Math.abs(s.height - s.css[1] * s.dpr) <= 1;
-  // After a resize: the backing store given up to 5 s to follow (a frame on a loaded machine
-  // can take longer than the 300 ms this waited before), then checked.
+  // After a resize: the backing store given up to 10 s to follow (a frame on a loaded machine
+  // can take longer than the 300 ms this waited before; with the viewer in a worker the size
+  // follows with the worker's next frame), then checked.
   const settled = () => page.waitForFunction(() => {
     const v = document.getElementById("view");
     const b = v.getBoundingClientRect();
     return Math.abs(v.width - b.width * devicePixelRatio) <= 1 && Math.abs(v.height - b.height * devicePixelRatio) <= 1;
-  }, null, { timeout: 5000 }).catch(() => {});
+  }, null, { timeout: 10000 }).catch(() => {});
   const s = await size();
   checks.check(fits(s) && s.dpr === ratio, width + "x" + height + " at ratio " + ratio + ": backing store " + s.width + "x" +
     s.height + " for " + s.css.join("x") + " CSS pixels");

@@ -33,7 +33,7 @@ import { $, params, state } from "./state.js";
 import { crosshairInfo, drawSlices, pick, setCrosshair, setSliceWindow, setupSlices, slicesInfo }
   from "./slices.js";
 import { replaceSurfaces, setupSurfaceList } from "./surfaces.js";
-import { afterFrame, change, clearMesh, fitCanvas, renderNow, requestFrame, showMesh, startViewer }
+import { afterFrame, change, clearMesh, drawn, fitCanvas, renderNow, requestFrame, showMesh, startViewer }
   from "./viewer.js";
 import { countBytes, request, requestJSON, sessionToken } from "./volume.js";
 
@@ -49,6 +49,7 @@ async function start() {
   if (!(await startViewer(canvas, probe))) {
     throw unsupported("WebGL2 is here but cannot run the GPU path: " + state.viewer.error());
   }
+  $("renderer").textContent = state.rendererNote;
   if (params.get("budget")) {
     $("budget").value = params.get("budget");
   }
@@ -98,8 +99,10 @@ async function start() {
     const key = JSON.stringify([state.surfaces, state.level]);
     if (key !== drawnKey) {
       drawnKey = key;
-      drawSlices();
-      drawHistogram();
+      // Each in its own task, so that neither adds to the frame's answer a main-thread task of
+      // both (the longtask budget: docs/web.md, The worker).
+      setTimeout(drawSlices);
+      setTimeout(drawHistogram);
     }
   });
   const reset = () => applyNamedView("anterior");
@@ -125,6 +128,7 @@ async function start() {
     scheduleLink();
   });
   renderNow();
+  await drawn(); // ready after the first frame (the worker's answer)
   // The "On the server" panel (Web/static/operations.js) is given what it needs here.
   setupOperations({
     dataset: d,
@@ -154,10 +158,12 @@ window.mediso = {
   ready,
   async setIsovalues(values) {
     replaceSurfaces(values.map((value) => ({ value })), true);
+    await drawn();
     return window.mediso.stats();
   },
   async setSurfaces(surfaces) {
     replaceSurfaces(surfaces, false);
+    await drawn();
     return window.mediso.stats();
   },
   // The camera in the module's scene frame (VTK's conventions; the fields ParaView's camera
@@ -166,6 +172,7 @@ window.mediso = {
     const scene = view.world ? Object.assign({}, view, sceneView(view.world)) : view;
     state.viewer.setView(scene);
     renderNow();
+    await drawn();
     return window.mediso.getView();
   },
   // {position, focalPoint, viewUp, viewAngle, parallelScale} in the scene frame, and world:
@@ -179,6 +186,7 @@ window.mediso = {
     }
     applyNamedView(name);
     renderNow();
+    await drawn();
     return window.mediso.getView();
   },
   // The orientation marker as drawn: each label's x (right), y (up) and toward (the viewer).
@@ -194,6 +202,7 @@ window.mediso = {
       state.viewer.setBackground(...background);
     }
     renderNow();
+    await drawn();
   },
   stats: () => ({
     path: state.path,
@@ -202,6 +211,16 @@ window.mediso = {
     threads: state.threads,
     level: state.level,
     levelNote: state.levelNote,
+    // where the viewer draws ("worker" or "main"); with the worker, whether the last frame was
+    // a drag's (interactive: a coarser level), whether it is at the full level, and the
+    // refinements a newer change made obsolete
+    renderer: state.remote ? "worker" : "main",
+    interactive: state.interactive,
+    settled: state.settled,
+    refinementsSkipped: state.refinementsSkipped,
+    lastRefinedMs: state.lastRefinedMs,
+    sampleDistance: state.sampleDistance,
+    frameNote: state.frameNote,
     primitives: state.primitives,
     triangles: state.triangles,
     fps: fps(),
@@ -216,20 +235,34 @@ window.mediso = {
     info: state.viewer ? state.viewer.info() : null,
   }),
   cpuCount: (values) => state.viewer.countOnCPU(values),
+  // The stats once the newest frame asked for is drawn at its full level (with the viewer in a
+  // worker, frames come after the change that asked for them; on the main thread, at once).
+  async drawn() {
+    await drawn();
+    return window.mediso.stats();
+  },
+  // The last frames drawn, oldest first (tests: a drag's levels, a refinement's steps).
+  frames: () => state.frameLog.map((f) => Object.assign({}, f)),
   async setPath(path) {
     await requestPath(path);
     change(() => {});
+    await drawn();
     return window.mediso.stats();
   },
   estimates: () => state.viewer.estimates(),
   // The CPU path's level of detail: 0-3, or -1 for the estimator's choice within the budget.
-  setCPULevel(level) {
+  // Resolves after the frame (with the viewer in a worker; the page's tests await it).
+  async setCPULevel(level) {
     change(() => state.viewer.setCPULevel(level));
+    await drawn();
     return window.mediso.stats();
   },
   // A surface the server made: binary PLY (vertex x, y, z; faces as index lists).
   showMesh: (ply, color = [0.55, 0.8, 1.0], opacity = 1) => showMesh(ply, color, opacity),
-  clearMesh,
+  clearMesh: async () => {
+    clearMesh();
+    await drawn();
+  },
   // The slice views (slices.js): for each, its name, labels, index axis and slice index, window,
   // the crosshair on its canvas (CSS pixels), mm per CSS pixel; with {contours: true} each
   // surface's contour points on the slice (LPS mm).

@@ -55,14 +55,24 @@ export function interact(canvas, { reset, changed }) {
     canvas.setPointerCapture(e.pointerId);
     canvas.focus({ preventScroll: true });
   });
-  canvas.addEventListener("pointerup", () => { last = null; });
-  canvas.addEventListener("pointercancel", () => { last = null; });
+  // The frames of a drag are interactive (a coarser level, viewer.js); its end asks for the
+  // full frame.
+  const release = () => {
+    last = null;
+    if (state.interacting) {
+      state.interacting = false;
+      requestFrame();
+    }
+  };
+  canvas.addEventListener("pointerup", release);
+  canvas.addEventListener("pointercancel", release);
   canvas.addEventListener("pointermove", (e) => {
     if (!last) {
       return;
     }
     const dx = e.clientX - last[0], dy = e.clientY - last[1];
     last = [e.clientX, e.clientY];
+    state.interacting = true;
     if (panning) {
       pan(canvas, dx, dy);
     } else {

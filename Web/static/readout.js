@@ -5,15 +5,22 @@
 
 import { $, state } from "./state.js";
 
-/** Frames per second: over the last second's frames, else from the last frame's time. */
-export function fps() {
-  const now = performance.now();
-  const recent = state.frameTimes.filter((f) => now - f.at < 1000);
-  if (recent.length >= 2) {
-    return recent.length / ((recent[recent.length - 1].at - recent[0].at) / 1000 || 1);
+// The window of the frame rate, ms.
+const FPS_WINDOW_MS = 2000;
+
+/**
+ * Frames per second: the frames drawn over the last FPS_WINDOW_MS (or since the first frame,
+ * when that is sooner) divided by that time: a rate, not one frame's inverse, and 0 when nothing
+ * has been drawn for the whole window.
+ */
+export function fps(now = performance.now()) {
+  const times = state.frameTimes;
+  if (!times.length) {
+    return 0;
   }
-  const last = state.frameTimes[state.frameTimes.length - 1];
-  return last ? 1000 / last.ms : 0;
+  const from = Math.max(now - FPS_WINDOW_MS, times[0].at - times[0].ms);
+  const drawn = times.filter((f) => f.at > from && f.at <= now).length;
+  return now > from ? drawn / ((now - from) / 1000) : 0;
 }
 
 export function updateReadout() {
@@ -21,9 +28,13 @@ export function updateReadout() {
     ["path", state.path.toUpperCase() + (state.reason ? " (" + state.reason + ")" : "")],
     ["frames per second", fps().toFixed(1)],
     ["threads", String(state.threads)],
-    ["last isovalue change", state.lastChangeMs.toFixed(1) + " ms (change + frame)"],
+    state.remote ? ["last isovalue change", state.lastChangeMs.toFixed(1) + " ms to the first frame, " +
+      state.lastRefinedMs.toFixed(1) + " ms to the full level"]
+      : ["last isovalue change", state.lastChangeMs.toFixed(1) + " ms (change + frame)"],
     state.path === "gpu" ? ["primitives", String(state.primitives)]
-                         : ["triangles", String(state.triangles) + " (level " + state.cpuLevel + ")"],
+                         : ["triangles", String(state.triangles) + " (level " + state.cpuLevel +
+                           (state.interactive ? ", while dragging" : state.settled ? "" : ", refining") + ")"],
+    ...(state.frameNote ? [["this frame", state.frameNote]] : []),
     ["bytes received", state.bytesReceived.toLocaleString()],
     ["bytes sent", state.bytesSent.toLocaleString()],
   ];

@@ -19,6 +19,8 @@ export const state = Object.seal({
   threads: null, // threads of the CPU path (1 unless the page is cross-origin isolated)
   software: false, // the WebGL2 renderer is a software one
   unmaskedRenderer: "",
+  remote: false, // the viewer draws in a worker (remote.js, render-worker.js)
+  rendererNote: "", // where the viewer draws, and why there
 
   // app.js, once: the dataset shown (/api/datasets' first).
   dataset: null,
@@ -56,4 +58,13 @@ export const state = Object.seal({
   triangles: 0,
   cpuLevel: null, // the CPU path's level of detail of the fetched volume
   pending: null, // the animation frame requested by interaction
+  // viewer.js, with the viewer in a worker: the frame's kind and the refinements.
+  interacting: false, // interaction.js: a drag is under way (its frames are interactive)
+  interactive: false, // the last frame was a drag's (a coarser level)
+  settled: true, // the last frame is at the full level
+  refinementsSkipped: 0, // refinements a newer change made obsolete
+  lastRefinedMs: 0, // the last change to its full-level frame
+  sampleDistance: 1, // the GPU path's image sample distance of the last frame
+  frameNote: "", // why the last frame is coarser than the full one ("" when it is not)
+  frameLog: [], // the last 200 frames: [{values, cpuLevel, triangles, primitives, sampleDistance, interactive, settled, ms, predictedMs}]
 });

@@ -5,14 +5,16 @@
 // strides, the isovalue limit, the GPU path's memory of a volume), read once into state.facts.
 
 import { parsePLY } from "./ply.js";
+import { RemoteViewer, offscreenWebGL2 } from "./remote.js";
 import { updateReadout } from "./readout.js";
 import { params, state } from "./state.js";
 
 // The module: with threads where the page is cross-origin isolated (the server sends the
-// headers), else on one thread.
-async function loadModule() {
+// headers), else on one thread. Where the viewer runs in a worker (remote.js), this thread's
+// module only keeps the camera and counts: one thread; the worker loads the threaded one.
+async function loadModule(inWorker) {
   const threads = window.crossOriginIsolated && params.get("threads") !== "0";
-  const name = threads ? "mediso-mt" : "mediso";
+  const name = threads && !inWorker ? "mediso-mt" : "mediso";
   await new Promise((resolve, reject) => {
     const script = Object.assign(document.createElement("script"), { src: "static/" + name + ".js" });
     script.onload = resolve;
@@ -20,7 +22,7 @@ async function loadModule() {
     document.head.append(script);
   });
   state.threads = threads ? navigator.hardwareConcurrency : 1;
-  const create = threads ? window.createMedisoThreads : window.createMediso;
+  const create = name === "mediso-mt" ? window.createMedisoThreads : window.createMediso;
   return create({ locateFile: (f) => "static/" + f });
 }
 
@@ -50,7 +52,9 @@ function readFacts(M) {
  * when given). `probe` is a WebGL2 context of the page's, which names the renderer.
  */
 export async function startViewer(canvas, probe) {
-  state.module = await loadModule();
+  // The viewer in a worker where the browser can draw WebGL2 there (?worker=0: on this thread).
+  const inWorker = params.get("worker") !== "0" && offscreenWebGL2();
+  state.module = await loadModule(inWorker);
   state.facts = readFacts(state.module);
   if (params.get("size")) { // WIDTHxHEIGHT (tests, benchmarks): a fixed backing store
     [canvas.width, canvas.height] = params.get("size").split("x").map(Number);
@@ -58,8 +62,21 @@ export async function startViewer(canvas, probe) {
   } else {
     [canvas.width, canvas.height] = backingStore(canvas.getBoundingClientRect());
   }
-  state.viewer = new state.module.WebViewer("#view");
+  if (inWorker) {
+    state.viewer = await RemoteViewer.start(canvas, state.module,
+      { threads: state.threads > 1, budgetMs: Number(params.get("frameBudget")) || 0 }, frameAnswered);
+    state.remote = true;
+    state.rendererNote = "Drawn in a worker (OffscreenCanvas): turning, typing and the panel do " +
+      "not wait for an extraction or a frame.";
+  } else {
+    state.viewer = new state.module.WebViewer("#view");
+    state.rendererNote = "Drawn on the page's main thread (" + (params.get("worker") === "0"
+      ? "asked for by ?worker=0" : "this browser cannot draw WebGL2 in a worker") +
+      "): the page waits for each extraction and frame.";
+  }
   state.viewer.resize(canvas.width, canvas.height);
+  // The frame rate decays to what it is when nothing is drawn.
+  setInterval(() => state.frameTimes.length && updateReadout(), 1000);
   if (!state.viewer.ready()) {
     return false;
   }
@@ -110,37 +127,90 @@ export function fitCanvas(canvas) {
 /** Called after every frame with the module's view (the orientation marker). */
 export const afterFrame = [];
 
-/** Draws now and waits for the GPU: the time of a change + frame. */
-export function renderNow() {
+// A frame drawn: its time and what it drew, into the state and the readout.
+function recordFrame(ms, stats) {
+  state.frameTimes.push({ at: performance.now(), ms });
+  if (state.frameTimes.length > 120) {
+    state.frameTimes.shift();
+  }
+  state.lastFrameMs = ms;
+  state.buildMs = stats.buildMs;
+  state.primitives = stats.primitives;
+  state.triangles = stats.triangles;
+  state.cpuLevel = stats.cpuLevel;
+  state.interactive = !!stats.interactive;
+  state.settled = stats.settled !== false;
+  state.refinementsSkipped = stats.refinementsSkipped || 0;
+  state.sampleDistance = stats.sampleDistance || 1;
+  state.frameNote = stats.note || "";
+  state.frameLog.push({ id: stats.id, values: stats.values, cpuLevel: stats.cpuLevel,
+    triangles: stats.triangles, primitives: stats.primitives, sampleDistance: state.sampleDistance,
+    interactive: state.interactive, settled: state.settled, ms, predictedMs: stats.predictedMs || 0 });
+  if (state.frameLog.length > 200) {
+    state.frameLog.shift();
+  }
+  updateReadout();
+  for (const call of afterFrame) {
+    call();
+  }
+}
+
+// The worker's answer to a frame (remote.js).
+function frameAnswered(stats) {
+  recordFrame(stats.ms, stats);
+}
+
+// The newest frame asked of the worker ({id, first, settled}: remote.js).
+let latest = null;
+
+/**
+ * Draws now. On this thread: waits for the GPU and returns the time of the frame. With the
+ * viewer in a worker: asks for the frame (`interactive` during a drag) and returns at once
+ * {id, first, settled}, promises of the frame's first answer and of its full level.
+ */
+export function renderNow(interactive = false) {
   const viewer = state.viewer;
   // A surface hidden (the source of a server result shown, operations.js) is not drawn.
   viewer.setSurfaces(state.surfaces.filter((s) => !s.hidden));
+  if (state.remote) {
+    latest = viewer.frame(interactive);
+    return latest;
+  }
   const start = performance.now();
   if (!viewer.render()) {
     throw new Error("render failed: " + viewer.stats().error);
   }
   viewer.finish();
   const ms = performance.now() - start;
-  state.frameTimes.push({ at: performance.now(), ms });
-  if (state.frameTimes.length > 120) {
-    state.frameTimes.shift();
-  }
-  state.lastFrameMs = ms;
-  const stats = viewer.stats();
-  state.buildMs = stats.buildMs;
-  state.primitives = stats.primitives;
-  state.triangles = stats.triangles;
-  state.cpuLevel = stats.cpuLevel;
-  updateReadout();
-  for (const call of afterFrame) {
-    call();
-  }
+  recordFrame(ms, viewer.stats());
   return ms;
 }
 
-/** A change (`apply` changes what is drawn), then its frame, timed. */
+/** Resolves when the newest frame asked for is drawn at its full level (automation). */
+export function drawn() {
+  return state.remote && latest ? latest.settled : Promise.resolve();
+}
+
+/**
+ * A change (`apply` changes what is drawn), then its frame, timed: on this thread the change
+ * and the frame; with the worker, from the change to its first frame answered (the first
+ * visible answer), and to the full level in state.lastRefinedMs.
+ */
 export function change(apply) {
   apply();
+  if (state.remote) {
+    const start = performance.now();
+    const frame = renderNow();
+    frame.first.then(() => {
+      state.lastChangeMs = performance.now() - start;
+      updateReadout();
+    });
+    frame.settled.then(() => {
+      state.lastRefinedMs = performance.now() - start;
+      updateReadout();
+    });
+    return;
+  }
   state.lastChangeMs = renderNow();
   updateReadout();
 }
@@ -150,7 +220,7 @@ export function requestFrame() {
   if (!state.pending) {
     state.pending = requestAnimationFrame(() => {
       state.pending = null;
-      renderNow();
+      renderNow(state.interacting);
     });
   }
 }
@@ -158,6 +228,11 @@ export function requestFrame() {
 /** Draws a surface the server made (a binary PLY) beside the isosurfaces. */
 export function showMesh(ply, color, opacity) {
   const mesh = parsePLY(ply);
+  if (state.remote) {
+    state.viewer.setResultArrays(mesh.points, mesh.triangles, color, opacity);
+    renderNow();
+    return { points: mesh.points.length / 3, triangles: mesh.triangles.length / 3 };
+  }
   const M = state.module;
   const points = M._malloc(mesh.points.byteLength);
   const triangles = M._malloc(mesh.triangles.byteLength);

@@ -113,6 +113,10 @@ export async function loadVolume(level) {
   if (!state.viewer.setVolume(type.value, state.volumePointer, dims, spacing, origin)) {
     throw new Error("the volume cannot be uploaded: " + state.viewer.stats().error);
   }
+  const refused = state.remote ? await state.viewer.uploaded : ""; // the worker's upload
+  if (refused) {
+    throw new Error("the volume cannot be uploaded: " + refused);
+  }
   if (kept) {
     state.viewer.setView(kept);
   }

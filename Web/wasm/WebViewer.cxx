@@ -22,7 +22,9 @@
 #include "BlockLOD.h"
 #include "BlockLODSurfaces.h"
 #include "Camera.h"
+#include "FrameTimeModel.h"
 #include "GLApiFunctions.h"
+#include "GLObjects.h"
 #include "GLProbe.h"
 #include "HistoPyramid.h"
 #include "HistogramThreshold.h"
@@ -192,6 +194,9 @@ public:
       {
         this->Meshes->Release();
       }
+      this->Sampled.Reset();
+      this->SampledColor.Reset();
+      this->SampledDepth.Reset();
       emscripten_webgl_destroy_context(this->Context);
     }
   }
@@ -264,6 +269,19 @@ public:
 
   /// The client's memory budget (bytes) for the CPU path's surfaces and their cache.
   void SetBudget(double bytes) { this->Budget = std::max(0.0, bytes); }
+
+  /**
+   * The image sample distance of the next frames, 1 to 8: above 1 the
+   * surfaces are drawn into a framebuffer 1/distance the size along each
+   * axis and scaled up to the canvas, as VTK's volume mappers do with
+   * ImageSampleDistance during interaction. The page's worker sets it for
+   * the frames of a drag on the GPU path, whose cost grows with the pixels
+   * each cell's footprint covers; 1 (every pixel) for still frames.
+   */
+  void SetSampleDistance(double distance)
+  {
+    this->SampleDistance = std::isfinite(distance) ? std::max(1.0, std::min(8.0, distance)) : 1.0;
+  }
 
   /// The estimator's table for the current isovalues: per level, triangles, MB and seconds.
   val Estimates()
@@ -443,6 +461,8 @@ public:
     emscripten_webgl_make_context_current(this->Context);
     const GLApi::Functions& f = this->GL->F();
     const double start = emscripten_get_now();
+    this->FrameStart = start;
+    this->MeshesUploaded = false;
     std::vector<double> values;
     for (const IsosurfaceLook& s : this->Frame.Surfaces)
     {
@@ -476,9 +496,13 @@ public:
     double bounds[6];
     this->Placement.Bounds(bounds);
     this->View.ResetClippingRange(bounds);
-    SetFrameView(this->Frame, this->View, this->Placement, this->Width, this->Height);
-    f.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    f.Viewport(0, 0, this->Width, this->Height);
+    // A sample distance above 1: the frame is drawn smaller, into Sampled, and scaled up below.
+    const bool sampled = this->SampleDistance > 1.0 && this->PrepareSampled();
+    const int width = sampled ? this->SampledSize[0] : this->Width;
+    const int height = sampled ? this->SampledSize[1] : this->Height;
+    SetFrameView(this->Frame, this->View, this->Placement, width, height);
+    f.BindFramebuffer(GL_FRAMEBUFFER, sampled ? this->Sampled.Get() : 0);
+    f.Viewport(0, 0, width, height);
     f.Enable(GL_DEPTH_TEST);
     f.DepthFunc(GL_LEQUAL);
     f.DepthMask(GL_TRUE);
@@ -509,16 +533,101 @@ public:
         return false;
       }
     }
+    if (sampled)
+    {
+      f.BindFramebuffer(GL_READ_FRAMEBUFFER, this->Sampled.Get());
+      f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+      glBlitFramebuffer(0, 0, width, height, 0, 0, this->Width, this->Height, GL_COLOR_BUFFER_BIT,
+        GL_LINEAR);
+      f.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    }
+    this->DrawnSampleDistance = sampled ? this->SampleDistance : 1.0;
+    this->FrameDrawn = true;
     this->LastFrameMs = emscripten_get_now() - start;
     return true;
   }
 
-  /// Waits for the GPU to finish (a one-pixel read-back): for timings.
+  /// Waits for the GPU to finish (a one-pixel read-back): for timings. A
+  /// frame that built nothing (GPU path: no pyramid build; CPU path: no
+  /// surface extracted or uploaded) is then given to the frame-time model
+  /// with its time to here (one-off work would inflate the fit).
   void Finish()
   {
     emscripten_webgl_make_context_current(this->Context);
     unsigned char pixel[4];
     this->GL->F().ReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, pixel);
+    const double seconds = (emscripten_get_now() - this->FrameStart) / 1000.0;
+    const bool oneOff = this->CPUPath ? this->MeshesUploaded : this->LastBuildMs > 0.0;
+    if (this->FrameDrawn && !oneOff)
+    {
+      this->Times.Observe(this->DrawnWork(this->DrawnSampleDistance), seconds);
+    }
+    this->FrameDrawn = false;
+  }
+
+  /**
+   * The frame that fits `budgetSeconds` on this client, from the frame-time
+   * model (mediso::FrameTimeModel, fitted from this viewer's frames) and, on
+   * the CPU path, the estimator's seconds for an extraction not yet cached:
+   * {level, sampleDistance, predictedMs, fullMs} for the current isovalues.
+   * CPU path: the finest level, at most the one the memory budget allows,
+   * whose extraction and drawing fit (the coarsest when none does). GPU path:
+   * the smallest image sample distance whose frame fits (1 to 4), from the
+   * last frame's primitives. fullMs: the prediction of the full frame (level
+   * the memory allows, every pixel), which the page states when it is over.
+   */
+  val ChooseFrame(double budgetSeconds)
+  {
+    std::vector<FrameTimeModel::Candidate> candidates;
+    std::vector<double> extraSeconds;
+    const int memoryLevel = this->CPUPath ? this->MemoryLevel() : NumberOfLevels - 1;
+    if (this->CPUPath)
+    {
+      for (int level = memoryLevel; level >= 0; --level)
+      {
+        FrameTimeModel::Candidate c;
+        c.Level = level;
+        double triangles = 0.0, seconds = 0.0;
+        for (const IsosurfaceLook& s : this->Frame.Surfaces)
+        {
+          triangles += this->CPU.Estimate(s.Value, level).Counts.Triangles;
+          seconds += std::max(0.0, this->CPU.EstimateSeconds(s.Value, level));
+        }
+        c.Work = this->Work(static_cast<std::uint64_t>(triangles), 1.0);
+        candidates.push_back(c);
+        extraSeconds.push_back(seconds);
+      }
+    }
+    else
+    {
+      for (double distance : { 1.0, 1.5, 2.0, 3.0, 4.0 })
+      {
+        FrameTimeModel::Candidate c;
+        c.Level = NumberOfLevels - 1;
+        c.SampleDistance = static_cast<float>(distance);
+        c.Work = this->Work(this->Stats.Primitives, distance);
+        candidates.push_back(c);
+        extraSeconds.push_back(0.0);
+      }
+    }
+    std::size_t chosen = candidates.size() - 1;
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+    {
+      // Choose() on the drawing alone, with the extraction added per candidate.
+      if (this->Times.Predict(candidates[i].Work) + extraSeconds[i] <= budgetSeconds)
+      {
+        chosen = i;
+        break;
+      }
+    }
+    val out = val::object();
+    out.set("level", candidates[chosen].Level);
+    out.set("sampleDistance", candidates[chosen].SampleDistance);
+    out.set("predictedMs",
+      1000.0 * (this->Times.Predict(candidates[chosen].Work) + extraSeconds[chosen]));
+    out.set("fullMs", 1000.0 * (this->Times.Predict(candidates[0].Work) + extraSeconds[0]));
+    out.set("memoryLevel", memoryLevel);
+    return out;
   }
 
   val GetStats() const
@@ -532,6 +641,9 @@ public:
     stats.set("footprint", std::string(this->Stats.PointFootprint ? "points" : "boxes"));
     stats.set("firstHit", this->Stats.FirstHit);
     stats.set("buildMs", this->LastBuildMs);
+    stats.set("sampleDistance", this->DrawnSampleDistance);
+    stats.set("pixels", static_cast<double>(this->Width) * this->Height /
+        (this->DrawnSampleDistance * this->DrawnSampleDistance));
     stats.set("frameMs", this->LastFrameMs);
     stats.set(
       "gpuBytes", this->Scene ? static_cast<double>(this->Scene->GetGPUMemoryBytes()) : 0.0);
@@ -564,6 +676,88 @@ public:
   }
 
 private:
+  // The work of a frame of the current surfaces with `primitives` (triangles on the CPU path)
+  // at an image sample distance.
+  FrameWork Work(std::uint64_t primitives, double sampleDistance) const
+  {
+    FrameWork work;
+    work.Method = this->CPUPath ? FrameMethod::Triangles : FrameMethod::CellRasterisation;
+    work.Primitives = primitives;
+    work.Pixels = FrameTimeModel::ShadedPixels(this->Width, this->Height, sampleDistance);
+    work.Translucent = std::any_of(this->Frame.Surfaces.begin(), this->Frame.Surfaces.end(),
+      [](const IsosurfaceLook& s) { return s.Opacity < 1.0f; });
+    return work;
+  }
+
+  // The last frame's work, as drawn.
+  FrameWork DrawnWork(double sampleDistance) const
+  {
+    return this->Work(this->CPUPath ? static_cast<std::uint64_t>(this->ShownTriangles)
+                                    : this->Stats.Primitives,
+      sampleDistance);
+  }
+
+  // The finest level whose estimated surfaces fit the memory budget (the
+  // estimator's choice that Update makes with LevelChoice::Auto; level 0 when
+  // none does).
+  int MemoryLevel()
+  {
+    if (this->RequestedLevel >= 0)
+    {
+      return this->RequestedLevel;
+    }
+    for (int level = NumberOfLevels - 1; level > 0; --level)
+    {
+      double bytes = 0.0;
+      for (const IsosurfaceLook& s : this->Frame.Surfaces)
+      {
+        bytes += this->CPU.GetLayout().Bytes(this->CPU.Estimate(s.Value, level).Counts);
+      }
+      if (bytes <= this->Budget)
+      {
+        return level;
+      }
+    }
+    return 0;
+  }
+
+  // The framebuffer of a sampled frame (colour and depth), at the canvas's size over the
+  // sample distance; false when it cannot be made (the frame is then drawn in full).
+  bool PrepareSampled()
+  {
+    const int width = std::max(1, static_cast<int>(std::ceil(this->Width / this->SampleDistance)));
+    const int height =
+      std::max(1, static_cast<int>(std::ceil(this->Height / this->SampleDistance)));
+    const GLApi::Functions& f = this->GL->F();
+    if (this->Sampled && this->SampledSize[0] == width && this->SampledSize[1] == height)
+    {
+      return true;
+    }
+    this->Sampled = glcore::Name(*this->GL, glcore::NameKind::Framebuffer);
+    this->SampledColor = glcore::Name(*this->GL, glcore::NameKind::Renderbuffer);
+    this->SampledDepth = glcore::Name(*this->GL, glcore::NameKind::Renderbuffer);
+    f.BindRenderbuffer(GL_RENDERBUFFER, this->SampledColor.Get());
+    f.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+    f.BindRenderbuffer(GL_RENDERBUFFER, this->SampledDepth.Get());
+    f.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    f.BindRenderbuffer(GL_RENDERBUFFER, 0);
+    f.BindFramebuffer(GL_FRAMEBUFFER, this->Sampled.Get());
+    f.FramebufferRenderbuffer(
+      GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, this->SampledColor.Get());
+    f.FramebufferRenderbuffer(
+      GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, this->SampledDepth.Get());
+    const bool complete = f.CheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    f.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (!complete)
+    {
+      this->Sampled.Reset();
+      return false;
+    }
+    this->SampledSize[0] = width;
+    this->SampledSize[1] = height;
+    return true;
+  }
+
   // The CPU path's model transform: the volume's direction about its origin
   // (the BlockLOD core places points at origin + spacing * index).
   matrix4::Matrix PlacementModel() const
@@ -632,6 +826,7 @@ private:
       const CPUSurface& surface = *surfaces[slot];
       if (!(this->ShownKeys[slot] == key))
       {
+        this->MeshesUploaded = true;
         this->Meshes->SetMesh(slot, surface.Points.data(), surface.Normals.data(),
           static_cast<std::int64_t>(surface.Points.size() / 3), surface.Triangles.data(),
           static_cast<std::int64_t>(surface.Triangles.size() / 3));
@@ -660,6 +855,13 @@ private:
   int Width = 640, Height = 480;
   float Background[3] = { 0.1f, 0.12f, 0.16f };
   double LastBuildMs = 0.0, LastFrameMs = 0.0;
+  double SampleDistance = 1.0, DrawnSampleDistance = 1.0;
+  FrameTimeModel Times; // this client's frames: the time each level or sample distance takes
+  double FrameStart = 0.0;
+  bool FrameDrawn = false; // a frame was drawn since the last Finish
+  bool MeshesUploaded = false; // the last frame made or uploaded a CPU path surface
+  glcore::Name Sampled, SampledColor, SampledDepth; // a sampled frame's framebuffer
+  int SampledSize[2] = { 0, 0 };
 
   // The CPU path.
   bool CPUPath = false;
@@ -812,6 +1014,8 @@ EMSCRIPTEN_BINDINGS(mediso_web)
     .function("setPath", &WebViewer::SetPath)
     .function("setCPULevel", &WebViewer::SetCPULevel)
     .function("setBudget", &WebViewer::SetBudget)
+    .function("setSampleDistance", &WebViewer::SetSampleDistance)
+    .function("chooseFrame", &WebViewer::ChooseFrame)
     .function("estimates", &WebViewer::Estimates)
     .function("setResultMesh", &WebViewer::SetResultMesh)
     .function("clearResultMesh", &WebViewer::ClearResultMesh);

@@ -1,0 +1,198 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The page's viewer in a worker (issue 30; docs/web.md, The worker), in Chromium (SwiftShader):
+// - the worker path draws the CPU path's triangles of the main-thread path at every level, and
+//   the GPU path's primitives are the CPU model's count;
+// - a change is drawn first at a coarse level and refined to the full level (?frameBudget=1: no
+//   level fits 1 ms, so the first answer is level 0);
+// - a change superseded while its refinement is owed never shows the old surface at the end,
+//   and the refinement is skipped;
+// - a drag draws coarser (CPU path: a level; GPU path: an image sample distance), says so in
+//   window.mediso.stats(), and the still frame after it is back at full level;
+// - on the 256^3 phantom no main-thread task exceeds 50 ms during changes and a drag with the
+//   worker, while the main-thread page (?worker=0) has longer ones on the same actions (the
+//   observer works).
+import { Checks, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
+
+const checks = new Checks();
+const small = await startServer(["phantom:64"]);
+const browser = await launchBrowser();
+
+// The page, with `query` after the token; long tasks collected from the start.
+async function open(server, query) {
+  const context = await browser.newContext({ viewport: { width: 1000, height: 700 } });
+  const page = await context.newPage();
+  await page.addInitScript(() => {
+    window.longTasks = [];
+    new PerformanceObserver((list) => {
+      for (const e of list.getEntries()) {
+        window.longTasks.push(e.duration);
+      }
+    }).observe({ type: "longtask", buffered: true });
+  });
+  await openPage(page, { url: server.url + query });
+  return page;
+}
+
+const stats = (page) => page.evaluate(() => window.mediso.stats());
+const frames = (page) => page.evaluate(() => window.mediso.frames());
+const settle = (page) => page.waitForFunction(() => window.mediso.stats().settled, null, { timeout: 120000 });
+const BONE = { value: 400, color: [1, 1, 1], opacity: 1 };
+
+// --- counts: the worker against the main thread and the CPU model ----------------------------------
+const worker = await open(small, "&path=cpu");
+const main = await open(small, "&path=cpu&worker=0");
+checks.check((await stats(worker)).renderer === "worker" && (await stats(main)).renderer === "main",
+  "the page draws in a worker where it can, on the main thread with ?worker=0");
+checks.check(/worker/.test(await worker.locator("#renderer").textContent()) &&
+  /main thread/.test(await main.locator("#renderer").textContent()), "the page says where it draws");
+const mainCounts = {};
+for (const page of [worker, main]) {
+  await page.evaluate((s) => window.mediso.setSurfaces([s]), BONE);
+}
+for (const level of [0, 1, 2, 3]) {
+  const w = await worker.evaluate((k) => window.mediso.setCPULevel(k), level);
+  const m = await main.evaluate((k) => window.mediso.setCPULevel(k), level);
+  mainCounts[level] = m.triangles;
+  checks.check(w.cpuLevel === level && m.cpuLevel === level && w.triangles === m.triangles && w.triangles > 0,
+    "level " + level + ": the worker's triangles (" + w.triangles + ") are the main thread's (" + m.triangles + ")");
+}
+{
+  const gpu = await worker.evaluate(() => window.mediso.setPath("gpu"));
+  const count = await worker.evaluate((v) => window.mediso.cpuCount([v]), BONE.value);
+  checks.check(gpu.path === "gpu" && gpu.primitives === count && count > 0,
+    "GPU path in the worker: primitives " + gpu.primitives + " = the CPU model's count " + count);
+}
+await worker.close();
+
+// --- refinement: a coarse first answer, then the full level ------------------------------------------
+const fast = await open(small, "&path=cpu&frameBudget=1");
+await fast.evaluate(() => window.mediso.setCPULevel(-1));
+{
+  const before = (await frames(fast)).length;
+  const s = await fast.evaluate((v) => window.mediso.setSurfaces([Object.assign({}, v, { value: 300 })]), BONE);
+  const steps = (await frames(fast)).slice(before);
+  const m = await main.evaluate(() => window.mediso.setSurfaces([{ value: 300, color: [1, 1, 1], opacity: 1 }]));
+  const full = await main.evaluate(() => window.mediso.setCPULevel(3));
+  console.log("refinement frames: " + JSON.stringify(steps.map((f) => [f.values, f.cpuLevel, f.settled])));
+  checks.check(steps.length >= 2 && steps[0].values[0] === 300 && steps[0].cpuLevel < 3 && !steps[0].settled,
+    "a change is drawn first at a coarse level (" + (steps[0] || {}).cpuLevel + ") within a 1 ms budget");
+  checks.check(s.settled && s.cpuLevel === 3 && s.triangles === full.triangles && m.path === "cpu",
+    "the refinement reaches the full level: level " + s.cpuLevel + ", " + s.triangles + " triangles (" +
+    full.triangles + " drawn at level 3 on the main thread)");
+}
+
+// --- a change superseded while its refinement is owed ---------------------------------------------
+{
+  const skippedBefore = (await stats(fast)).refinementsSkipped;
+  const before = (await frames(fast)).length;
+  await fast.evaluate(async () => {
+    const box = document.querySelector("#surfaces .isovalue");
+    const type = (v) => {
+      box.value = String(v);
+      box.dispatchEvent(new Event("input"));
+    };
+    type(250);
+    // the coarse frame of 250 shown, its refinement owed: the next change comes now
+    await new Promise((resolve) => {
+      const poll = setInterval(() => {
+        const f = window.mediso.frames();
+        if (f.length && f[f.length - 1].values[0] === 250) {
+          clearInterval(poll);
+          resolve();
+        }
+      }, 1);
+    });
+    type(350);
+  });
+  await fast.waitForFunction(() => {
+    const f = window.mediso.frames();
+    return f.length && f[f.length - 1].values[0] === 350 && f[f.length - 1].settled;
+  }, null, { timeout: 120000 });
+  await fast.waitForTimeout(300); // nothing owed may still come
+  const steps = (await frames(fast)).slice(before);
+  const s = await stats(fast);
+  const m = await main.evaluate(() => window.mediso.setSurfaces([{ value: 350, color: [1, 1, 1], opacity: 1 }]));
+  console.log("superseded frames: " + JSON.stringify(steps.map((f) => [f.values, f.cpuLevel, f.settled])));
+  const last = steps[steps.length - 1];
+  checks.check(last.values[0] === 350 && last.settled && last.cpuLevel === 3 && s.triangles === m.triangles,
+    "the last frame is the newer change's surface at the full level (" + s.triangles + " triangles, " +
+    m.triangles + " on the main thread)");
+  checks.check(!steps.some((f) => f.values[0] === 250 && f.settled),
+    "the superseded change's surface is never refined nor shown after the newer one");
+  checks.check(s.refinementsSkipped > skippedBefore,
+    "the superseded refinement was skipped (" + skippedBefore + " -> " + s.refinementsSkipped + ")");
+}
+
+// --- a drag: coarser while it lasts, the full frame after it --------------------------------------------
+async function drag(page, moves = 12) {
+  const box = await page.locator("#view").boundingBox();
+  const x = box.x + box.width / 2, y = box.y + box.height / 2;
+  await page.mouse.move(x, y);
+  await page.mouse.down();
+  const during = [];
+  for (let i = 1; i <= moves; ++i) {
+    await page.mouse.move(x + 6 * i, y + 2 * i);
+    await page.waitForTimeout(40);
+    during.push(await stats(page));
+  }
+  await page.mouse.up();
+  return during;
+}
+{
+  const before = (await frames(fast)).length;
+  const during = await drag(fast);
+  await settle(fast);
+  await fast.waitForTimeout(200);
+  const steps = (await frames(fast)).slice(before);
+  const s = await stats(fast);
+  const coarse = steps.filter((f) => f.interactive && f.cpuLevel < 3);
+  const said = during.find((d) => d.interactive && d.cpuLevel < 3 && /dragging/.test(d.frameNote));
+  checks.check(coarse.length > 0 && !!said, "CPU path: " + coarse.length + " of the drag's " +
+    steps.filter((f) => f.interactive).length + " frames at a coarser level, said in stats(): " +
+    JSON.stringify(said && { interactive: said.interactive, cpuLevel: said.cpuLevel, frameNote: said.frameNote }));
+  checks.check(!s.interactive && s.settled && s.cpuLevel === 3,
+    "CPU path: the still frame after the drag is at level " + s.cpuLevel);
+}
+{
+  await fast.evaluate(() => window.mediso.setPath("gpu"));
+  const before = (await frames(fast)).length;
+  const during = await drag(fast, 16);
+  await settle(fast);
+  await fast.waitForTimeout(200);
+  const steps = (await frames(fast)).slice(before);
+  const s = await stats(fast);
+  const sampled = steps.filter((f) => f.interactive && f.sampleDistance > 1);
+  const said = during.find((d) => d.interactive && d.sampleDistance > 1);
+  checks.check(sampled.length > 0 && !!said, "GPU path: " + sampled.length + " of the drag's frames at " +
+    "an image sample distance above 1 (largest " + Math.max(1, ...steps.map((f) => f.sampleDistance)).toFixed(2) +
+    "), said in stats()");
+  checks.check(!s.interactive && s.sampleDistance === 1, "GPU path: the still frame after the drag has every pixel");
+}
+
+// --- long tasks on the 256^3 phantom ---------------------------------------------------------------
+const large = await startServer(["phantom:256"]);
+const longest = {};
+for (const [name, query] of [["worker", "&path=cpu"], ["main", "&path=cpu&worker=0"]]) {
+  const page = await open(large, query);
+  // The load's own long tasks (the volume's arrival, its copies collected) are not counted: a
+  // first change, then a second's rest, before the count starts.
+  await page.evaluate(() => window.mediso.setIsovalues([100]));
+  await page.waitForTimeout(1000);
+  await page.evaluate(() => { window.longTasks = []; });
+  for (const v of [300, -500, 500, 200]) {
+    await page.evaluate((value) => window.mediso.setIsovalues([value]), v);
+  }
+  await drag(page, 20);
+  await settle(page);
+  await page.waitForTimeout(300);
+  longest[name] = await page.evaluate(() => Math.max(0, ...window.longTasks));
+  console.log(name + ": longest main-thread task " + longest[name].toFixed(0) + " ms, " +
+    JSON.stringify((await stats(page)).triangles) + " triangles");
+  await page.close();
+}
+checks.check(longest.main > 50, "the observer sees the main-thread page's long tasks (" +
+  longest.main.toFixed(0) + " ms)");
+checks.check(longest.worker <= 50, "with the worker no main-thread task over 50 ms during 4 changes and " +
+  "a drag on the 256^3 phantom (longest " + longest.worker.toFixed(0) + " ms)");
+
+await checks.finish(browser, small, large);

@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The interactive benchmark's browser side (Python/benchmark_web.py --interactive runs it): in one
+// Chromium, each page (the main branch's, drawing on the main thread, and this one's, drawing in
+// a worker) on each path takes the same isovalue changes and the same mouse drag; measured in the
+// page: the time to the first visible answer of a change (its first frame) and to the full level,
+// the frames of the drag (their times, their level or sample distance, the rate), and the longest
+// main-thread task (PerformanceObserver longtask) over the changes and the drag.
+//   node bench-interactive.mjs CONFIG.json OUT.json
+// CONFIG: {pages: {name: url}, paths: ["cpu", "gpu"], size: [w, h], isovalues: [...], moves}
+import { launch } from "./page.mjs";
+import { readFileSync, writeFileSync } from "node:fs";
+
+const [configFile, outFile] = process.argv.slice(2);
+const config = JSON.parse(readFileSync(configFile, "utf8"));
+const browser = await launch();
+const result = { runs: [] };
+const median = (a) => {
+  const s = [...a].sort((x, y) => x - y);
+  return s.length ? (s.length % 2 ? s[(s.length - 1) / 2] : (s[s.length / 2 - 1] + s[s.length / 2]) / 2) : NaN;
+};
+
+for (const path of config.paths) {
+  for (const [name, url] of Object.entries(config.pages)) {
+    const page = await browser.newPage({ viewport: { width: config.size[0] + 420, height: config.size[1] + 100 } });
+    page.on("pageerror", (e) => console.log(name + " pageerror: " + e.message));
+    await page.addInitScript(() => {
+      window.longTasks = [];
+      new PerformanceObserver((list) => {
+        for (const e of list.getEntries()) {
+          window.longTasks.push(e.duration);
+        }
+      }).observe({ type: "longtask", buffered: true });
+    });
+    await page.goto(url + "&path=" + path + "&size=" + config.size.join("x"), { waitUntil: "commit" });
+    await page.waitForFunction(() => window.mediso, null, { timeout: 300000 });
+    await page.evaluate(() => window.mediso.ready);
+    // the load's own tasks left out: a first change, a second's rest
+    await page.evaluate((v) => window.mediso.setIsovalues([v]), config.isovalues[0]);
+    await page.waitForTimeout(1000);
+    await page.evaluate(() => { window.longTasks = []; });
+    const run = { page: name, path, changes: [], drag: {} };
+    for (const v of config.isovalues.slice(1)) {
+      const s = await page.evaluate((value) => window.mediso.setIsovalues([value]), v);
+      run.changes.push({ value: v, firstMs: s.lastChangeMs, fullMs: s.lastRefinedMs || s.lastChangeMs,
+        level: s.cpuLevel, elements: path === "gpu" ? s.primitives : s.triangles });
+    }
+    const before = await page.evaluate(() => (window.mediso.frames ? window.mediso.frames().length : 0));
+    const box = await page.locator("#view").boundingBox();
+    const x = box.x + box.width / 2, y = box.y + box.height / 2;
+    await page.mouse.move(x, y);
+    await page.mouse.down();
+    const sampled = [];
+    const t0 = Date.now();
+    for (let i = 1; i <= config.moves; ++i) {
+      await page.mouse.move(x + 4 * i, y + i);
+      await page.waitForTimeout(30);
+      sampled.push(await page.evaluate(() => window.mediso.stats().lastFrameMs));
+    }
+    await page.mouse.up();
+    const dragSeconds = (Date.now() - t0) / 1000;
+    await page.waitForFunction(() => window.mediso.stats().settled !== false, null, { timeout: 300000 });
+    await page.waitForTimeout(500);
+    const frames = await page.evaluate((n) => (window.mediso.frames ? window.mediso.frames().slice(n) : null), before);
+    if (frames) {
+      const drag = frames.filter((f) => f.interactive);
+      run.drag = { frameMs: median(drag.map((f) => f.ms)), frames: drag.length, rate: drag.length / dragSeconds,
+        levels: [...new Set(drag.map((f) => f.cpuLevel))], sampleDistances: [...new Set(drag.map((f) => f.sampleDistance))],
+        predictionError: median(drag.filter((f) => f.predictedMs > 0).map((f) => Math.abs(f.predictedMs - f.ms) / f.ms)) };
+    } else {
+      run.drag = { frameMs: median(sampled), frames: null, rate: null, levels: null, sampleDistances: [1] };
+    }
+    run.longestTaskMs = await page.evaluate(() => Math.max(0, ...window.longTasks));
+    run.stats = await page.evaluate(() => window.mediso.stats());
+    console.log(JSON.stringify({ page: name, path, first: median(run.changes.map((c) => c.firstMs)),
+      drag: run.drag.frameMs, longest: run.longestTaskMs }));
+    result.runs.push(run);
+    await page.close();
+  }
+}
+writeFileSync(outFile, JSON.stringify(result, null, 1));
+await browser.close();

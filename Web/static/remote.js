@@ -1,0 +1,184 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The viewer in a worker (docs/web.md, The worker): RemoteViewer has the WebViewer's methods,
+// so the rest of the page calls it as it calls the module's viewer, but the drawing happens in
+// render-worker.js on the canvas handed over as an OffscreenCanvas. The camera stays here (the
+// module's ViewCamera, the same C++ camera), so that getView answers at once between frames;
+// the surfaces and the camera go to the worker with each frame; the worker answers every frame
+// with the viewer's stats, which stats() gives until the next one. What WebViewer answered
+// synchronously from the drawing (render, finish, estimates) is a promise or the last frame's.
+
+/** True when this browser can draw WebGL2 into an OffscreenCanvas (which a worker may hold). */
+export function offscreenWebGL2() {
+  try {
+    return typeof OffscreenCanvas === "function" && typeof Worker === "function" &&
+      !!HTMLCanvasElement.prototype.transferControlToOffscreen &&
+      !!new OffscreenCanvas(1, 1).getContext("webgl2");
+  } catch {
+    return false;
+  }
+}
+
+export class RemoteViewer {
+  /**
+   * Starts the worker on `canvas` (its control handed over for good) with the module `M` of
+   * this thread (the camera, the CPU model's count); `threads`: the worker loads the threaded
+   * module; `budgetMs`: the frame budget (0: the worker's). Resolves to the viewer, or rejects.
+   */
+  static async start(canvas, M, { threads, budgetMs }, onFrame) {
+    const worker = new Worker("static/render-worker.js");
+    const offscreen = canvas.transferControlToOffscreen();
+    const viewer = new RemoteViewer(worker, M, onFrame);
+    const base = new URL("static/", location.href).href;
+    const ready = await new Promise((resolve, reject) => {
+      viewer.onReady = resolve;
+      worker.onerror = (e) => reject(new Error("the render worker failed: " + (e.message || "no reason given")));
+      worker.postMessage({ op: "init", canvas: offscreen, base, threads, budgetMs }, [offscreen]);
+    });
+    viewer.readyState = ready;
+    return viewer;
+  }
+
+  constructor(worker, M, onFrame) {
+    this.worker = worker;
+    this.M = M;
+    this.camera = new M.ViewCamera();
+    this.typeBytes = new Map(M.scalarTypes().map((t) => [t.value, t.bytes]));
+    this.onFrame = onFrame;
+    this.surfaces = [];
+    this.nextId = 1;
+    this.lastStats = { error: "", primitives: 0, triangles: 0, cpuLevel: 3, buildMs: 0, frameMs: 0 };
+    this.waiting = []; // [{id, settled, resolve}]
+    this.answers = new Map(); // id -> resolve
+    this.volume = null; // {type, pointer, dims}: the main thread's copy (this module's memory)
+    this.lastDrawn = 0; // the newest frame id the worker answered
+    worker.onmessage = (e) => this.receive(e.data);
+  }
+
+  receive(m) {
+    if (m.op === "ready") {
+      this.onReady(m);
+    } else if (m.op === "answer") {
+      const resolve = this.answers.get(m.id);
+      this.answers.delete(m.id);
+      if (resolve) {
+        resolve(m.value);
+      }
+    } else if (m.op === "frame") {
+      m.stats.id = m.id;
+      this.lastStats = m.stats;
+      this.lastDrawn = Math.max(this.lastDrawn, m.id);
+      this.onFrame(m.stats, m.id);
+      this.waiting = this.waiting.filter((w) => {
+        const done = w.id <= m.id && (!w.settled || m.stats.settled || !m.stats.ok);
+        if (done) {
+          w.resolve(m.stats);
+        }
+        return !done;
+      });
+    } else if (m.op === "error") {
+      this.lastStats = Object.assign({}, this.lastStats, { error: m.message });
+      console.error("render worker: " + m.message);
+    }
+  }
+
+  call(method, ...args) {
+    this.worker.postMessage({ op: "call", method, args });
+  }
+
+  ask(method, ...args) {
+    const id = this.nextId++;
+    return new Promise((resolve) => {
+      this.answers.set(id, resolve);
+      this.worker.postMessage({ op: "call", method, args, id });
+    });
+  }
+
+  ready() {
+    return !!this.readyState.ok;
+  }
+  error() {
+    return this.readyState.error || "";
+  }
+  info() {
+    return this.readyState.info || { error: this.error() };
+  }
+
+  /**
+   * The volume at `pointer` in this thread's module: kept here (the CPU model's count, and
+   * the page's own reading of values) and copied to the worker. The answer comes with the
+   * worker's upload; the camera is reset here at once, as WebViewer.setVolume resets its own.
+   */
+  setVolume(type, pointer, dims, spacing, origin) {
+    this.volume = { type, pointer, dims: [...dims] };
+    const byteLength = this.typeBytes.get(type) * dims[0] * dims[1] * dims[2];
+    const bytes = this.M.HEAPU8.slice(pointer, pointer + byteLength);
+    this.camera.setVolume(dims, spacing, origin);
+    const id = this.nextId++;
+    this.uploaded = new Promise((resolve) => this.answers.set(id, resolve));
+    this.worker.postMessage({ op: "volume", id, type, bytes: bytes.buffer, dims, spacing, origin },
+      [bytes.buffer]);
+    return true;
+  }
+
+  setSurfaces(surfaces) {
+    this.surfaces = surfaces.map((s) => ({ value: s.value, color: [...s.color], opacity: s.opacity }));
+    return true;
+  }
+
+  resize(width, height) {
+    this.camera.resize(width, height);
+    this.call("resize", width, height);
+  }
+
+  // The camera, here.
+  resetCamera() { this.camera.resetCamera(); }
+  azimuth(d) { this.camera.azimuth(d); }
+  elevation(d) { this.camera.elevation(d); }
+  zoom(f) { this.camera.zoom(f); }
+  dolly(f) { this.camera.dolly(f); }
+  setParallel(p) {
+    this.camera.setParallel(p);
+    this.call("setParallel", p);
+  }
+  setView(view) { this.camera.setView(view); }
+  getView() { return this.camera.getView(); }
+
+  setBackground(r, g, b) { this.call("setBackground", r, g, b); }
+  setMaterial(a, d, s, p) { this.call("setMaterial", a, d, s, p); }
+  setPath(path) { this.call("setPath", path); }
+  setCPULevel(level) { this.call("setCPULevel", level); }
+  setBudget(bytes) { this.call("setBudget", bytes); }
+  /** The estimator's table, from the worker (a promise). */
+  estimates() { return this.ask("estimates"); }
+  clearResultMesh() { this.call("clearResultMesh"); }
+  /** A surface the server made: the arrays themselves (copied to the worker). */
+  setResultArrays(points, triangles, color, opacity) {
+    this.worker.postMessage({ op: "mesh", points, triangles, color, opacity });
+  }
+
+  /**
+   * Asks the worker for a frame of the surfaces and camera as they are now; `interactive`
+   * during a drag. Resolves with the first frame answered for it (or a newer one), or, with
+   * `settled`, with the frame at the full level (a refinement's).
+   */
+  frame(interactive = false) {
+    const id = this.nextId++;
+    this.worker.postMessage({ op: "frame", id, surfaces: this.surfaces, view: this.camera.getView(),
+      interactive });
+    const first = new Promise((resolve) => this.waiting.push({ id, settled: false, resolve }));
+    const settled = new Promise((resolve) => this.waiting.push({ id, settled: true, resolve }));
+    return { id, first, settled };
+  }
+
+  render() {
+    return true;
+  }
+  finish() {}
+  stats() {
+    return this.lastStats;
+  }
+  countOnCPU(values) {
+    const v = this.volume;
+    return v ? this.M.countCrossings(v.type, v.pointer, v.dims, values) : 0;
+  }
+}

@@ -1,0 +1,220 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The page's renderer off the main thread (docs/web.md, The worker): the WebAssembly module and
+// its WebViewer run here, drawing into the page's canvas handed over as an OffscreenCanvas, so
+// that an extraction or a slow software frame never holds the page's main thread (input, the
+// panel, typing). The main thread keeps the camera (ViewCamera, the same C++ camera) and the
+// volume's values, and sends what changes; this worker answers every frame with the viewer's
+// stats. A classic worker, not a module: it loads the Emscripten module with importScripts.
+//
+// Messages in (each applied in the order sent):
+//   {op: "init", canvas, base, threads}                 load the module, make the viewer
+//   {op: "call", method, args, id?}                      a WebViewer call; with id, its answer
+//   {op: "volume", type, bytes, dims, spacing, origin}   the volume's values (transferred)
+//   {op: "mesh", points, triangles, color, opacity}      a surface the server made
+//   {op: "frame", id, surfaces, view, interactive}       the frame wanted now
+// Messages out: {op: "ready", ok, error, info}, {op: "answer", id, value},
+//   {op: "frame", id, stats, settled}, {op: "error", message}.
+//
+// Frames. Only the newest frame wanted is drawn: messages that arrived while a frame was drawn
+// are all applied first, and the frames they asked for collapse into the last one. On the CPU
+// path, with the estimator choosing the level (setCPULevel(-1)), a new set of isovalues is drawn
+// first at the finest level whose predicted frame fits the frame budget, and refined to the
+// level the memory budget allows in a later task, which a newer change makes obsolete: the
+// refinement is then skipped (counted in stats.refinementsSkipped). During a drag
+// (interactive: true) the same coarse level is drawn; the still frame after it is the full one.
+"use strict";
+
+let M = null;
+let viewer = null;
+let wanted = null; // the newest frame asked for, not drawn yet
+let refine = null; // {id, surfacesKey}: the full-level frame owed after a coarse one
+let scheduled = false;
+let requestedLevel = -1; // the page's setCPULevel (-1: the estimator's, within the budget)
+let path = "gpu";
+let shownKey = ""; // the isovalues of the last frame drawn
+let skipped = 0;
+let volumeBytes = 0; // the pointer of the volume in this module's memory
+
+// The frame budget of interactive frames and of a change's first frame (the page's
+// ?frameBudget=MS, else 100 ms), and how long a coarse frame waits before its refinement starts,
+// so that the next change of a burst (typing, a slider) finds it not yet begun.
+let budgetSeconds = 0.1;
+const REFINE_DELAY_MS = 40;
+
+function post(message, transfer) {
+  self.postMessage(message, transfer || []);
+}
+
+async function init(m) {
+  const name = m.threads ? "mediso-mt" : "mediso";
+  importScripts(m.base + name + ".js");
+  const create = m.threads ? self.createMedisoThreads : self.createMediso;
+  M = await create({ locateFile: (f) => m.base + f, mainScriptUrlOrBlob: m.base + name + ".js" });
+  if (!M.specialHTMLTargets) {
+    post({ op: "ready", ok: false, error: "the module cannot be given an OffscreenCanvas" });
+    return;
+  }
+  M.specialHTMLTargets["#view"] = m.canvas;
+  if (m.budgetMs > 0) {
+    budgetSeconds = m.budgetMs / 1000;
+  }
+  viewer = new M.WebViewer("#view");
+  post({ op: "ready", ok: viewer.ready(), error: viewer.error(), info: viewer.info() });
+}
+
+function schedule() {
+  if (!scheduled) {
+    scheduled = true;
+    setTimeout(pump, 0);
+  }
+}
+
+// The frame that fits the budget on this client: WebViewer.chooseFrame, from the cores' frame-time
+// model (mediso::FrameTimeModel, fitted from this viewer's frames) and the estimator's seconds of
+// an extraction: {level, sampleDistance, predictedMs, fullMs, memoryLevel}.
+function choose(frame) {
+  viewer.setSurfaces(frame.surfaces);
+  viewer.setCPULevel(requestedLevel);
+  return viewer.chooseFrame(budgetSeconds);
+}
+
+function keyOf(surfaces) {
+  return JSON.stringify(surfaces.map((s) => s.value));
+}
+
+// Draws `frame` at CPU level `level` (-1: the estimator's within the memory budget) and sample
+// distance `distance`; the viewer's stats with the frame's time and what it was.
+function draw(frame, level, distance) {
+  viewer.setSurfaces(frame.surfaces);
+  viewer.setView(frame.view);
+  if (path === "cpu") {
+    viewer.setCPULevel(level);
+  }
+  viewer.setSampleDistance(distance);
+  const start = performance.now();
+  const ok = viewer.render();
+  if (ok) {
+    viewer.finish();
+  }
+  const ms = performance.now() - start;
+  const stats = viewer.stats();
+  stats.ok = ok;
+  stats.ms = ms;
+  stats.values = frame.surfaces.map((s) => s.value);
+  stats.refinementsSkipped = skipped;
+  stats.budgetMs = 1000 * budgetSeconds;
+  return stats;
+}
+
+function pump() {
+  scheduled = false;
+  if (!viewer || !volumeBytes) {
+    return;
+  }
+  if (wanted) {
+    const frame = wanted;
+    wanted = null;
+    const key = keyOf(frame.surfaces);
+    if (refine) {
+      // A newer frame: a change or a drag makes the owed refinement obsolete (skipped); a still
+      // frame of the same surfaces draws the full level itself.
+      if (refine.key !== key || frame.interactive) {
+        ++skipped;
+      }
+      clearTimeout(refine.timer);
+      refine = null;
+    }
+    const auto = path === "cpu" && requestedLevel < 0;
+    const coarse = auto && (frame.interactive || key !== shownKey);
+    let level = requestedLevel, distance = 1, note = "", choice = null;
+    if (coarse || (path === "gpu" && frame.interactive)) {
+      choice = choose(frame);
+      level = path === "cpu" ? choice.level : requestedLevel;
+      distance = path === "gpu" ? choice.sampleDistance : 1;
+    }
+    const stats = draw(frame, level, distance);
+    if (choice) {
+      stats.predictedMs = choice.predictedMs;
+      const over = "the full frame would take about " + Math.round(choice.fullMs) + " ms on this " +
+        "client, over the " + Math.round(1000 * budgetSeconds) + " ms budget";
+      if (path === "cpu" && stats.cpuLevel < choice.memoryLevel) {
+        note = (frame.interactive ? "While dragging" : "First answer") + ": level " + stats.cpuLevel +
+          " (" + over + ")" + (frame.interactive ? "." : "; refining.");
+      } else if (path === "gpu" && distance > 1) {
+        note = "While dragging: one pixel in " + distance + " along each axis, scaled up (" + over + ").";
+      }
+    }
+    shownKey = key;
+    stats.interactive = !!frame.interactive;
+    // A coarse level that is the one the memory allows leaves nothing to refine.
+    stats.settled = !frame.interactive && (!coarse || stats.cpuLevel >= choice.memoryLevel);
+    stats.note = note;
+    if (!stats.settled && !frame.interactive && stats.ok) {
+      refine = { id: frame.id, key, frame };
+      refine.timer = setTimeout(refineNow, REFINE_DELAY_MS);
+    }
+    post({ op: "frame", id: frame.id, stats });
+  }
+}
+
+// The full level owed after a coarse frame (skipped when a newer frame made it obsolete).
+function refineNow() {
+  if (!refine) {
+    return;
+  }
+  if (wanted) { // a newer frame came in first: pump decides
+    return;
+  }
+  const { id, frame } = refine;
+  refine = null;
+  const stats = draw(frame, -1, 1);
+  stats.interactive = false;
+  stats.settled = true;
+  stats.note = "";
+  post({ op: "frame", id, stats });
+}
+
+self.onmessage = async (event) => {
+  const m = event.data;
+  try {
+    if (m.op === "init") {
+      await init(m);
+    } else if (m.op === "call") {
+      if (m.method === "setPath") {
+        path = m.args[0];
+      } else if (m.method === "setCPULevel") {
+        requestedLevel = m.args[0];
+      }
+      const value = viewer[m.method](...m.args);
+      if (m.id !== undefined) {
+        post({ op: "answer", id: m.id, value });
+      }
+    } else if (m.op === "volume") {
+      if (volumeBytes) {
+        M._free(volumeBytes);
+      }
+      const bytes = new Uint8Array(m.bytes);
+      volumeBytes = M._malloc(bytes.length);
+      M.HEAPU8.set(bytes, volumeBytes);
+      const ok = viewer.setVolume(m.type, volumeBytes, m.dims, m.spacing, m.origin);
+      shownKey = "";
+      refine = null;
+      post({ op: "answer", id: m.id, value: ok ? "" : viewer.stats().error || "the volume cannot be uploaded" });
+    } else if (m.op === "mesh") {
+      const points = M._malloc(m.points.byteLength);
+      const triangles = M._malloc(m.triangles.byteLength);
+      M.HEAPU8.set(new Uint8Array(m.points.buffer, m.points.byteOffset, m.points.byteLength), points);
+      M.HEAPU8.set(new Uint8Array(m.triangles.buffer, m.triangles.byteOffset, m.triangles.byteLength), triangles);
+      viewer.setResultMesh(points, m.points.length / 3, triangles, m.triangles.length / 3, m.color, m.opacity);
+      M._free(points);
+      M._free(triangles);
+    } else if (m.op === "frame") {
+      wanted = m;
+      schedule();
+    }
+  } catch (error) {
+    const message = String(error && error.message || error);
+    // A failed start answers the page's wait for "ready" (it then says why it cannot draw).
+    post(m.op === "init" ? { op: "ready", ok: false, error: message } : { op: "error", message });
+  }
+};
