@@ -7,28 +7,20 @@
 // - a change superseded while its refinement is owed never shows the old surface at the end,
 //   and the refinement is skipped;
 // - a drag draws coarser (CPU path: a level; GPU path: an image sample distance), says so in
-//   window.mediso.stats(), and the still frame after it is back at full level;
-// - on the 256^3 phantom no main-thread task exceeds 50 ms during changes and a drag with the
-//   worker, while the main-thread page (?worker=0) has longer ones on the same actions (the
-//   observer works).
+//   window.mediso.stats(), and the still frame after it is back at full level.
+// How long the main thread is busy is a timing, so it is measured by the benchmark
+// (Python/benchmark_web.py --interactive: the longest main-thread task, PerformanceObserver
+// "longtask"), not asserted here.
 import { Checks, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 const small = await startServer(["phantom:64"]);
 const browser = await launchBrowser();
 
-// The page, with `query` after the token; long tasks collected from the start.
+// The page, with `query` after the token.
 async function open(server, query) {
   const context = await browser.newContext({ viewport: { width: 1000, height: 700 } });
   const page = await context.newPage();
-  await page.addInitScript(() => {
-    window.longTasks = [];
-    new PerformanceObserver((list) => {
-      for (const e of list.getEntries()) {
-        window.longTasks.push(e.duration);
-      }
-    }).observe({ type: "longtask", buffered: true });
-  });
   await openPage(page, { url: server.url + query });
   return page;
 }
@@ -169,30 +161,4 @@ async function drag(page, moves = 12) {
   checks.check(!s.interactive && s.sampleDistance === 1, "GPU path: the still frame after the drag has every pixel");
 }
 
-// --- long tasks on the 256^3 phantom ---------------------------------------------------------------
-const large = await startServer(["phantom:256"]);
-const longest = {};
-for (const [name, query] of [["worker", "&path=cpu"], ["main", "&path=cpu&worker=0"]]) {
-  const page = await open(large, query);
-  // The load's own long tasks (the volume's arrival, its copies collected) are not counted: a
-  // first change, then a second's rest, before the count starts.
-  await page.evaluate(() => window.mediso.setIsovalues([100]));
-  await page.waitForTimeout(1000);
-  await page.evaluate(() => { window.longTasks = []; });
-  for (const v of [300, -500, 500, 200]) {
-    await page.evaluate((value) => window.mediso.setIsovalues([value]), v);
-  }
-  await drag(page, 20);
-  await settle(page);
-  await page.waitForTimeout(300);
-  longest[name] = await page.evaluate(() => Math.max(0, ...window.longTasks));
-  console.log(name + ": longest main-thread task " + longest[name].toFixed(0) + " ms, " +
-    JSON.stringify((await stats(page)).triangles) + " triangles");
-  await page.close();
-}
-checks.check(longest.main > 50, "the observer sees the main-thread page's long tasks (" +
-  longest.main.toFixed(0) + " ms)");
-checks.check(longest.worker <= 50, "with the worker no main-thread task over 50 ms during 4 changes and " +
-  "a drag on the 256^3 phantom (longest " + longest.worker.toFixed(0) + " ms)");
-
-await checks.finish(browser, small, large);
+await checks.finish(browser, small);
