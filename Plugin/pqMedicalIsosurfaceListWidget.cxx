@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "pqMedicalIsosurfaceListWidget.h"
 
+#include "pqMedicalHistogramWidget.h"
+#include "pqUndoStack.h"
+#include "pqView.h"
 #include "vtkCommand.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkEventQtSlotConnect.h"
@@ -12,6 +15,8 @@
 #include "vtkSMPropertyHelper.h"
 #include "vtkSMProxy.h"
 #include "vtkSMSourceProxy.h"
+#include "vtkSMViewProxy.h"
+#include "vtkScalarsToColors.h"
 
 #include <QCheckBox>
 #include <QColorDialog>
@@ -22,6 +27,7 @@
 #include <QPixmap>
 #include <QPushButton>
 #include <QTableWidget>
+#include <QTimer>
 #include <QToolButton>
 #include <QVBoxLayout>
 
@@ -81,6 +87,8 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   , AddButton(new QToolButton(this))
   , RemoveButton(new QPushButton(tr("Remove"), this))
   , ColorEachSurface(new QCheckBox(tr("Color Each Surface"), this))
+  , Histogram(new pqMedicalHistogramWidget(this))
+  , PreviewTimer(new QTimer(this))
   , Connections(vtkEventQtSlotConnect::New())
 {
   this->setObjectName("MedicalIsosurfaceList");
@@ -91,6 +99,16 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   this->ColorEachSurface->setObjectName("ColorEachSurface");
 
   this->Table->setHorizontalHeaderLabels({ tr("Isovalue"), tr("Color"), tr("Opacity") });
+  this->Table->horizontalHeaderItem(ValueColumn)
+    ->setToolTip(tr("The value each surface is drawn at, in the array's units (Hounsfield units "
+                    "for a CT). Double-click to type one, or drag its marker in the histogram."));
+  this->Table->horizontalHeaderItem(ColorColumn)
+    ->setToolTip(tr("The color each surface is drawn in: its own with Color Each Surface "
+                    "checked, else the solid color (solid) or the color map at the isovalue "
+                    "(map). Double-click to choose one."));
+  this->Table->horizontalHeaderItem(OpacityColumn)
+    ->setToolTip(tr("Each surface's opacity, 0 (invisible) to 1 (opaque). Double-click to "
+                    "edit it."));
   this->Table->horizontalHeader()->setSectionResizeMode(ValueColumn, QHeaderView::Stretch);
   this->Table->horizontalHeader()->setSectionResizeMode(ColorColumn, QHeaderView::Fixed);
   this->Table->horizontalHeader()->setSectionResizeMode(OpacityColumn, QHeaderView::Stretch);
@@ -143,6 +161,7 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
   layout->addWidget(this->RangeLabel);
+  layout->addWidget(this->Histogram);
   layout->addWidget(this->Table);
   layout->addLayout(buttons);
 
@@ -158,6 +177,17 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
     &pqMedicalIsosurfaceListWidget::updateTable);
   QObject::connect(this->ColorEachSurface, &QCheckBox::clicked, this,
     &pqMedicalIsosurfaceListWidget::colorsChanged);
+  QObject::connect(this->Histogram, &pqMedicalHistogramWidget::markerMoved, this,
+    &pqMedicalIsosurfaceListWidget::previewMarker);
+  QObject::connect(this->Histogram, &pqMedicalHistogramWidget::markerReleased, this,
+    &pqMedicalIsosurfaceListWidget::commitMarker);
+  QObject::connect(this->Histogram, &pqMedicalHistogramWidget::markerCancelled, this,
+    &pqMedicalIsosurfaceListWidget::cancelMarker);
+  // One preview render per pass of the event loop, however many moves came.
+  this->PreviewTimer->setSingleShot(true);
+  this->PreviewTimer->setInterval(0);
+  QObject::connect(this->PreviewTimer, &QTimer::timeout, this,
+    &pqMedicalIsosurfaceListWidget::renderPreview);
 
   vtkSMProperty* isovalues = smproxy->GetProperty("IsosurfaceValues");
   this->addPropertyLink(this, "values", SIGNAL(valuesChanged()), isovalues);
@@ -176,6 +206,13 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   {
     this->Connections->Connect(colorArray, vtkCommand::ModifiedEvent, this, SLOT(updateRange()));
     this->Connections->Connect(colorArray, vtkCommand::ModifiedEvent, this, SLOT(updateTable()));
+  }
+  for (const char* name : { "LookupTable", "DiffuseColor" })
+  {
+    if (vtkSMProperty* drawn = smproxy->GetProperty(name))
+    {
+      this->Connections->Connect(drawn, vtkCommand::ModifiedEvent, this, SLOT(updateTable()));
+    }
   }
   this->updateRange();
   this->updateTable();
@@ -307,6 +344,8 @@ void pqMedicalIsosurfaceListWidget::updateTable()
 {
   this->Updating = true;
   const bool colorEach = this->ColorEachSurface->isChecked();
+  std::vector<double> values;
+  std::vector<QColor> colors;
   this->Table->setRowCount(static_cast<int>(this->Rows.size()));
   for (int i = 0; i < static_cast<int>(this->Rows.size()); ++i)
   {
@@ -316,10 +355,14 @@ void pqMedicalIsosurfaceListWidget::updateTable()
     this->Table->setItem(i, ValueColumn, value);
     auto* color = new QTableWidgetItem();
     color->setFlags(Qt::ItemIsSelectable | Qt::ItemIsEnabled);
+    const QColor drawn = this->drawnColor(row);
+    colors.push_back(drawn);
+    values.push_back(row.Value);
+    // The swatch is an icon: unlike a background, it shows in a selected row.
+    color->setData(Qt::DecorationRole, Swatch(drawn));
     if (colorEach)
     {
       color->setBackground(row.Color);
-      color->setData(Qt::DecorationRole, Swatch(row.Color));
       color->setToolTip(tr("Double-click to choose this surface's color"));
     }
     else
@@ -329,8 +372,11 @@ void pqMedicalIsosurfaceListWidget::updateTable()
       const char* name = colorArray.GetInputArrayNameToProcess();
       color->setText((name && name[0]) ? tr("map") : tr("solid"));
       color->setTextAlignment(Qt::AlignCenter);
-      color->setToolTip(tr("Double-click (or check Color Each Surface) to give this surface "
-                           "its own color"));
+      color->setToolTip((name && name[0])
+          ? tr("Drawn in the color map's color at the isovalue. Double-click (or check Color "
+               "Each Surface) to give this surface its own color")
+          : tr("Drawn in the display's solid color. Double-click (or check Color Each "
+               "Surface) to give this surface its own color"));
       color->setForeground(this->palette().color(QPalette::Disabled, QPalette::Text));
     }
     this->Table->setItem(i, ColorColumn, color);
@@ -339,7 +385,121 @@ void pqMedicalIsosurfaceListWidget::updateTable()
     this->Table->setItem(i, OpacityColumn, opacity);
   }
   this->RemoveButton->setEnabled(!this->Rows.empty());
+  this->Histogram->setMarkers(values, colors);
   this->Updating = false;
+}
+
+//------------------------------------------------------------------------------
+QColor pqMedicalIsosurfaceListWidget::drawnColor(const Row& row) const
+{
+  if (this->ColorEachSurface->isChecked())
+  {
+    return row.Color;
+  }
+  vtkSMProxy* display = this->proxy();
+  vtkSMPropertyHelper colorArray(display, "ColorArrayName", /*quiet=*/true);
+  const char* name = colorArray.GetInputArrayNameToProcess();
+  if (name && name[0])
+  {
+    // The map's colour at the isovalue, from the client's copy of the map
+    // (transfer functions live on the client too: the colour legend uses it).
+    vtkSMPropertyHelper map(display, "LookupTable", /*quiet=*/true);
+    vtkSMProxy* lut = map.GetAsProxy();
+    auto* colors = lut ? vtkScalarsToColors::SafeDownCast(lut->GetClientSideObject()) : nullptr;
+    if (colors && std::isfinite(row.Value))
+    {
+      double rgb[3];
+      colors->GetColor(row.Value, rgb);
+      return QColor::fromRgbF(rgb[0], rgb[1], rgb[2]);
+    }
+    return this->palette().color(QPalette::Disabled, QPalette::Text);
+  }
+  double rgb[3] = { 1.0, 1.0, 1.0 };
+  if (display->GetProperty("DiffuseColor"))
+  {
+    vtkSMPropertyHelper(display, "DiffuseColor").Get(rgb, 3);
+  }
+  return QColor::fromRgbF(std::min(1.0, std::max(0.0, rgb[0])),
+    std::min(1.0, std::max(0.0, rgb[1])), std::min(1.0, std::max(0.0, rgb[2])));
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::setValuesOutsideUndo(const std::vector<double>& values)
+{
+  const pqScopedUndoExclude outside;
+  vtkSMProxy* display = this->proxy();
+  vtkSMPropertyHelper(display, "IsosurfaceValues")
+    .Set(values.data(), static_cast<unsigned int>(values.size()));
+  display->UpdateVTKObjects();
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::previewMarker(int row, double value)
+{
+  if (row < 0 || row >= static_cast<int>(this->Rows.size()))
+  {
+    return;
+  }
+  if (this->BeforeDrag.empty())
+  {
+    this->BeforeDrag = vtkSMPropertyHelper(this->proxy(), "IsosurfaceValues").GetArray<double>();
+  }
+  this->Rows[static_cast<std::size_t>(row)].Value = value;
+  std::vector<double> values;
+  for (const Row& each : this->Rows)
+  {
+    values.push_back(each.Value);
+  }
+  this->setValuesOutsideUndo(values);
+  this->PreviewTimer->start();
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::renderPreview()
+{
+  pqView* view = this->view();
+  if (vtkSMViewProxy* viewProxy = view ? view->getViewProxy() : nullptr)
+  {
+    viewProxy->InteractiveRender();
+  }
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::commitMarker(int row, double value)
+{
+  this->PreviewTimer->stop();
+  if (!this->BeforeDrag.empty())
+  {
+    // The undo step must start from the values before the drag, not from the
+    // last preview.
+    const std::vector<double> before = this->BeforeDrag;
+    this->BeforeDrag.clear();
+    this->setValuesOutsideUndo(before);
+  }
+  if (row < 0 || row >= static_cast<int>(this->Rows.size()))
+  {
+    return;
+  }
+  // As a typed value: the panel applies it in one undo set and renders.
+  this->Rows[static_cast<std::size_t>(row)].Value = value;
+  this->rowsEdited();
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::cancelMarker(int, double)
+{
+  this->PreviewTimer->stop();
+  if (this->BeforeDrag.empty())
+  {
+    return;
+  }
+  const std::vector<double> before = this->BeforeDrag;
+  this->BeforeDrag.clear();
+  this->setValuesOutsideUndo(before);
+  if (pqView* view = this->view())
+  {
+    view->render();
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -477,6 +637,16 @@ void pqMedicalIsosurfaceListWidget::updateRange()
   {
     array->GetComponentRange(0, this->Range);
     this->HasRange = this->Range[0] <= this->Range[1];
+  }
+  if (this->HasRange)
+  {
+    vtkSMPropertyHelper colorArray(this->proxy(), "ColorArrayName", /*quiet=*/true);
+    this->Histogram->gatherHistogram(
+      source, input.GetOutputPort(), colorArray.GetInputArrayNameToProcess());
+  }
+  else
+  {
+    this->Histogram->clearHistogram();
   }
   if (this->HasRange)
   {
