@@ -100,15 +100,19 @@ pqBlockLODLevelWidget::pqBlockLODLevelWidget(
 
   auto* layout = new QGridLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
-  layout->addWidget(this->Histogram, 0, 0, 1, 3);
-  layout->addWidget(this->AutoLOD, 1, 0, 1, 3);
-  layout->addWidget(new QLabel(tr("LOD"), this), 2, 0);
-  layout->addWidget(this->Level, 2, 1);
-  layout->addWidget(this->LevelNote, 2, 2);
-  layout->addWidget(new QLabel(tr("Memory Budget"), this), 3, 0);
-  layout->addWidget(this->MemoryBudget, 3, 1, 1, 2);
-  layout->addWidget(this->Table, 4, 0, 1, 3);
-  layout->addWidget(this->Caption, 5, 0, 1, 3);
+  auto* histogramCaption =
+    new QLabel(tr("Histogram (log scale): drag a marker to change that isovalue."), this);
+  histogramCaption->setObjectName("HistogramCaption");
+  layout->addWidget(histogramCaption, 0, 0, 1, 3);
+  layout->addWidget(this->Histogram, 1, 0, 1, 3);
+  layout->addWidget(this->AutoLOD, 2, 0, 1, 3);
+  layout->addWidget(new QLabel(tr("LOD"), this), 3, 0);
+  layout->addWidget(this->Level, 3, 1);
+  layout->addWidget(this->LevelNote, 3, 2);
+  layout->addWidget(new QLabel(tr("Memory Budget"), this), 4, 0);
+  layout->addWidget(this->MemoryBudget, 4, 1, 1, 2);
+  layout->addWidget(this->Table, 5, 0, 1, 3);
+  layout->addWidget(this->Caption, 6, 0, 1, 3);
   layout->setColumnStretch(2, 1);
 
   this->addPropertyLink(this->AutoLOD, "AutoLOD");

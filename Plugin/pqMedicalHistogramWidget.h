@@ -8,8 +8,8 @@
  * (pqBlockLODLevelWidget). It draws:
  *
  * - the bins as bars whose heights are log(1 + count) (a CT's air and soft
- *   tissue outnumber its bone a hundred to one: a linear scale shows two
- *   spikes and nothing of the bone);
+ *   tissue bins hold a hundred to five hundred times more points than its
+ *   bone's: a linear scale shows two spikes and nothing of the bone);
  * - the data range on the axis below;
  * - one vertical line per isovalue in its surface's colour, outlined so a
  *   white or black surface still shows on either palette; a value outside

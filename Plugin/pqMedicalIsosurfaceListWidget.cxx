@@ -130,6 +130,19 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
        "opacity, or another value (the middle of the data range for the first row, else a "
        "tenth of the range above the last row). Double-click the new value to edit it."));
   auto* presets = new QMenu(this->AddButton);
+  presets->setToolTipsVisible(true);
+  // What each preset shows on a CT, in TissuePresets' order.
+  const QString presetTips[] = {
+    tr("The skin's outer surface, translucent. Stay above -600 HU: below, foam padding and "
+       "blankets show."),
+    tr("Muscle and brain, translucent, inside the skin."),
+    tr("Vessels filled with contrast agent (on a contrast-enhanced CT; without contrast this "
+       "value gives thin bone)."),
+    tr("Bone, opaque. Values from 1000 HU keep only dense cortical bone."),
+  };
+  static_assert(sizeof(presetTips) / sizeof(presetTips[0]) ==
+      sizeof(TissuePresets) / sizeof(TissuePresets[0]),
+    "a tooltip per preset");
   presets->setObjectName("Presets");
   for (int i = 0; i < static_cast<int>(sizeof(TissuePresets) / sizeof(TissuePresets[0])); ++i)
   {
@@ -138,11 +151,14 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
       QIcon(Swatch(QColor::fromRgbF(preset.Color[0], preset.Color[1], preset.Color[2]))),
       tr("%1 (%2 HU)").arg(tr(preset.Name)).arg(preset.Value));
     action->setObjectName(QString("Preset%1").arg(i));
+    action->setToolTip(presetTips[i]);
     QObject::connect(action, &QAction::triggered, this, [this, i]() { this->addPreset(i); });
   }
   presets->addSeparator();
   QAction* other = presets->addAction(tr("Other value"));
   other->setObjectName("OtherValue");
+  other->setToolTip(tr("A row in the next palette color: the middle of the data range for the "
+                       "first row, else a tenth of the range above the last row."));
   QObject::connect(other, &QAction::triggered, this, &pqMedicalIsosurfaceListWidget::addRow);
   this->AddButton->setMenu(presets);
   this->RemoveButton->setToolTip(

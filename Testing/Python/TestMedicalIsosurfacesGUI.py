@@ -307,6 +307,20 @@ if wanted("help"):
             events.append('<pqevent object="%s/AutoLOD" command="set_boolean" arguments="false" />' % levels)
         else:
             events.append('<pqcheck object="%s/%s" property="%s" arguments="%s" />' % ((levels,) + entry))
+    # The histogram above the levels (the phantom: -1000 to 1075 HU, the plot
+    # 507 pixels wide at this dock width): bone's marker at 400 (x 348) dragged to
+    # x 250, about 0 HU, edits the isovalue (1: rounded to whole HU) on release,
+    # and the panel then has a change to apply (played first: the Auto LOD
+    # events above leave one too).
+    events[:0] = ['<pqevent object="%s/Histogram" command="mousePress" arguments="1,1,0,348,30" />' % levels,
+               '<pqevent object="%s/Histogram" command="mouseMove" arguments="1,0,0,300,30" />' % levels,
+               '<pqevent object="%s/Histogram" command="mouseMove" arguments="1,0,0,250,30" />' % levels,
+               '<pqcheck object="pqClientMainWindow/propertiesDock/propertiesPanel/Accept" '
+               'property="enabled" arguments="false" />',
+               '<pqevent object="%s/Histogram" command="mouseRelease" arguments="1,0,0,250,30" />' % levels,
+               '<pqcheck object="%s/Histogram" property="markerValues" arguments="1" />' % levels,
+               '<pqcheck object="pqClientMainWindow/propertiesDock/propertiesPanel/Accept" '
+               'property="enabled" arguments="true" />']
     events.append('<pqevent object="pqClientMainWindow/propertiesDock/propertiesPanel/Help" '
                   'command="activate" arguments="" />')
     process, status_path, log = start_paraview("help", "\n".join(events))
