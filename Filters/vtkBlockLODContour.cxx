@@ -32,6 +32,7 @@
 #include "vtkTypeInt32Array.h"
 #include "vtkTypeInt64Array.h"
 #include "vtkUnsignedCharArray.h"
+#include "vtkWeakPointer.h"
 
 #include <algorithm>
 #include <cctype>
@@ -428,6 +429,13 @@ struct vtkBlockLODContour::vtkInternals
     ProcessCostModel() };
   bool WarnedMissing = false; // NaN or infinite values, once per input
 
+  // What the last successful update made, for GenerateLevel: its isovalues,
+  // the array they were read from (and its time then), and when.
+  std::vector<double> LastValues;
+  vtkWeakPointer<vtkDataArray> LastArray;
+  vtkMTimeType LastArrayTime = 0;
+  vtkTimeStamp LastUpdate;
+
   // Cells that are not ghosts, as an inclusive cell index range per axis:
   // ghost layers of a structured piece are whole slabs at its faces. Without
   // a ghost array (a filter upstream dropped it), the piece's extent without
@@ -722,6 +730,8 @@ void vtkBlockLODContour::Execute(
 {
   vtkInternals& in = *this->Internals;
   const double start = Now();
+  in.LastValues.clear();
+  in.LastArray = nullptr;
 
   // Check: an array the core can read, on a grid it can contour.
   vtkDataArray* array = this->CheckInput(input, inputVector);
@@ -775,12 +785,16 @@ void vtkBlockLODContour::Execute(
   }
   this->UpdateProgress(0.9);
   step = "assembling the output";
-  if (!this->AssembleOutput(output))
+  if (!this->AssembleOutput(output, this->ChosenLevel))
   {
     output->Initialize();
     this->ChosenLevel = -1;
     return;
   }
+  in.LastValues = values;
+  in.LastArray = array;
+  in.LastArrayTime = array->GetMTime();
+  in.LastUpdate.Modified();
   // The cost model learns from updates that extracted something and did no
   // one-time work (block ranges, coarse copies).
   in.Surfaces.RecordCost(update, Now() - start);
@@ -1083,7 +1097,7 @@ void vtkBlockLODContour::ReportEstimates(double isovalue)
 }
 
 //------------------------------------------------------------------------------
-bool vtkBlockLODContour::AssembleOutput(vtkPolyData* output)
+bool vtkBlockLODContour::AssembleOutput(vtkPolyData* output, int level)
 {
   const std::vector<vtkSmartPointer<vtkPolyData>>& pieces = this->Internals->Surfaces.GetSurfaces();
   if (pieces.size() == 1)
@@ -1185,11 +1199,92 @@ bool vtkBlockLODContour::AssembleOutput(vtkPolyData* output)
     std::copy(v, v + n, a->GetPointer(0));
     output->GetFieldData()->AddArray(a);
   };
-  const double chosen = this->ChosenLevel;
-  addField("BlockLODLevel", &chosen, 1);
+  const double made = level;
+  addField("BlockLODLevel", &made, 1);
   addField("BlockLODEstimatedTriangles", this->EstimatedTriangles, 4);
   addField("BlockLODEstimatedMB", this->EstimatedMegabytes, 4);
   addField("BlockLODEstimatedSeconds", this->EstimatedSeconds, 4);
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkBlockLODContour::HasCurrentOutput()
+{
+  const vtkInternals& in = *this->Internals;
+  // The core's volume still describes the input array's memory only while the
+  // array lives unchanged; the isovalues and options only while the filter
+  // has not been modified since.
+  return !in.LastValues.empty() && in.LastArray && in.LastArray->GetMTime() == in.LastArrayTime &&
+    this->GetMTime() < in.LastUpdate.GetMTime();
+}
+
+//------------------------------------------------------------------------------
+double vtkBlockLODContour::EstimateLevelTriangles(int level)
+{
+  if (level < 0 || level >= mediso::NumberOfLevels || !this->HasCurrentOutput())
+  {
+    return -1.0;
+  }
+  double triangles = 0.0;
+  for (double value : this->Internals->LastValues)
+  {
+    const mediso::SurfaceEstimate e = this->Internals->Surfaces.Estimate(value, level);
+    if (e.Method == mediso::EstimateMethod::None)
+    {
+      return -1.0;
+    }
+    triangles += e.Counts.Triangles;
+  }
+  return triangles;
+}
+
+//------------------------------------------------------------------------------
+bool vtkBlockLODContour::GenerateLevel(int level, vtkPolyData* output)
+{
+  if (!output)
+  {
+    return false;
+  }
+  output->Initialize();
+  if (level < 0 || level >= mediso::NumberOfLevels || !this->HasCurrentOutput())
+  {
+    return false;
+  }
+  vtkInternals& in = *this->Internals;
+  // The update's choices, at a fixed level: the core serves cached pairs and
+  // plans and extracts the others, checking memory as for the output.
+  const mediso::SurfaceLayout layout = OutputLayout(this);
+  mediso::LevelChoice choice;
+  choice.Level = level;
+  mediso::UpdateHooks hooks;
+  try
+  {
+    const mediso::SurfacesUpdate update =
+      in.Surfaces.Update(in.LastValues, choice, vtkInternals::Maker(layout), hooks);
+    this->NumberOfExtractions += update.Extractions;
+    this->NumberOfCacheHits += update.CacheHits;
+    if (update.Status != mediso::SurfacesUpdate::Outcome::Done)
+    {
+      if (update.Status == mediso::SurfacesUpdate::Outcome::OutOfMemory)
+      {
+        vtkWarningMacro("Level " << level << " of the surfaces could not be made: "
+                                 << update.Message << ".");
+      }
+      return false;
+    }
+    if (!this->AssembleOutput(output, level))
+    {
+      output->Initialize();
+      return false;
+    }
+  }
+  catch (const std::bad_alloc&)
+  {
+    output->Initialize();
+    vtkWarningMacro("The process ran out of memory while making level "
+      << level << " of the surfaces" << DescribeAllowance() << ".");
+    return false;
+  }
   return true;
 }
 

@@ -72,6 +72,12 @@
  * while they are written and stored with the arrays (VTK's range cache), so
  * ParaView's data information and color maps do not read them again.
  *
+ * Other levels of the same output: GenerateLevel() fills a vtkPolyData with
+ * the last update's isovalues at another level (from the cache, or extracted
+ * once and cached), and EstimateLevelTriangles() predicts its size first.
+ * ParaView's render view draws such a coarser level while the camera moves
+ * (vtkBlockLODSurfaceRepresentation), instead of a decimated copy.
+ *
  * Parallel pieces: every level samples the whole volume's grid (multiples of
  * the level's stride from the whole extent's origin, and the whole extent's
  * last point), not the piece's. A piece of a parallel run asks its input for
@@ -123,6 +129,7 @@
 
 class vtkDataArray;
 class vtkImageData;
+class vtkPolyData;
 namespace mediso
 {
 struct SurfacesUpdate;
@@ -277,6 +284,30 @@ public:
   ///@}
 
   /**
+   * The last update's surfaces at another level of detail, into `output`:
+   * the same isovalues, arrays and options as the output, field data
+   * "BlockLODLevel" set to `level`. Taken from the cache, or extracted now and
+   * cached (counted in GetNumberOfExtractions()), so a second call is free.
+   * This is how a renderer gets a coarser copy of the output to draw while
+   * the camera moves (vtkBlockLODSurfaceRepresentation). Returns false and
+   * leaves `output` empty when there is no current output to match: before
+   * the first update, after a change of the filter or its input array that
+   * has not been updated yet, when the last update made nothing, or for a
+   * level outside 0..3. A level that does not fit in the process's memory
+   * gives one warning and false. No output port or pipeline request is
+   * involved: the filter's own output is not touched.
+   */
+  bool GenerateLevel(int level, vtkPolyData* output);
+
+  /**
+   * Triangles of the last update's isovalues, all together, at `level`:
+   * exact when the level is the output's, cached or planned, else the
+   * estimator's prediction (EstimateTriangles). -1 when there is no current
+   * output (as for GenerateLevel).
+   */
+  double EstimateLevelTriangles(int level);
+
+  /**
    * Empty the triangle cache (block ranges are kept).
    */
   void ClearCache();
@@ -330,7 +361,9 @@ private:
   std::vector<double> IsovaluesWithSurface();
   void ReportEstimates(double isovalue);
   void ReportUpdate(const mediso::SurfacesUpdate& update);
-  bool AssembleOutput(vtkPolyData* output);
+  bool AssembleOutput(vtkPolyData* output, int level);
+  // The last update's output can be matched by GenerateLevel.
+  bool HasCurrentOutput();
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

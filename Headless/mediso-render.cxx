@@ -27,6 +27,7 @@
 #include "VolumeSources.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -68,6 +69,11 @@ Scene:
                         (default 0.15,0.8,0.25,30)
   --no-points           never draw point footprints (always quads)
   --no-first-hit        draw opaque frames in one pass
+  --clip A,B,C,D        keep the part of the volume where A x + B y + C z + D >= 0
+                        (world coordinates, as VTK's clipping planes); up to 6
+  --crop I0,I1,J0,J1,K0,K1
+                        keep the box of point indices I0..I1, J0..J1, K0..K1
+                        (cropping); cut faces are left open
 The camera is VTK's: reset to the volume's bounds (view angle 30 degrees,
 looking down -z), then azimuth, elevation, orthogonalised view up, zoom.
 
@@ -97,6 +103,9 @@ struct Options
   double Background[3] = { 0.1, 0.12, 0.16 };
   double Material[4] = { 0.15, 0.8, 0.25, 30.0 };
   bool Points = true, FirstHit = true;
+  std::vector<std::array<double, 4>> ClipPlanes; // world
+  bool Crop = false;
+  double CropBox[6] = { 0, 0, 0, 0, 0, 0 }; // point indices
   std::string Output;
   int Resample[3] = { 0, 0, 0 };
   std::string WriteVolume;
@@ -244,6 +253,29 @@ Options Parse(int argc, char* argv[])
         throw UsageError{ arg + " takes " + std::to_string(n) + " numbers" };
       }
       std::copy(v.begin(), v.end(), arg == "--background" ? opt.Background : opt.Material);
+    }
+    else if (arg == "--clip")
+    {
+      const std::vector<double> v = Numbers(value("--clip"), ',', "--clip");
+      if (v.size() != 4 || (v[0] == 0.0 && v[1] == 0.0 && v[2] == 0.0))
+      {
+        throw UsageError{ "--clip takes 4 numbers A,B,C,D with (A, B, C) not zero" };
+      }
+      if (opt.ClipPlanes.size() == 6)
+      {
+        throw UsageError{ "--clip: at most 6 planes" };
+      }
+      opt.ClipPlanes.push_back({ v[0], v[1], v[2], v[3] });
+    }
+    else if (arg == "--crop")
+    {
+      const std::vector<double> v = Numbers(value("--crop"), ',', "--crop");
+      if (v.size() != 6 || v[0] > v[1] || v[2] > v[3] || v[4] > v[5])
+      {
+        throw UsageError{ "--crop takes 6 indices I0,I1,J0,J1,K0,K1 with I0 <= I1, J0 <= J1, K0 <= K1" };
+      }
+      opt.Crop = true;
+      std::copy(v.begin(), v.end(), opt.CropBox);
     }
     else if (arg == "--no-points")
     {
@@ -475,6 +507,34 @@ public:
     this->Frame.SpecularPower = static_cast<float>(this->Opt.Material[3]);
     this->Frame.AllowPointFootprint = this->Opt.Points;
     this->Frame.FirstHitPass = this->Opt.FirstHit;
+    // Clipping planes to index space (a plane is a row vector: its value at
+    // M x is (plane M) x), then the cropping box's faces (already there).
+    this->Frame.ClipPlanes.clear();
+    const matrix4::Matrix indexToWorld = placement.IndexToWorld();
+    for (const auto& plane : this->Opt.ClipPlanes)
+    {
+      std::array<double, 4> index = { 0.0, 0.0, 0.0, 0.0 };
+      for (int c = 0; c < 4; ++c)
+      {
+        for (int r = 0; r < 4; ++r)
+        {
+          index[c] += plane[r] * indexToWorld[4 * r + c];
+        }
+      }
+      this->Frame.ClipPlanes.push_back(index);
+    }
+    if (this->Opt.Crop)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        std::array<double, 4> low = { 0.0, 0.0, 0.0, -this->Opt.CropBox[2 * a] };
+        std::array<double, 4> high = { 0.0, 0.0, 0.0, this->Opt.CropBox[2 * a + 1] };
+        low[a] = 1.0;
+        high[a] = -1.0;
+        this->Frame.ClipPlanes.push_back(low);
+        this->Frame.ClipPlanes.push_back(high);
+      }
+    }
   }
 
   // Builds the pyramid for `surfaces` (ahead of the frame, to time it apart); "" or why not.

@@ -3,6 +3,7 @@
 
 #include "vtkActor.h"
 #include "vtkBlockLODContour.h"
+#include "vtkClipPolyData.h"
 #include "vtkDataArray.h"
 #include "vtkDepthSortPolyData.h"
 #include "vtkImageData.h"
@@ -11,11 +12,13 @@
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkOpenGLState.h"
+#include "vtkPlane.h"
 #include "vtkPointData.h"
 #include "vtkPolyData.h"
 #include "vtkPolyDataMapper.h"
 #include "vtkProperty.h"
 #include "vtkRenderer.h"
+#include "vtkSmartPointer.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
@@ -39,6 +42,68 @@ struct vtkBlockLODIsosurfaces::Internals
   vtkNew<vtkPolyDataMapper> PolyMapper;
   vtkNew<vtkActor> Actor;
   vtkNew<vtkMatrix4x4> ActorMatrix;
+  // Clipping: the planes in world coordinates, the same in index space (the
+  // space of Colored) and one clip filter per plane, chained after Colored.
+  std::vector<Plane> WorldPlanes;
+  std::vector<Plane> IndexPlanes;
+  std::vector<vtkSmartPointer<vtkClipPolyData>> Clips;
+
+  // The clip chain for `planes` (index space), remade only when they change.
+  void SetIndexPlanes(const std::vector<Plane>& planes)
+  {
+    if (planes == this->IndexPlanes)
+    {
+      return;
+    }
+    this->IndexPlanes = planes;
+    this->Clips.clear();
+    for (const Plane& p : planes)
+    {
+      // vtkPlane's value n . (x - origin) is a x + b y + c z + d for the
+      // origin -d n / |n|^2; vtkClipPolyData keeps its positive side.
+      const double norm2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+      vtkNew<vtkPlane> plane;
+      plane->SetNormal(p[0], p[1], p[2]);
+      plane->SetOrigin(-p[3] * p[0] / norm2, -p[3] * p[1] / norm2, -p[3] * p[2] / norm2);
+      auto clip = vtkSmartPointer<vtkClipPolyData>::New();
+      clip->SetClipFunction(plane);
+      if (this->Clips.empty())
+      {
+        clip->SetInputData(this->Colored);
+      }
+      else
+      {
+        clip->SetInputConnection(this->Clips.back()->GetOutputPort());
+      }
+      this->Clips.push_back(clip);
+    }
+    vtkAlgorithmOutput* shown = this->Clips.empty() ? nullptr : this->Clips.back()->GetOutputPort();
+    if (shown)
+    {
+      this->Sort->SetInputConnection(shown);
+    }
+    else
+    {
+      this->Sort->SetInputData(this->Colored);
+    }
+    if (this->PolyMapper->GetInputAlgorithm() != this->Sort.GetPointer())
+    {
+      this->ConnectUnsorted();
+    }
+  }
+
+  // The mapper's input without sorting: Colored, or its clipped copy.
+  void ConnectUnsorted()
+  {
+    if (this->Clips.empty())
+    {
+      this->PolyMapper->SetInputData(this->Colored);
+    }
+    else
+    {
+      this->PolyMapper->SetInputConnection(this->Clips.back()->GetOutputPort());
+    }
+  }
 };
 
 //------------------------------------------------------------------------------
@@ -64,6 +129,12 @@ vtkBlockLODIsosurfaces::vtkBlockLODIsosurfaces()
 
 //------------------------------------------------------------------------------
 vtkBlockLODIsosurfaces::~vtkBlockLODIsosurfaces() = default;
+
+//------------------------------------------------------------------------------
+void vtkBlockLODIsosurfaces::SetClipPlanes(const std::vector<Plane>& worldPlanes)
+{
+  this->Impl->WorldPlanes = worldPlanes;
+}
 
 //------------------------------------------------------------------------------
 void vtkBlockLODIsosurfaces::ReleaseGraphicsResources(vtkWindow* win)
@@ -170,7 +241,18 @@ void vtkBlockLODIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol,
     impl.ColoredSurfaceTime = surface->GetMTime();
     impl.ColoredLooks = looks;
   }
-  this->NumberOfTriangles = static_cast<std::uint64_t>(surface->GetNumberOfPolys());
+  impl.SetIndexPlanes(
+    vtkOpenGLHistoPyramidIsosurfaces::PullBackPlanes(impl.WorldPlanes, impl.ActorMatrix));
+  if (impl.Clips.empty())
+  {
+    this->NumberOfTriangles = static_cast<std::uint64_t>(surface->GetNumberOfPolys());
+  }
+  else
+  {
+    impl.Clips.back()->Update();
+    this->NumberOfTriangles =
+      static_cast<std::uint64_t>(impl.Clips.back()->GetOutput()->GetNumberOfPolys());
+  }
 
   vtkVolumeProperty* property = vol->GetProperty();
   vtkProperty* actorProperty = impl.Actor->GetProperty();
@@ -205,7 +287,7 @@ void vtkBlockLODIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol,
   {
     if (impl.PolyMapper->GetInputAlgorithm() == impl.Sort.GetPointer())
     {
-      impl.PolyMapper->SetInputData(impl.Colored);
+      impl.ConnectUnsorted();
     }
     ostate->vtkglDisable(GL_BLEND);
     ostate->vtkglDepthMask(GL_TRUE);

@@ -12,7 +12,10 @@
  * isovalue (RGBA), recoloured only when the surface or the looks change.
  * Translucent surfaces are drawn sorted back to front (vtkDepthSortPolyData)
  * with blending: the renderer's depth peeling does not reach geometry a
- * volume mapper draws.
+ * volume mapper draws. Clipping planes (a cropping box's faces among them)
+ * cut the coloured triangles exactly (vtkClipPolyData, one per plane, in the
+ * index space of the copy), recut only when the planes or the surface change;
+ * the cut faces are left open, as on the GPU path.
  *
  * @sa vtkHistoPyramidIsoMapper vtkOpenGLHistoPyramidIsosurfaces vtkBlockLODContour
  */
@@ -46,7 +49,13 @@ public:
   void RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image,
     vtkDataArray* scalars, const std::vector<Surface>& surfaces);
 
-  /// Triangles of the last frame.
+  using Plane = vtkOpenGLHistoPyramidIsosurfaces::Plane;
+
+  /// Clipping planes in world coordinates for the next RenderIsosurfaces() (see
+  /// vtkOpenGLHistoPyramidIsosurfaces::SetClipPlanes()).
+  void SetClipPlanes(const std::vector<Plane>& worldPlanes);
+
+  /// Triangles of the last frame (after clipping).
   vtkGetMacro(NumberOfTriangles, std::uint64_t);
 
   void ReleaseGraphicsResources(vtkWindow* win);

@@ -5,12 +5,16 @@
 #include "vtkColorTransferFunction.h"
 #include "vtkContourValues.h"
 #include "vtkDataArray.h"
+#include "vtkDiscretizableColorTransferFunction.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkMatrix4x4.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLHistoPyramidIsosurfaces.h"
 #include "vtkPiecewiseFunction.h"
+#include "vtkPlane.h"
+#include "vtkPlaneCollection.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkVolume.h"
@@ -110,6 +114,58 @@ void vtkHistoPyramidIsoMapper::ReleaseGraphicsResources(vtkWindow* win)
 {
   this->Impl->GPU->ReleaseGraphicsResources(win);
   this->Impl->Fallback->ReleaseGraphicsResources(win);
+}
+
+//------------------------------------------------------------------------------
+bool vtkHistoPyramidIsoMapper::MapsScalarOpacity(vtkVolumeProperty* property) const
+{
+  if (this->ColorSource != TransferFunctionColors || !property)
+  {
+    return false;
+  }
+  // ParaView's colour maps are vtkDiscretizableColorTransferFunctions; like
+  // its Surface representation's mapper, apply their opacity function only
+  // when the map says so (a plain vtkColorTransferFunction has no such switch).
+  auto* map = vtkDiscretizableColorTransferFunction::SafeDownCast(
+    property->GetColorChannels(0) == 1 ? nullptr : property->GetRGBTransferFunction(0));
+  return !map || map->GetEnableOpacityMapping();
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoMapper::GetSurfaceLook(
+  vtkVolumeProperty* property, int index, double value, double color[3], double& opacity) const
+{
+  const std::size_t i = static_cast<std::size_t>(std::max(0, index));
+  opacity = 1.0;
+  if (this->ColorSource == TransferFunctionColors && property)
+  {
+    if (property->GetColorChannels(0) == 1)
+    {
+      color[0] = color[1] = color[2] = property->GetGrayTransferFunction(0)->GetValue(value);
+    }
+    else
+    {
+      property->GetRGBTransferFunction(0)->GetColor(value, color);
+    }
+    vtkPiecewiseFunction* map = property->GetScalarOpacity(0);
+    if (map && this->MapsScalarOpacity(property))
+    {
+      opacity = map->GetValue(value);
+    }
+  }
+  else if (this->ColorSource == SurfaceColors && 3 * i < this->SurfaceColorValues.size())
+  {
+    std::copy_n(&this->SurfaceColorValues[3 * i], 3, color);
+  }
+  else
+  {
+    std::copy_n(this->SolidColor, 3, color);
+  }
+  if (i < this->SurfaceOpacityValues.size())
+  {
+    opacity *= this->SurfaceOpacityValues[i];
+  }
+  opacity = std::min(1.0, std::max(0.0, opacity * this->Opacity));
 }
 
 //------------------------------------------------------------------------------
@@ -214,40 +270,11 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
   std::vector<Surface> surfaces;
-  vtkPiecewiseFunction* opacity = property->GetScalarOpacity(0);
   for (std::size_t k = 0; k < requested.Surfaces.size(); ++k)
   {
-    const double v = requested.Surfaces[k].Value;
-    const std::size_t index = static_cast<std::size_t>(requested.Sources[k]);
     Surface s;
-    s.Value = v;
-    s.Opacity = 1.0;
-    if (this->ColorSource == TransferFunctionColors)
-    {
-      if (property->GetColorChannels(0) == 1)
-      {
-        const double gray = property->GetGrayTransferFunction(0)->GetValue(v);
-        s.Color[0] = s.Color[1] = s.Color[2] = gray;
-      }
-      else
-      {
-        property->GetRGBTransferFunction(0)->GetColor(v, s.Color);
-      }
-      s.Opacity = opacity ? opacity->GetValue(v) : 1.0;
-    }
-    else if (this->ColorSource == SurfaceColors && 3 * index < this->SurfaceColorValues.size())
-    {
-      std::copy_n(&this->SurfaceColorValues[3 * index], 3, s.Color);
-    }
-    else
-    {
-      std::copy_n(this->SolidColor, 3, s.Color);
-    }
-    if (index < this->SurfaceOpacityValues.size())
-    {
-      s.Opacity *= this->SurfaceOpacityValues[index];
-    }
-    s.Opacity = std::min(1.0, std::max(0.0, s.Opacity * this->Opacity));
+    s.Value = requested.Surfaces[k].Value;
+    this->GetSurfaceLook(property, requested.Sources[k], s.Value, s.Color, s.Opacity);
     if (s.Opacity > 0.0)
     {
       surfaces.push_back(s);
@@ -259,7 +286,69 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
 
-  // 3. The GPU path, or the fallback when it cannot run (said once, with the reason).
+  // 3. The clipping planes and the cropping box's faces, in world
+  //    coordinates (the cropping planes are in the volume's own, as for
+  //    VTK's volume mappers: moved by the volume's matrix).
+  using Plane = vtkOpenGLHistoPyramidIsosurfaces::Plane;
+  std::vector<Plane> planes;
+  if (this->ClippingPlanes)
+  {
+    const int count = this->ClippingPlanes->GetNumberOfItems();
+    if (count > 6)
+    {
+      sayOnce(false,
+        "more than 6 clipping planes (" + std::to_string(count) + "): only the first 6 are used.");
+    }
+    for (int i = 0; i < std::min(count, 6); ++i)
+    {
+      vtkPlane* plane = this->ClippingPlanes->GetItem(i);
+      const double* n = plane->GetNormal();
+      const double* o = plane->GetOrigin();
+      const Plane p = { n[0], n[1], n[2], -(n[0] * o[0] + n[1] * o[1] + n[2] * o[2]) };
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]) ||
+        !std::isfinite(p[3]) || (p[0] == 0.0 && p[1] == 0.0 && p[2] == 0.0))
+      {
+        sayOnce(
+          false, "a clipping plane has a zero or non-finite normal or origin: it is ignored.");
+        continue;
+      }
+      planes.push_back(p);
+    }
+  }
+  if (this->Cropping)
+  {
+    if (this->CroppingRegionFlags != VTK_CROP_SUBVOLUME)
+    {
+      std::ostringstream msg;
+      msg << "cropping region flags 0x" << std::hex << this->CroppingRegionFlags
+          << " are not supported (only the subvolume, 0x" << VTK_CROP_SUBVOLUME
+          << "): the volume is drawn uncropped.";
+      sayOnce(false, msg.str());
+    }
+    else
+    {
+      std::vector<Plane> box;
+      for (int a = 0; a < 3; ++a)
+      {
+        Plane low = { 0.0, 0.0, 0.0, -this->CroppingRegionPlanes[2 * a] };
+        low[a] = 1.0;
+        Plane high = { 0.0, 0.0, 0.0, this->CroppingRegionPlanes[2 * a + 1] };
+        high[a] = -1.0;
+        box.push_back(low);
+        box.push_back(high);
+      }
+      vtkNew<vtkMatrix4x4> worldToModel;
+      vtkMatrix4x4::Invert(vol->GetMatrix(), worldToModel);
+      for (const Plane& p : vtkOpenGLHistoPyramidIsosurfaces::PullBackPlanes(box, worldToModel))
+      {
+        planes.push_back(p);
+      }
+    }
+  }
+  impl.GPU->SetClipPlanes(planes);
+  impl.Fallback->SetClipPlanes(planes);
+
+  // 4. The GPU path, or the fallback when it cannot run (said once, with the reason).
   vtkOpenGLHistoPyramidIsosurfaces* gpu = impl.GPU;
   std::string reason;
   if (this->ForceCPUFallback)

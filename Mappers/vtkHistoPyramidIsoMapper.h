@@ -44,6 +44,18 @@
  * matrix are honoured. Surfaces are always shaded (an unshaded isosurface
  * shows no shape), regardless of vtkVolumeProperty::GetShade().
  *
+ * Clipping and cropping: the mapper's clipping planes
+ * (vtkAbstractMapper::AddClippingPlane(), world coordinates, at most 6; the
+ * normal points to the side that is kept) and vtkVolumeMapper's cropping
+ * (SetCropping(), SetCroppingRegionPlanes() in the volume's own coordinates,
+ * as for VTK's volume mappers) cut the surfaces exactly, on both paths: the
+ * GPU path cuts each fragment's ray (a surface behind a removed one shows
+ * through) and skips cells wholly removed; the CPU path cuts its triangles
+ * (vtkClipPolyData). Cut faces are left open (not capped). Of the cropping
+ * region flags, only the subvolume (VTK_CROP_SUBVOLUME, the default: keep the
+ * box) is supported; other flags are warned about once and the volume is
+ * drawn uncropped. Planes beyond the sixth are warned about once and ignored.
+ *
  * Capability check and fallback: the first render in a window runs
  * vtkMedicalGLCapabilities::Probe(); if the context lacks OpenGL 3.2 or
  * working integer textures, a shader does not build, the volume exceeds the
@@ -80,6 +92,7 @@
 #include <string>  // For std::string
 #include <vector>  // For std::vector
 
+class vtkVolumeProperty;
 
 class MEDICALISOSURFACESMAPPERS_EXPORT vtkHistoPyramidIsoMapper : public vtkVolumeMapper
 {
@@ -233,6 +246,13 @@ public:
    * SurfaceOpacity(i) (1 where none is set) and by Opacity: an application
    * can give each surface its own colour and opacity without editing
    * transfer functions. A surface of opacity 0 is not drawn.
+   *
+   * The scalar opacity function applies only with TransferFunctionColors,
+   * and, when the colour function is a vtkDiscretizableColorTransferFunction
+   * (ParaView's colour maps), only while its EnableOpacityMapping is on: the
+   * rule of VTK's surface mappers and of ParaView's Surface representation
+   * (whose colour map editor calls it "Enable opacity mapping for surfaces"),
+   * so colouring by an array does not make a surface translucent unasked.
    */
   vtkSetClampMacro(ColorSource, int, TransferFunctionColors, SurfaceColors);
   vtkGetMacro(ColorSource, int);
@@ -247,6 +267,18 @@ public:
   vtkSetClampMacro(Opacity, double, 0.0, 1.0);
   vtkGetMacro(Opacity, double);
   ///@}
+
+  /**
+   * The colour and opacity the isovalue `value`, the `index`-th of
+   * `property`'s isovalues, is drawn with under the rules above (an opacity
+   * of 0: not drawn). Render() takes every surface's look from here; a host
+   * reads it to show or export what the view draws.
+   */
+  void GetSurfaceLook(
+    vtkVolumeProperty* property, int index, double value, double color[3], double& opacity) const;
+
+  /// Whether `property`'s scalar opacity function applies (see SetColorSource()).
+  bool MapsScalarOpacity(vtkVolumeProperty* property) const;
 
   /**
    * Why an image of this spacing holds no surface (a zero or non-finite

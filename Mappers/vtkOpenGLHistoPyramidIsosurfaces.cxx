@@ -48,6 +48,7 @@ struct vtkOpenGLHistoPyramidIsosurfaces::Internals
   bool Usable = false;
   std::string Reason;
   mediso::IsosurfaceScene Scene{ ParallelFor };
+  std::vector<Plane> ClipPlanes; // world coordinates
 
   // Frees the scene's objects (the window's context must be current).
   void Release()
@@ -115,6 +116,34 @@ void vtkOpenGLHistoPyramidIsosurfaces::ReleaseGraphicsResources(vtkWindow* win)
   {
     impl.Probed = false;
   }
+}
+
+//------------------------------------------------------------------------------
+void vtkOpenGLHistoPyramidIsosurfaces::SetClipPlanes(const std::vector<Plane>& worldPlanes)
+{
+  this->Impl->ClipPlanes = worldPlanes;
+}
+
+//------------------------------------------------------------------------------
+std::vector<vtkOpenGLHistoPyramidIsosurfaces::Plane>
+vtkOpenGLHistoPyramidIsosurfaces::PullBackPlanes(
+  const std::vector<Plane>& planes, vtkMatrix4x4* toSpace)
+{
+  // A plane is a row vector: its value at M x is (plane M) x.
+  std::vector<Plane> pulled;
+  for (const Plane& plane : planes)
+  {
+    Plane p = { 0.0, 0.0, 0.0, 0.0 };
+    for (int c = 0; c < 4; ++c)
+    {
+      for (int r = 0; r < 4; ++r)
+      {
+        p[c] += plane[r] * toSpace->GetElement(r, c);
+      }
+    }
+    pulled.push_back(p);
+  }
+  return pulled;
 }
 
 //------------------------------------------------------------------------------
@@ -256,6 +285,7 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
   }
   frame.AllowPointFootprint = allowPointFootprint;
   frame.FirstHitPass = firstHitPass;
+  frame.ClipPlanes = PullBackPlanes(impl.ClipPlanes, indexToWorld);
 
   // 4. Draw.
   if (!impl.Scene.Render(frame, reason))

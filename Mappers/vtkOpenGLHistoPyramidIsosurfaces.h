@@ -33,6 +33,7 @@
 #include "MedicalIsosurfacesMappersModule.h" // For export macro
 #include "vtkObject.h"
 
+#include <array>   // For std::array
 #include <cstdint> // For std::uint64_t
 #include <memory>  // For std::unique_ptr
 #include <string>  // For std::string
@@ -40,6 +41,7 @@
 
 class vtkDataArray;
 class vtkImageData;
+class vtkMatrix4x4;
 class vtkRenderer;
 class vtkVolume;
 class vtkWindow;
@@ -67,6 +69,19 @@ public:
   bool RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image,
     vtkDataArray* scalars, const std::vector<Surface>& surfaces, bool allowPointFootprint,
     bool firstHitPass, std::string& reason);
+
+  /// A plane (a, b, c, d): the points where a x + b y + c z + d >= 0 are kept.
+  using Plane = std::array<double, 4>;
+
+  /**
+   * Clipping planes in world coordinates (at most mediso::MaximumClipPlanes,
+   * a cropping box's faces among them) for the next RenderIsosurfaces(): the
+   * surfaces are cut exactly at them, left open.
+   */
+  void SetClipPlanes(const std::vector<Plane>& worldPlanes);
+
+  /// `planes` moved from the space `toSpace` maps to, to the space it maps from.
+  static std::vector<Plane> PullBackPlanes(const std::vector<Plane>& planes, vtkMatrix4x4* toSpace);
 
   /**
    * What the GPU path did (the scene's stats: the last frame drawn, the last

@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "pqMedicalIsosurfaceListWidget.h"
 
+#include "pqApplicationCore.h"
 #include "pqMedicalHistogramWidget.h"
 #include "pqUndoStack.h"
 #include "pqView.h"
 #include "vtkCommand.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkEventQtSlotConnect.h"
+#include "vtkHistoPyramidIsoRepresentation.h"
 #include "vtkPVArrayInformation.h"
 #include "vtkPVDataInformation.h"
 #include "vtkPVDataSetAttributesInformation.h"
@@ -17,6 +19,9 @@
 #include "vtkSMSourceProxy.h"
 #include "vtkSMViewProxy.h"
 #include "vtkScalarsToColors.h"
+#if MEDISO_WITH_PYTHON
+#include "pqPythonManager.h"
+#endif
 
 #include <QCheckBox>
 #include <QColorDialog>
@@ -26,6 +31,7 @@
 #include <QMenu>
 #include <QPixmap>
 #include <QPushButton>
+#include <QStyledItemDelegate>
 #include <QTableWidget>
 #include <QTimer>
 #include <QToolButton>
@@ -76,6 +82,36 @@ QPixmap Swatch(const QColor& color)
   swatch.fill(color);
   return swatch;
 }
+
+#if MEDISO_WITH_PYTHON
+// The GUI's Python (null where ParaView runs without it).
+pqPythonManager* PythonManager()
+{
+  pqApplicationCore* core = pqApplicationCore::instance();
+  return core ? qobject_cast<pqPythonManager*>(core->manager("PYTHON_MANAGER")) : nullptr;
+}
+#endif
+
+// The Opacity column: the row's own opacity, which the editor edits, and
+// after it the opacity drawn where that differs (kept in Qt::UserRole: a
+// QTableWidgetItem's display and edit texts are one).
+class OpacityDelegate : public QStyledItemDelegate
+{
+public:
+  using QStyledItemDelegate::QStyledItemDelegate;
+
+protected:
+  void initStyleOption(QStyleOptionViewItem* option, const QModelIndex& index) const override
+  {
+    QStyledItemDelegate::initStyleOption(option, index);
+    const QVariant drawn = index.data(Qt::UserRole);
+    if (drawn.isValid())
+    {
+      option->text = pqMedicalIsosurfaceListWidget::tr("%1 (drawn %2)")
+                       .arg(option->text, FormatNumber(drawn.toDouble()));
+    }
+  }
+};
 }
 
 //------------------------------------------------------------------------------
@@ -89,6 +125,8 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   , ColorEachSurface(new QCheckBox(tr("Color Each Surface"), this))
   , Histogram(new pqMedicalHistogramWidget(this))
   , PreviewTimer(new QTimer(this))
+  , RangeWarning(new QLabel(this))
+  , MeshButton(new QPushButton(tr("Make Mesh"), this))
   , Connections(vtkEventQtSlotConnect::New())
 {
   this->setObjectName("MedicalIsosurfaceList");
@@ -97,6 +135,8 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   this->AddButton->setObjectName("Add");
   this->RemoveButton->setObjectName("Remove");
   this->ColorEachSurface->setObjectName("ColorEachSurface");
+  this->RangeWarning->setObjectName("RangeWarning");
+  this->MeshButton->setObjectName("MakeMesh");
 
   this->Table->setHorizontalHeaderLabels({ tr("Isovalue"), tr("Color"), tr("Opacity") });
   this->Table->horizontalHeaderItem(ValueColumn)
@@ -174,11 +214,39 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   buttons->addStretch(1);
   buttons->addWidget(this->ColorEachSurface);
 
+  // Opacities drawn, the out-of-range warning, the mesh of what is shown.
+  this->Table->setItemDelegateForColumn(OpacityColumn, new OpacityDelegate(this->Table));
+  this->RangeWarning->setWordWrap(true);
+  this->RangeWarning->setStyleSheet("QLabel { color: #b3261e; }");
+  this->RangeWarning->setVisible(false);
+  this->MeshButton->setToolTip(
+    tr("Make the surfaces shown a mesh to save (File > Save Data: STL, PLY, VTP): a Block LOD "
+       "Contour of this display's input at these isovalues (Auto LOD: the finest level the "
+       "memory estimator allows), each triangle labelled with its surface's color and name. "
+       "Python: medical_isosurfaces.MakeMeshFromView()."));
+#if MEDISO_WITH_PYTHON
+  this->MeshButton->setVisible(PythonManager() != nullptr);
+#else
+  this->MeshButton->setVisible(false);
+#endif
+  buttons->addWidget(this->MeshButton);
+  QObject::connect(
+    this->MeshButton, &QPushButton::clicked, this, &pqMedicalIsosurfaceListWidget::makeMesh);
+  QObject::connect(this, &pqPropertyWidget::viewChanged, this, [this](pqView* view) {
+    QObject::disconnect(this->RenderConnection);
+    if (view)
+    {
+      this->RenderConnection = QObject::connect(
+        view, &pqView::endRender, this, &pqMedicalIsosurfaceListWidget::updateLooks);
+    }
+  });
+
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
   layout->addWidget(this->RangeLabel);
   layout->addWidget(this->Histogram);
   layout->addWidget(this->Table);
+  layout->addWidget(this->RangeWarning);
   layout->addLayout(buttons);
 
   QObject::connect(
@@ -398,11 +466,26 @@ void pqMedicalIsosurfaceListWidget::updateTable()
     this->Table->setItem(i, ColorColumn, color);
     auto* opacity = new QTableWidgetItem(FormatNumber(row.Opacity));
     opacity->setTextAlignment(Qt::AlignRight | Qt::AlignVCenter);
+    if (this->HasRange && !(row.Value >= this->Range[0] && row.Value <= this->Range[1]))
+    {
+      opacity->setData(Qt::UserRole, 0.0);
+      opacity->setToolTip(tr("Outside the data range: not drawn."));
+    }
+    else if (static_cast<std::size_t>(i) < this->DrawnOpacities.size() &&
+      std::abs(this->DrawnOpacities[static_cast<std::size_t>(i)] - row.Opacity) > 1e-6)
+    {
+      opacity->setData(Qt::UserRole, this->DrawnOpacities[static_cast<std::size_t>(i)]);
+      opacity->setToolTip(tr("Drawn at %1: this surface's opacity times the opacity map at its "
+                             "value (while the color map's opacity mapping is enabled) and the "
+                             "display's Opacity. Double-click to edit this surface's own.")
+                            .arg(FormatNumber(this->DrawnOpacities[static_cast<std::size_t>(i)])));
+    }
     this->Table->setItem(i, OpacityColumn, opacity);
   }
   this->RemoveButton->setEnabled(!this->Rows.empty());
   this->Histogram->setMarkers(values, colors);
   this->Updating = false;
+  this->updateWarning();
 }
 
 //------------------------------------------------------------------------------
@@ -675,4 +758,65 @@ void pqMedicalIsosurfaceListWidget::updateRange()
   {
     this->RangeLabel->setText(tr("Data range: unknown (no one-component point array)"));
   }
+  this->RangeName = this->HasRange && array->GetName() ? array->GetName() : "";
+  // The rows outside the range and the warning follow the range.
+  this->updateTable();
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::updateWarning()
+{
+  std::vector<double> values;
+  for (const Row& row : this->Rows)
+  {
+    values.push_back(row.Value);
+  }
+  const std::string warning = this->HasRange
+    ? vtkHistoPyramidIsoRepresentation::OutsideRangeMessage(values.data(),
+        static_cast<int>(values.size()), this->Range, this->RangeName.c_str())
+    : std::string();
+  this->RangeWarning->setText(QString::fromStdString(warning));
+  this->RangeWarning->setVisible(!warning.empty());
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::updateLooks()
+{
+  vtkSMProperty* looks = this->propertyGroup()->GetProperty("Looks");
+  if (!looks)
+  {
+    return;
+  }
+  this->proxy()->UpdatePropertyInformation(looks);
+  const std::vector<double> all = vtkSMPropertyHelper(looks).GetArray<double>();
+  std::vector<double> drawn;
+  for (std::size_t i = 3; i < all.size(); i += 4)
+  {
+    drawn.push_back(all[i]);
+  }
+  if (drawn != this->DrawnOpacities)
+  {
+    this->DrawnOpacities = drawn;
+    this->updateTable();
+  }
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::makeMesh()
+{
+#if MEDISO_WITH_PYTHON
+  pqPythonManager* python = PythonManager();
+  if (!python)
+  {
+    return;
+  }
+  // The one implementation, shared with pvpython: the plugin's Python module.
+  const QString code = QString("import medical_isosurfaces\n"
+                               "medical_isosurfaces._make_mesh_for_panel(%1, %2)\n")
+                         .arg(this->proxy()->GetGlobalID())
+                         .arg(this->view() ? this->view()->getProxy()->GetGlobalID() : 0);
+  BEGIN_UNDO_SET(tr("Make Mesh"));
+  python->executeCode(code.toUtf8());
+  END_UNDO_SET();
+#endif
 }

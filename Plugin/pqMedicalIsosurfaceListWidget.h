@@ -41,6 +41,16 @@
  * The colour column always shows the colour a surface is drawn in, as an
  * icon (visible in a selected row too): its own colour with Color Each
  * Surface, else the solid colour or the colour map's colour at the value.
+ *
+ * The Opacity column edits each row's own opacity and shows, after each
+ * render, the opacity the surface is drawn with where that differs (the
+ * colour map's opacity map, when its opacity mapping is on, and the
+ * display's Opacity multiply it: the representation's SurfaceLooks). Below
+ * the list, a warning names isovalues outside the data range (the text the
+ * representation gives in Output Messages). *Make Mesh* runs the plugin's
+ * Python call medical_isosurfaces.MakeMeshFromView() on this display: the
+ * surfaces as a Block LOD Contour + Isosurface Labels mesh to save (hidden
+ * where ParaView has no Python).
  */
 #ifndef pqMedicalIsosurfaceListWidget_h
 #define pqMedicalIsosurfaceListWidget_h
@@ -50,6 +60,7 @@
 #include <QColor>
 #include <QList>
 #include <QVariant>
+#include <string>
 #include <vector>
 
 class QCheckBox;
@@ -99,6 +110,12 @@ private Q_SLOTS:
   void cellEdited(int row, int column);
   void cellDoubleClicked(int row, int column);
   void updateRange();
+  /// Reads the opacities drawn (SurfaceLooks) after a render.
+  void updateLooks();
+  /// Says which isovalues lie outside the data range.
+  void updateWarning();
+  /// The mesh of the surfaces shown (medical_isosurfaces.MakeMeshFromView).
+  void makeMesh();
   /// Rebuilds the table from Rows without signalling an edit.
   void updateTable();
   /// A histogram marker dragged to a value: preview it.
@@ -132,7 +149,10 @@ private:
   void setValuesOutsideUndo(const std::vector<double>& values);
 
   std::vector<Row> Rows;
+  std::vector<double> DrawnOpacities;
+  QMetaObject::Connection RenderConnection;
   double Range[2] = { 0.0, 0.0 };
+  std::string RangeName;
   bool HasRange = false;
   bool Updating = false;
   QTableWidget* Table;
@@ -144,6 +164,8 @@ private:
   QTimer* PreviewTimer;
   /// IsosurfaceValues before the drag in progress (empty: no preview made).
   std::vector<double> BeforeDrag;
+  QLabel* RangeWarning;
+  QPushButton* MeshButton;
   vtkEventQtSlotConnect* Connections;
 };
 

@@ -4,6 +4,8 @@
         [--repeats N] [--quick] [--sweep N] [--isovalues=-500,400] [--backend STDThread|Sequential]
         [--threads 2] [--out FILE.md] [--json FILE.json] [--plugin PATH] [--marching-cubes]
         [--frames [--frame-size 1024x768] [--frame-steps 9]]
+    pvpython Python/benchmark_blocklod.py --interaction [--inputs ct] [--frame-size 1024x768]
+        [--rotation-frames 20] [--isovalues=-500,400] [--plugin PATH] [--out FILE.md]
 
 Inputs (each in its own child process): the real head CT (256x256x108 int16), the CT resampled
 (linear) to 512x512x216, the plugin's MedicalPhantom at 256^3 and 512^3, and noisy stand-ins for
@@ -31,6 +33,15 @@ backend and thread count:
 4. Peak memory: the peak RSS (VmHWM, reset through /proc/self/clear_refs before every timed call)
    is recorded per call, so each method's peak and its growth over the RSS before the call are
    isolated.
+
+With --interaction (under X, in this process, no children): ParaView rotation frames of Block LOD
+Contour's displays, skin (first isovalue) over bone (second) each from its own filter at level 3,
+skin opaque and then at opacity 0.3: still frames (Render) against interactive frames
+(InteractiveRender, as during a mouse drag), with the coarser Block LOD levels while interacting
+(the default) and with ParaView's own decimated LOD (BlockLODInteractiveLevels off), at the view's
+default LODThreshold and the displays' default budgets; per frame median, the first interactive
+frame (which makes the LOD geometry) apart, the level and triangles each display drew, and the
+frame time its model predicted for that level when it was chosen.
 
 Ends with the issue's targets: cold level 3 <= 0.6x vtkFlyingEdges3D, warm isovalue change at
 level 3 <= 0.3x vtkFlyingEdges3D, level 0 under 10 ms on the 512-wide inputs, estimator within
@@ -138,7 +149,12 @@ def parse_args(argv=None):
                              "(filter, representation update, frame) for BlockLODContour, Contour "
                              "and the Volume representation's isosurface mode (needs X: run under "
                              "Testing/Scripts/with-xvfb.sh)")
-    parser.add_argument("--frame-size", default="1024x768", help="view size for --frames")
+    parser.add_argument("--frame-size", default="1024x768",
+                        help="view size for --frames and --interaction")
+    parser.add_argument("--interaction", action="store_true",
+                        help="still vs interactive rotation frames of the displays (see above)")
+    parser.add_argument("--rotation-frames", type=int, default=20,
+                        help="frames per --interaction series (1 degree each)")
     parser.add_argument("--frame-steps", type=int, default=9,
                         help="isovalue changes per method for --frames (default 9)")
     parser.add_argument("--plugin", default=default_plugin(), help="path of MedicalIsosurfaces.so")
@@ -1234,9 +1250,107 @@ def run_parent(args, argv):
     return 0 if results else 1
 
 
+def run_interaction(args):
+    """--interaction: still and interactive rotation frames of Block LOD Contour's displays."""
+    import paraview.simple as pvs
+
+    if not os.environ.get("DISPLAY"):
+        print("--interaction renders: run it under X (Testing/Scripts/with-xvfb.sh)")
+        return 1
+    pvs.LoadPlugin(args.plugin)
+    width, height = [int(v) for v in args.frame_size.lower().split("x")]
+    lines = ["# Block LOD Contour: still vs interactive frames in ParaView", "",
+             "Command: `%s`" % " ".join(shlex.quote(a) for a in sys.argv),
+             "Machine: %s, %.0f GB; load average before: %s" % (cpu_model(), mem_total_gb(),
+                                                                 load_average()), ""]
+    for name in (args.inputs.split(",") if args.inputs else ["ct"]):
+        source, image, label, keep = make_input(name, pvs, pvs.MedicalPhantom)
+        array_name = image.GetPointData().GetScalars().GetName()
+        skin, bone = (isovalues_for(args, name) + [400.0])[:2]
+        view = pvs.CreateView("RenderView")
+        view.ViewSize = [width, height]
+        view.OrientationAxesVisibility = 0
+        filters, displays = [], []
+        for iso in (skin, bone):
+            f = pvs.BlockLODContour(Input=source, ContourBy=["POINTS", array_name], Isosurfaces=[iso])
+            f.LOD = 3
+            f.AutoLOD = 0
+            d = pvs.Show(f, view)
+            d.ColorArrayName = [None, ""]
+            filters.append(f)
+            displays.append(d)
+        pvs.ResetCamera(view)
+        camera = view.GetActiveCamera()
+        still_triangles = [int(f.GetDataInformation().GetNumberOfCells()) for f in filters]
+        rows = []
+
+        def drawn(d):
+            sub = d.SMProxy.GetProperty("BlockLODInteractiveLevel").GetParent()
+            sub.UpdatePropertyInformation()
+            return (int(d.GetProperty("BlockLODInteractiveLevel")[0]),
+                    int(d.GetProperty("BlockLODInteractiveTriangles")[0]),
+                    float(d.GetProperty("BlockLODPredictedInteractiveSeconds")[0]))
+
+        for opacity in (1.0, 0.3):
+            displays[0].Opacity = opacity
+            for mode, levels in (("Block LOD levels", 1), ("ParaView decimation", 0)):
+                for d in displays:
+                    d.BlockLODInteractiveLevels = levels
+                pvs.Render(view)
+                pvs.Render(view)
+                still, moving = [], []
+                for _ in range(args.rotation_frames):
+                    camera.Azimuth(1.0)
+                    t0 = time.perf_counter()
+                    pvs.Render(view)
+                    still.append(time.perf_counter() - t0)
+                camera.Azimuth(1.0)
+                t0 = time.perf_counter()
+                view.SMProxy.InteractiveRender()  # makes and delivers the LOD geometry
+                first = time.perf_counter() - t0
+                for _ in range(args.rotation_frames):
+                    camera.Azimuth(1.0)
+                    t0 = time.perf_counter()
+                    view.SMProxy.InteractiveRender()
+                    moving.append(time.perf_counter() - t0)
+                what = [drawn(d) for d in displays]
+                rows.append(["%s (%s)" % ("translucent skin %.1f" % opacity if opacity < 1 else "opaque",
+                                          mode),
+                             fmt_s(statistics.median(still)), fmt_s(statistics.median(moving)),
+                             "%.2f" % (statistics.median(moving) / statistics.median(still)),
+                             fmt_s(first),
+                             " / ".join("L%d %d" % w[:2] if w[0] >= 0 else "decimated %d" % w[1]
+                                        for w in what),
+                             " / ".join(fmt_s(w[2]) if w[0] >= 0 else "-" for w in what)])
+                progress("[%s] %s" % (name, rows[-1]))
+        lines += ["## %s, %dx%d, LODThreshold %g MB, skin %g + bone %g (level 3: %s triangles)"
+                  % (label, width, height, view.LODThreshold, skin, bone,
+                     " + ".join(str(t) for t in still_triangles)), ""]
+        lines += markdown_table(["scene (interactive LOD)", "still median", "interactive median",
+                                 "ratio", "first interactive", "drawn while moving (skin / bone)",
+                                 "predicted (skin / bone)"],
+                                rows)
+        lines += [""]
+        for d in displays:
+            pvs.Delete(d)
+        for f in filters:
+            pvs.Delete(f)
+        pvs.Delete(view)
+        del keep
+    lines += ["Load average after: %s" % load_average()]
+    text = "\n".join(lines) + "\n"
+    sys.stdout.write(text)
+    if args.out:
+        with open(args.out, "w") as f:
+            f.write(text)
+    return 0
+
+
 def main():
     argv = sys.argv[1:]
     args = parse_args(argv)
+    if args.interaction:
+        return run_interaction(args)
     if args.child:
         return run_child(args)
     if args.report_from:

@@ -110,6 +110,7 @@ def histopyramid_view(volume, view, array_name, bounds, frames, width, height, p
     lut = GetColorTransferFunction(array_name)
     lut.RGBPoints = [skin - 1000.0] + list(skin_colour) + [middle - 1.0] + list(skin_colour) + \
         [middle + 1.0] + list(bone_colour) + [bone + 4000.0] + list(bone_colour)
+    lut.EnableOpacityMapping = 1  # the opacity map applies only with it, as for surfaces
     pwf = GetOpacityTransferFunction(array_name)
     pwf.Points = [skin - 1000.0, skin_opacity, 0.5, 0.0, middle - 1.0, skin_opacity, 0.5, 0.0,
                   middle + 1.0, bone_opacity, 0.5, 0.0, bone + 4000.0, bone_opacity, 0.5, 0.0]

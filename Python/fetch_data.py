@@ -75,6 +75,17 @@ MRI_PACKAGE_FILE = "usr/share/mricron/templates/ch2.nii.gz"
 MRI_EXPECTED_DIMS = (181, 217, 181)
 MRI_EXPECTED_SPACING = (1.0, 1.0, 1.0)
 
+# The volumes' direction matrices in patient space (LPS, as DICOM and ITK), row-major with the
+# voxel axes as columns, as the TransformMatrix is written (and Headless/MetaImage.cxx reads it;
+# both matrices here are diagonal, so a reader taking the rows as the axes agrees).
+# The head CT: InVesalius' reader (vtkGDCMImageReader, rows flipped to VTK's lower-left origin)
+# leaves x along the series' rows, the patient's left in an axial series, y towards the face
+# (anterior: -y in LPS) and z up the slices (superior). The file keeps no DICOM header, so x's
+# sense is the reader's and cannot be checked from it; y and z are what the volume shows (face
+# at +j, crown at +k). The MRI's comes from ch2.nii.gz's sform.
+CT_DIRECTION = ((1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, 1.0))
+IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
 SPACING_TOLERANCE = 1e-4
 
 # MetaImage element type, array typecode and bytes per voxel of each scalar type.
@@ -138,7 +149,9 @@ def save_manifest(cache_dir, manifest):
     manifest["format_version"] = MANIFEST_FORMAT
     manifest["generator"] = "MedicalIsosurfaces Python/fetch_data.py"
     manifest["note"] = ("Fetched from Debian packages on demand; never commit these files. "
-                        "Offsets are 0 0 0; axes are the stored voxel axes (x fastest).")
+                        "Offsets are 0 0 0; axes are the stored voxel axes (x fastest), their "
+                        "directions in patient space (LPS) in each file's TransformMatrix and "
+                        "'axes'.")
     path = cache_dir / MANIFEST_NAME
     tmp = path.with_name(path.name + ".tmp")
     with open(tmp, "w", encoding="utf-8") as f:
@@ -327,15 +340,18 @@ def format_number(value):
     return str(int(value)) if value.is_integer() else repr(value)
 
 
-def write_mha(path, dims, spacing, scalar_type, data_le):
-    """Write a single-file MetaImage: ASCII header, ElementDataFile = LOCAL, raw bytes."""
+def write_mha(path, dims, spacing, scalar_type, data_le, axes=IDENTITY):
+    """Write a single-file MetaImage: ASCII header, ElementDataFile = LOCAL, raw bytes. `axes`:
+    the direction matrix in patient space (LPS), rows of 3, the voxel axes as columns, written as
+    the TransformMatrix (ITK, 3D Slicer and the web server place the volume by it; VTK's and
+    ParaView's readers leave it out, so their images and surfaces are the same as without)."""
     header = "\n".join([
         "ObjectType = Image",
         "NDims = 3",
         "BinaryData = True",
         "BinaryDataByteOrderMSB = False",
         "CompressedData = False",
-        "TransformMatrix = 1 0 0 0 1 0 0 0 1",
+        "TransformMatrix = " + " ".join(format_number(c) for axis in axes for c in axis),
         "Offset = 0 0 0",
         "CenterOfRotation = 0 0 0",
         "ElementSpacing = " + " ".join(format_number(s) for s in spacing),
@@ -380,8 +396,10 @@ def parse_mha(path):
     file_bytes = os.path.getsize(path)
     if len(dims) != 3 or len(spacing) != 3 or file_bytes != header_bytes + data_bytes:
         raise ValueError("size %d != header %d + data %d" % (file_bytes, header_bytes, data_bytes))
+    t = [float(v) for v in fields.get("TransformMatrix", "1 0 0 0 1 0 0 0 1").split()]
     return {"dims": dims, "spacing": spacing, "scalar_type": scalar_type,
-            "data_bytes": data_bytes, "file_bytes": file_bytes}
+            "data_bytes": data_bytes, "file_bytes": file_bytes,
+            "axes": [t[0:3], t[3:6], t[6:9]]}
 
 
 # --------------------------------------------------------------------------
@@ -509,7 +527,7 @@ def prepare_ct(apt, cache_dir, use_system, force):
     check_ct_range(vmin, vmax)
 
     out = cache_dir / "ct_head.mha"
-    file_bytes = write_mha(out, dims, spacing, "int16", little_endian_bytes(values))
+    file_bytes = write_mha(out, dims, spacing, "int16", little_endian_bytes(values), CT_DIRECTION)
     log("ct_head: wrote %s (%d bytes)" % (out, file_bytes))
     return {
         "path": str(out),
@@ -517,6 +535,7 @@ def prepare_ct(apt, cache_dir, use_system, force):
         "dims": list(dims),
         "spacing": list(spacing),
         "origin": [0.0, 0.0, 0.0],
+        "axes": [list(a) for a in CT_DIRECTION],
         "scalar_type": "int16",
         "met_element_type": "MET_SHORT",
         "value_range": [vmin, vmax],
@@ -580,6 +599,18 @@ def parse_nifti1_header(data):
     }
 
 
+def nifti_axes_lps(header):
+    """The direction matrix in LPS (rows of 3, the voxel axes as columns) from the NIfTI sform:
+    its columns normalised, x and y negated (RAS to LPS), rounded to 6 places; the identity
+    without an sform."""
+    if header["sform_code"] <= 0:
+        return IDENTITY
+    lengths = [sum(header["srow"][r][c] ** 2 for r in range(3)) ** 0.5 or 1.0 for c in range(3)]
+    return tuple(tuple(round(sign * header["srow"][r][c] / lengths[c], 6) + 0.0
+                       for c in range(3))
+                 for r, sign in zip(range(3), (-1, -1, 1)))
+
+
 def prepare_mri(apt, cache_dir, use_system, force):
     source, version, how = locate_package_file(apt, MRI_PACKAGE, MRI_PACKAGE_FILE, cache_dir,
                                                use_system, force)
@@ -612,7 +643,10 @@ def prepare_mri(apt, cache_dir, use_system, force):
     if source.resolve() != original.resolve():
         shutil.copyfile(source, original)
     out = cache_dir / "mri_head.mha"
-    file_bytes = write_mha(out, dims, spacing, scalar_type, little_endian_bytes(values))
+    axes = nifti_axes_lps(header)
+    log("mri_head: axes in LPS (from the %s): %s" % (
+        "sform" if header["sform_code"] > 0 else "missing sform: identity", axes))
+    file_bytes = write_mha(out, dims, spacing, scalar_type, little_endian_bytes(values), axes)
     log("mri_head: wrote %s (%d bytes) and %s" % (out, file_bytes, original))
     return {
         "path": str(out),
@@ -622,6 +656,7 @@ def prepare_mri(apt, cache_dir, use_system, force):
         "dims": list(dims),
         "spacing": list(spacing),
         "origin": [0.0, 0.0, 0.0],
+        "axes": [list(a) for a in axes],
         "scalar_type": scalar_type,
         "met_element_type": SCALAR_TYPES[scalar_type][0],
         "value_range": [vmin, vmax],
@@ -635,8 +670,8 @@ def prepare_mri(apt, cache_dir, use_system, force):
         "licence": "BSD-3-clause per the mricron-data Debian copyright file (ch2 / Colin 27 "
                    "template, MRIcron by Chris Rorden); do not commit the data",
         "isovalues": {"skin": 30},
-        "notes": "T1 MRI template, scalp included; skin about 25-40. The .mha drops the NIfTI "
-                 "sform (origin 0 0 0); ch2.nii.gz keeps it.",
+        "notes": "T1 MRI template, scalp included; skin about 25-40. The .mha keeps the NIfTI "
+                 "sform's axes (in LPS) but not its origin (0 0 0); ch2.nii.gz keeps both.",
     }
 
 
@@ -661,8 +696,8 @@ def cached_entry(cache_dir, manifest, name):
     except (OSError, ValueError, KeyError, UnicodeDecodeError):
         return None
     if (info["file_bytes"] != entry.get("file_bytes") or info["data_bytes"] != entry.get("data_bytes")
-            or info["dims"] != entry.get("dims")):
-        return None
+            or info["dims"] != entry.get("dims") or info["axes"] != entry.get("axes")):
+        return None  # (a file written before the axes were: written again, with them)
     if "original_path" in entry:
         original = Path(entry["original_path"])
         if not original.is_file() or original.stat().st_size != entry.get("original_bytes"):

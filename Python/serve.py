@@ -31,6 +31,8 @@ import signal
 import socket
 import sys
 from dataclasses import dataclass, field
+from email.utils import formatdate, parsedate_to_datetime
+from typing import Optional
 from urllib.parse import urlsplit
 
 from aiohttp import WSMsgType, web
@@ -46,6 +48,13 @@ from serve_messages import LEVEL_STRIDES, BadRequest, parse_message  # noqa: E40
 
 MAX_FRAME = 1024 * 1024        # above this aiohttp closes the socket (1009, message too big)
 MAX_SESSIONS = 64              # WebSockets open at once
+# How /api/volume encodes a level (byte-shuffled, gzip level 6): part of its ETag, so that a
+# change of the encoding is a new representation to the browser's cache.
+VOLUME_ENCODING = "shuffle-gzip6"
+# The volume may be kept by the browser, but is revalidated at each use (ETag, Last-Modified):
+# a conditional request passes the token check like any other, so the bytes and the 304 both
+# need the token. "private": no shared cache keeps it.
+VOLUME_CACHE_CONTROL = "private, no-cache"
 # The page's WebAssembly build, served beside Web/static from --wasm.
 WASM_FILES = ("mediso.js", "mediso.wasm", "mediso-mt.js", "mediso-mt.wasm", "mediso-mt.worker.js")
 # The page loads its scripts as ES modules, which browsers run only when served as JavaScript.
@@ -121,7 +130,10 @@ class Dataset:
     type: str  # numpy's name: serve_operations.SCALAR_TYPES
     range: list
     values: object  # numpy array, (z, y, x)
+    format: dict  # {"name", "space"}: serve_operations.source_format
+    modified: Optional[float] = None  # the source file's time (None: the phantom)
     encoded: dict = field(default_factory=dict)  # level -> gzip'd shuffled bytes
+    digest: Optional[str] = None  # of the values and geometry (validators)
 
     @classmethod
     def load(cls, ident, volume):
@@ -129,7 +141,24 @@ class Dataset:
         import numpy
         return cls(ident, volume["name"], volume["dims"], volume["spacing"], volume["origin"],
                    volume["direction"], volume["type"], volume["range"],
-                   numpy.load(volume["values"], mmap_mode="r"))
+                   numpy.load(volume["values"], mmap_mode="r"), volume["format"],
+                   volume.get("modified"))
+
+    def fingerprint(self):
+        """A digest of what /api/volume sends (values, type, geometry): the volume's ETag is
+        made of it, so another volume under the same id gets another ETag (made once)."""
+        if self.digest is None:
+            import hashlib
+            import json
+            h = hashlib.blake2b(digest_size=12)
+            h.update(json.dumps([self.dims, self.spacing, self.origin, self.type]).encode())
+            h.update(memoryview(numpy_contiguous(self.values)).cast("B"))
+            self.digest = h.hexdigest()
+        return self.digest
+
+    def etag(self, k):
+        """Level k's ETag: the fingerprint, the level and the encoding (VOLUME_ENCODING)."""
+        return '"%s-%d-%s"' % (self.fingerprint(), k, VOLUME_ENCODING)
 
     def level(self, k):
         """Level k's values: the points at multiples of LEVEL_STRIDES[k] along each axis."""
@@ -145,7 +174,8 @@ class Dataset:
                            "spacing": [s * step for s in self.spacing], "bytes": int(v.nbytes)})
         return {"id": self.ident, "name": self.name, "dims": self.dims, "spacing": self.spacing,
                 "origin": self.origin, "direction": self.direction, "type": self.type,
-                "range": self.range, "bytes": int(self.values.nbytes), "levels": levels}
+                "range": self.range, "bytes": int(self.values.nbytes), "levels": levels,
+                "format": self.format}
 
     def encode(self, k):
         """Level k byte-shuffled and gzip'd (made once)."""
@@ -156,6 +186,11 @@ class Dataset:
             planes = v.view(numpy.uint8).reshape(-1, size).T  # byte b of every value, in a row
             self.encoded[k] = gzip.compress(numpy.ascontiguousarray(planes).tobytes(), 6)
         return self.encoded[k]
+
+
+def numpy_contiguous(values):
+    import numpy
+    return numpy.ascontiguousarray(values)
 
 
 def open_datasets(volumes):
@@ -179,6 +214,7 @@ class ServerState:
     sessions: set = field(default_factory=set)
     opened: int = 0                                # WebSockets opened so far (session numbers)
     encoding: dict = field(default_factory=dict)  # (dataset, level) -> future of its bytes
+    fingerprints: dict = field(default_factory=dict)  # dataset -> future of its digest
 
     def __post_init__(self):
         self.by_id = {d.ident: d for d in self.datasets}
@@ -232,18 +268,44 @@ async def volume(request):
         k = -1
     if not 0 <= k < len(LEVEL_STRIDES):
         raise web.HTTPBadRequest(text="level is 0, 1, 2 or 3\n")
+    loop = asyncio.get_running_loop()
+    if d.digest is None:  # once per dataset, off the event loop
+        if d.ident not in state.fingerprints:
+            state.fingerprints[d.ident] = loop.run_in_executor(None, d.fingerprint)
+        await asyncio.shield(state.fingerprints[d.ident])
+    validators = {"ETag": d.etag(k), "Cache-Control": VOLUME_CACHE_CONTROL}
+    if d.modified is not None:
+        validators["Last-Modified"] = formatdate(d.modified, usegmt=True)
+    if not_modified(request, validators["ETag"], d.modified):
+        return web.Response(status=304, headers=validators)
     key = (d.ident, k)
     if key not in state.encoding:  # each level is encoded once
-        state.encoding[key] = asyncio.get_running_loop().run_in_executor(None, d.encode, k)
+        state.encoding[key] = loop.run_in_executor(None, d.encode, k)
     body = await asyncio.shield(state.encoding[key])
     level = d.describe()["levels"][k]
-    headers = {"Content-Encoding": "gzip", "Content-Type": "application/octet-stream",
-               "X-Mediso-Dims": ",".join(map(str, level["dims"])),
-               "X-Mediso-Spacing": ",".join(repr(s) for s in level["spacing"]),
-               "X-Mediso-Origin": ",".join(repr(s) for s in d.origin),
-               "X-Mediso-Type": d.type, "X-Mediso-Raw-Bytes": str(level["bytes"]),
-               "Cache-Control": "no-store"}
+    headers = dict(validators, **{
+        "Content-Encoding": "gzip", "Content-Type": "application/octet-stream",
+        "X-Mediso-Dims": ",".join(map(str, level["dims"])),
+        "X-Mediso-Spacing": ",".join(repr(s) for s in level["spacing"]),
+        "X-Mediso-Origin": ",".join(repr(s) for s in d.origin),
+        "X-Mediso-Type": d.type, "X-Mediso-Raw-Bytes": str(level["bytes"])})
     return web.Response(body=body, headers=headers)
+
+
+def not_modified(request, etag, modified):
+    """True when the request's validators match (RFC 9110 13.1): If-None-Match by weak
+    comparison when given, else If-Modified-Since against the source's time."""
+    given = request.headers.get("If-None-Match")
+    if given is not None:
+        tags = [t.strip() for t in given.split(",")]
+        return "*" in tags or etag in [t[2:] if t.startswith("W/") else t for t in tags]
+    since = request.headers.get("If-Modified-Since")
+    if since is None or modified is None:
+        return False
+    try:
+        return int(modified) <= parsedate_to_datetime(since).timestamp()
+    except (TypeError, ValueError):
+        return False
 
 
 async def result(request):

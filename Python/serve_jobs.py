@@ -20,7 +20,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Optional
 
-from serve_messages import BadRequest
+from serve_messages import REPORT, BadRequest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 MAX_PENDING = 4                # operations queued or running per page
@@ -264,7 +264,8 @@ class Operations:
         ident = job.request["id"]
         r = job.request
         line = {"job": job.number, "rid": job.rid, "dataset": self.index[r["dataset"].ident],
-                "isovalue": r["isovalue"], "level": r["level"], "steps": r["steps"]}
+                "isovalue": r["isovalue"], "level": r["level"], "steps": r["steps"],
+                "export": r["export"]}
         for attempt in (1, 2):
             if job.cancelled:  # while the worker started
                 await job.session.send({"id": ident, "cancelled": True})
@@ -362,7 +363,8 @@ class Operations:
                    "boundaryEdges": message["boundaryEdges"], "bounds": message["bounds"],
                    "bytes": message["bytes"], "stages": message["stages"],
                    "seconds": message["seconds"], "dataset": r["dataset"].ident,
-                   "isovalue": r["isovalue"], "level": r["level"]}
+                   "isovalue": r["isovalue"], "level": r["level"], "export": r["export"],
+                   "report": {key: message["report"][key] for key in REPORT}}
         if message.get("warnings"):
             summary["warnings"] = message["warnings"]
         result = Result(job.rid, session, summary, self.folder)

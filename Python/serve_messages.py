@@ -69,6 +69,12 @@ def vector(nonzero=False):
     return check
 
 
+def boolean(value, where, context=None):
+    if not isinstance(value, bool):
+        raise BadRequest("%s: true or false (%s)" % (where, _short(value)))
+    return value
+
+
 def dataset(value, where, context):
     datasets = context["datasets"]
     found = datasets.get(value) if isinstance(value, str) else None
@@ -92,10 +98,16 @@ def steps(value, where, context):
     return [_step(s, "%s[%d]" % (where, i)) for i, s in enumerate(value)]
 
 
+def export(value, where, context):
+    options = _fields(value, where, EXPORT, {}, prefix=where + ".")
+    return {key: options.get(key, spec.default) for key, spec in EXPORT.items()}
+
+
 @dataclass(frozen=True)
 class Field:
     check: Callable
     required: bool = True
+    default: object = None  # what a field left out means (optional fields)
 
 
 # ------------------------------------------------------------------------------ the table
@@ -112,7 +124,8 @@ LEVELS = len(LEVEL_STRIDES)
 # op -> its fields besides "op" and "id", checked in this order.
 MESSAGES = {
     "surface": {"dataset": Field(dataset), "isovalue": Field(isovalue),
-                "level": Field(integer(0, LEVELS - 1)), "steps": Field(steps, required=False)},
+                "level": Field(integer(0, LEVELS - 1)), "steps": Field(steps, required=False),
+                "export": Field(export, required=False)},
     "cancel": {},
 }
 
@@ -123,6 +136,38 @@ STEPS = {
     "fillHoles": {"size": Field(number(above=0))},
     "clip": {"origin": Field(vector()), "normal": Field(vector(nonzero=True))},
     "decimate": {"reduction": Field(number(0, 0.99))},
+}
+
+
+# The export options, applied after the steps (serve_operations.Worker.export; docs/web.md,
+# "Export"). Cleaning is on unless asked off: an STL reader (a slicer, a mesh checker) merges
+# corners at the same position, so unmerged duplicates and zero-length edges would otherwise be
+# found there as degenerate triangles and spurious edges.
+EXPORT = {
+    "clean": Field(boolean, required=False, default=True),  # merge points at the same position,
+    # drop triangles left with fewer than three corners and all but one of triangles on the same
+    # three corners
+    "largestComponent": Field(boolean, required=False, default=False),  # keep the largest
+    # connected piece (by triangles), drop the rest
+    "cap": Field(boolean, required=False, default=False),  # close the surface where the
+    # volume's box cuts it: contoured with one more sample of the data's minimum around the volume
+}
+
+# The mesh report of a result, the "report" of the done message: each field stated once, as the
+# worker computes it with VTK on the written mesh (serve_operations.mesh_report), the page shows
+# it and TestWebServerExport counts it again with numpy on the STL. Corners at the same position
+# are one point, as an STL reader sees them; edges and pieces are those of the triangles with three
+# distinct corners.
+REPORT = {
+    "triangles": "triangles in the files",
+    "points": "distinct corner positions",
+    "components": "connected pieces (triangles sharing a corner), vtkPolyDataConnectivityFilter",
+    "boundaryEdges": "edges of one triangle only, vtkFeatureEdges (0: no hole, no open cut)",
+    "nonManifoldEdges": "edges of three or more triangles, vtkFeatureEdges",
+    "degenerateTriangles": "triangles with two or three corners at the same position",
+    "duplicateTriangles": "triangles on the same three corners as an earlier one (either "
+                          "orientation)",
+    "watertight": "no boundary and no non-manifold edge: every edge between exactly two triangles",
 }
 
 
@@ -179,4 +224,5 @@ def parse_message(text, datasets):
         raise
     if op == "surface":
         fields.setdefault("steps", [])
+        fields.setdefault("export", export({}, "export", {}))
     return dict(fields, op=op, id=ident)

@@ -219,6 +219,59 @@ def open_sources(specs, ns, log, opening=None):
     return opened
 
 
+def source_format(spec):
+    """{"name", "space"}: the source's format and the patient space its world coordinates are in
+    (the page places the volume by it, docs/web.md "Orientation"): NIfTI's RAS; DICOM's LPS;
+    MetaImage's LPS (ITK's convention, which writes its TransformMatrix in LPS); the plugin's
+    phantom, built in NIfTI's frame, RAS; any other file LPS, as ITK takes it."""
+    if spec.startswith(PHANTOM):
+        return {"name": "phantom", "space": "RAS"}
+    if os.path.isdir(spec):
+        return {"name": "DICOM", "space": "LPS"}
+    lower = spec.lower()
+    if lower.endswith(NIFTI_SUFFIXES):
+        return {"name": "NIfTI", "space": "RAS"}
+    if lower.endswith((".mha", ".mhd")):
+        return {"name": "MetaImage", "space": "LPS"}
+    if lower.endswith(".vti"):
+        return {"name": "VTK image", "space": "LPS"}
+    return {"name": os.path.splitext(lower)[1].lstrip(".") or "unknown", "space": "LPS"}
+
+
+def source_modified(spec):
+    """When the source's file (a series' newest file) last changed, in seconds since the epoch;
+    None for the phantom."""
+    if spec.startswith(PHANTOM):
+        return None
+    if os.path.isdir(spec):
+        times = [os.path.getmtime(os.path.join(spec, n)) for n in os.listdir(spec)
+                 if os.path.isfile(os.path.join(spec, n))]
+        return max(times) if times else os.path.getmtime(spec)
+    return os.path.getmtime(spec)
+
+
+def metaimage_direction(spec):
+    """The direction matrix a MetaImage header states (TransformMatrix, row-major, columns =
+    axes), or None. VTK's and ParaView's MetaImage readers leave it out (their images have the
+    identity), as ITK and 3D Slicer do not: the server states it to the page, which places the
+    volume in patient space by it; the worker's image keeps VTK's identity, so that its surfaces
+    are in the frame the page draws in."""
+    try:
+        with open(spec, "rb") as f:
+            for _ in range(64):
+                key, sep, value = f.readline().decode("ascii", "replace").partition("=")
+                key = key.strip()
+                if not sep or key == "ElementDataFile":
+                    return None
+                if key in ("TransformMatrix", "Rotation", "Orientation"):
+                    # row by row, the axes as columns (as Headless/MetaImage.cxx reads it)
+                    t = [float(v) for v in value.split()]
+                    return t if len(t) == 9 else None
+    except (OSError, ValueError):
+        return None
+    return None
+
+
 def describe(spec, name, image, array):
     """What the server needs of a volume, besides its values: its geometry, type and range."""
     import math
@@ -226,10 +279,13 @@ def describe(spec, name, image, array):
     if not (math.isfinite(lo) and math.isfinite(hi)) or lo >= hi:
         raise ValueError("%s: its values span no range (%g..%g)" % (spec, lo, hi))
     matrix = image.GetDirectionMatrix()
+    direction = [matrix.GetElement(r, c) for r in range(3) for c in range(3)]
+    if source_format(spec)["name"] == "MetaImage":
+        direction = metaimage_direction(spec) or direction
     return {"name": name, "dims": list(image.GetDimensions()), "spacing": list(image.GetSpacing()),
-            "origin": list(image.GetOrigin()),
-            "direction": [matrix.GetElement(r, c) for r in range(3) for c in range(3)],
-            "range": [float(lo), float(hi)]}
+            "origin": list(image.GetOrigin()), "direction": direction,
+            "range": [float(lo), float(hi)], "format": source_format(spec),
+            "modified": source_modified(spec)}
 
 
 def export(index, spec, name, image, array, folder):
@@ -246,6 +302,123 @@ def export(index, spec, name, image, array, folder):
     return dict(description, type=values.dtype.name, values=path)
 
 
+# ------------------------------------------------------------------------------- export and report
+def padded(image, array, pad, value):
+    """The image with `pad` more samples of `value` on every side (same spacing and type), so
+    that a contour of it closes where the volume's box cut the surface (docs/web.md, "Export").
+    Level k samples the points at multiples of its stride from the first: a pad of that stride
+    keeps the level's lattice on the volume's own samples."""
+    import numpy
+    from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    nx, ny, nz = image.GetDimensions()
+    values = numpy.pad(vtk_to_numpy(array).reshape(nz, ny, nx), pad, constant_values=value)
+    extent = image.GetExtent()
+    spacing = image.GetSpacing()
+    matrix = image.GetDirectionMatrix()
+    # index i' = i + pad: origin' = origin + D ((extent start - pad) x spacing)
+    shift = [(extent[2 * a] - pad) * spacing[a] for a in range(3)]
+    origin = [image.GetOrigin()[r] + sum(matrix.GetElement(r, c) * shift[c] for c in range(3))
+              for r in range(3)]
+    out = vtkImageData()
+    out.SetDimensions(nx + 2 * pad, ny + 2 * pad, nz + 2 * pad)
+    out.SetSpacing(spacing)
+    out.SetOrigin(origin)
+    out.SetDirectionMatrix(matrix)
+    scalars = numpy_to_vtk(values.ravel(), deep=True, array_type=array.GetDataType())
+    scalars.SetName(array.GetName())
+    out.GetPointData().SetScalars(scalars)
+    return out
+
+
+def _float_points(mesh):
+    """The mesh with float32 points, as the STL holds them (positions equal in float32 are one
+    corner there, even where they differ in double)."""
+    from vtkmodules.util.vtkConstants import VTK_FLOAT
+    from vtkmodules.vtkCommonDataModel import vtkPolyData
+    if mesh.GetPoints().GetDataType() == VTK_FLOAT:
+        return mesh
+    from vtkmodules.vtkCommonCore import vtkPoints
+    points = vtkPoints()
+    points.SetDataTypeToFloat()
+    points.DeepCopy(mesh.GetPoints())
+    points.SetDataTypeToFloat()
+    out = vtkPolyData()
+    out.SetPoints(points)
+    out.SetPolys(mesh.GetPolys())
+    return out
+
+
+def merged(mesh, merge=True):
+    """vtkCleanPolyData with tolerance 0: corners at the same position made one point (when
+    `merge`), triangles left with fewer than three corners dropped (no line or vertex made of
+    them), unused points dropped."""
+    from vtkmodules.vtkFiltersCore import vtkCleanPolyData
+    f = vtkCleanPolyData()
+    f.SetInputData(mesh)
+    f.SetTolerance(0.0)
+    f.SetPointMerging(merge)
+    f.ConvertPolysToLinesOff()
+    f.ConvertLinesToPointsOff()
+    f.ConvertStripsToPolysOff()
+    f.Update()
+    return f.GetOutput()
+
+
+def without_duplicates(mesh):
+    """All but the first of the triangles on the same three points (vtkRemoveDuplicatePolys)."""
+    from vtkmodules.vtkFiltersCore import vtkRemoveDuplicatePolys
+    f = vtkRemoveDuplicatePolys()
+    f.SetInputData(mesh)
+    f.Update()
+    return f.GetOutput()
+
+
+def edge_counts(mesh):
+    """(boundary edges, non-manifold edges) by vtkFeatureEdges."""
+    from vtkmodules.vtkFiltersCore import vtkFeatureEdges
+    counts = []
+    for boundary in (True, False):
+        f = vtkFeatureEdges()
+        f.SetInputData(mesh)
+        f.SetBoundaryEdges(boundary)
+        f.SetNonManifoldEdges(not boundary)
+        f.FeatureEdgesOff()
+        f.ManifoldEdgesOff()
+        f.Update()
+        counts.append(f.GetOutput().GetNumberOfCells())
+    return counts
+
+
+def components(mesh, largest=False):
+    """The number of connected pieces, or (largest=True) the largest piece alone."""
+    from vtkmodules.vtkFiltersCore import vtkPolyDataConnectivityFilter
+    f = vtkPolyDataConnectivityFilter()
+    f.SetInputData(mesh)
+    if largest:
+        f.SetExtractionModeToLargestRegion()
+    else:
+        f.SetExtractionModeToAllRegions()
+    f.Update()
+    return merged(f.GetOutput(), merge=False) if largest else f.GetNumberOfExtractedRegions()
+
+
+def mesh_report(mesh):
+    """serve_messages.REPORT's fields of a triangle mesh, by VTK, as an STL reader would find
+    them: corners at the same float32 position are one point."""
+    mesh = _float_points(mesh)
+    whole = merged(mesh)
+    boundary, non_manifold = edge_counts(whole)
+    duplicates = whole.GetNumberOfCells() - without_duplicates(whole).GetNumberOfCells()
+    return {"triangles": mesh.GetNumberOfCells(), "points": whole.GetNumberOfPoints(),
+            "components": components(whole), "boundaryEdges": boundary,
+            "nonManifoldEdges": non_manifold,
+            "degenerateTriangles": mesh.GetNumberOfCells() - whole.GetNumberOfCells(),
+            "duplicateTriangles": duplicates,
+            "watertight": whole.GetNumberOfCells() > 0 and boundary == 0 and non_manifold == 0
+            and duplicates == 0}
+
+
 # ---------------------------------------------------------------------------------- the worker
 class Cancelled(Exception):
     pass
@@ -258,7 +431,7 @@ class JobFailed(Exception):
 class Worker:
     """Runs jobs one at a time on the opened volumes; reports on `out` (JSON lines)."""
 
-    STAGES = ("surface", "smooth", "fillHoles", "clip", "decimate", "write")
+    STAGES = ("surface", "smooth", "fillHoles", "clip", "decimate", "export", "report", "write")
 
     def __init__(self, sources, ns, results, out):
         self.sources = sources
@@ -324,19 +497,32 @@ class Worker:
             raise JobFailed("%s: %s" % (stage, self.errors[0]))
 
     # -- the steps
-    def contour(self, index):
-        """One BlockLODContour per dataset, kept: its cache makes a repeated isovalue free."""
-        if index not in self.contours:
-            source, _, _, array = self.sources[index]
+    def contour(self, index, pad=0):
+        """One BlockLODContour per dataset (and per pad of a capped surface), kept: its cache
+        makes a repeated isovalue free. With a pad, it contours the volume with `pad` samples of
+        the data's minimum around it (padded())."""
+        if (index, pad) not in self.contours:
+            source, name, image, array = self.sources[index]
+            if pad:
+                source = _producer(padded(image, array, pad, array.GetRange()[0]),
+                                   "%s-padded-%d" % (name, pad))
             contour = self.ns["BlockLODContour"](Input=source,
                                                 ContourBy=["POINTS", array.GetName()],
                                                 ComputeNormals=0, AutoLOD=0)
-            self.contours[index] = contour
-        return self.contours[index]
+            self.contours[(index, pad)] = contour
+        return self.contours[(index, pad)]
 
     def surface(self, job, count):
         from vtkmodules.vtkCommonDataModel import vtkPolyData
-        contour = self.contour(job["dataset"])
+        from serve_messages import LEVEL_STRIDES
+        pad = 0
+        if job["export"]["cap"]:
+            lo = self.sources[job["dataset"]][3].GetRange()[0]
+            if not job["isovalue"] > lo:
+                raise JobFailed("cap: the isovalue is the data's minimum (%g): nothing lies "
+                                "below it to close the surface with" % lo)
+            pad = LEVEL_STRIDES[job["level"]]
+        contour = self.contour(job["dataset"], pad)
         algorithm = contour.GetClientSideObject()
         algorithm.RemoveAllObservers()
         self.watch(algorithm, "surface", 0, count)
@@ -392,6 +578,18 @@ class Worker:
             return self.run_filter(f, name, index, count, data)
         raise JobFailed("unknown step %s" % name)
 
+    def apply_export(self, options, index, count, data):
+        """The export options (serve_messages.EXPORT): cleaning, then the largest piece."""
+        self.report(index / count, "export")
+        mesh = _float_points(data)
+        if options["clean"]:
+            mesh = without_duplicates(merged(mesh))
+        self.check("export")
+        if options["largestComponent"]:
+            mesh = components(mesh, largest=True)
+        self.check("export")
+        return mesh
+
     def write(self, rid, surface, index, count):
         from vtkmodules.vtkCommonDataModel import vtkPolyData
         from vtkmodules.vtkIOGeometry import vtkSTLWriter
@@ -427,18 +625,6 @@ class Worker:
             sizes[fmt] = os.path.getsize(path)
         return sizes
 
-    @staticmethod
-    def boundary_edges(surface):
-        from vtkmodules.vtkFiltersCore import vtkFeatureEdges
-        edges = vtkFeatureEdges()
-        edges.SetInputData(surface)
-        edges.BoundaryEdgesOn()
-        edges.FeatureEdgesOff()
-        edges.ManifoldEdgesOff()
-        edges.NonManifoldEdgesOff()
-        edges.Update()
-        return edges.GetOutput().GetNumberOfCells()
-
     def run(self, job):
         self.job = job["job"]
         self.cancel = False
@@ -446,7 +632,7 @@ class Worker:
         self.last = (0.0, 0.0, None)
         start = time.monotonic()
         steps = job["steps"]
-        count = len(steps) + 2  # the surface, each step, the files
+        count = len(steps) + 4  # the surface, each step, the export options, the report, files
         stages = []
         try:
             t = time.monotonic()
@@ -461,11 +647,20 @@ class Worker:
                                "seconds": round(time.monotonic() - t, 3)})
                 if surface.GetNumberOfCells() == 0:
                     raise JobFailed("%s left no triangles" % name)
+            t = time.monotonic()
+            surface = self.apply_export(job["export"], count - 3, count, surface)
+            stages.append({"stage": "export", "triangles": surface.GetNumberOfCells(),
+                           "seconds": round(time.monotonic() - t, 3)})
+            if surface.GetNumberOfCells() == 0:
+                raise JobFailed("export left no triangles")
+            self.report((count - 2) / count, "report")
+            report = mesh_report(surface)
+            self.check("report")
             sizes = self.write(job["rid"], surface, count - 1, count)
             self.send({"job": self.job, "done": True, "result": job["rid"],
                        "triangles": surface.GetNumberOfCells(),
                        "points": surface.GetNumberOfPoints(),
-                       "boundaryEdges": self.boundary_edges(surface),
+                       "boundaryEdges": report["boundaryEdges"], "report": report,
                        "bounds": [round(b, 4) for b in surface.GetBounds()],
                        "bytes": sizes, "stages": stages, "warnings": self.warnings[:5],
                        "seconds": round(time.monotonic() - start, 3)})

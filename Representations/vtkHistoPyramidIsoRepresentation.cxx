@@ -4,13 +4,16 @@
 #include "vtkCellData.h"
 #include "vtkContourValues.h"
 #include "vtkDataArray.h"
+#include "vtkDataObject.h"
 #include "vtkFieldData.h"
 #include "vtkHistoPyramidIsoMapper.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkMatrix4x4.h"
 #include "vtkMultiProcessController.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVLODVolume.h"
+#include "vtkPlaneCollection.h"
 #include "vtkPointData.h"
 #include "vtkRectilinearGrid.h"
 #include "vtkResampleToImage.h"
@@ -23,6 +26,7 @@
 #include <cstdint>
 #include <new>
 #include <sstream>
+#include <vector>
 
 namespace
 {
@@ -334,9 +338,86 @@ int vtkHistoPyramidIsoRepresentation::RequestData(
 }
 
 //------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetClipPlane(bool use)
+{
+  if (use != this->ClipPlane)
+  {
+    this->ClipPlane = use;
+    this->Modified(); // read at render time (UpdateMapperParameters)
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetClipPlaneOrigin(double x, double y, double z)
+{
+  this->ClipPlaneOrigin[0] = x;
+  this->ClipPlaneOrigin[1] = y;
+  this->ClipPlaneOrigin[2] = z;
+  this->Modified(); // read at render time (UpdateMapperParameters)
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetClipPlaneNormal(double x, double y, double z)
+{
+  this->ClipPlaneNormal[0] = x;
+  this->ClipPlaneNormal[1] = y;
+  this->ClipPlaneNormal[2] = z;
+  this->Modified(); // read at render time (UpdateMapperParameters)
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetClipPlaneInvert(bool invert)
+{
+  if (invert != this->ClipPlaneInvert)
+  {
+    this->ClipPlaneInvert = invert;
+    this->Modified(); // read at render time (UpdateMapperParameters)
+  }
+}
+
+//------------------------------------------------------------------------------
 void vtkHistoPyramidIsoRepresentation::UpdateMapperParameters()
 {
   this->Superclass::UpdateMapperParameters();
+
+  // The clipping plane, in world coordinates (the display's transform moves
+  // the data), with its normal towards the kept side as the mapper takes it.
+  if (this->ClipPlane)
+  {
+    const double sign = this->ClipPlaneInvert ? -1.0 : 1.0;
+    const double* n = this->ClipPlaneNormal;
+    const double* o = this->ClipPlaneOrigin;
+    vtkMatrix4x4* dataToWorld = this->Actor->GetMatrix();
+    vtkNew<vtkMatrix4x4> worldToData;
+    vtkMatrix4x4::Invert(dataToWorld, worldToData);
+    const std::vector<vtkOpenGLHistoPyramidIsosurfaces::Plane> world =
+      vtkOpenGLHistoPyramidIsosurfaces::PullBackPlanes(
+        { { sign * n[0], sign * n[1], sign * n[2],
+          -sign * (n[0] * o[0] + n[1] * o[1] + n[2] * o[2]) } },
+        worldToData);
+    const auto& p = world[0];
+    const double norm2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+    if (norm2 > 0.0 && std::isfinite(norm2) && std::isfinite(p[3]))
+    {
+      this->MapperClipPlane->SetNormal(p[0], p[1], p[2]);
+      this->MapperClipPlane->SetOrigin(
+        -p[3] * p[0] / norm2, -p[3] * p[1] / norm2, -p[3] * p[2] / norm2);
+    }
+    else
+    {
+      this->MapperClipPlane->SetNormal(0.0, 0.0, 0.0); // the mapper says it is ignored
+    }
+    vtkPlaneCollection* planes = this->IsoMapper->GetClippingPlanes();
+    if (!planes || !planes->IsItemPresent(this->MapperClipPlane))
+    {
+      this->IsoMapper->AddClippingPlane(this->MapperClipPlane);
+    }
+  }
+  else if (this->IsoMapper->GetClippingPlanes() &&
+    this->IsoMapper->GetClippingPlanes()->IsItemPresent(this->MapperClipPlane))
+  {
+    this->IsoMapper->RemoveClippingPlane(this->MapperClipPlane);
+  }
 
   // The base class hides the volume when no colour array is chosen (volume
   // mappers need one). An isosurface needs only scalars: use the active ones,
@@ -385,15 +466,22 @@ std::string vtkHistoPyramidIsoRepresentation::IsovaluesOutsideRange()
   }
   double range[2];
   array->GetRange(range, 0);
+  vtkContourValues* values = this->Property->GetIsoSurfaceValues();
+  return OutsideRangeMessage(
+    values->GetValues(), values->GetNumberOfContours(), range, array->GetName());
+}
+
+//------------------------------------------------------------------------------
+std::string vtkHistoPyramidIsoRepresentation::OutsideRangeMessage(
+  const double* values, int count, const double range[2], const char* arrayName)
+{
   std::ostringstream outside;
-  const int count = this->Property->GetIsoSurfaceValues()->GetNumberOfContours();
   int n = 0;
   for (int i = 0; i < count; ++i)
   {
-    const double value = this->Property->GetIsoSurfaceValues()->GetValue(i);
-    if (value < range[0] || value > range[1])
+    if (values[i] < range[0] || values[i] > range[1])
     {
-      outside << (n++ ? ", " : "") << value;
+      outside << (n++ ? ", " : "") << values[i];
     }
   }
   if (n == 0)
@@ -403,9 +491,36 @@ std::string vtkHistoPyramidIsoRepresentation::IsovaluesOutsideRange()
   std::ostringstream message;
   message << "HistoPyramid Isosurface: isovalue" << (n > 1 ? "s " : " ") << outside.str()
           << (n > 1 ? " are" : " is") << " outside the range [" << range[0] << ", " << range[1]
-          << "] of the array \"" << (array->GetName() ? array->GetName() : "")
-          << "\": no surface is drawn for " << (n > 1 ? "them" : "it") << ".";
+          << "] of the array \"" << (arrayName ? arrayName : "") << "\": no surface is drawn for "
+          << (n > 1 ? "them" : "it") << ".";
   return message.str();
+}
+
+//------------------------------------------------------------------------------
+vtkDoubleArray* vtkHistoPyramidIsoRepresentation::GetSurfaceLooks()
+{
+  // The colouring as UpdateMapperParameters() sets it, from the properties
+  // alone: in client/server mode the client's copy, which ParaView reads
+  // information from, never renders.
+  vtkInformation* array = this->GetInputArrayInformation(0);
+  const char* name = array && array->Has(vtkDataObject::FIELD_NAME())
+    ? array->Get(vtkDataObject::FIELD_NAME())
+    : nullptr;
+  this->IsoMapper->SetColorSource(this->ColorEachSurface
+      ? vtkHistoPyramidIsoMapper::SurfaceColors
+      : ((name && name[0]) ? vtkHistoPyramidIsoMapper::TransferFunctionColors
+                           : vtkHistoPyramidIsoMapper::SolidColors));
+  vtkContourValues* values = this->Property->GetIsoSurfaceValues();
+  const int count = values->GetNumberOfContours();
+  this->SurfaceLooks->SetNumberOfComponents(4);
+  this->SurfaceLooks->SetNumberOfTuples(count);
+  for (int i = 0; i < count; ++i)
+  {
+    double look[4];
+    this->IsoMapper->GetSurfaceLook(this->Property, i, values->GetValue(i), look, look[3]);
+    this->SurfaceLooks->SetTypedTuple(i, look);
+  }
+  return this->SurfaceLooks;
 }
 
 //------------------------------------------------------------------------------

@@ -48,11 +48,14 @@
 #define vtkHistoPyramidIsoRepresentation_h
 
 #include "MedicalIsosurfacesRepresentationsModule.h" // For export macro
+#include "vtkDoubleArray.h"                          // For vtkNew<vtkDoubleArray>
 #include "vtkImageVolumeRepresentation.h"
-#include "vtkNew.h" // For vtkNew
+#include "vtkNew.h"   // For vtkNew
+#include "vtkPlane.h" // For vtkPlane
 
 #include <string> // For std::string
 
+class vtkDoubleArray;
 class vtkHistoPyramidIsoMapper;
 
 class MEDICALISOSURFACESREPRESENTATIONS_EXPORT vtkHistoPyramidIsoRepresentation
@@ -98,6 +101,23 @@ public:
 
   ///@{
   /**
+   * A clipping plane, the representation's counterpart of ParaView's Clip
+   * filter with a Plane: on (ClipPlane), the surfaces are cut at the plane
+   * through ClipPlaneOrigin with ClipPlaneNormal (data coordinates, moved with
+   * the display's transform) and left open at the cut. As Clip does, the side
+   * the normal points to is removed while ClipPlaneInvert is on (the default)
+   * and kept when it is off. Both paths honour it (the mapper's clipping
+   * planes), together with cropping (UseCropping). Default off, origin 0,
+   * normal +x.
+   */
+  void SetClipPlane(bool use);
+  void SetClipPlaneOrigin(double x, double y, double z);
+  void SetClipPlaneNormal(double x, double y, double z);
+  void SetClipPlaneInvert(bool invert);
+  ///@}
+
+  ///@{
+  /**
    * Colouring of the surfaces (see the class description): the solid colour,
    * one colour per surface (used when ColorEachSurface is on), an opacity per
    * surface, and a global opacity multiplier. Surface i is the i-th value of
@@ -136,6 +156,23 @@ public:
   double GetFrameBufferMB() { return this->GetFrameBufferBytes() / 1.0e6; }
   ///@}
 
+  /**
+   * What each isovalue, in the order of IsosurfaceValues, is drawn with:
+   * red, green, blue and opacity per isovalue (vtkHistoPyramidIsoMapper::
+   * GetSurfaceLook() under the colouring of the last update; opacity 0: not
+   * drawn). The panel's Opacity column and the mesh made from the view read
+   * it, so both show what the view draws.
+   */
+  vtkDoubleArray* GetSurfaceLooks();
+
+  /**
+   * The warning for `count` isovalues `values` outside `range` of the array
+   * `arrayName` ("" when all are inside): the one text the representation
+   * gives in Output Messages and the panel shows above the list.
+   */
+  static std::string OutsideRangeMessage(
+    const double* values, int count, const double range[2], const char* arrayName);
+
 protected:
   vtkHistoPyramidIsoRepresentation();
   ~vtkHistoPyramidIsoRepresentation() override;
@@ -167,7 +204,13 @@ private:
   std::string IsovaluesOutsideRange();
 
   vtkNew<vtkHistoPyramidIsoMapper> IsoMapper;
+  vtkNew<vtkDoubleArray> SurfaceLooks;
   bool ColorEachSurface = false;
+  bool ClipPlane = false;
+  double ClipPlaneOrigin[3] = { 0.0, 0.0, 0.0 };
+  double ClipPlaneNormal[3] = { 1.0, 0.0, 0.0 };
+  bool ClipPlaneInvert = true;
+  vtkNew<vtkPlane> MapperClipPlane; // the plane as the mapper takes it (world, kept side)
   std::string LastResampleMessage;
   std::string LastRangeMessage;
 };

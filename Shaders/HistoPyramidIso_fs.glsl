@@ -33,6 +33,12 @@
 //    cells hidden behind a surface already drawn cost no ray casting (the
 //    paper's reason for sorting).
 //
+// Clipping planes (MEDISO_CLIP_PLANES, their number): the kept part of the
+// volume is the intersection of the planes' kept half-spaces, which is
+// convex, so the ray's piece in the cell keeps one interval [t0, t1] and the
+// root search runs only there. A ray that enters the kept part at a plane
+// finds the surface behind it: the cut is seen through, left open.
+//
 // Variants: the renderer defines MEDISO_POINT_FOOTPRINT (see the vertex
 // stage), MEDISO_TRANSLUCENT (any isovalue with opacity < 1), MEDISO_LIGHTS (the
 // number of lights) and MEDISO_ISOVALUES (the number of isovalues, for the
@@ -107,6 +113,9 @@ uniform float specular;
 uniform float specularPower;
 uniform vec3 lightDirections[6]; // view space, from the surface towards the light
 uniform vec3 lightColors[6];
+#ifdef MEDISO_CLIP_PLANES
+uniform vec4 clipPlanes[MEDISO_CLIP_PLANES]; // index space; a p + w >= 0 is kept
+#endif
 
 // The corners' central-difference gradients, interpolated trilinearly.
 vec3 gradient(vec3 p)
@@ -329,6 +338,20 @@ void main()
   {
     t0 = max(t0, -1.0); // the eye
   }
+#ifdef MEDISO_CLIP_PLANES
+  // Each plane's value along the ray is linear in t: the kept half-space
+  // bounds t from below where the ray goes towards it, from above where it
+  // leaves, and keeps all or nothing of a ray parallel to the plane.
+  vec3 start = vec3(gCell) + o;
+  for (int i = 0; i < MEDISO_CLIP_PLANES; ++i)
+  {
+    float along = dot(clipPlanes[i].xyz, d);
+    float at = dot(clipPlanes[i].xyz, start) + clipPlanes[i].w;
+    float crossing = -at / (along == 0.0 ? 1.0 : along);
+    t0 = along > 0.0 ? max(t0, crossing) : t0;
+    t1 = along < 0.0 ? min(t1, crossing) : (along == 0.0 && at < 0.0 ? -3.0e38 : t1);
+  }
+#endif
   if (!(t0 <= t1))
   {
     discard;

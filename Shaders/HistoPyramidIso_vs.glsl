@@ -448,6 +448,27 @@ bool cellOffScreen(ivec3 c)
 }
 #endif
 
+#ifdef MEDISO_CLIP_PLANES
+uniform vec4 clipPlanes[MEDISO_CLIP_PLANES]; // index space; a p + w >= 0 is kept
+
+// Whether the whole cell [c, c + 1] lies on the removed side of a clipping
+// plane: the plane's largest value over the cell's corners is negative. The
+// fragment stage would find no hit in such a cell; skipping it here saves
+// its corner fetches and footprint.
+bool cellClippedAway(ivec3 c)
+{
+  for (int i = 0; i < MEDISO_CLIP_PLANES; ++i)
+  {
+    vec4 plane = clipPlanes[i];
+    if (dot(plane.xyz, vec3(c)) + plane.w + dot(max(plane.xyz, vec3(0.0)), vec3(1.0)) < 0.0)
+    {
+      return true;
+    }
+  }
+  return false;
+}
+#endif
+
 void main()
 {
   uint index = uint(MEDISO_PRIMITIVE);
@@ -528,6 +549,12 @@ void main()
   }
 #ifdef MEDISO_CULL_CELLS
   if (vIsovalue >= 0 && cellOffScreen(cell))
+  {
+    vIsovalue = -1;
+  }
+#endif
+#ifdef MEDISO_CLIP_PLANES
+  if (vIsovalue >= 0 && cellClippedAway(cell))
   {
     vIsovalue = -1;
   }

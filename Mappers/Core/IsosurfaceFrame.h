@@ -15,6 +15,7 @@
 #define MedicalIsosurfaces_IsosurfaceFrame_h
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -23,6 +24,10 @@ namespace mediso
 
 /// Most lights a frame takes.
 constexpr int MaximumLights = 6;
+
+/// Most clipping planes a frame takes: VTK's six clipping planes and the six
+/// faces of a cropping box.
+constexpr int MaximumClipPlanes = 12;
 
 /// One isosurface: its value, colour and opacity (0 < opacity <= 1).
 struct IsosurfaceLook
@@ -59,6 +64,12 @@ struct IsosurfaceFrame
   bool AllowPointFootprint = true;
   /// Draw opaque frames with point footprints through the first-hit pass.
   bool FirstHitPass = true;
+  /// Clipping planes in cell-index space, at most MaximumClipPlanes: plane (a, b, c, d)
+  /// keeps the points where a i + b j + c k + d >= 0. The kept part of the volume is the
+  /// intersection of the planes' kept half-spaces (convex), so each ray meets it in one
+  /// interval: the surfaces are cut exactly at the planes and left open there, and a
+  /// surface behind a removed one shows through. A cropping box is six of them.
+  std::vector<std::array<double, 4>> ClipPlanes;
 
   /// The lights a program draws with (NumberOfLights within 0..MaximumLights): its
   /// MEDISO_LIGHTS, a constant of the program, since a software rasteriser runs every

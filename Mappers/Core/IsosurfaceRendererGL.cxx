@@ -11,6 +11,7 @@
 #include <climits>
 #include <cmath>
 #include <sstream>
+#include <string>
 
 namespace mediso
 {
@@ -152,6 +153,11 @@ struct FrameVariant
   bool Points = false;
   bool FirstHit = false;
   bool Cull = false;
+  // The clipping planes that cut the volume (index space); Clipped: one of
+  // them removes all of it.
+  int ClipPlanes = 0;
+  float ClipPlaneValues[4 * MaximumClipPlanes] = { 0 };
+  bool Clipped = false;
 
   // Several opaque isovalues in the first-hit pass: one primitive per cell
   // whose fragments take the nearest hit of the cell's isovalues.
@@ -159,6 +165,45 @@ struct FrameVariant
   // Each cell drawn once, with all its isovalues.
   bool OneRankPerCell() const { return this->Translucent || this->Nearest(); }
 };
+
+// The frame's clipping planes that cut the index box [0, cells] (one that
+// keeps all 8 corners costs nothing and is left out, so a cropping box at the
+// volume's bounds compiles no clipping at all). "" or why they are unusable.
+std::string ChooseClipPlanes(const IsosurfaceFrame& frame, FrameVariant& v)
+{
+  if (frame.ClipPlanes.size() > static_cast<std::size_t>(MaximumClipPlanes))
+  {
+    return "more than " + std::to_string(MaximumClipPlanes) + " clipping planes";
+  }
+  for (const auto& plane : frame.ClipPlanes)
+  {
+    if (!std::isfinite(plane[0]) || !std::isfinite(plane[1]) || !std::isfinite(plane[2]) ||
+      !std::isfinite(plane[3]) || (plane[0] == 0.0 && plane[1] == 0.0 && plane[2] == 0.0))
+    {
+      return "a clipping plane has no normal or a value that is not finite";
+    }
+    int kept = 0;
+    for (int i = 0; i < 8; ++i)
+    {
+      const double x = (i & 1) ? v.Cells[0] : 0.0, y = (i & 2) ? v.Cells[1] : 0.0,
+                   z = (i & 4) ? v.Cells[2] : 0.0;
+      kept += plane[0] * x + plane[1] * y + plane[2] * z + plane[3] >= 0.0 ? 1 : 0;
+    }
+    if (kept == 0)
+    {
+      v.Clipped = true;
+    }
+    else if (kept < 8)
+    {
+      for (int c = 0; c < 4; ++c)
+      {
+        v.ClipPlaneValues[4 * v.ClipPlanes + c] = static_cast<float>(plane[c]);
+      }
+      ++v.ClipPlanes;
+    }
+  }
+  return "";
+}
 
 // Step 1: the variant. "" or why the frame cannot be drawn.
 std::string ChooseVariant(
@@ -214,7 +259,7 @@ std::string ChooseVariant(
   // volume is: in a whole-volume view the test is not compiled in at all (a
   // uniform branch still costs a software rasteriser its instructions).
   v.Cull = !BoxInsideClipVolume(v.IndexToClip, v.Cells);
-  return "";
+  return ChooseClipPlanes(frame, v);
 }
 } // namespace
 
@@ -368,6 +413,10 @@ Program* IsosurfaceRendererGL::Internals::ComposeProgram(const HistoPyramidWalk&
   {
     defines << "#define MEDISO_CULL_CELLS 1\n";
   }
+  if (v.ClipPlanes > 0)
+  {
+    defines << "#define MEDISO_CLIP_PLANES " << v.ClipPlanes << "\n";
+  }
   defines << "#define MEDISO_LIGHTS " << frame.LightsUsed() << "\n";
   defines << "#define MEDISO_ISOVALUES " << (v.OneRankPerCell() ? v.Counted : MaximumIsovalues)
           << "\n";
@@ -418,6 +467,10 @@ void IsosurfaceRendererGL::Internals::SetUniforms(Program& program, const HistoP
   program.Set1fv("isovalues", MaximumIsovalues, v.IsoValues);
   program.Set4fv("isoColors", MaximumIsovalues, v.IsoColors);
   SetLightingUniforms(program, frame);
+  if (v.ClipPlanes > 0)
+  {
+    program.Set4fv("clipPlanes", v.ClipPlanes, v.ClipPlaneValues);
+  }
   // Where the cells are drawn: the viewport, or in the first-hit pass the
   // same viewport in buffers whose pixel (0, 0) is window pixel HitRect.xy.
   const int* viewport = frame.Viewport;
@@ -525,6 +578,11 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
   {
     error = unusable;
     return false;
+  }
+  if (v.Clipped)
+  {
+    stats.Primitives = 0;
+    return true; // a clipping plane removes the whole volume
   }
 
   // 2. The first-hit pass's buffers, made before the program is chosen, so

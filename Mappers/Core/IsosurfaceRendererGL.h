@@ -28,8 +28,17 @@
  *    drawing order (the nearest) before any ray is cast, then that colour and
  *    depth into the host's framebuffer. Translucent frames draw each cell
  *    once, back to front, compositing all its isovalues' hits in depth order.
+ * -# Clipping planes (IsosurfaceFrame::ClipPlanes, a cropping box among
+ *    them) cut each fragment's ray before its root is sought: the part of
+ *    the volume they keep is convex, so the ray keeps one interval of its
+ *    piece in the cell, and the first root in that interval is the first
+ *    visible hit. A surface behind a clipped one is therefore seen through
+ *    the cut, in the first-hit pass (only fragments that hit write) and in
+ *    translucent compositing alike; cut faces are left open. The vertex
+ *    stage skips cells wholly on a removed side, and planes that keep the
+ *    whole volume are not compiled in.
  * -# Programs are compiled per variant (footprint, opaque or translucent,
- *    first hit, lights, isovalues, the pyramid's layout): a software
+ *    first hit, lights, isovalues, clipping planes, the pyramid's layout): a software
  *    rasteriser runs every branch of a shader under SIMD masks, so one
  *    mode's code must not sit in another's program.
  *

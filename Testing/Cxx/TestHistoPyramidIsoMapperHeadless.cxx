@@ -4,7 +4,7 @@
 // the same scene: the volume written as a MetaImage, the same isosurfaces,
 // colours, material, background, image size and camera (VTK's ResetCamera,
 // then Azimuth, Elevation, OrthogonalizeViewUp, Zoom), and VTK's headlight.
-//   TestHistoPyramidIsoMapperHeadless MEDISO_RENDER TEMP_DIR Sphere|Torus|CT
+//   TestHistoPyramidIsoMapperHeadless MEDISO_RENDER TEMP_DIR Sphere|Torus|Clip|CT
 // Passes when the two images differ by more than 24 levels (of 255, in any
 // channel) in at most 0.5% of the pixels, and both drew the same number of
 // primitives. Skipped (125) where either path cannot run, or without the CT
@@ -18,6 +18,7 @@
 #include "vtkMetaImageWriter.h"
 #include "vtkPNGReader.h"
 #include "vtkPNGWriter.h"
+#include "vtkPlane.h"
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkUnsignedCharArray.h"
@@ -25,8 +26,10 @@
 #include "vtkWindowToImageFilter.h"
 #include <vtksys/SystemTools.hxx>
 
+#include <array>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -37,6 +40,39 @@ namespace
 {
 using medical_test::Check;
 
+// A MetaImage header's TransformMatrix (row-major, the axes as columns, as
+// Headless/MetaImage.cxx reads it); the identity without one.
+std::vector<double> MetaImageDirection(const std::string& path)
+{
+  std::vector<double> m = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int i = 0; i < 64 && std::getline(in, line); ++i)
+  {
+    const auto equals = line.find('=');
+    std::string key;
+    std::istringstream(line.substr(0, equals)) >> key;
+    if (key == "ElementDataFile" || equals == std::string::npos)
+    {
+      break;
+    }
+    if (key == "TransformMatrix")
+    {
+      std::istringstream values(line.substr(equals + 1));
+      std::vector<double> read(9);
+      for (double& v : read)
+      {
+        values >> v;
+      }
+      if (values)
+      {
+        m = read;
+      }
+    }
+  }
+  return m;
+}
+
 struct Scene
 {
   vtkSmartPointer<vtkImageData> Image;
@@ -45,6 +81,10 @@ struct Scene
   int Size[2] = { 400, 300 };
   double Azimuth = 0.0, Elevation = 0.0, Zoom = 1.0;
   bool Parallel = false;
+  // Clipping planes (world: a x + b y + c z + d >= 0 kept) and a cropping box
+  // of point indices (none when Crop[0] > Crop[1]).
+  std::vector<std::array<double, 4>> ClipPlanes;
+  int Crop[6] = { 1, 0, 0, 0, 0, 0 };
 };
 
 // The scene's image drawn by vtkHistoPyramidIsoMapper, and its primitives.
@@ -59,6 +99,25 @@ vtkSmartPointer<vtkImageData> RenderWithVTK(const Scene& s, std::uint64_t& primi
   window->AddRenderer(renderer);
   vtkNew<vtkHistoPyramidIsoMapper> mapper;
   auto volume = iso_test::MakeVolume(s.Image, s.Looks, mapper);
+  for (const auto& p : s.ClipPlanes)
+  {
+    // The plane's point nearest the origin: -d n / |n|^2.
+    const double norm2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+    vtkNew<vtkPlane> plane;
+    plane->SetNormal(p[0], p[1], p[2]);
+    plane->SetOrigin(-p[3] * p[0] / norm2, -p[3] * p[1] / norm2, -p[3] * p[2] / norm2);
+    mapper->AddClippingPlane(plane);
+  }
+  if (s.Crop[0] <= s.Crop[1])
+  {
+    double planes[6];
+    for (int i = 0; i < 6; ++i)
+    {
+      planes[i] = s.Image->GetOrigin()[i / 2] + s.Crop[i] * s.Image->GetSpacing()[i / 2];
+    }
+    mapper->SetCropping(true);
+    mapper->SetCroppingRegionPlanes(planes);
+  }
   renderer->AddVolume(volume);
   vtkCamera* camera = renderer->GetActiveCamera();
   camera->SetParallelProjection(s.Parallel);
@@ -95,6 +154,15 @@ vtkSmartPointer<vtkImageData> RenderHeadless(const Scene& s, const std::string& 
   command << Quote(program) << " " << Quote(s.Volume) << " --size " << s.Size[0] << "x" << s.Size[1]
           << " --azimuth " << s.Azimuth << " --elevation " << s.Elevation << " --zoom " << s.Zoom
           << (s.Parallel ? " --parallel" : "") << " --output " << Quote(png) << " --stats";
+  for (const auto& p : s.ClipPlanes)
+  {
+    command << " --clip " << p[0] << "," << p[1] << "," << p[2] << "," << p[3];
+  }
+  if (s.Crop[0] <= s.Crop[1])
+  {
+    command << " --crop " << s.Crop[0] << "," << s.Crop[1] << "," << s.Crop[2] << "," << s.Crop[3]
+            << "," << s.Crop[4] << "," << s.Crop[5];
+  }
   for (const iso_test::Look& look : s.Looks)
   {
     command << " --iso " << look.Value << ":" << look.Color[0] << "," << look.Color[1] << ","
@@ -165,7 +233,7 @@ int TestHistoPyramidIsoMapperHeadless(int argc, char* argv[])
 {
   if (argc < 4)
   {
-    std::printf("usage: TestHistoPyramidIsoMapperHeadless MEDISO_RENDER TEMP_DIR Sphere|Torus|CT\n");
+    std::printf("usage: TestHistoPyramidIsoMapperHeadless MEDISO_RENDER TEMP_DIR Sphere|Torus|Clip|CT\n");
     return 1;
   }
   const std::string program = argv[1], temp = argv[2], which = argv[3];
@@ -215,6 +283,21 @@ int TestHistoPyramidIsoMapperHeadless(int argc, char* argv[])
     s.Zoom = 30.0;
     scenes.push_back(s);
   }
+  else if (which == "Clip")
+  {
+    // The torus cut by an oblique plane and cropped to a box (--clip, --crop).
+    Scene s;
+    s.Image = iso_test::Torus(48, 12.0);
+    s.Volume = writeVolume(s.Image, "torus_clip.mha");
+    s.Looks = { { 4.5, { 0.8, 0.8, 0.4 }, 1.0 }, { 7.0, { 0.4, 0.6, 0.9 }, 0.4 } };
+    s.Azimuth = -35.0;
+    s.Elevation = 50.0;
+    s.Zoom = 1.2;
+    s.ClipPlanes = { { 1.0, 0.5, 0.3, -2.0 } };
+    const int crop[6] = { 4, 40, 0, 47, 2, 23 };
+    std::copy(crop, crop + 6, s.Crop);
+    scenes.push_back(s);
+  }
   else if (which == "CT")
   {
     const std::string ct = medical_test::CachedDataFile("ct_head.mha", "the real CT");
@@ -227,6 +310,10 @@ int TestHistoPyramidIsoMapperHeadless(int argc, char* argv[])
     reader->Update();
     Scene s;
     s.Image = reader->GetOutput();
+    // mediso-render places the file by its TransformMatrix (Python/fetch_data.py writes the
+    // CT's direction in patient space), which VTK's reader leaves out: the same direction on
+    // VTK's image, so that both draw the same scene.
+    s.Image->SetDirectionMatrix(MetaImageDirection(ct).data());
     s.Volume = ct;
     s.Size[0] = 480;
     s.Size[1] = 360;

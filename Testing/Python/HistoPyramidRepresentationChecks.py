@@ -58,6 +58,9 @@ def make_scene(source):
     lut = GetColorTransferFunction("HU")
     lut.RGBPoints = [-1000.0, 0.93, 0.75, 0.62, -100.0, 0.93, 0.75, 0.62,
                      100.0, 0.96, 0.94, 0.86, 3000.0, 0.96, 0.94, 0.86]
+    # The opacity map applies only with the colour map's opacity mapping on,
+    # as for ParaView's Surface representation.
+    lut.EnableOpacityMapping = 1
     pwf = GetOpacityTransferFunction("HU")
     # skin 0.35, bone 1 (x, value, midpoint, sharpness)
     pwf.Points = [-1000.0, 0.35, 0.5, 0.0, -100.0, 0.35, 0.5, 0.0,

@@ -15,6 +15,11 @@ Environment (set by the driver, Testing/Python/TestMedicalIsosurfacesGUI.py):
                        (MEDISO_GUI_DATA) shown as HistoPyramid Isosurface with
                        nothing set (its start: skin over bone); the driver's
                        events then add a preset, or drag a histogram marker
+                       "mesh": the phantom as HistoPyramid Isosurface at -500,
+                       400 and 5000 (outside the range: the panel's warning),
+                       selected: the driver's events click Make Mesh; once the
+                       mesh is drawn, what it is goes to MEDISO_GUI_STATUS
+                       with "-mesh" appended
     MEDISO_GUI_STATUS  where to write what the proxies say, as JSON, once the
                        scene is set up (the driver waits for this file)
     MEDISO_GUI_DATA    the head CT (.mha) for the "ct-" panels
@@ -113,6 +118,47 @@ elif panel.startswith("ct-"):
     display.SMProxy.GetProperty("IsosurfaceValues").AddObserver(
         "ModifiedEvent", lambda *_: record("values", list(display.IsosurfaceValues)))
     view.SMProxy.AddObserver("EndEvent", lambda *_: record("render"))
+    SetActiveSource(head)
+elif panel == "mesh":
+    display.SetRepresentationType("HistoPyramid Isosurface")
+    display.IsosurfaceValues = [-500.0, 400.0, 5000.0]
+    display.HistoPyramidColorEachSurface = 1
+    display.HistoPyramidSurfaceColors = [0.93, 0.75, 0.62, 0.96, 0.94, 0.86, 0.2, 0.2, 1.0]
+    display.HistoPyramidSurfaceOpacities = [0.4, 1.0, 1.0]
+    view.ResetCamera()
+    Render(view)
+    # What a Block LOD Contour of the drawn values makes at the level Auto LOD
+    # chooses (3 here), to compare with the mesh the button makes.
+    reference = BlockLODContour(Input=head, ContourBy=["POINTS", "HU"], Isosurfaces=[-500.0, 400.0],
+                                LOD=3)
+    reference.UpdatePipeline()
+    status.update({"reference_triangles": reference.GetDataInformation().GetNumberOfCells(),
+                   "head_visible": display.Visibility})
+    Delete(reference)
+    del reference
+
+    def mesh_drawn(caller, event):
+        mesh = FindSource("Mesh of MedicalPhantom1")
+        if mesh is None or os.path.exists(status_path + "-mesh"):
+            return
+        contour = mesh.Input
+        contour.UpdatePropertyInformation()
+        mesh_status = {
+            "triangles": mesh.GetDataInformation().GetNumberOfCells(),
+            "contour_values": list(contour.GetPropertyValue("ContourValues")),
+            "auto_lod": contour.GetPropertyValue("AutoLOD"),
+            "chosen_level": contour.GetProperty("ChosenLevel")[0],
+            "surface_names": list(mesh.SurfaceNames),
+            "surface_colors": list(mesh.SurfaceColors),
+            "head_visible": GetDisplayProperties(head, view).Visibility,
+            "mesh_visible": GetDisplayProperties(mesh, view).Visibility,
+        }
+        with open(status_path + "-mesh.part", "w") as f:
+            json.dump(mesh_status, f, indent=1)
+        os.replace(status_path + "-mesh.part", status_path + "-mesh")
+
+    # The button runs medical_isosurfaces.MakeMeshFromView, whose last step renders.
+    view.SMProxy.AddObserver("EndEvent", mesh_drawn)
     SetActiveSource(head)
 else:
     Hide(head, view)

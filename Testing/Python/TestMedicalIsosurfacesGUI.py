@@ -2,8 +2,11 @@
 
     pvpython TestMedicalIsosurfacesGUI.py --paraview PATH --plugin-dir DIR --settings INI
                                           --baseline PNG --out DIR [--qch FILE]
+                                          [--panels NAME ...] [--data MHA]
 
-Starts the `paraview` executable three times, each with a fresh home holding
+Starts the `paraview` executable once per session --panels names (by default
+the phantom's six below; TestMedicalIsosurfacesGUI_CT names the head CT's
+ct-start, ct-preset and ct-drag), each with a fresh home holding
 Testing/Data/GUI/ParaView5.11.0.ini (no welcome dialog, a left dock wide enough
 to read), the plugin on PV_PLUGIN_PATH, and Testing/Python/MedicalIsosurfacesGUIScene.py
 as its --script:
@@ -18,6 +21,12 @@ as its --script:
 2b. "apply": the phantom as HistoPyramid Isosurface (pure red skin); recorded
    events add Block LOD Contour from the Filters menu and click Apply: the
    phantom's display must be hidden (no red left on the screen);
+2c. "mesh": the phantom as HistoPyramid Isosurface at -500, 400 and 5000
+   (outside the range); recorded events check that the panel shows the range
+   warning and click Make Mesh; the scene reports the mesh: the triangles of a
+   Block LOD Contour of the drawn values at Auto LOD's level, each surface's
+   name, colour and opacity, the phantom hidden (the representation's one
+   warning about 5000 is expected in the log);
 3. "help": as 2, then recorded events: with Auto LOD the level control is
    disabled and shows the level used, the budget enabled; Auto LOD unchecked,
    the level is enabled and shows its setting, the budget disabled (QtTesting
@@ -54,7 +63,7 @@ import HistoPyramidRepresentationChecks as hp
 
 # The sessions: the plugin's panels on the phantom (TestMedicalIsosurfacesGUI)
 # and the head CT's start, a preset and a histogram drag (..._CT).
-DEFAULT_PANELS = ["representation", "blocklod", "start", "apply", "help"]
+DEFAULT_PANELS = ["representation", "blocklod", "start", "apply", "mesh", "help"]
 CT_PANELS = ["ct-start", "ct-preset", "ct-drag"]
 parser = argparse.ArgumentParser()
 parser.add_argument("--paraview", required=True)
@@ -64,7 +73,7 @@ parser.add_argument("--baseline", required=True)
 parser.add_argument("--out", required=True)
 parser.add_argument("--qch", help="the plugin's built help collection")
 parser.add_argument("--panels", nargs="+", default=DEFAULT_PANELS,
-                    help="the sessions to run (default: the phantom's five; the CT's: " + " ".join(CT_PANELS) + ")")
+                    help="the sessions to run (default: the phantom's six; the CT's: " + " ".join(CT_PANELS) + ")")
 parser.add_argument("--data", help="the head CT (.mha) for the ct- panels (default: the data cache's)")
 args = parser.parse_args()
 
@@ -160,8 +169,9 @@ def wait_for(path, process, seconds):
     return None
 
 
-def stop_paraview(panel, process, log):
-    """Kill paraview (SIGKILL: nothing more to print) and check what it printed."""
+def stop_paraview(panel, process, log, expected=None):
+    """Kill paraview (SIGKILL: nothing more to print) and check what it printed: no error or
+    warning, except one warning containing `expected` (and its VTK header line) when given."""
     if process.poll() is None:
         process.send_signal(signal.SIGKILL)
     process.wait()
@@ -171,6 +181,12 @@ def stop_paraview(panel, process, log):
     bad = [line for line in lines
            if "ERROR" in line or "Warning: In" in line or " ERR|" in line or " WARN|" in line
            or "critical:" in line or "Traceback" in line]
+    if expected is not None:
+        said = [i for i, line in enumerate(lines) if expected in line]
+        check(len(said) == 1, "%s: one warning saying %r (%d)" % (panel, expected, len(said)))
+        # The warning and the "Warning: In file, line N" header VTK prints above it.
+        allowed = set(lines[i] for i in said) | set(lines[i - 1] for i in said if i > 0)
+        bad = [line for line in bad if line not in allowed]
     check(not bad, "%s: paraview printed no error or warning (got %r)" % (panel, bad[:5]))
 
 
@@ -219,6 +235,9 @@ if wanted("representation"):
     status = wait_for(status_path, process, 120)
     if status:
         wait_for_playback(log, 60)
+    # As for 1b and 2b: the window may not be painted yet when the status is
+    # written (a black screen was captured twice a second apart under load).
+    time.sleep(3.0)
     representation_screen = stable_screen() if status else None
     stop_paraview("representation", process, log)
     if check(status is not None, "representation: the scene script ran (status written)"):
@@ -289,6 +308,39 @@ if wanted("apply"):
         write_png(os.path.join(args.out, NAME + "-apply.png"), apply_screen)
         check(int(red.sum()) < 50,
               "apply: after Apply the phantom's red skin is hidden (%d red pixels in the view)" % int(red.sum()))
+
+# --- 2c. Make Mesh, and the out-of-range warning ------------------------------
+# The phantom as HistoPyramid Isosurface at -500, 400 and 5000 (outside its
+# range): the recorded events check that the panel shows the warning, then
+# click Make Mesh. The scene script reports the mesh once it is drawn: the
+# triangles of a Block LOD Contour of the two drawn values at the level Auto LOD
+# chooses, the colours and names carried, the phantom hidden and the mesh shown.
+# The representation's one warning about 5000 is expected in the log.
+if wanted("mesh"):
+    panel_list = ("pqClientMainWindow/propertiesDock/propertiesPanel/scrollArea/qt_scrollarea_viewport/"
+                  "scrollAreaWidgetContents/DisplayFrame/ProxyPanel/medical_isosurface_list")
+    mesh_events = ('<pqcheck object="%s/RangeWarning" property="visible" arguments="true" />\n'
+                   '<pqevent object="%s/MakeMesh" command="activate" arguments="" />'
+                   % (panel_list, panel_list))
+    process, status_path, log = start_paraview("mesh", mesh_events)
+    status = wait_for(status_path, process, 120)
+    mesh_status = wait_for(status_path + "-mesh", process, 90) if status else None
+    stop_paraview("mesh", process, log,
+                  expected="isovalue 5000 is outside the range")
+    if check(status is not None and mesh_status is not None,
+             "mesh: the scene ran and Make Mesh made a mesh (%s)" % mesh_status):
+        check(status["head_visible"] == 1 and mesh_status["head_visible"] == 0
+              and mesh_status["mesh_visible"] == 1,
+              "mesh: the phantom's display hidden, the mesh shown")
+        check(mesh_status["contour_values"] == [-500.0, 400.0] and mesh_status["auto_lod"] == 1
+              and mesh_status["chosen_level"] == 3
+              and mesh_status["triangles"] == status["reference_triangles"] > 1000,
+              "mesh: the drawn values (5000 left out) at Auto LOD's level 3, the Block LOD "
+              "Contour's %d triangles (%d)" % (status["reference_triangles"], mesh_status["triangles"]))
+        check(mesh_status["surface_names"] == ["HU -500", "HU 400"]
+              and [round(c, 4) for c in mesh_status["surface_colors"]]
+              == [0.93, 0.75, 0.62, 0.4, 0.96, 0.94, 0.86, 1.0],
+              "mesh: each surface's name, colour and opacity carried (%s)" % mesh_status)
 
 # --- 3. the "?" button opens the plugin's documentation ----------------------
 # Before the click, the level-of-detail controls: with Auto LOD the level is

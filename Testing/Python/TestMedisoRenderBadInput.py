@@ -81,6 +81,12 @@ def main():
     expect(binary, "nine isovalues", [good] + sum((["--iso", str(v)] for v in range(9)), []), 2,
            ["at most 8"])
     expect(binary, "bad api", [good, "--iso", "0", "--api", "vulkan"], 2, ["--api"])
+    expect(binary, "clip plane without a normal", [good, "--iso", "0", "--clip", "0,0,0,1"], 2,
+           ["--clip"])
+    expect(binary, "clip plane of 3 numbers", [good, "--iso", "0", "--clip", "1,0,0"], 2, ["--clip"])
+    expect(binary, "seven clip planes", [good, "--iso", "0"] + ["--clip", "1,0,0,0"] * 7, 2,
+           ["at most 6"])
+    expect(binary, "empty crop box", [good, "--iso", "0", "--crop", "3,1,0,4,0,3"], 2, ["--crop"])
 
     # Volumes.
     expect(binary, "missing file", [os.path.join(temp, "none.mha"), "--iso", "0"], 3,

@@ -107,13 +107,24 @@ async def wait_idle(http, seconds):
 
 async def same_surface(http, ws):
     for level in (3, 1):
-        progress, answer = await webserver.operation(ws, request(1, "d0", ISO, level))
+        # Not cleaned: the surface as extracted (the default export cleans it, below).
+        raw = dict(request(1, "d0", ISO, level), export={"clean": False})
+        progress, answer = await webserver.operation(ws, raw)
         triangles, points = reference_counts(level)
         checks(answer.get("done") and answer["triangles"] == triangles and
                answer["points"] == points,
-               "level %d, no steps: %s triangles, %s points; %s here %d, %d"
+               "level %d, no steps, not cleaned: %s triangles, %s points; %s here %d, %d"
                % (level, answer.get("triangles"), answer.get("points"),
                   "vtkFlyingEdges3D" if level == 3 else "BlockLODContour", triangles, points))
+        report = answer.get("report", {})
+        _, cleaned = await webserver.operation(ws, request(1, "d0", ISO, level))
+        checks(cleaned.get("done") and cleaned["triangles"] == triangles -
+               report.get("degenerateTriangles", -1) - report.get("duplicateTriangles", -1)
+               and cleaned["points"] == report.get("points"),
+               "... cleaned (the default): %s triangles, the %d less the %s degenerate and %s "
+               "duplicate ones the report found; its %s points" % (
+                   cleaned.get("triangles"), triangles, report.get("degenerateTriangles"),
+                   report.get("duplicateTriangles"), report.get("points")))
 
 
 async def watertight(http, ws, folder):

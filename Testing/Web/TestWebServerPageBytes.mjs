@@ -2,8 +2,9 @@
 // The paper's claim on the wire, counted by Chrome itself (CDP network events, WebSocket frames
 // included): the page fetches the volume once, in at most 0.6x its raw bytes, and then 20
 // isovalue changes, 5 colour and opacity changes and 5 camera changes send and receive nothing
-// at all: no request, no WebSocket frame, 0 bytes; the page's own readout agrees. On the
-// server's default dataset: the head CT when it is fetched, else the phantom (said).
+// at all: no request, no WebSocket frame, 0 bytes; the page's own readout agrees. A reload then
+// revalidates the volume (304) instead of fetching it again. On the server's default dataset:
+// the head CT when it is fetched, else the phantom (said).
 import { Checks, countWire, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
 
 const checks = new Checks();
@@ -77,4 +78,22 @@ checks.check(wire.received === before.received && wire.events === before.events,
 checks.check(stats1.bytesSent === stats0.bytesSent && stats1.bytesReceived === stats0.bytesReceived,
   "... and the page's readout agrees (" + stats1.bytesSent + " B sent, " +
   stats1.bytesReceived + " B received since it loaded)");
+
+// A reload: the browser kept the volume (ETag, Cache-Control no-cache) and revalidates it; the
+// server answers 304 and the volume's bytes do not cross again (docs/web.md, "Caching").
+const kept = new Set(wire.responses.keys());
+await page.reload({ waitUntil: "commit" });
+await page.waitForFunction(() => window.mediso !== undefined, null, { timeout: 120000 });
+await page.evaluate(() => window.mediso.ready);
+const again = [...wire.responses.entries()].filter(([id, r]) => !kept.has(id) &&
+  r.url.includes("/api/volume/")).map(([, r]) => r);
+const stats2 = await page.evaluate(() => window.mediso.stats());
+// Chrome reports the cached response (status 200) after a 304; what crossed is the 304's headers:
+// more than nothing (it was asked again, not taken unrevalidated) and far less than the volume.
+checks.check(again.length === 1 && again[0].encodedDataLength > 0 && again[0].encodedDataLength < 2000,
+  "after a reload the volume is revalidated, not sent: " + again.map((r) => "status " + r.status +
+    " as Chrome reports it, " + r.encodedDataLength + " bytes on the wire").join("; "));
+checks.check((stats2.primitives || stats2.triangles) > 0 && stats2.bytesReceived < 0.05 * dataset.bytes,
+  "... the page draws it from the browser's copy and counts " + stats2.bytesReceived +
+  " B received (the volume's raw bytes: " + dataset.bytes + ")");
 await checks.finish(browser, server);

@@ -4,7 +4,9 @@
 // STL downloaded through the panel's link is binary, holds the summary's triangles and is
 // watertight (every edge shared by two triangles); the PLY goes to window.mediso.showMesh; the
 // WebSocket opens only at the first request and its frames (counted by CDP) are in the page's
-// readout; a server refusal (a hole size of 0) and a cancel show in the panel; with a second
+// readout; the mesh report shows before the download, the source surface is hidden while its
+// result is shown (a toggle for each) and the surface choice follows the isovalue box; a server
+// refusal (a hole size of 0) and a cancel show in the panel; with a second
 // browser running a long operation the first one's waits, and runs when the second closes
 // mid-operation; the page then still changes isovalues without a byte.
 import { readFileSync } from "node:fs";
@@ -72,6 +74,34 @@ checks.check(wire.framesSent >= 1 && wire.framesReceived >= 2,
   wire.framesReceived + " received)");
 const triangles = Number(/([\d,]+) triangles/.exec(summary)[1].replace(/,/g, ""));
 checks.check(/closed \(no boundary edges\)/.test(summary), "the summary says the surface is closed");
+
+// The mesh report, shown before any download; the source surface hidden while the result is
+// shown, and its toggle; the surface choice follows the isovalue box.
+const report = await page.evaluate(() => ({
+  watertight: document.getElementById("op-run").closest("section").dataset.watertight,
+  fields: [...document.querySelectorAll("#op-result .report li[data-field]")].map((li) => li.textContent),
+  head: document.querySelector("#op-result .report li")?.textContent }));
+checks.check(report.watertight === "true" && report.fields.length === 7 &&
+  /Watertight: yes/.test(report.head) && report.fields.includes("boundary edges: 0") &&
+  report.fields.includes("pieces: 1"),
+  "the mesh report is shown: " + report.head + "; " + report.fields.join(", "));
+const drawn = (s) => (s.path === "gpu" ? s.primitives : s.triangles);
+const hidden = await page.evaluate(() => window.mediso.stats());
+const sourceBox = await page.isChecked("#op-show-source");
+await page.click("#op-show-source");
+const shownAgain = await page.evaluate(() => window.mediso.stats());
+await page.click("#op-show-source");
+const hiddenAgain = await page.evaluate(() => window.mediso.stats());
+checks.check(!sourceBox && drawn(hidden) < drawn(stats0) && drawn(shownAgain) === drawn(stats0) &&
+  drawn(hiddenAgain) === drawn(hidden),
+  "the source is hidden while the result is shown (" + drawn(stats0) + " -> " + drawn(hidden) +
+  " drawn on the " + hidden.path + " path), its toggle shows it (" + drawn(shownAgain) +
+  ") and hides it again (" + drawn(hiddenAgain) + ")");
+checks.check(await page.isChecked("#op-show-result"), "the result's toggle is on");
+await page.fill("#surfaces .isovalue", "850");
+const choice = await page.evaluate(() => document.getElementById("op-surface").selectedOptions[0].textContent);
+checks.check(choice === "850", "the surface choice shows the isovalue as changed: " + choice);
+await page.fill("#surfaces .isovalue", String(ISO));
 
 // The STL through the panel's link, read here.
 const [download] = await Promise.all([page.waitForEvent("download"),

@@ -117,7 +117,8 @@ export async function countWire(context, page) {
   });
   cdp.on("Network.responseReceived", (e) => {
     wire.events++;
-    wire.responses.set(e.requestId, { url: e.response.url, headers: e.response.headers });
+    wire.responses.set(e.requestId, { url: e.response.url, headers: e.response.headers,
+      status: e.response.status });
   });
   cdp.on("Network.dataReceived", () => { wire.events++; });
   cdp.on("Network.loadingFinished", (e) => {

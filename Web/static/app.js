@@ -16,6 +16,9 @@
 //   readout.js      the stats, the notes, and why the page cannot run
 //   operations.js   the "On the server" panel
 //   ply.js          the server's surfaces, read
+//   slices.js       the axial, coronal and sagittal views: window, crosshair, contours
+//   histogram.js    the volume's histogram, its isovalue markers dragged
+//   presets.js      the first surfaces (Hounsfield units or Otsu), the CT presets
 
 import { interact } from "./interaction.js";
 import { linkedView, readLink, scheduleLink } from "./link.js";
@@ -23,8 +26,12 @@ import { setupOperations } from "./operations.js";
 import { VIEWS, applyNamedView, drawMarker, markerLabels, sceneView, setDataset, withWorld }
   from "./orientation.js";
 import { applyPath, drawnLevel, requestPath } from "./path.js";
+import { drawHistogram, histogramInfo, setupHistogram } from "./histogram.js";
+import { setupPresets } from "./presets.js";
 import { fps, showDataset, unsupported, updateReadout } from "./readout.js";
 import { $, params, state } from "./state.js";
+import { crosshairInfo, drawSlices, pick, setCrosshair, setSliceWindow, setupSlices, slicesInfo }
+  from "./slices.js";
 import { replaceSurfaces, setupSurfaceList } from "./surfaces.js";
 import { afterFrame, change, clearMesh, fitCanvas, renderNow, requestFrame, showMesh, startViewer }
   from "./viewer.js";
@@ -81,6 +88,20 @@ async function start() {
   if (link.surfaces) {
     replaceSurfaces(link.surfaces, true);
   }
+  // Choosing the value: the CT presets, the histogram and the slice views, redrawn after a frame
+  // whose surfaces or volume level changed.
+  setupPresets((surfaces) => replaceSurfaces(surfaces, false));
+  setupHistogram();
+  setupSlices(histogramInfo());
+  let drawnKey = "";
+  afterFrame.push(() => {
+    const key = JSON.stringify([state.surfaces, state.level]);
+    if (key !== drawnKey) {
+      drawnKey = key;
+      drawSlices();
+      drawHistogram();
+    }
+  });
   const reset = () => applyNamedView("anterior");
   interact(canvas, { reset, changed: scheduleLink });
   for (const button of document.querySelectorAll("#views [data-view]")) {
@@ -117,6 +138,9 @@ async function start() {
     count(sent, received) {
       countBytes(sent, received);
       updateReadout();
+    },
+    showSurface(surface, shown) {
+      change(() => { surface.hidden = !shown; });
     },
   });
 }
@@ -206,6 +230,26 @@ window.mediso = {
   // A surface the server made: binary PLY (vertex x, y, z; faces as index lists).
   showMesh: (ply, color = [0.55, 0.8, 1.0], opacity = 1) => showMesh(ply, color, opacity),
   clearMesh,
+  // The slice views (slices.js): for each, its name, labels, index axis and slice index, window,
+  // the crosshair on its canvas (CSS pixels), mm per CSS pixel; with {contours: true} each
+  // surface's contour points on the slice (LPS mm).
+  slices: (options = {}) => slicesInfo(Boolean(options.contours)),
+  // The crosshair (LPS mm) moved, the slices with it; the point is kept within the volume.
+  setCrosshair(point) {
+    setCrosshair(point);
+    return window.mediso.slices();
+  },
+  getCrosshair: () => crosshairInfo(),
+  // A view's window: a preset's name ("Soft tissue", "Bone", "Full range", ...) or {width, level}.
+  setSliceWindow(view, choice) {
+    setSliceWindow(view, choice);
+    return window.mediso.slices();
+  },
+  // The first point of a drawn surface under (x, y), CSS pixels of the 3D view, LPS mm; null.
+  pick: (x, y) => pick($("view"), x, y),
+  // The histogram (histogram.js): bins {low, width, count}, counts, Otsu's threshold, each
+  // isovalue's marker (x in CSS pixels of the histogram's canvas).
+  histogram: () => histogramInfo(),
   // What the WebAssembly module states for the page (scalar types, levels of detail and their
   // strides, the isovalue limit), as plain data.
   facts: () => ({

@@ -5,6 +5,9 @@
 // the first request (an idle page keeps no connection); progress and the result's summary come
 // back, and the result itself only when asked for: downloads (STL, PLY, VTP), and the PLY for
 // window.mediso.showMesh when the page can draw a mesh. Every byte is counted into the readout.
+// The export options (clean, largest piece, cap) go with the request; the result's mesh report,
+// computed by VTK on the server (serve_messages.REPORT), is shown before any download. While the
+// result is shown its source surface is hidden (a toggle for each).
 
 import { $ } from "./state.js";
 
@@ -15,8 +18,20 @@ const STAGES = {
   fillHoles: "filling holes",
   clip: "clipping",
   decimate: "decimating",
+  export: "cleaning and choosing the piece",
+  report: "checking the mesh",
   write: "writing the files",
 };
+// The report's fields as the panel names them (docs/web.md, "Export"; serve_messages.REPORT).
+const REPORT = [
+  ["components", "pieces"],
+  ["boundaryEdges", "boundary edges"],
+  ["nonManifoldEdges", "non-manifold edges"],
+  ["degenerateTriangles", "degenerate triangles"],
+  ["duplicateTriangles", "duplicate triangles"],
+  ["triangles", "triangles"],
+  ["points", "points"],
+];
 const AXES = { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, 1] };
 
 // Bytes of one WebSocket frame on the wire: header, the client's mask, the payload.
@@ -38,6 +53,7 @@ function megabytes(n) {
  *   level()                  the level of the whole volume its surfaces are drawn at
  *   request(url)             the page's counted fetch (volume.js): {response, body}
  *   count(sent, received)    adds bytes the panel moved itself (WebSocket) to the readout
+ *   showSurface(s, shown)    shows or hides one of the page's surfaces (its source), redrawn
  */
 export function setupOperations(page) {
   const section = $("op-run").closest("section");
@@ -48,7 +64,8 @@ export function setupOperations(page) {
   let socket = null;
   let opening = null;
   let nextId = 1;
-  let current = null; // {id, isovalue, level} of the operation in flight
+  let current = null; // {id, isovalue, level, surface} of the operation in flight
+  let source = null; // the page's surface whose result is shown
 
   // The levels to choose from, finest first, after "as on the page".
   $("op-level").append(...Array.from({ length: page.levels }, (_, i) => {
@@ -125,6 +142,11 @@ export function setupOperations(page) {
     return list;
   }
 
+  function exportOptions() {
+    return { clean: $("op-clean").checked, largestComponent: $("op-largest").checked,
+             cap: $("op-cap").checked };
+  }
+
   async function run() {
     const surface = page.surfaces()[Number($("op-surface").value)];
     if (!surface) {
@@ -133,13 +155,13 @@ export function setupOperations(page) {
     }
     const choice = $("op-level").value;
     const level = choice === "page" ? page.level() : Number(choice);
-    current = { id: nextId++, isovalue: surface.value, level };
+    current = { id: nextId++, isovalue: surface.value, level, surface };
     bar.value = 0;
     setState("running", "Sending the parameters...");
     try {
       await connect();
       send({ op: "surface", id: current.id, dataset: page.dataset.id, isovalue: surface.value,
-             level, steps: steps() });
+             level, steps: steps(), export: exportOptions() });
     } catch (error) {
       current = null;
       setState("error", error.message);
@@ -158,8 +180,9 @@ export function setupOperations(page) {
       out.textContent = (STAGES[message.stage] || message.stage) + "... " +
         Math.round(100 * message.progress) + "%";
     } else if (message.done) {
+      const surface = current.surface;
       current = null;
-      showResult(message);
+      showResult(message, surface);
     } else if (message.cancelled) {
       current = null;
       setState("cancelled", "Cancelled.");
@@ -181,7 +204,56 @@ export function setupOperations(page) {
     setTimeout(() => URL.revokeObjectURL(link.href), 10000);
   }
 
-  function showResult(result) {
+  // The mesh report, as a list; the section's data-watertight says it for automation.
+  function reportList(report) {
+    const list = document.createElement("ul");
+    list.className = "report";
+    const head = document.createElement("li");
+    head.textContent = "Watertight: " + (report.watertight ? "yes" : "no") +
+      " (checked by VTK on the server)";
+    list.append(head);
+    for (const [key, label] of REPORT) {
+      const item = document.createElement("li");
+      item.textContent = label + ": " + report[key].toLocaleString();
+      item.dataset.field = key;
+      list.append(item);
+    }
+    section.dataset.watertight = String(report.watertight);
+    return list;
+  }
+
+  // A checkbox and its label; `toggle(checked)` runs on each change.
+  function toggle(text, id, checked, change) {
+    const box = Object.assign(document.createElement("input"), { type: "checkbox", id, checked });
+    box.onchange = () => change(box.checked);
+    const label = document.createElement("label");
+    label.append(box, " " + text);
+    return label;
+  }
+
+  // The toggles of the result and its source, the source hidden at first.
+  function toggles(surface, mesh) {
+    if (source && source !== surface) {
+      page.showSurface(source, true); // an earlier result's source comes back
+    }
+    source = surface;
+    page.showSurface(surface, false);
+    const box = document.createElement("div");
+    box.className = "toggles";
+    box.append(
+      toggle("Show the source surface (isovalue " + surface.value + ")", "op-show-source", false,
+        (shown) => page.showSurface(surface, shown)),
+      toggle("Show the result", "op-show-result", true, (shown) => {
+        if (!shown) {
+          window.mediso.clearMesh();
+        } else if (mesh.body) {
+          window.mediso.showMesh(mesh.body);
+        }
+      }));
+    return box;
+  }
+
+  function showResult(result, surface) {
     setState("done", "");
     section.dataset.result = result.result;
     const closed = result.boundaryEdges === 0 ? "closed (no boundary edges)"
@@ -203,10 +275,17 @@ export function setupOperations(page) {
       };
       links.append(a, " ");
     }
-    out.replaceChildren(summary, "Download: ", links);
+    out.replaceChildren(summary, reportList(result.report), "Download: ", links);
     if (window.mediso && typeof window.mediso.showMesh === "function") {
+      const mesh = { body: null };
+      out.append(toggles(surface, mesh));
       page.request("/api/result/" + result.result + "?format=ply")
-        .then(({ body }) => window.mediso.showMesh(body))
+        .then(({ body }) => {
+          mesh.body = body;
+          if ($("op-show-result").checked) {
+            window.mediso.showMesh(body);
+          }
+        })
         .catch((error) => setState("error", "The result could not be shown: " + error.message));
     }
   }

@@ -46,22 +46,33 @@ export const AXES = [
 // arrays), source, space line}. Set once per dataset by setDataset.
 let frame = null;
 
-/** What the source's world frame is, from what the server says of the dataset. */
+/**
+ * What the source's world frame is: the server states it (the dataset's `format`: {name, space},
+ * docs/web.md). Older servers state no format: then it is guessed from the dataset's name (a
+ * NIfTI suffix RAS, the phantom RAS, a folder a DICOM series, the rest LPS), and the space line
+ * says it was guessed.
+ */
 export function sourceFrame(d) {
+  const stated = d.format && (d.format.space === "RAS" || d.format.space === "LPS");
+  if (stated) {
+    const name = d.format.name === "phantom" ? "the phantom" : d.format.name;
+    return { world: d.format.space, source: name + " (" + d.format.space + ")" };
+  }
   const name = String(d.name || "");
+  const guessed = (frame) => ({ world: frame.world, source: frame.source + ", guessed from the name" });
   if (/\.nii(\.gz)?$/i.test(name)) {
-    return { world: "RAS", source: "NIfTI (RAS)" };
+    return guessed({ world: "RAS", source: "NIfTI (RAS)" });
   }
   if (/^MedicalPhantom/.test(name)) {
-    return { world: "RAS", source: "the phantom (RAS, as NIfTI)" };
+    return guessed({ world: "RAS", source: "the phantom (RAS, as NIfTI)" });
   }
   if (/\.(mha|mhd)$/i.test(name)) {
-    return { world: "LPS", source: "MetaImage (taken as LPS, as ITK)" };
+    return guessed({ world: "LPS", source: "MetaImage (taken as LPS, as ITK)" });
   }
   if (!/\.[a-z0-9]{2,4}$/i.test(name)) { // a folder: a DICOM series
-    return { world: "LPS", source: "DICOM (LPS)" };
+    return guessed({ world: "LPS", source: "DICOM (LPS)" });
   }
-  return { world: "LPS", source: "taken as LPS" };
+  return guessed({ world: "LPS", source: "taken as LPS" });
 }
 
 /** The dataset's placement; returns a note when its direction matrix cannot be used. */
@@ -85,6 +96,14 @@ export function setDataset(d) {
   // LPS = F * world, F = diag(-1, -1, 1) for a RAS world.
   const f = world === "RAS" ? [-1, -1, 1] : [1, 1, 1];
   const rows = [0, 1, 2].map((r) => [0, 1, 2].map((c) => f[r] * m[3 * r + c]));
+  // Axes that are a mirror image of patient space (determinant -1: a series read with its rows
+  // flipped, as the cached ct_head.mha, or a NIfTI stored left to right) cannot be turned into
+  // it: the module draws the grid as it is, so the views face the right way with left and right
+  // swapped in the picture. Said, not hidden.
+  if (!note && dot(rows[0], cross(rows[1], rows[2])) < 0) {
+    note = "the volume's axes are a mirror image of patient space: the views face the right way, " +
+      "with left and right swapped in the picture";
+  }
   frame = { origin: d.origin.map(Number), rows, flip: f, world, source };
   return { space: "patient space (LPS) from " + source, note };
 }

@@ -27,6 +27,11 @@ export const state = Object.seal({
   // moved (its requests, and the server panel's WebSocket frames counted through volume.js).
   volumePointer: 0,
   level: null,
+  // volume.js too: the page's own copy of the fetched level's values (a typed array of its
+  // scalar type) and its grid {dims, spacing, origin}: the slices and the histogram read them
+  // (slices.js, histogram.js), never the module's memory.
+  values: null,
+  grid: null,
   bytesSent: 0,
   bytesReceived: 0,
 
@@ -38,7 +43,8 @@ export const state = Object.seal({
   levelNote: "",
 
   // surfaces.js (and app.js's automation, through surfaces.js): the isosurfaces
-  // [{value, color: [r, g, b], opacity}].
+  // [{value, color: [r, g, b], opacity}], and hidden: true on the source of a server result
+  // while the result is shown (operations.js, through app.js).
   surfaces: [],
 
   // viewer.js, at each frame: its times and what it drew.

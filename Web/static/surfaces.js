@@ -3,19 +3,17 @@
 // dataset's range), the "Add a surface" button, and the server panel's choice of surface. Every
 // change draws at once (viewer.js's change: change + frame, timed).
 
+import { countHistogram } from "./histogram.js";
+import { BONE, firstSurfaces } from "./presets.js";
 import { $, state } from "./state.js";
 import { change } from "./viewer.js";
 
-const SKIN = [0.93, 0.75, 0.62];
-const BONE = [0.97, 0.95, 0.88];
-
-/** The surfaces a dataset opens with: skin and bone for a CT in Hounsfield units. */
+/**
+ * The surfaces a dataset opens with (presets.js): skin and bone for a CT in Hounsfield units,
+ * else Otsu's threshold of the fetched volume's histogram.
+ */
 export function defaultSurfaces(d) {
-  if (d.range[0] <= -900 && d.range[1] >= 400) { // a CT in Hounsfield units
-    return [{ value: -500, color: SKIN, opacity: 0.35 }, { value: 400, color: BONE, opacity: 1 }];
-  }
-  const v = d.range[0] + 0.3 * (d.range[1] - d.range[0]);
-  return [{ value: Number(v.toPrecision(4)), color: SKIN, opacity: 1 }];
+  return firstSurfaces(d, countHistogram());
 }
 
 function hex(color) {
@@ -73,13 +71,17 @@ export function buildSurfaceList() {
       const x = checked(value, message, "isovalue", d.range[0], d.range[1]);
       if (x !== null) {
         change(() => { s.value = x; slider.value = String(x); });
+        updateServerChoice();
       }
     };
-    slider.oninput = () => change(() => {
-      s.value = Number(slider.value);
-      value.value = slider.value;
-      checked(value, message, "isovalue", d.range[0], d.range[1]);
-    });
+    slider.oninput = () => {
+      change(() => {
+        s.value = Number(slider.value);
+        value.value = slider.value;
+        checked(value, message, "isovalue", d.range[0], d.range[1]);
+      });
+      updateServerChoice();
+    };
     color.oninput = () => change(() => { s.color = fromHex(color.value); });
     opacity.oninput = () => {
       const x = checked(opacity, message, "opacity", 0, 1);
@@ -92,9 +94,21 @@ export function buildSurfaceList() {
       remove, slider, message);
     box.append(row);
   });
+  updateServerChoice();
+}
+
+/**
+ * The server panel's surface choice: one option per surface, its current isovalue, the choice
+ * kept where the surface still is (an isovalue changed in its box or slider shows here at once).
+ */
+function updateServerChoice() {
   const pick = $("op-surface");
+  const chosen = pick.value;
   pick.replaceChildren(...state.surfaces.map((s, i) =>
     Object.assign(document.createElement("option"), { value: i, textContent: String(s.value) })));
+  if (chosen !== "" && Number(chosen) < state.surfaces.length) {
+    pick.value = chosen;
+  }
 }
 
 /** The dataset's default surfaces in the list, and the "Add a surface" button. */

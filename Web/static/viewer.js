@@ -35,6 +35,13 @@ function readFacts(M) {
     maximumIsovalues: M.MaximumIsovalues,
     // {bytes, texture: [x, y, z] texels} of a volume of ScalarType value `type` on the GPU path
     gpuVolume: (type, dims) => M.gpuVolume(type, dims),
+    // The first isovalue's rule of the ParaView side (Filters/Core/HistogramThreshold.h):
+    // whether a range is a CT's in Hounsfield units, skin and bone, the bins a range is counted
+    // in ({low, width, count}) and Otsu's threshold of such counts (NaN: nothing to split).
+    hounsfield: { skin: M.SkinHounsfield, bone: M.BoneHounsfield,
+      looksLike: (lo, hi) => M.looksLikeHounsfieldUnits(lo, hi) },
+    histogramBins: (lo, hi, integral) => M.histogramBins(lo, hi, integral),
+    otsuThreshold: (counts, bins) => M.otsuThreshold(counts, bins.low, bins.width),
   };
 }
 
@@ -106,7 +113,8 @@ export const afterFrame = [];
 /** Draws now and waits for the GPU: the time of a change + frame. */
 export function renderNow() {
   const viewer = state.viewer;
-  viewer.setSurfaces(state.surfaces);
+  // A surface hidden (the source of a server result shown, operations.js) is not drawn.
+  viewer.setSurfaces(state.surfaces.filter((s) => !s.hidden));
   const start = performance.now();
   if (!viewer.render()) {
     throw new Error("render failed: " + viewer.stats().error);

@@ -16,17 +16,34 @@ function withToken(url) {
   return url + (url.includes("?") ? "&" : "?") + "token=" + encodeURIComponent(token);
 }
 
-/** Every request of the page's own goes through here, so that the bytes are counted. */
-export async function request(url) {
+// The bytes that crossed for a request, from its resource timing entry when the browser has one
+// (transferSize: headers and body on the wire; only the headers of a 304 that the browser
+// answered from its cache, docs/web.md "Caching"). Null without an entry.
+function transferred(url) {
+  const entries = performance.getEntriesByName(new URL(url, location.href).href, "resource");
+  const last = entries[entries.length - 1];
+  return last && last.transferSize > 0 ? last.transferSize : null;
+}
+
+/**
+ * Every request of the page's own goes through here, so that the bytes are counted. `cache`:
+ * "no-store" (the default: never kept) or "no-cache" (the volume: kept by the browser and
+ * revalidated with the server at each use, which answers 304 when it has not changed).
+ */
+export async function request(url, cache = "no-store") {
   const full = withToken(url);
   state.bytesSent += full.length + 64; // the request line and the few headers a browser adds
-  const response = await fetch(full, { cache: "no-store" });
+  const response = await fetch(full, { cache });
   if (!response.ok) {
     throw new Error(url + ": " + response.status + " " + (await response.text()));
   }
   const wire = Number(response.headers.get("Content-Length") || 0);
   const body = await response.arrayBuffer();
-  state.bytesReceived += (wire || body.byteLength) + 200;
+  if (cache !== "no-store") {
+    await new Promise((resolve) => setTimeout(resolve)); // the timing entry is queued as a task
+  }
+  const crossed = cache === "no-store" ? null : transferred(full);
+  state.bytesReceived += crossed !== null ? crossed : (wire || body.byteLength) + 200;
   return { response, body };
 }
 
@@ -57,10 +74,20 @@ function unshuffle(shuffled, size) {
   return out;
 }
 
+// The values as JavaScript reads them (little-endian, as the server sends them and every browser
+// stores them): the page's own view of the fetched level, for the slices and the histogram.
+const TYPED_ARRAYS = { int8: Int8Array, uint8: Uint8Array, int16: Int16Array, uint16: Uint16Array,
+  int32: Int32Array, uint32: Uint32Array, float32: Float32Array, float64: Float64Array };
+function typedValues(bytes, typeName) {
+  const Typed = TYPED_ARRAYS[typeName];
+  const copy = bytes.byteOffset % Typed.BYTES_PER_ELEMENT === 0 ? bytes : bytes.slice();
+  return new Typed(copy.buffer, copy.byteOffset, copy.length / Typed.BYTES_PER_ELEMENT);
+}
+
 /** Fetches level `level` of the dataset and gives it to the viewer (the module's memory). */
 export async function loadVolume(level) {
   const d = state.dataset;
-  const { response, body } = await request("/api/volume/" + d.id + "?level=" + level);
+  const { response, body } = await request("/api/volume/" + d.id + "?level=" + level, "no-cache");
   const typeName = response.headers.get("X-Mediso-Type");
   const type = state.facts.scalarTypes.get(typeName);
   if (!type) {
@@ -70,6 +97,8 @@ export async function loadVolume(level) {
   const spacing = response.headers.get("X-Mediso-Spacing").split(",").map(Number);
   const origin = response.headers.get("X-Mediso-Origin").split(",").map(Number);
   const bytes = unshuffle(new Uint8Array(body), type.bytes);
+  state.values = typedValues(bytes, typeName);
+  state.grid = { dims, spacing, origin };
   const M = state.module;
   const pointerBefore = state.volumePointer;
   if (state.volumePointer) {

@@ -25,6 +25,7 @@
 #include "GLApiFunctions.h"
 #include "GLProbe.h"
 #include "HistoPyramid.h"
+#include "HistogramThreshold.h"
 #include "IsosurfaceScene.h"
 #include "MeshRenderer.h"
 #include "PyramidLayout.h"
@@ -42,6 +43,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -735,6 +737,42 @@ val GPUVolume(int type, const val& dims)
   out.set("texture", size);
   return out;
 }
+
+// The first isovalue's rule (Filters/Core/HistogramThreshold.h), the one the
+// ParaView side applies, handed to the page's histogram
+// (Web/static/histogram.js): the page counts the values of the volume it holds
+// into these bins, and the module says whether the range is Hounsfield units
+// and where Otsu's threshold lies.
+
+/// The bins the first isovalue's rule counts a range in: {low, width, count}.
+val HistogramBinsFor(double min, double max, bool integral)
+{
+  const HistogramBins bins = HistogramBins::For(min, max, integral);
+  val out = val::object();
+  out.set("low", bins.Low);
+  out.set("width", bins.Width);
+  out.set("count", static_cast<double>(bins.Count));
+  return out;
+}
+
+/// Otsu's threshold of `counts` (a JavaScript array, one entry per bin of
+/// {low, width}); NaN when the histogram has fewer than two non-empty bins.
+double Otsu(const val& counts, double low, double width)
+{
+  const std::size_t n = counts["length"].as<std::size_t>();
+  std::vector<std::uint64_t> values(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    values[i] = static_cast<std::uint64_t>(std::max(0.0, counts[i].as<double>()));
+  }
+  HistogramBins bins;
+  bins.Low = low;
+  bins.Width = width;
+  bins.Count = n;
+  double threshold = 0.0;
+  return OtsuThreshold(values, bins, threshold) ? threshold
+                                                : std::numeric_limits<double>::quiet_NaN();
+}
 } // namespace
 
 EMSCRIPTEN_BINDINGS(mediso_web)
@@ -744,6 +782,11 @@ EMSCRIPTEN_BINDINGS(mediso_web)
   emscripten::function("levelStride", &Stride);
   emscripten::constant("MaximumIsovalues", MaximumIsovalues);
   emscripten::function("gpuVolume", &GPUVolume);
+  emscripten::function("looksLikeHounsfieldUnits", &LooksLikeHounsfieldUnits);
+  emscripten::constant("SkinHounsfield", SkinHounsfield);
+  emscripten::constant("BoneHounsfield", BoneHounsfield);
+  emscripten::function("histogramBins", &HistogramBinsFor);
+  emscripten::function("otsuThreshold", &Otsu);
   emscripten::class_<WebViewer>("WebViewer")
     .constructor<std::string>()
     .function("ready", &WebViewer::Ready)

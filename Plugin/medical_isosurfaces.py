@@ -1,0 +1,151 @@
+"""Python calls of the MedicalIsosurfaces plugin (embedded in it: importable once it is loaded).
+
+The plugin's sources and filters (MedicalPhantom, BlockLODContour, IsosurfaceLabels, the readers)
+are ServerManager proxies: ``LoadPlugin(path, ns=globals())`` adds them to ``paraview.simple``
+like any filter. What is not a proxy lives here:
+
+``MakeMeshFromView(display=None, view=None, level=None, names=None, show=True)``
+    the surfaces a *HistoPyramid Isosurface* display shows, as a mesh to save (File > Save
+    Data: STL, PLY, VTP): a Block LOD Contour of the display's input with the display's
+    isovalues and array, at ``level`` (0-3; ``None``: the finest level the memory estimator
+    fits in the filter's Memory Budget, Auto LOD), followed by Isosurface Labels, which adds
+    each triangle's surface index and colour (cell data ``SurfaceIndex``, ``SurfaceColor``)
+    and each surface's name, value and colour (field data). The panel's *Make Mesh* button
+    runs this function.
+"""
+
+import math
+
+from paraview import servermanager, simple
+from paraview.vtk import vtkDataSetAttributes
+
+#: The representation type the mesh is made from.
+REPRESENTATION = "HistoPyramid Isosurface"
+
+
+def _display_proxy(display, view):
+    if display is None:
+        source = simple.GetActiveSource()
+        if source is None:
+            raise ValueError("MakeMeshFromView: no active source; pass the display.")
+        display = simple.GetDisplayProperties(source, view)
+    return display
+
+
+def _contoured_array(display, source, port):
+    """The array the display contours (its colouring array, else the input's active point
+    scalars) and its range ((name, None) when the data information has no such array)."""
+    info = source.GetDataInformation(port).DataInformation.GetPointDataInformation()
+    name = display.ColorArrayName[1] if display.ColorArrayName[0] in ("POINTS", "") else ""
+    array = info.GetArrayInformation(name) if name else \
+        info.GetAttributeInformation(vtkDataSetAttributes.SCALARS)
+    if array is None:
+        return name, None
+    return array.GetName(), array.GetComponentRange(0)
+
+
+def _format(value):
+    return ("%.6g" % value)
+
+
+def MakeMeshFromView(display=None, view=None, level=None, names=None, show=True):
+    """Returns the IsosurfaceLabels proxy of the mesh of ``display``'s surfaces (see the module).
+
+    ``display``: a display shown as HistoPyramid Isosurface (default: the active source's in
+    ``view``); ``view``: its view (default: the active view), rendered once so that the colours
+    are those drawn; ``level``: 0-3, or None for Auto LOD; ``names``: one name per isovalue
+    (default: the array's name and the value, e.g. "HU 400"); ``show``: show the mesh in ``view``
+    coloured by surface (a categorical colour map of its own: the surfaces' names, colours and
+    opacities) and hide the display, as a filter's Apply replaces its input.
+    Surfaces the display does not draw (opacity 0, values outside the array's range or not
+    numbers) are left out.
+    """
+    if view is None:
+        view = simple.GetActiveView()
+    display = _display_proxy(display, view)
+    if display.GetProperty("Representation") is None or display.Representation != REPRESENTATION:
+        raise ValueError("MakeMeshFromView: the display is not shown as %s." % REPRESENTATION)
+    if level is not None and level not in (0, 1, 2, 3):
+        raise ValueError("MakeMeshFromView: level must be 0, 1, 2, 3 or None (Auto LOD), not %r."
+                         % (level,))
+    input_property = display.GetProperty("Input")
+    source = servermanager._getPyProxy(input_property.GetProxy(0))
+    port = input_property.GetOutputPortForConnection(0)
+    array, data_range = _contoured_array(display, source, port)
+
+    # The colour and opacity each isovalue is drawn with, as of a render.
+    if view is not None:
+        simple.Render(view)
+    display.UpdatePropertyInformation()
+    looks = list(display.GetProperty("HistoPyramidSurfaceLooks"))
+    isovalues = list(display.IsosurfaceValues)
+    if names is not None and len(names) != len(isovalues):
+        raise ValueError("MakeMeshFromView: %d names for %d isovalues." % (len(names), len(isovalues)))
+    values, colors, labels = [], [], []
+    for i, value in enumerate(isovalues):
+        look = looks[4 * i:4 * i + 4] if len(looks) >= 4 * (i + 1) else [1.0, 1.0, 1.0, 1.0]
+        outside = data_range is not None and not data_range[0] <= value <= data_range[1]
+        if math.isnan(value) or outside or look[3] <= 0.0 or value in values:
+            continue
+        values.append(value)
+        colors.extend(look)
+        labels.append(names[i] if names is not None else
+                      ("%s %s" % (array, _format(value))).strip())
+    if not values:
+        raise ValueError("MakeMeshFromView: the display draws no surface.")
+
+    # The plugin's proxies as paraview.simple's functions (LoadPlugin adds them
+    # to the caller's namespace only).
+    proxies = {}
+    simple._add_functions(proxies)
+    contour = proxies["BlockLODContour"](Input=servermanager.OutputPort(source, port))
+    # By property name, not by the labels paraview.simple derives names from.
+    settings = [("SelectInputScalars", ["POINTS", array]), ("ContourValues", values),
+                ("ComputeScalars", 1), ("AutoLOD", 1 if level is None else 0)]
+    if level is not None:
+        settings.append(("LOD", level))
+    for name, value in settings:
+        contour.SetPropertyWithName(name, value)
+    mesh = proxies["IsosurfaceLabels"](Input=contour)
+    mesh.SurfaceValues = values
+    mesh.SurfaceColors = colors
+    mesh.SurfaceNames = labels
+    source_name = next((key[0] for key, proxy in simple.GetSources().items() if proxy == source), "")
+    simple.RenameSource(("Mesh of %s" % source_name) if source_name else "Isosurface mesh", mesh)
+    mesh.UpdatePipeline()
+    if show and view is not None:
+        shown = simple.Show(mesh, view)
+        _color_by_surface(shown, labels, colors)
+        simple.Hide(source, view)
+        simple.Render(view)
+    return mesh
+
+
+def _color_by_surface(shown, labels, colors):
+    """Colours the mesh's display by SurfaceIndex through a colour map of its own: categorical,
+    one annotation (the name), one colour and one opacity per surface (opacity mapping enabled
+    where one is below 1). ParaView's PLY writer maps colours through the display's colour map
+    (Save Data: Enable Coloring, SurfaceIndex), so this map also writes each surface's colour
+    (and opacity, with Enable Alpha) to a PLY file."""
+    simple.ColorBy(shown, ("CELLS", "SurfaceIndex"), True)
+    lut = simple.GetColorTransferFunction("SurfaceIndex", shown, True)
+    lut.InterpretValuesAsCategories = 1
+    annotations, indexed = [], []
+    for i, name in enumerate(labels):
+        annotations += [str(i), name]
+        indexed += colors[4 * i:4 * i + 3]
+    lut.Annotations = annotations
+    lut.IndexedColors = indexed
+    lut.IndexedOpacities = colors[3::4]
+    lut.EnableOpacityMapping = 1 if min(colors[3::4]) < 1.0 else 0
+
+
+def _make_mesh_for_panel(display_id, view_id):
+    """The panel's Make Mesh button: MakeMeshFromView on proxies given by their global ids."""
+    session = servermanager.ActiveConnection.Session
+
+    def proxy(global_id):
+        found = session.GetRemoteObject(global_id) if global_id else None
+        return servermanager._getPyProxy(found) if found is not None else None
+
+    return MakeMeshFromView(proxy(display_id), proxy(view_id))

@@ -1,0 +1,531 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "vtkBlockLODSurfaceRepresentation.h"
+
+#include "FrameTimeModel.h"
+#include "vtkBlockLODContour.h"
+#include "vtkCallbackCommand.h"
+#include "vtkCommand.h"
+#include "vtkCommunicator.h"
+#include "vtkCompositeDataIterator.h"
+#include "vtkCompositeDataSet.h"
+#include "vtkDataArray.h"
+#include "vtkFieldData.h"
+#include "vtkInformation.h"
+#include "vtkIntArray.h"
+#include "vtkMultiProcessController.h"
+#include "vtkObjectFactory.h"
+#include "vtkPVRenderView.h"
+#include "vtkPVView.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkProperty.h"
+#include "vtkRenderer.h"
+#include "vtkSmartPointer.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <vector>
+
+vtkStandardNewMacro(vtkBlockLODSurfaceRepresentation);
+
+namespace
+{
+constexpr int Levels = 4;
+
+// The frames of this process, for every Block LOD display in it: the model
+// describes the renderer and the machine, not one display. A frame is
+// observed once, with the triangles of every Block LOD display it drew
+// together, and a display's candidate level is predicted with the other
+// displays' last triangles added (what the frame will draw besides it).
+struct ProcessFrames
+{
+  struct Frame
+  {
+    double Triangles = 0.0;
+    bool Learn = true; // false when a display drew new data (its upload)
+    bool Translucent = false;
+    double Start = 0.0;
+  };
+  std::mutex Mutex;
+  mediso::FrameTimeModel Model;
+  // Per renderer: the frame being drawn, and each display's last triangles.
+  std::map<const void*, Frame> Pending;
+  std::map<const void*, std::map<const void*, double>> Drawn;
+
+  double OthersDrawn(const void* renderer, const void* display)
+  {
+    double sum = 0.0;
+    for (const auto& entry : this->Drawn[renderer])
+    {
+      sum += entry.first == display ? 0.0 : entry.second;
+    }
+    return sum;
+  }
+};
+ProcessFrames& Frames()
+{
+  static ProcessFrames frames;
+  return frames;
+}
+
+double Now()
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// The first vtkPolyData of a delivered piece (a vtkPolyData, or a composite
+// dataset around one).
+vtkPolyData* FirstSurface(vtkDataObject* data)
+{
+  if (auto* surface = vtkPolyData::SafeDownCast(data))
+  {
+    return surface;
+  }
+  if (auto* composite = vtkCompositeDataSet::SafeDownCast(data))
+  {
+    vtkSmartPointer<vtkCompositeDataIterator> it;
+    it.TakeReference(composite->NewIterator());
+    for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+    {
+      if (auto* surface = vtkPolyData::SafeDownCast(it->GetCurrentDataObject()))
+      {
+        return surface;
+      }
+    }
+  }
+  return nullptr;
+}
+
+// The field that marks LOD geometry made here, with its level (a decimated
+// copy may carry the output's own "BlockLODLevel" along).
+const char* const LevelMark = "BlockLODInteractiveLevel";
+
+// Triangles and level of a delivered LOD piece (-1 when it is not marked as
+// a Block LOD level: the decimated copy).
+void DescribeLOD(vtkDataObject* data, int& level, double& triangles)
+{
+  level = -1;
+  triangles = 0.0;
+  if (auto* composite = vtkCompositeDataSet::SafeDownCast(data))
+  {
+    vtkSmartPointer<vtkCompositeDataIterator> it;
+    it.TakeReference(composite->NewIterator());
+    for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+    {
+      if (auto* surface = vtkPolyData::SafeDownCast(it->GetCurrentDataObject()))
+      {
+        triangles += static_cast<double>(surface->GetNumberOfPolys());
+      }
+    }
+  }
+  else if (auto* surface = vtkPolyData::SafeDownCast(data))
+  {
+    triangles = static_cast<double>(surface->GetNumberOfPolys());
+  }
+  vtkPolyData* first = FirstSurface(data);
+  vtkDataArray* field = first ? first->GetFieldData()->GetArray(LevelMark) : nullptr;
+  if (field && field->GetNumberOfTuples() == 1)
+  {
+    level = static_cast<int>(field->GetTuple1(0));
+  }
+}
+}
+
+//------------------------------------------------------------------------------
+vtkBlockLODSurfaceRepresentation::vtkBlockLODSurfaceRepresentation() = default;
+vtkBlockLODSurfaceRepresentation::~vtkBlockLODSurfaceRepresentation() = default;
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::SetInteractiveLevels(bool use)
+{
+  if (use != this->InteractiveLevels)
+  {
+    this->InteractiveLevels = use;
+    // The LOD geometry is remade by the next update's REQUEST_UPDATE_LOD.
+    this->MarkModified();
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::SetInteractiveFrameBudget(double seconds)
+{
+  seconds = std::max(0.0, seconds);
+  if (seconds != this->InteractiveFrameBudget)
+  {
+    this->InteractiveFrameBudget = seconds;
+    this->MarkModified();
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::SetInteractiveTriangleBudget(double triangles)
+{
+  triangles = std::max(0.0, triangles);
+  if (triangles != this->InteractiveTriangleBudget)
+  {
+    this->InteractiveTriangleBudget = triangles;
+    this->MarkModified();
+  }
+}
+
+//------------------------------------------------------------------------------
+vtkBlockLODContour* vtkBlockLODSurfaceRepresentation::FindContour()
+{
+  if (this->GetNumberOfInputPorts() < 1 || this->GetNumberOfInputConnections(0) != 1)
+  {
+    return nullptr; // the client's copy, in client/server
+  }
+  // ParaView's own pass-through filters between a source and its displays
+  // (vtkPVPostFilter) are skipped; any other filter ends the search.
+  vtkAlgorithm* producer = this->GetInputAlgorithm(0, 0);
+  while (producer && producer->IsA("vtkPVPostFilter") && producer->GetNumberOfInputPorts() == 1 &&
+    producer->GetNumberOfInputConnections(0) == 1)
+  {
+    producer = producer->GetInputAlgorithm(0, 0);
+  }
+  auto* contour = vtkBlockLODContour::SafeDownCast(producer);
+  if (!contour)
+  {
+    return nullptr;
+  }
+  // The filter's output must be the data shown here: shallow copies along
+  // the way share its points array.
+  auto* shown = vtkPolyData::SafeDownCast(this->GetInputDataObject(0, 0));
+  vtkPolyData* made = contour->GetOutput();
+  if (!shown || !made || !shown->GetPoints() || !made->GetPoints() ||
+    shown->GetPoints()->GetData() != made->GetPoints()->GetData())
+  {
+    return nullptr;
+  }
+  return contour;
+}
+
+//------------------------------------------------------------------------------
+bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
+{
+  this->ChosenInteractiveLevel = -1;
+  this->PredictedInteractiveSeconds = 0.0;
+  this->LevelSurface->Initialize();
+  vtkBlockLODContour* contour = this->FindContour();
+  const int still = contour ? contour->GetChosenLevel() : -1;
+
+  // Triangles per level, this process's (unknown: -1), then summed over the
+  // processes so that every piece picks the same level. Every data process
+  // runs this pass, with or without a piece.
+  std::array<double, Levels> triangles;
+  triangles.fill(-1.0);
+  if (still >= 0 && still < Levels)
+  {
+    auto* shown = vtkPolyData::SafeDownCast(this->GetInputDataObject(0, 0));
+    triangles[still] = static_cast<double>(shown->GetNumberOfPolys());
+    for (int level = still - 1; level >= 0; --level)
+    {
+      triangles[level] = contour->EstimateLevelTriangles(level);
+    }
+  }
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  const bool parallel = controller && controller->GetNumberOfProcesses() > 1;
+  if (parallel)
+  {
+    // Unknown counts are summed as a large negative number, so that a level
+    // unknown on any process stays unknown; a process without a Block LOD
+    // piece (an empty piece) adds nothing.
+    std::array<double, Levels> local, global;
+    for (int level = 0; level < Levels; ++level)
+    {
+      local[level] = !contour ? 0.0 : (triangles[level] < 0 ? -1e300 : triangles[level]);
+    }
+    controller->AllReduce(local.data(), global.data(), Levels, vtkCommunicator::SUM_OP);
+    triangles = global;
+  }
+
+  // The finest level, from the output's down, within the triangle budget (when
+  // set) and predicted within the frame budget (when set); else the coarsest.
+  // Levels stands for none.
+  int chosen = Levels;
+  std::vector<mediso::FrameTimeModel::Candidate> candidates;
+  if (contour && still >= 0 && still < Levels)
+  {
+    mediso::FrameWork work;
+    work.Method = mediso::FrameMethod::Triangles;
+    work.Translucent = this->Property->GetOpacity() < 1.0;
+    if (auto* view = vtkPVRenderView::SafeDownCast(this->GetView()))
+    {
+      const int* size = view->GetSize();
+      work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
+        static_cast<std::uint64_t>(std::max(0, size[1]));
+    }
+    double others = 0.0;
+    if (this->ObservedRenderer)
+    {
+      std::lock_guard<std::mutex> lock(Frames().Mutex);
+      others = Frames().OthersDrawn(this->ObservedRenderer.GetPointer(), this);
+    }
+    for (int level = still; level >= 0; --level)
+    {
+      const bool allowed =
+        this->InteractiveTriangleBudget <= 0 || triangles[level] <= this->InteractiveTriangleBudget;
+      if (triangles[level] >= 0 && (allowed || level == 0))
+      {
+        mediso::FrameTimeModel::Candidate candidate;
+        candidate.Level = level;
+        candidate.Work = work;
+        candidate.Work.Primitives = static_cast<std::uint64_t>(triangles[level] + others);
+        candidates.push_back(candidate);
+      }
+    }
+    if (!candidates.empty())
+    {
+      std::size_t pick = 0;
+      if (this->InteractiveFrameBudget > 0)
+      {
+        std::lock_guard<std::mutex> lock(Frames().Mutex);
+        pick = Frames().Model.Choose(candidates, this->InteractiveFrameBudget);
+      }
+      chosen = candidates[pick].Level;
+    }
+  }
+  if (parallel)
+  {
+    // Every piece draws the same level: the coarsest any process chose (each
+    // process's frame-time model learnt from its own frames).
+    int local = chosen, agreed = Levels;
+    controller->AllReduce(&local, &agreed, 1, vtkCommunicator::MIN_OP);
+    chosen = agreed;
+  }
+  if (!contour || chosen >= Levels || chosen > still)
+  {
+    return false;
+  }
+  double predicted = 0.0;
+  for (const auto& candidate : candidates)
+  {
+    if (candidate.Level == chosen)
+    {
+      std::lock_guard<std::mutex> lock(Frames().Mutex);
+      predicted = Frames().Model.Predict(candidate.Work);
+    }
+  }
+  if (chosen == still)
+  {
+    // Within the budget already: the shown surface is its own LOD.
+    this->LevelSurface->ShallowCopy(this->GetInputDataObject(0, 0));
+  }
+  else if (!contour->GenerateLevel(chosen, this->LevelSurface))
+  {
+    return false;
+  }
+  // Marked in field data of its own (a shallow copy shares the source's).
+  vtkNew<vtkFieldData> fields;
+  fields->ShallowCopy(this->LevelSurface->GetFieldData());
+  vtkNew<vtkIntArray> mark;
+  mark->SetName(LevelMark);
+  mark->InsertNextValue(chosen);
+  fields->AddArray(mark);
+  this->LevelSurface->SetFieldData(fields);
+  this->ChosenInteractiveLevel = chosen;
+  this->PredictedInteractiveSeconds = predicted;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+vtkDataObject* vtkBlockLODSurfaceRepresentation::WrapLikePiece(vtkDataObject* piece)
+{
+  // The view moves LOD geometry between processes as data of the piece's
+  // type (the client's placeholder is an empty piece of that type): the level
+  // takes the place of the piece's surface in a copy of its structure.
+  auto* composite = vtkCompositeDataSet::SafeDownCast(piece);
+  if (!composite)
+  {
+    return this->LevelSurface;
+  }
+  this->LevelPiece.TakeReference(composite->NewInstance());
+  this->LevelPiece->CopyStructure(composite);
+  vtkSmartPointer<vtkCompositeDataIterator> it;
+  it.TakeReference(composite->NewIterator());
+  for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+  {
+    if (vtkPolyData::SafeDownCast(it->GetCurrentDataObject()))
+    {
+      this->LevelPiece->SetDataSet(it, this->LevelSurface);
+      break;
+    }
+  }
+  return this->LevelPiece;
+}
+
+//------------------------------------------------------------------------------
+int vtkBlockLODSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKey* request_type,
+  vtkInformation* inInfo,
+  vtkInformation* outInfo)
+{
+  if (request_type == vtkPVView::REQUEST_UPDATE_LOD() && this->InteractiveLevels &&
+    !this->SuppressLOD && !inInfo->Has(vtkPVRenderView::USE_OUTLINE_FOR_LOD()))
+  {
+    // vtkGeometryRepresentation's pass would decimate the data; the surfaces
+    // base class adds nothing to this pass, so only the data
+    // representation's bookkeeping runs before the level replaces it.
+    if (!this->vtkPVDataRepresentation::ProcessViewRequest(request_type, inInfo, outInfo))
+    {
+      return 0;
+    }
+    // Run on every data process (a parallel run reduces counts in it).
+    const bool made = this->MakeLevelLOD();
+    vtkDataObject* piece = vtkPVView::GetPiece(inInfo, this);
+    if (made && piece != nullptr)
+    {
+      vtkPVView::SetPieceLOD(inInfo, this, this->WrapLikePiece(piece));
+      return 1;
+    }
+  }
+  else if (request_type == vtkPVView::REQUEST_UPDATE_LOD())
+  {
+    this->ChosenInteractiveLevel = -1;
+  }
+
+  if (!this->Superclass::ProcessViewRequest(request_type, inInfo, outInfo))
+  {
+    return 0;
+  }
+  if (request_type == vtkPVView::REQUEST_RENDER())
+  {
+    vtkDataObject* lod = vtkPVView::GetDeliveredPieceLOD(inInfo, this);
+    this->LastRenderUsedLOD =
+      !this->SuppressLOD && inInfo->Has(vtkPVRenderView::USE_LOD()) == 1 && lod != nullptr;
+    if (lod)
+    {
+      DescribeLOD(lod, this->InteractiveLevel, this->InteractiveTriangles);
+    }
+    else
+    {
+      this->InteractiveLevel = -1;
+      this->InteractiveTriangles = 0.0;
+    }
+    // What the coming frame draws, for the frame-time model: the LOD's
+    // triangles or the full data's, unless that data is new here (its upload
+    // is not a frame's cost).
+    vtkDataObject* drawn =
+      this->LastRenderUsedLOD ? lod : vtkPVView::GetDeliveredPiece(inInfo, this);
+    if (drawn && this->GetVisibility() && this->ObservedRenderer)
+    {
+      int level = -1;
+      double triangles = 0.0;
+      DescribeLOD(drawn, level, triangles);
+      std::lock_guard<std::mutex> lock(Frames().Mutex);
+      ProcessFrames::Frame& frame = Frames().Pending[this->ObservedRenderer.GetPointer()];
+      frame.Triangles += triangles;
+      frame.Learn = frame.Learn && drawn->GetMTime() == this->DrawnDataTime;
+      frame.Translucent = frame.Translucent || this->Property->GetOpacity() < 1.0;
+      Frames().Drawn[this->ObservedRenderer.GetPointer()][this] = triangles;
+      this->DrawnDataTime = drawn->GetMTime();
+    }
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+bool vtkBlockLODSurfaceRepresentation::AddToView(vtkView* view)
+{
+  if (!this->Superclass::AddToView(view))
+  {
+    return false;
+  }
+  if (auto* renderView = vtkPVRenderView::SafeDownCast(view))
+  {
+    this->ObservedRenderer = renderView->GetRenderer();
+    this->StartObserver = this->ObservedRenderer->AddObserver(
+      vtkCommand::StartEvent, this, &vtkBlockLODSurfaceRepresentation::OnRenderStart);
+    this->EndObserver = this->ObservedRenderer->AddObserver(
+      vtkCommand::EndEvent, this, &vtkBlockLODSurfaceRepresentation::OnRenderEnd);
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkBlockLODSurfaceRepresentation::RemoveFromView(vtkView* view)
+{
+  if (this->ObservedRenderer)
+  {
+    {
+      std::lock_guard<std::mutex> lock(Frames().Mutex);
+      Frames().Drawn[this->ObservedRenderer.GetPointer()].erase(this);
+      if (Frames().Drawn[this->ObservedRenderer.GetPointer()].empty())
+      {
+        Frames().Drawn.erase(this->ObservedRenderer.GetPointer());
+        Frames().Pending.erase(this->ObservedRenderer.GetPointer());
+      }
+    }
+    this->ObservedRenderer->RemoveObserver(this->StartObserver);
+    this->ObservedRenderer->RemoveObserver(this->EndObserver);
+    this->ObservedRenderer = nullptr;
+  }
+  return this->Superclass::RemoveFromView(view);
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::OnRenderStart()
+{
+  // Every Block LOD display observes the renderer; the first one to hear of
+  // a prepared frame starts its clock.
+  std::lock_guard<std::mutex> lock(Frames().Mutex);
+  auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
+  if (frame != Frames().Pending.end() && frame->second.Start == 0.0)
+  {
+    frame->second.Start = Now();
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::OnRenderEnd()
+{
+  // The first display to hear of the frame's end records it, once.
+  const double end = Now();
+  std::lock_guard<std::mutex> lock(Frames().Mutex);
+  auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
+  if (frame == Frames().Pending.end())
+  {
+    return;
+  }
+  const ProcessFrames::Frame drawn = frame->second;
+  Frames().Pending.erase(frame);
+  if (!drawn.Learn || drawn.Triangles <= 0 || drawn.Start == 0.0)
+  {
+    return;
+  }
+  mediso::FrameWork work;
+  work.Method = mediso::FrameMethod::Triangles;
+  work.Primitives = static_cast<std::uint64_t>(drawn.Triangles);
+  const int* size = this->ObservedRenderer->GetSize();
+  work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
+    static_cast<std::uint64_t>(std::max(0, size[1]));
+  work.Translucent = drawn.Translucent;
+  Frames().Model.Observe(work, end - drawn.Start);
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::SetVisibility(bool visible)
+{
+  if (!visible && this->ObservedRenderer)
+  {
+    std::lock_guard<std::mutex> lock(Frames().Mutex);
+    Frames().Drawn[this->ObservedRenderer.GetPointer()].erase(this);
+  }
+  this->Superclass::SetVisibility(visible);
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "InteractiveLevels: " << this->InteractiveLevels << "\n";
+  os << indent << "InteractiveFrameBudget: " << this->InteractiveFrameBudget << " s\n";
+  os << indent << "PredictedInteractiveSeconds: " << this->PredictedInteractiveSeconds << "\n";
+  os << indent << "InteractiveTriangleBudget: " << this->InteractiveTriangleBudget << "\n";
+  os << indent << "InteractiveLevel: " << this->InteractiveLevel << "\n";
+  os << indent << "InteractiveTriangles: " << this->InteractiveTriangles << "\n";
+  os << indent << "LastRenderUsedLOD: " << this->LastRenderUsedLOD << "\n";
+  os << indent << "ChosenInteractiveLevel: " << this->ChosenInteractiveLevel << "\n";
+}

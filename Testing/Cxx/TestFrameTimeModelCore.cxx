@@ -1,0 +1,261 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The frame-time model on synthetic frames whose cost is known exactly: the
+// prior before any frame, the prior scaled by one frame, coefficients recovered
+// from frames that vary all three counts, recency, non-negativity, Choose, and
+// bad input (never NaN, never a negative time, never an empty choice).
+#include "FrameTimeModel.h"
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace
+{
+int failures = 0;
+void Check(bool ok, const std::string& what)
+{
+  std::printf("%s: %s\n", ok ? "ok" : "FAILED", what.c_str());
+  failures += ok ? 0 : 1;
+}
+
+std::string Number(double value)
+{
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.9g", value);
+  return text;
+}
+
+bool Near(double value, double expected, double relative)
+{
+  return std::fabs(value - expected) <= relative * std::fabs(expected);
+}
+
+mediso::FrameWork Work(mediso::FrameMethod method, std::uint64_t primitives, std::uint64_t pixels,
+  bool translucent = false)
+{
+  mediso::FrameWork work;
+  work.Method = method;
+  work.Primitives = primitives;
+  work.Pixels = pixels;
+  work.Translucent = translucent;
+  return work;
+}
+
+double Cost(double a, double b, double c, const mediso::FrameWork& work)
+{
+  return a + b * static_cast<double>(work.Primitives) + c * static_cast<double>(work.Pixels);
+}
+} // namespace
+
+int main()
+{
+  using mediso::FrameMethod;
+  using mediso::FrameTimeModel;
+  const std::uint64_t viewport = 1024 * 768;
+
+  // Shaded pixels of a viewport at a sample distance.
+  Check(FrameTimeModel::ShadedPixels(1024, 768, 1.0) == viewport, "distance 1: every pixel");
+  Check(FrameTimeModel::ShadedPixels(1024, 768, 2.0) == viewport / 4, "distance 2: a quarter");
+  Check(FrameTimeModel::ShadedPixels(1024, 768, 3.0) == 87381, "distance 3: rounded down");
+  Check(FrameTimeModel::ShadedPixels(1, 1, 100.0) == 1, "a tiny viewport shades one pixel");
+  Check(FrameTimeModel::ShadedPixels(0, 768, 1.0) == 0, "an empty viewport shades none");
+  Check(FrameTimeModel::ShadedPixels(1024, 768, 0.0) == 0 &&
+      FrameTimeModel::ShadedPixels(1024, 768, -1.0) == 0 &&
+      FrameTimeModel::ShadedPixels(1024, 768, std::nan("")) == 0,
+    "a distance that is not positive and finite shades none");
+
+  // Before any frame: the prior, per method and translucency.
+  {
+    FrameTimeModel model;
+    const auto work = Work(FrameMethod::CellRasterisation, 800000, viewport);
+    const FrameTimeModel::Coefficients prior =
+      FrameTimeModel::Prior(FrameMethod::CellRasterisation, false);
+    Check(!model.HasObservations(FrameMethod::CellRasterisation, false) &&
+        model.ObservationCount(FrameMethod::Triangles, true) == 0,
+      "a new model has no frames");
+    Check(model.Predict(work) == prior.Evaluate(work), "no frames: the prior predicts");
+    Check(model.Predict(Work(FrameMethod::CellRasterisation, 800000, viewport, true)) >
+        model.Predict(work),
+      "the translucent prior is the more expensive");
+    Check(model.Predict(Work(FrameMethod::Triangles, 0, 0)) ==
+          FrameTimeModel::Prior(FrameMethod::Triangles, false).Seconds &&
+        model.Predict(Work(FrameMethod::Triangles, 0, 0)) > 0.0,
+      "zero work: the fixed cost, positive");
+  }
+
+  // One frame: the prior scaled to it. The frame itself is predicted exactly,
+  // another work by the prior's ratio.
+  {
+    FrameTimeModel model;
+    const auto drawn = Work(FrameMethod::CellRasterisation, 800000, viewport);
+    const auto coarser = Work(FrameMethod::CellRasterisation, 800000, viewport / 4);
+    model.Observe(drawn, 0.06);
+    const FrameTimeModel::Coefficients prior =
+      FrameTimeModel::Prior(FrameMethod::CellRasterisation, false);
+    const double expected = 0.06 * prior.Evaluate(coarser) / prior.Evaluate(drawn);
+    Check(model.HasObservations(FrameMethod::CellRasterisation, false) &&
+        model.ObservationCount(FrameMethod::CellRasterisation, false) == 1,
+      "one frame observed");
+    Check(Near(model.Predict(drawn), 0.06, 1e-9),
+      "one frame: predicted as measured (" + Number(model.Predict(drawn)) + ")");
+    Check(Near(model.Predict(coarser), expected, 1e-9),
+      "one frame: a quarter of the pixels by the prior's ratio (" + Number(model.Predict(coarser)) +
+        " vs " + Number(expected) + ")");
+    Check(!model.HasObservations(FrameMethod::CellRasterisation, true) &&
+        !model.HasObservations(FrameMethod::Triangles, false),
+      "other pairs keep their prior");
+    // Many frames of the same work (a rotation): still the prior's shape.
+    for (int i = 0; i < 10; ++i)
+    {
+      model.Observe(drawn, 0.06);
+    }
+    Check(Near(model.Predict(coarser), expected, 1e-9),
+      "frames of one work: the prior's shape, scaled (" + Number(model.Predict(coarser)) + ")");
+  }
+
+  // Frames that vary primitives and pixels (levels and sample distances):
+  // the known coefficients are recovered and an unseen frame is predicted.
+  {
+    const double a = 0.004, b = 2.5e-7, c = 1.2e-7;
+    FrameTimeModel model;
+    const std::uint64_t primitives[] = { 900000, 300000, 100000 };
+    const double distances[] = { 1.0, 1.5, 2.0, 3.0 };
+    for (int repeat = 0; repeat < 3; ++repeat)
+    {
+      for (std::uint64_t p : primitives)
+      {
+        for (double d : distances)
+        {
+          const auto work =
+            Work(FrameMethod::Triangles, p, FrameTimeModel::ShadedPixels(1024, 768, d), true);
+          model.Observe(work, Cost(a, b, c, work));
+        }
+      }
+    }
+    const FrameTimeModel::Coefficients fit = model.Fit(FrameMethod::Triangles, true);
+    Check(
+      Near(fit.Seconds, a, 1e-3) && Near(fit.PerPrimitive, b, 1e-3) && Near(fit.PerPixel, c, 1e-3),
+      "recovers a, b, c (" + Number(fit.Seconds) + ", " + Number(fit.PerPrimitive) + ", " +
+        Number(fit.PerPixel) + ")");
+    Check(model.ObservationCount(FrameMethod::Triangles, true) == FrameTimeModel::HistoryLength,
+      "keeps the last HistoryLength frames");
+    const auto unseen =
+      Work(FrameMethod::Triangles, 50000, FrameTimeModel::ShadedPixels(1024, 768, 4.0), true);
+    Check(Near(model.Predict(unseen), Cost(a, b, c, unseen), 1e-3),
+      "an unseen level and distance predicted (" + Number(model.Predict(unseen)) + " vs " +
+        Number(Cost(a, b, c, unseen)) + ")");
+
+    // The machine slows down threefold: the recent frames take over at once,
+    // and alone once the old ones have left the history.
+    const auto full = Work(FrameMethod::Triangles, 900000, viewport, true);
+    const auto observeSlower = [&](int frames)
+    {
+      for (int i = 0; i < frames; ++i)
+      {
+        const auto work = Work(FrameMethod::Triangles, i % 4 < 2 ? 900000 : 100000,
+          FrameTimeModel::ShadedPixels(1024, 768, i % 2 ? 1.0 : 2.0), true);
+        model.Observe(work, 3.0 * Cost(a, b, c, work));
+      }
+    };
+    observeSlower(8);
+    Check(Near(model.Predict(full), 3.0 * Cost(a, b, c, full), 0.15),
+      "8 frames after a change of load: within 15% (" + Number(model.Predict(full)) + " vs " +
+        Number(3.0 * Cost(a, b, c, full)) + ")");
+    observeSlower(static_cast<int>(FrameTimeModel::HistoryLength) - 8);
+    Check(Near(model.Predict(full), 3.0 * Cost(a, b, c, full), 1e-3),
+      "HistoryLength frames after it: exact (" + Number(model.Predict(full)) + ")");
+  }
+
+  // Non-negative coefficients: frames whose unconstrained fit has a negative
+  // intercept (cost falls faster than the counts) get a = 0, and no
+  // prediction is negative.
+  {
+    FrameTimeModel model;
+    const std::uint64_t p[] = { 1000000, 500000, 250000, 100000 };
+    const double seconds[] = { 0.5, 0.2, 0.08, 0.02 };
+    for (int i = 0; i < 4; ++i)
+    {
+      model.Observe(Work(FrameMethod::CellRasterisation, p[i], viewport), seconds[i]);
+    }
+    const FrameTimeModel::Coefficients fit = model.Fit(FrameMethod::CellRasterisation, false);
+    Check(fit.Seconds >= 0.0 && fit.PerPrimitive >= 0.0 && fit.PerPixel >= 0.0,
+      "coefficients are non-negative (" + Number(fit.Seconds) + ", " + Number(fit.PerPrimitive) +
+        ", " + Number(fit.PerPixel) + ")");
+    Check(model.Predict(Work(FrameMethod::CellRasterisation, 0, 0)) >= 0.0,
+      "zero work after such frames: not negative");
+  }
+
+  // Choose: the first candidate within the budget, finest first.
+  {
+    FrameTimeModel model;
+    const double a = 0.002, b = 1e-7, c = 2e-7;
+    for (double d : { 1.0, 2.0, 1.0, 3.0, 1.5, 1.0 })
+    {
+      for (std::uint64_t p : { std::uint64_t(800000), std::uint64_t(200000) })
+      {
+        const auto work =
+          Work(FrameMethod::CellRasterisation, p, FrameTimeModel::ShadedPixels(1024, 768, d));
+        model.Observe(work, Cost(a, b, c, work));
+      }
+    }
+    std::vector<FrameTimeModel::Candidate> candidates;
+    for (int level : { 3, 2 })
+    {
+      for (float d : { 1.0f, 1.5f, 2.0f, 3.0f })
+      {
+        FrameTimeModel::Candidate candidate;
+        candidate.Level = level;
+        candidate.SampleDistance = d;
+        candidate.Work = Work(FrameMethod::CellRasterisation, level == 3 ? 800000 : 200000,
+          FrameTimeModel::ShadedPixels(1024, 768, d));
+        candidates.push_back(candidate);
+      }
+    }
+    // Costs: level 3 at 1, 1.5, 2, 3: 0.2393, 0.1519, 0.1213, 0.0995; level 2:
+    // 0.1793, 0.0919, 0.0613, 0.0395 (seconds).
+    Check(model.Choose(candidates, 1.0) == 0, "a large budget: the finest");
+    Check(model.Choose(candidates, 0.125) == 2, "0.125 s: level 3 at distance 2");
+    Check(model.Choose(candidates, 0.1) == 3, "0.1 s: level 3 at distance 3");
+    Check(model.Choose(candidates, 0.07) == 6, "0.07 s: level 2 at distance 2");
+    Check(model.Choose(candidates, 0.001) == candidates.size() - 1, "too small: the coarsest");
+    Check(model.Choose(candidates, std::nan("")) == candidates.size() - 1,
+      "a NaN budget: the coarsest");
+    Check(
+      model.Choose(candidates, -1.0) == candidates.size() - 1, "a negative budget: the coarsest");
+    Check(model.Choose(candidates, std::numeric_limits<double>::infinity()) == 0,
+      "an infinite budget: the finest");
+    Check(model.Choose({}, 0.1) == 0, "no candidates: 0, never past the end");
+  }
+
+  // Bad input: not observed, never NaN.
+  {
+    FrameTimeModel model;
+    const auto work = Work(FrameMethod::Triangles, 1000, 1000);
+    model.Observe(work, std::nan(""));
+    model.Observe(work, -0.5);
+    model.Observe(work, std::numeric_limits<double>::infinity());
+    model.Observe(Work(static_cast<FrameMethod>(7), 1000, 1000), 0.1);
+    Check(!model.HasObservations(FrameMethod::Triangles, false) &&
+        !model.HasObservations(FrameMethod::CellRasterisation, false),
+      "NaN, negative, infinite seconds and an unknown method are not "
+      "observed");
+    const double odd = model.Predict(Work(static_cast<FrameMethod>(7), 1000, 1000));
+    Check(std::isfinite(odd) && odd > 0.0, "an unknown method predicts the costliest prior");
+    model.Observe(work, 0.0);
+    const double zero = model.Predict(work);
+    Check(std::isfinite(zero) && zero >= 0.0, "a frame timed at 0 s: finite, not negative");
+    const double huge = model.Predict(Work(FrameMethod::Triangles,
+      std::numeric_limits<std::uint64_t>::max(), std::numeric_limits<std::uint64_t>::max()));
+    Check(std::isfinite(huge) && huge >= 0.0, "the largest counts: finite");
+    model.Reset();
+    Check(!model.HasObservations(FrameMethod::Triangles, false) &&
+        model.Predict(work) == FrameTimeModel::Prior(FrameMethod::Triangles, false).Evaluate(work),
+      "Reset forgets every frame");
+  }
+
+  std::printf("%d failure(s)\n", failures);
+  return failures == 0 ? 0 : 1;
+}
