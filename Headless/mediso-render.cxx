@@ -74,6 +74,8 @@ Scene:
   --crop I0,I1,J0,J1,K0,K1
                         keep the box of point indices I0..I1, J0..J1, K0..K1
                         (cropping); cut faces are left open
+  --sample-distance D   image sample distance (>= 1, default 1): draw into a target of
+                        size / D pixels, then up to the image (interactive frames)
 The camera is VTK's: reset to the volume's bounds (view angle 30 degrees,
 looking down -z), then azimuth, elevation, orthogonalised view up, zoom.
 
@@ -106,6 +108,7 @@ struct Options
   std::vector<std::array<double, 4>> ClipPlanes; // world
   bool Crop = false;
   double CropBox[6] = { 0, 0, 0, 0, 0, 0 }; // point indices
+  double SampleDistance = 1.0;
   std::string Output;
   int Resample[3] = { 0, 0, 0 };
   std::string WriteVolume;
@@ -284,6 +287,14 @@ Options Parse(int argc, char* argv[])
     else if (arg == "--no-first-hit")
     {
       opt.FirstHit = false;
+    }
+    else if (arg == "--sample-distance")
+    {
+      opt.SampleDistance = Number(value("--sample-distance"), "--sample-distance");
+      if (!(opt.SampleDistance >= 1.0) || !std::isfinite(opt.SampleDistance))
+      {
+        throw UsageError{ "--sample-distance must be a number of at least 1" };
+      }
     }
     else if (arg == "--output")
     {
@@ -535,6 +546,7 @@ public:
         this->Frame.ClipPlanes.push_back(high);
       }
     }
+    this->Frame.SampleDistance = static_cast<float>(this->Opt.SampleDistance);
   }
 
   // Builds the pyramid for `surfaces` (ahead of the frame, to time it apart); "" or why not.
@@ -729,7 +741,8 @@ int Run(int argc, char* argv[])
            << ", \"framebuffer_bytes\": " << scene.Scene.GetFrameBufferBytes()
            << ", \"volume_bytes\": " << image.Bytes.size()
            << ", \"footprint\": " << JsonString(stats.PointFootprint ? "points" : "boxes")
-           << ", \"first_hit\": " << (stats.FirstHit ? "true" : "false") << "}";
+           << ", \"first_hit\": " << (stats.FirstHit ? "true" : "false")
+           << ", \"sample_distance\": " << stats.SampleDistance << "}";
       std::printf("%s\n", json.str().c_str());
     }
   }

@@ -24,6 +24,7 @@
 #include "vtkVolumeProperty.h"
 #include "vtk_glew.h"
 
+#include <array>
 #include <cmath>
 
 vtkStandardNewMacro(vtkBlockLODIsosurfaces);
@@ -36,6 +37,13 @@ struct vtkBlockLODIsosurfaces::Internals
   vtkNew<vtkPolyData> Colored;
   vtkMTimeType ColoredSurfaceTime = 0; // Colored was made from this surface
   std::vector<double> ColoredLooks;    // and these values, colours, opacities
+  // The coloured surface of each level drawn for the current input and looks,
+  // so that switching levels (vtkHistoPyramidIsoMapper's interactive frames)
+  // neither runs the filter nor recolours; ColoredLevel is the one in Colored.
+  std::array<vtkSmartPointer<vtkPolyData>, 4> LevelColored;
+  vtkMTimeType LevelInputTime = 0;
+  std::vector<double> LevelLooks;
+  int ColoredLevel = -1;
   // Translucent surfaces: the triangles sorted back to front for the current
   // camera (blending in drawing order is only right in that order).
   vtkNew<vtkDepthSortPolyData> Sort;
@@ -112,6 +120,10 @@ vtkBlockLODIsosurfaces::vtkBlockLODIsosurfaces()
 {
   Internals& impl = *this->Impl;
   impl.Contour->SetLOD(3);
+  // Set once: vtkAlgorithm::SetInputArrayToProcess marks the filter modified
+  // on every call, which would extract (and recolour) again on every frame.
+  impl.Contour->SetInputArrayToProcess(
+    0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
   impl.Contour->SetComputeNormals(true);
   impl.Contour->SetComputeScalars(true);
   impl.Sort->SetInputData(impl.Colored);
@@ -134,6 +146,18 @@ vtkBlockLODIsosurfaces::~vtkBlockLODIsosurfaces() = default;
 void vtkBlockLODIsosurfaces::SetClipPlanes(const std::vector<Plane>& worldPlanes)
 {
   this->Impl->WorldPlanes = worldPlanes;
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODIsosurfaces::SetLevel(int level)
+{
+  this->Impl->Contour->SetLOD(level);
+}
+
+//------------------------------------------------------------------------------
+int vtkBlockLODIsosurfaces::GetLevel() const
+{
+  return this->Impl->Contour->GetLOD();
 }
 
 //------------------------------------------------------------------------------
@@ -182,8 +206,6 @@ void vtkBlockLODIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol,
   }
 
   impl.Contour->SetInputData(impl.IndexImage);
-  impl.Contour->SetInputArrayToProcess(
-    0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
   bool valuesChanged = impl.Contour->GetNumberOfContours() != static_cast<vtkIdType>(surfaces.size());
   for (std::size_t i = 0; i < surfaces.size() && !valuesChanged; ++i)
   {
@@ -197,11 +219,6 @@ void vtkBlockLODIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol,
       impl.Contour->SetValue(static_cast<int>(i), surfaces[i].Value);
     }
   }
-  impl.Contour->Update();
-  vtkPolyData* surface = impl.Contour->GetOutput();
-
-  // Colour every point by its isovalue (RGBA, opacity in alpha).
-  // Recoloured only when the surface or the looks change (not every frame).
   bool translucent = false;
   std::vector<double> looks;
   for (const Surface& s : surfaces)
@@ -209,7 +226,33 @@ void vtkBlockLODIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol,
     translucent = translucent || s.Opacity < 1.0;
     looks.insert(looks.end(), { s.Value, s.Color[0], s.Color[1], s.Color[2], s.Opacity });
   }
-  if (surface->GetMTime() != impl.ColoredSurfaceTime || looks != impl.ColoredLooks)
+  // A level already coloured for this input and these looks is drawn as it is.
+  const int level = impl.Contour->GetLOD();
+  const vtkMTimeType inputTime = impl.IndexImage->GetMTime();
+  if (inputTime != impl.LevelInputTime || looks != impl.LevelLooks)
+  {
+    impl.LevelColored.fill(nullptr);
+    impl.LevelInputTime = inputTime;
+    impl.LevelLooks = looks;
+  }
+  vtkPolyData* cached = impl.LevelColored[static_cast<std::size_t>(level)];
+  this->LastFrameExtracted = false;
+  if (cached && impl.ColoredLevel != level)
+  {
+    impl.Colored->ShallowCopy(cached);
+    impl.ColoredLevel = level;
+  }
+  vtkPolyData* surface = cached ? cached : impl.Contour->GetOutput();
+  if (!cached)
+  {
+    const vtkMTimeType extractedBefore = impl.Contour->GetOutput()->GetMTime();
+    impl.Contour->Update();
+    this->LastFrameExtracted = surface->GetMTime() != extractedBefore;
+  }
+
+  // Colour every point by its isovalue (RGBA, opacity in alpha).
+  // Recoloured only when the surface or the looks change (not every frame).
+  if (!cached && (surface->GetMTime() != impl.ColoredSurfaceTime || looks != impl.ColoredLooks))
   {
     impl.Colored->ShallowCopy(surface);
     vtkDataArray* which = surface->GetPointData()->GetArray("Isovalue");
@@ -240,6 +283,10 @@ void vtkBlockLODIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol,
     impl.Colored->GetPointData()->SetScalars(colors);
     impl.ColoredSurfaceTime = surface->GetMTime();
     impl.ColoredLooks = looks;
+    auto copy = vtkSmartPointer<vtkPolyData>::New();
+    copy->ShallowCopy(impl.Colored);
+    impl.LevelColored[static_cast<std::size_t>(level)] = copy;
+    impl.ColoredLevel = level;
   }
   impl.SetIndexPlanes(
     vtkOpenGLHistoPyramidIsosurfaces::PullBackPlanes(impl.WorldPlanes, impl.ActorMatrix));

@@ -16,6 +16,11 @@
  * cut the coloured triangles exactly (vtkClipPolyData, one per plane, in the
  * index space of the copy), recut only when the planes or the surface change;
  * the cut faces are left open, as on the GPU path.
+ * SetLevel() picks a coarser level (vtkBlockLODContour's
+ * LOD 0..2, cube edges of 8, 4, 2 voxels): vtkHistoPyramidIsoMapper's
+ * interactive frames. The coloured surface of each level drawn is kept
+ * for the current input and looks (dropped when either changes), so that
+ * switching back and forth neither runs the filter nor recolours.
  *
  * @sa vtkHistoPyramidIsoMapper vtkOpenGLHistoPyramidIsosurfaces vtkBlockLODContour
  */
@@ -58,6 +63,16 @@ public:
   /// Triangles of the last frame (after clipping).
   vtkGetMacro(NumberOfTriangles, std::uint64_t);
 
+  ///@{
+  /// The level drawn (vtkBlockLODContour's LOD, 0..3; default 3, full resolution).
+  void SetLevel(int level);
+  int GetLevel() const;
+  ///@}
+
+  /// Whether the last frame extracted its surfaces (a new level, values or input) rather than
+  /// drawing ones already extracted: such a frame's time is not a drawing time.
+  vtkGetMacro(LastFrameExtracted, bool);
+
   void ReleaseGraphicsResources(vtkWindow* win);
 
 protected:
@@ -69,6 +84,7 @@ private:
   void operator=(const vtkBlockLODIsosurfaces&) = delete;
 
   std::uint64_t NumberOfTriangles = 0;
+  bool LastFrameExtracted = false;
   struct Internals;
   std::unique_ptr<Internals> Impl;
 };

@@ -19,10 +19,13 @@
 #include "vtkRenderer.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
+#include "vtk_glew.h"
 
 #include "IsosurfaceScene.h"
 
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -50,6 +53,14 @@ bool SupportedType(int type)
       return false;
   }
 }
+
+// Image sample distances an interactive GPU frame chooses from, finest first.
+constexpr float SampleDistances[] = { 1.0f, 1.5f, 2.0f, 2.5f, 3.0f, 4.0f, 5.0f, 6.0f, 8.0f };
+
+// The full-resolution Block LOD level (vtkBlockLODContour's LOD 3: cubes of one voxel).
+constexpr int FullLevel = 3;
+
+using Clock = std::chrono::steady_clock;
 } // anonymous namespace
 
 //------------------------------------------------------------------------------
@@ -59,6 +70,36 @@ struct vtkHistoPyramidIsoMapper::Internals
   vtkNew<vtkOpenGLHistoPyramidIsosurfaces> GPU;
   vtkNew<vtkBlockLODIsosurfaces> Fallback;
   std::set<std::string> Said;
+
+  // The frame-time model and what it is fed: the first frame of each sample
+  // distance and translucency pays for shader builds and buffers, so it is
+  // not observed (Warm says which were seen).
+  mediso::FrameTimeModel Model;
+  std::set<std::pair<int, bool>> Warm;
+  // The fallback's triangles per level for the current values and input
+  // (-1: not drawn yet), which its interactive choice predicts from.
+  std::array<double, 4> LevelTriangles = { { -1.0, -1.0, -1.0, -1.0 } };
+  std::vector<double> CountedValues;
+  vtkMTimeType CountedStamp = 0;
+  // Active pairs of the last GPU frame of these values and input (0: none yet).
+  std::uint64_t Primitives = 0;
+
+  // Triangles of `level`: drawn, or scaled from the nearest level drawn
+  // (a surface's triangles grow about 4x per finer level); 0 when none was.
+  double TrianglesAt(int level) const
+  {
+    for (int distance = 0; distance < 4; ++distance)
+    {
+      for (int other : { level + distance, level - distance })
+      {
+        if (other >= 0 && other < 4 && this->LevelTriangles[other] >= 0.0)
+        {
+          return this->LevelTriangles[other] * std::pow(4.0, level - other);
+        }
+      }
+    }
+    return 0.0;
+  }
 };
 
 //------------------------------------------------------------------------------
@@ -98,6 +139,12 @@ const char* vtkHistoPyramidIsoMapper::GetLastRenderPathAsString() const
 }
 
 //------------------------------------------------------------------------------
+const mediso::FrameTimeModel& vtkHistoPyramidIsoMapper::GetFrameTimeModel() const
+{
+  return this->Impl->Model;
+}
+
+//------------------------------------------------------------------------------
 std::uint64_t vtkHistoPyramidIsoMapper::GetGPUMemoryBytes() const
 {
   return this->Impl->GPU->GetGPUMemoryBytes();
@@ -114,6 +161,7 @@ void vtkHistoPyramidIsoMapper::ReleaseGraphicsResources(vtkWindow* win)
 {
   this->Impl->GPU->ReleaseGraphicsResources(win);
   this->Impl->Fallback->ReleaseGraphicsResources(win);
+  this->Impl->Warm.clear();
 }
 
 //------------------------------------------------------------------------------
@@ -175,6 +223,11 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   this->LastRenderPath = NoPath;
   this->GPUStats.Primitives = 0;
   this->NumberOfFallbackTriangles = 0;
+  this->LastInteractive = false;
+  this->LastSampleDistance = 1.0;
+  this->LastLevel = FullLevel;
+  this->LastPredictedSeconds = 0.0;
+  this->LastMeasuredSeconds = 0.0;
 
   // Say a message once (per distinct text), as an error or a warning.
   auto sayOnce = [&](bool error, const std::string& text)
@@ -348,22 +401,178 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   impl.GPU->SetClipPlanes(planes);
   impl.Fallback->SetClipPlanes(planes);
 
-  // 4. The GPU path, or the fallback when it cannot run (said once, with the reason).
+  // 4. Interactive or still (VTK's rule: less than a second allocated to
+  //    the prop), the budget, and the counts the frame-time model predicts
+  //    from (known for these values and this input once drawn).
+  const double allocated = vol->GetAllocatedRenderTime();
+  const bool adjust = this->InteractiveAdjust;
+  const bool interactive = adjust && allocated < 1.0;
+  const double budget =
+    this->InteractiveFrameBudget > 0.0 ? this->InteractiveFrameBudget : allocated;
+  int width = 0, height = 0;
+  ren->GetTiledSize(&width, &height);
+  bool translucent = false;
+  std::vector<double> drawnValues;
+  for (const Surface& s : surfaces)
+  {
+    translucent = translucent || s.Opacity < 1.0;
+    drawnValues.push_back(s.Value);
+  }
+  if (drawnValues != impl.CountedValues || scalars->GetMTime() != impl.CountedStamp)
+  {
+    impl.LevelTriangles.fill(-1.0);
+    impl.Primitives = 0;
+    impl.CountedValues = drawnValues;
+    impl.CountedStamp = scalars->GetMTime();
+  }
+  this->LastInteractive = interactive;
+  const std::uint64_t fullPixels = mediso::FrameTimeModel::ShadedPixels(width, height, 1.0);
+  // Triangles of a Block LOD level: drawn, scaled from a level drawn, or
+  // (none drawn yet) from the GPU path's active pairs, about two triangles
+  // each at the full level.
+  auto trianglesAt = [&](int level)
+  {
+    const double drawn = impl.TrianglesAt(level);
+    return static_cast<std::uint64_t>(
+      drawn > 0.0 ? drawn : 2.0 * static_cast<double>(impl.Primitives) * std::pow(4.0, level - 3));
+  };
+  auto gpuCandidate = [&](float distance, std::uint64_t primitives)
+  {
+    mediso::FrameTimeModel::Candidate candidate;
+    candidate.Level = FullLevel;
+    candidate.SampleDistance = distance;
+    candidate.Work.Method = mediso::FrameMethod::CellRasterisation;
+    candidate.Work.Primitives = primitives;
+    candidate.Work.Pixels = mediso::FrameTimeModel::ShadedPixels(width, height, distance);
+    candidate.Work.Translucent = translucent;
+    return candidate;
+  };
+  auto triangleCandidate = [&](int level)
+  {
+    mediso::FrameTimeModel::Candidate candidate;
+    candidate.Level = level;
+    candidate.Work.Method = mediso::FrameMethod::Triangles;
+    candidate.Work.Primitives = trianglesAt(level);
+    candidate.Work.Pixels = fullPixels;
+    candidate.Work.Translucent = translucent;
+    return candidate;
+  };
+
+  // The triangles of a Block LOD level (the CPU path: the fallback, or an
+  // interactive frame that even the GPU path's coarsest distance would not
+  // fit in the budget), timed and observed unless it extracted.
+  auto drawTriangles = [&](int level)
+  {
+    impl.Fallback->SetLevel(level);
+    const Clock::time_point start = Clock::now();
+    impl.Fallback->RenderIsosurfaces(ren, vol, image, scalars, surfaces);
+    this->NumberOfFallbackTriangles = impl.Fallback->GetNumberOfTriangles();
+    this->LastRenderPath = FallbackPath;
+    this->LastLevel = level;
+    impl.LevelTriangles[static_cast<std::size_t>(level)] =
+      static_cast<double>(this->NumberOfFallbackTriangles);
+    if (adjust)
+    {
+      mediso::FrameWork work;
+      work.Method = mediso::FrameMethod::Triangles;
+      work.Primitives = this->NumberOfFallbackTriangles;
+      work.Pixels = fullPixels;
+      work.Translucent = translucent;
+      this->LastPredictedSeconds = impl.Model.Predict(work);
+      glFinish();
+      this->LastMeasuredSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+      if (!impl.Fallback->GetLastFrameExtracted())
+      {
+        impl.Model.Observe(work, this->LastMeasuredSeconds);
+      }
+    }
+  };
+
+  // 5. An interactive frame whose GPU distances are all predicted over the
+  //    budget (the primitives dominate: a coarser volume is needed) draws a
+  //    coarser Block LOD level's triangles instead, when one is predicted
+  //    to fit better. Needs the active pairs of a GPU frame of these values.
   vtkOpenGLHistoPyramidIsosurfaces* gpu = impl.GPU;
+  if (interactive && this->InteractiveTriangleLevels && !this->ForceCPUFallback &&
+    impl.Primitives > 0 && this->LastGPUPathWorked)
+  {
+    std::vector<mediso::FrameTimeModel::Candidate> candidates;
+    for (float distance : SampleDistances)
+    {
+      candidates.push_back(gpuCandidate(distance, impl.Primitives));
+    }
+    for (int level = FullLevel - 1; level >= 0; --level)
+    {
+      candidates.push_back(triangleCandidate(level));
+    }
+    const mediso::FrameTimeModel::Candidate& chosen =
+      candidates[impl.Model.Choose(candidates, budget)];
+    if (chosen.Work.Method == mediso::FrameMethod::Triangles)
+    {
+      this->FallbackReason.clear();
+      drawTriangles(chosen.Level);
+      return;
+    }
+  }
+
+  // 6. The GPU path, or the fallback when it cannot run (said once, with the reason).
   std::string reason;
+  mediso::FrameWork chosenWork;
+  vtkOpenGLHistoPyramidIsosurfaces::SampleDistanceChooser chooser;
+  if (adjust)
+  {
+    chooser = [&](std::uint64_t primitives)
+    {
+      std::vector<mediso::FrameTimeModel::Candidate> candidates;
+      for (float distance : SampleDistances)
+      {
+        candidates.push_back(gpuCandidate(distance, primitives));
+      }
+      const std::size_t chosen = interactive ? impl.Model.Choose(candidates, budget) : 0;
+      chosenWork = candidates[chosen].Work;
+      this->LastPredictedSeconds = impl.Model.Predict(chosenWork);
+      return candidates[chosen].SampleDistance;
+    };
+  }
+  const std::uint64_t buildsBefore = gpu->GetStats().PyramidBuilds;
+  const std::uint64_t uploadsBefore = gpu->GetStats().VolumeUploads;
+  const Clock::time_point gpuStart = Clock::now();
   if (this->ForceCPUFallback)
   {
     reason = "ForceCPUFallback is on";
   }
   else if (gpu->RenderIsosurfaces(ren, vol, image, scalars, surfaces, this->AllowPointFootprint,
-             this->FirstHitPass, reason))
+             this->FirstHitPass, chooser, reason))
   {
     this->LastRenderPath = GPUPath;
+    this->LastGPUPathWorked = true;
     this->FallbackReason.clear();
     this->GPUStats = gpu->GetStats();
     this->LastFootprint = this->GPUStats.PointFootprint ? PointFootprint : BoxFootprint;
+    this->LastSampleDistance = this->GPUStats.SampleDistance;
+    impl.Primitives = this->GPUStats.Primitives;
+    if (adjust && this->GPUStats.Primitives > 0)
+    {
+      // Timed to the frame's end: a GL frame's calls return before its work is done.
+      glFinish();
+      this->LastMeasuredSeconds = std::chrono::duration<double>(Clock::now() - gpuStart).count();
+      const bool rebuilt = this->GPUStats.PyramidBuilds != buildsBefore ||
+        this->GPUStats.VolumeUploads != uploadsBefore;
+      const std::pair<int, bool> key(
+        static_cast<int>(std::lround(100.0 * this->LastSampleDistance)), chosenWork.Translucent);
+      if (!rebuilt && !impl.Warm.insert(key).second)
+      {
+        impl.Model.Observe(chosenWork, this->LastMeasuredSeconds);
+      }
+    }
+    else
+    {
+      this->LastPredictedSeconds = 0.0;
+    }
     return;
   }
+  this->LastGPUPathWorked = false;
+  this->LastPredictedSeconds = 0.0;
   if (!this->ForceCPUFallback)
   {
     sayOnce(false,
@@ -371,9 +580,20 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         "); rendering with vtkBlockLODContour and vtkPolyDataMapper instead.");
   }
   this->FallbackReason = reason;
-  impl.Fallback->RenderIsosurfaces(ren, vol, image, scalars, surfaces);
-  this->NumberOfFallbackTriangles = impl.Fallback->GetNumberOfTriangles();
-  this->LastRenderPath = FallbackPath;
+
+  // The fallback's level: the finest predicted within the budget while
+  // interactive, from the triangles each level had for these values.
+  int level = FullLevel;
+  if (interactive)
+  {
+    std::vector<mediso::FrameTimeModel::Candidate> candidates;
+    for (int l = FullLevel; l >= 0; --l)
+    {
+      candidates.push_back(triangleCandidate(l));
+    }
+    level = candidates[impl.Model.Choose(candidates, budget)].Level;
+  }
+  drawTriangles(level);
 }
 
 //------------------------------------------------------------------------------
@@ -387,4 +607,12 @@ void vtkHistoPyramidIsoMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfPyramidBuilds: " << this->GPUStats.PyramidBuilds << "\n";
   os << indent << "NumberOfVolumeUploads: " << this->GPUStats.VolumeUploads << "\n";
   os << indent << "GPUMemoryBytes: " << this->GetGPUMemoryBytes() << "\n";
+  os << indent << "InteractiveAdjust: " << this->InteractiveAdjust << "\n";
+  os << indent << "InteractiveFrameBudget: " << this->InteractiveFrameBudget << "\n";
+  os << indent << "InteractiveTriangleLevels: " << this->InteractiveTriangleLevels << "\n";
+  os << indent << "LastInteractive: " << this->LastInteractive << "\n";
+  os << indent << "LastSampleDistance: " << this->LastSampleDistance << "\n";
+  os << indent << "LastLevel: " << this->LastLevel << "\n";
+  os << indent << "LastPredictedSeconds: " << this->LastPredictedSeconds << "\n";
+  os << indent << "LastMeasuredSeconds: " << this->LastMeasuredSeconds << "\n";
 }

@@ -65,6 +65,28 @@
  * the CPU path. GetLastRenderPath() tells which path drew the last frame,
  * GetFallbackReason() why.
  *
+ * Interactive frames (InteractiveAdjust, on by default): a render whose
+ * prop has less than a second allocated (vtkVolume::GetAllocatedRenderTime(),
+ * the render window's DesiredUpdateRate shared among its props: the rule
+ * vtkGPUVolumeRayCastMapper's AutoAdjustSampleDistances uses; ParaView's
+ * interactive renders ask for 5 frames a second, its still ones for 0.002)
+ * is drawn within InteractiveFrameBudget seconds as the frame-time model
+ * (mediso::FrameTimeModel, fitted from this mapper's own frames) predicts:
+ * the GPU path at the finest image sample distance predicted within the
+ * budget (the surfaces drawn into a reduced target, then up to the viewport
+ * with their depth), the CPU fallback at the finest Block LOD level
+ * predicted within it. Where even the GPU path's coarsest distance is
+ * predicted over the budget (its per-cell work dominates: the frame needs a
+ * coarser volume), the frame draws the triangles of the finest coarser
+ * Block LOD level predicted within it (level 0 when none is), the CPU
+ * path's cached levels (InteractiveTriangleLevels; such a frame reports the
+ * "fallback" path with an empty FallbackReason). Other renders are full
+ * quality, the same image as with InteractiveAdjust off. GetLastSampleDistance(), GetLastLevel(),
+ * GetLastPredictedSeconds() and GetLastMeasuredSeconds() say what the last
+ * frame did; frames are timed to their end (glFinish) while InteractiveAdjust
+ * is on. The GPU path itself draws the full volume (level 3); coarser
+ * volumes reach the screen through the Block LOD triangles.
+ *
  * GPU memory: GetGPUMemoryBytes() (the volume texture plus about 0.16 bytes
  * per padded cell for the pyramid) stays the same across isovalue changes;
  * ReleaseGraphicsResources() frees every OpenGL object.
@@ -80,6 +102,7 @@
 #ifndef vtkHistoPyramidIsoMapper_h
 #define vtkHistoPyramidIsoMapper_h
 
+#include "FrameTimeModel.h"                  // For mediso::FrameTimeModel
 #include "IsosurfaceFrame.h"                 // For mediso::IsosurfaceSceneStats
 #include "MedicalIsosurfacesMappersModule.h" // For export macro
 #include "vtkOpenGLHistoPyramidIsosurfaces.h" // For Surface
@@ -183,7 +206,61 @@ public:
   vtkBooleanMacro(FirstHitPass, bool);
   ///@}
 
+  ///@{
+  /**
+   * Draw interactive renders (the prop's allocated render time below one
+   * second, see the class description) at the image sample distance (GPU
+   * path) or Block LOD level (CPU fallback) that the frame-time model
+   * predicts within the budget. Still renders are always full quality.
+   * Default on.
+   */
+  vtkSetMacro(InteractiveAdjust, bool);
+  vtkGetMacro(InteractiveAdjust, bool);
+  vtkBooleanMacro(InteractiveAdjust, bool);
+  ///@}
+
+  ///@{
+  /**
+   * Seconds an interactive frame may take. Default 0.1. When positive it
+   * wins over the prop's allocated render time; 0 takes the allocated
+   * render time as the budget, as VTK's volume mappers do (ParaView's
+   * interactive renders allocate 0.2 s shared among the view's props).
+   */
+  vtkSetClampMacro(InteractiveFrameBudget, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(InteractiveFrameBudget, double);
+  ///@}
+
+  ///@{
+  /**
+   * Let an interactive GPU frame whose coarsest sample distance is still
+   * predicted over the budget draw a coarser Block LOD level's triangles
+   * instead (see the class description). Off: interactive GPU frames stay
+   * on the GPU path at its coarsest distance. Default on.
+   */
+  vtkSetMacro(InteractiveTriangleLevels, bool);
+  vtkGetMacro(InteractiveTriangleLevels, bool);
+  vtkBooleanMacro(InteractiveTriangleLevels, bool);
+  ///@}
+
+  ///@{
+  /**
+   * What the last frame did: whether it was an interactive render, the image
+   * sample distance (1: every pixel) and Block LOD level (3: full
+   * resolution; the GPU path always draws the full volume) it drew at, the
+   * seconds the frame-time model predicted for it and the seconds it took
+   * (0 while InteractiveAdjust is off or nothing was drawn).
+   */
+  vtkGetMacro(LastInteractive, bool);
+  vtkGetMacro(LastSampleDistance, double);
+  vtkGetMacro(LastLevel, int);
+  vtkGetMacro(LastPredictedSeconds, double);
+  vtkGetMacro(LastMeasuredSeconds, double);
+  ///@}
+
 #if !defined(__VTK_WRAP__)
+  /// The frame-time model fitted from this mapper's frames.
+  const mediso::FrameTimeModel& GetFrameTimeModel() const;
+
   /**
    * What the GPU path did, as the core's scene says it (the last GPU frame,
    * the last pyramid build and volume upload, the builds and uploads so far):
@@ -306,6 +383,15 @@ private:
   bool AllowPointFootprint = true;
   int LastFootprint = BoxFootprint;
   bool FirstHitPass = true;
+  bool InteractiveAdjust = true;
+  double InteractiveFrameBudget = 0.1;
+  bool InteractiveTriangleLevels = true;
+  bool LastInteractive = false;
+  double LastSampleDistance = 1.0;
+  int LastLevel = 3;
+  double LastPredictedSeconds = 0.0;
+  double LastMeasuredSeconds = 0.0;
+  bool LastGPUPathWorked = false;
   mediso::IsosurfaceSceneStats GPUStats;
   std::uint64_t NumberOfFallbackTriangles = 0;
   int ColorSource = TransferFunctionColors;

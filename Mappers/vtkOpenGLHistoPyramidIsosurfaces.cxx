@@ -167,7 +167,8 @@ std::uint64_t vtkOpenGLHistoPyramidIsosurfaces::GetFrameBufferBytes() const
 //------------------------------------------------------------------------------
 bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol,
   vtkImageData* image, vtkDataArray* scalars, const std::vector<Surface>& surfaces,
-  bool allowPointFootprint, bool firstHitPass, std::string& reason)
+  bool allowPointFootprint, bool firstHitPass, const SampleDistanceChooser& sampleDistance,
+  std::string& reason)
 {
   Internals& impl = *this->Impl;
   auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
@@ -286,6 +287,10 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
   frame.AllowPointFootprint = allowPointFootprint;
   frame.FirstHitPass = firstHitPass;
   frame.ClipPlanes = PullBackPlanes(impl.ClipPlanes, indexToWorld);
+  if (sampleDistance)
+  {
+    frame.SampleDistance = sampleDistance(impl.Scene.GetActivePairs());
+  }
 
   // 4. Draw.
   if (!impl.Scene.Render(frame, reason))

@@ -33,8 +33,9 @@
 #include "MedicalIsosurfacesMappersModule.h" // For export macro
 #include "vtkObject.h"
 
-#include <array>   // For std::array
-#include <cstdint> // For std::uint64_t
+#include <array>      // For std::array
+#include <cstdint>    // For std::uint64_t
+#include <functional> // For std::function
 #include <memory>  // For std::unique_ptr
 #include <string>  // For std::string
 #include <vector>  // For std::vector
@@ -61,14 +62,21 @@ public:
     double Opacity;
   };
 
+  /// The image sample distance of a frame, from the primitives it will draw (see
+  /// RenderIsosurfaces).
+  using SampleDistanceChooser = std::function<float(std::uint64_t primitives)>;
+
   /**
    * Draw `surfaces` (increasing values, at most 8) of the single-component
    * point array `scalars` of `image` for `vol` into `ren`. False, with the
    * reason, when the GPU path cannot draw them (the caller falls back).
+   * `sampleDistance`, when set, is asked for the frame's image sample
+   * distance once the pyramid is up to date (its argument: the active
+   * cell-isovalue pairs the frame draws); unset, the frame draws every pixel.
    */
   bool RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image,
     vtkDataArray* scalars, const std::vector<Surface>& surfaces, bool allowPointFootprint,
-    bool firstHitPass, std::string& reason);
+    bool firstHitPass, const SampleDistanceChooser& sampleDistance, std::string& reason);
 
   /// A plane (a, b, c, d): the points where a x + b y + c z + d >= 0 are kept.
   using Plane = std::array<double, 4>;

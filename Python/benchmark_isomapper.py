@@ -5,6 +5,7 @@
         [--sweep 95] [--windows 1920x1080,1024x768] [--isovalues=-500,400]
         [--rc-factors 0.5[,1.0]] [--methods hp,rc,fe] [--images DIR] [--out FILE.md]
         [--json FILE.json] [--binary build/bin/BenchmarkHistoPyramidIsoMapper]
+        [--interactive-budget 0.1 [--opacity 0.3 --together]]
 
 Runs the C++ program BenchmarkHistoPyramidIsoMapper (the plugin's classes are not Python-wrapped)
 under its own Xvfb (Testing/Scripts/with-xvfb.sh), one process per input, with
@@ -25,6 +26,11 @@ VTK_SMP_BACKEND_IN_USE=STDThread, and turns its "bench-result:" lines into markd
 Methods, in the same process: vtkHistoPyramidIsoMapper (GetLastRenderPath() must be the GPU path),
 vtkGPUVolumeRayCastMapper in isosurface blend mode (shading on, AutoAdjustSampleDistances off,
 SampleDistance = factor x the smallest spacing), vtkFlyingEdges3D (normals on) + vtkPolyDataMapper.
+With --interactive-budget S (issue 30), every hp rotation is followed by as many interactive
+frames (the render window's DesiredUpdateRate 1000, InteractiveFrameBudget S): their median
+against the still median, the image sample distances the mapper chose, and the frame-time model's
+predicted against measured seconds for the frames it chose; --opacity and --together draw skin
+(the first isovalue) at that opacity over bone in one scene.
 Ends with the issue's targets: rotation frame time <= 0.5x the ray caster's, isovalue change+frame
 <= 0.5x FlyingEdges + PolyDataMapper's, GPU memory <= 1.5x the volume's bytes.
 """
@@ -77,6 +83,12 @@ def parse_args(argv):
                                                     "BenchmarkHistoPyramidIsoMapper"))
     p.add_argument("--out", default="", help="write the tables (markdown) to this file")
     p.add_argument("--json", default="", help="write the raw records to this file")
+    p.add_argument("--interactive-budget", type=float, default=0.0,
+                   help="> 0: interactive rotation frames of hp with this budget (seconds)")
+    p.add_argument("--opacity", type=float, default=1.0,
+                   help="opacity of the first isovalue (the others opaque)")
+    p.add_argument("--together", action="store_true",
+                   help="one rotation scene with all the isovalues (skin over bone)")
     return p.parse_args(argv)
 
 
@@ -86,6 +98,12 @@ def run_input(args, name):
                "--sweep", str(args.sweep), "--windows", args.windows,
                "--isovalues=" + args.isovalues, "--methods", args.methods,
                "--rc-factors", args.rc_factors]
+    if args.interactive_budget > 0:
+        command += ["--interactive-budget", str(args.interactive_budget)]
+    if args.opacity != 1.0:
+        command += ["--opacity", str(args.opacity)]
+    if args.together:
+        command += ["--together", "1"]
     if args.images:
         os.makedirs(args.images, exist_ok=True)
         command += ["--images", args.images]
@@ -191,6 +209,39 @@ def report(args, command, records, failed, started, wall, load_before, load_afte
     lines.extend(table(["input", "window", "iso", "method", "frames", "min s", "median s",
                         "fps (1/median)", "total s", "primitives", "ours / ray caster (median)"],
                        rows))
+
+    # 1b. interactive frames (issue 30)
+    inter = [r for r in records if r["kind"] == "interactive"]
+    if inter:
+        out("")
+        out("## Interactive frames (seconds per frame, Render + glFinish; budget %g s)"
+            % inter[0]["budget_s"])
+        out("")
+        rows = []
+        for r in inter:
+            rows.append(["%s %s" % (r["input"], dims.get(r["input"], "")), r["window"],
+                         "%g (%d isovalues, first at opacity %g)" % (r["iso"], r["isovalues"],
+                                                                     r["opacity"]),
+                         r["frames"], fmt_s(r["still_median_s"]), fmt_s(r["median_s"]),
+                         "%.2f" % (r["median_s"] / r["still_median_s"]),
+                         "%g (%g..%g)" % (r["distance_median"], r["distance_min"],
+                                          r["distance_max"]),
+                         "%d; level median %g, min %g" % (r["triangle_frames"],
+                                                          r["level_median"], r["level_min"]),
+                         "%s / %s" % (fmt_s(r["predicted_median_s"]),
+                                      fmt_s(r["measured_median_s"])),
+                         "%.0f%%" % (100.0 * r["error_median"]),
+                         "%.0f%%" % (100.0 * r["within_25"]),
+                         "%s at %g" % (fmt_s(r["still_after_s"]), r["still_after_distance"])])
+            targets.append(target_row("interactive frame median <= 0.1 s",
+                                      "%s, %s" % (r["input"], r["window"]),
+                                      r["median_s"] / 0.1, 1.0))
+        lines.extend(table(["input", "window", "isovalues", "frames", "still median s",
+                            "interactive median s", "interactive / still",
+                            "sample distance median (min..max)",
+                            "frames as Block LOD triangles",
+                            "predicted / measured median s", "median |error|",
+                            "frames predicted within 25%", "still frame after"], rows))
 
     # 2. sweep
     out("")

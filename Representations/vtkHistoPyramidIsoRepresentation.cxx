@@ -111,6 +111,72 @@ bool vtkHistoPyramidIsoRepresentation::GetFirstHitPass()
 }
 
 //------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetInteractiveAdjust(bool adjust)
+{
+  this->IsoMapper->SetInteractiveAdjust(adjust);
+}
+
+//------------------------------------------------------------------------------
+bool vtkHistoPyramidIsoRepresentation::GetInteractiveAdjust()
+{
+  return this->IsoMapper->GetInteractiveAdjust();
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetInteractiveFrameBudget(double seconds)
+{
+  this->IsoMapper->SetInteractiveFrameBudget(seconds);
+}
+
+//------------------------------------------------------------------------------
+double vtkHistoPyramidIsoRepresentation::GetInteractiveFrameBudget()
+{
+  return this->IsoMapper->GetInteractiveFrameBudget();
+}
+
+//------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetInteractiveTriangleLevels(bool use)
+{
+  this->IsoMapper->SetInteractiveTriangleLevels(use);
+}
+
+//------------------------------------------------------------------------------
+bool vtkHistoPyramidIsoRepresentation::GetInteractiveTriangleLevels()
+{
+  return this->IsoMapper->GetInteractiveTriangleLevels();
+}
+
+//------------------------------------------------------------------------------
+double vtkHistoPyramidIsoRepresentation::GetLastInteractive()
+{
+  return this->IsoMapper->GetLastInteractive() ? 1.0 : 0.0;
+}
+
+//------------------------------------------------------------------------------
+double vtkHistoPyramidIsoRepresentation::GetLastSampleDistance()
+{
+  return this->IsoMapper->GetLastSampleDistance();
+}
+
+//------------------------------------------------------------------------------
+double vtkHistoPyramidIsoRepresentation::GetLastLevel()
+{
+  return static_cast<double>(this->IsoMapper->GetLastLevel());
+}
+
+//------------------------------------------------------------------------------
+double vtkHistoPyramidIsoRepresentation::GetLastPredictedSeconds()
+{
+  return this->IsoMapper->GetLastPredictedSeconds();
+}
+
+//------------------------------------------------------------------------------
+double vtkHistoPyramidIsoRepresentation::GetLastMeasuredSeconds()
+{
+  return this->IsoMapper->GetLastMeasuredSeconds();
+}
+
+//------------------------------------------------------------------------------
 void vtkHistoPyramidIsoRepresentation::SetDiffuseColor(double r, double g, double b)
 {
   this->IsoMapper->SetSolidColor(r, g, b);

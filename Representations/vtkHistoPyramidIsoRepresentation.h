@@ -118,6 +118,37 @@ public:
 
   ///@{
   /**
+   * Interactive frames (vtkHistoPyramidIsoMapper::SetInteractiveAdjust,
+   * SetInteractiveFrameBudget): during the view's interactive renders draw
+   * within the budget (seconds; 0: the time the view allocates), at a coarser
+   * image sample distance (GPU) or Block LOD level (fallback; also the GPU
+   * path's frames that no distance fits, with InteractiveTriangleLevels).
+   * Defaults on, 0.1 s, on.
+   */
+  void SetInteractiveAdjust(bool adjust);
+  bool GetInteractiveAdjust();
+  void SetInteractiveFrameBudget(double seconds);
+  double GetInteractiveFrameBudget();
+  void SetInteractiveTriangleLevels(bool use);
+  bool GetInteractiveTriangleLevels();
+  ///@}
+
+  ///@{
+  /**
+   * What the last frame on this process did: interactive (1) or still (0),
+   * its image sample distance and Block LOD level, the seconds predicted
+   * and measured (see vtkHistoPyramidIsoMapper). Doubles for the
+   * ServerManager's information helpers.
+   */
+  double GetLastInteractive();
+  double GetLastSampleDistance();
+  double GetLastLevel();
+  double GetLastPredictedSeconds();
+  double GetLastMeasuredSeconds();
+  ///@}
+
+  ///@{
+  /**
    * Colouring of the surfaces (see the class description): the solid colour,
    * one colour per surface (used when ColorEachSurface is on), an opacity per
    * surface, and a global opacity multiplier. Surface i is the i-th value of

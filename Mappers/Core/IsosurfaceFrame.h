@@ -70,6 +70,11 @@ struct IsosurfaceFrame
   /// interval: the surfaces are cut exactly at the planes and left open there, and a
   /// surface behind a removed one shows through. A cropping box is six of them.
   std::vector<std::array<double, 4>> ClipPlanes;
+  /// Image sample distance: above 1, the surfaces are drawn into a target of
+  /// Viewport / SampleDistance pixels (rounded up), then up to the viewport with their
+  /// depth (interactive frames: about 1 / SampleDistance^2 of the fragment work). 1 (or
+  /// anything not above 1) draws every pixel, the full-quality image.
+  float SampleDistance = 1.0f;
 
   /// The lights a program draws with (NumberOfLights within 0..MaximumLights): its
   /// MEDISO_LIGHTS, a constant of the program, since a software rasteriser runs every
@@ -88,6 +93,10 @@ struct IsosurfaceSceneStats
   bool PointFootprint = false;
   bool FirstHit = false;
   ///@}
+
+  /// The image sample distance the last frame was drawn at (1: every pixel; see
+  /// IsosurfaceFrame::SampleDistance).
+  float SampleDistance = 1.0f;
 
   ///@{
   /// The last pyramid build: seconds (its passes and the read-back of the total), the level-1

@@ -274,6 +274,67 @@ struct IsosurfaceRendererGL::Internals
   int HitSize[2] = { 0, 0 };
   int HitRect[4] = { 0, 0, 0, 0 };
 
+  // Reduced target of frames drawn at an image sample distance above 1.
+  Name ReducedFBO, ReducedColor, ReducedDepth;
+  int ReducedSize[2] = { 0, 0 };
+  // Set around the reduced pass: translucent surfaces there write the depth
+  // of their nearest hit (the cells come back to front, so the last write of
+  // a pixel is its nearest hit), which the second pass tests with.
+  bool WriteTranslucentDepth = false;
+  bool LastTranslucent = false;
+
+  void ReleaseReduced()
+  {
+    this->ReducedFBO.Reset();
+    this->ReducedColor.Reset();
+    this->ReducedDepth.Reset();
+    this->ReducedSize[0] = this->ReducedSize[1] = 0;
+  }
+
+  // The reduced target at exactly width x height. "" when ready, else why not.
+  std::string PrepareReduced(int width, int height)
+  {
+    if (this->ReducedFBO && this->ReducedSize[0] == width && this->ReducedSize[1] == height)
+    {
+      return "";
+    }
+    this->ReleaseReduced();
+    const GLApi& gl = *this->GL;
+    const GLApi::Functions& f = gl.F();
+    gl.TakeErrors();
+    this->ReducedColor = Name(gl, NameKind::Texture);
+    BindTextureUnit(gl, 0, GL_TEXTURE_2D, this->ReducedColor.Get());
+    SetNearest(gl, GL_TEXTURE_2D);
+    f.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    this->ReducedDepth = Name(gl, NameKind::Texture);
+    BindTextureUnit(gl, 0, GL_TEXTURE_2D, this->ReducedDepth.Get());
+    SetNearest(gl, GL_TEXTURE_2D);
+    f.TexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, width, height, 0, GL_DEPTH_COMPONENT,
+      GL_FLOAT, nullptr);
+    this->ReducedFBO = Name(gl, NameKind::Framebuffer);
+    f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, this->ReducedFBO.Get());
+    f.FramebufferTexture2D(
+      GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, this->ReducedColor.Get(), 0);
+    f.FramebufferTexture2D(
+      GL_DRAW_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, this->ReducedDepth.Get(), 0);
+    const GLenum buffers[1] = { GL_COLOR_ATTACHMENT0 };
+    f.DrawBuffers(1, buffers);
+    std::string problem = FramebufferProblem(gl);
+    const std::string errors = gl.TakeErrors();
+    if (problem.empty() && !errors.empty())
+    {
+      problem = errors;
+    }
+    if (!problem.empty())
+    {
+      this->ReleaseReduced();
+      return problem;
+    }
+    this->ReducedSize[0] = width;
+    this->ReducedSize[1] = height;
+    return "";
+  }
+
   void ReleaseHitBuffers()
   {
     this->HitFBO.Reset();
@@ -376,14 +437,17 @@ IsosurfaceRendererGL::~IsosurfaceRendererGL() = default;
 void IsosurfaceRendererGL::Release()
 {
   this->Impl->ReleaseHitBuffers();
+  this->Impl->ReleaseReduced();
   this->Impl->Programs.Clear();
   this->Impl->VertexArray.Reset();
 }
 
 std::uint64_t IsosurfaceRendererGL::GetFrameBufferBytes() const
 {
-  // RGBA8 colour, 32-bit depth (R32F or R32UI), 16-bit depth buffer.
-  return static_cast<std::uint64_t>(this->Impl->HitSize[0]) * this->Impl->HitSize[1] * 10u;
+  // First hit: RGBA8 colour, 32-bit depth (R32F or R32UI), 16-bit depth
+  // buffer. Reduced target: RGBA8 colour, 32-bit float depth.
+  return static_cast<std::uint64_t>(this->Impl->HitSize[0]) * this->Impl->HitSize[1] * 10u +
+    static_cast<std::uint64_t>(this->Impl->ReducedSize[0]) * this->Impl->ReducedSize[1] * 8u;
 }
 
 //------------------------------------------------------------------------------
@@ -541,6 +605,20 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
   const GLApi& gl = *impl.GL;
   const GLApi::Functions& f = gl.F();
   stats = IsosurfaceFrameStats();
+  // An image sample distance above 1 that leaves fewer pixels: the reduced
+  // target, then up to the viewport.
+  if (frame.SampleDistance > 1.0f && std::isfinite(frame.SampleDistance) && pyramid.IsBuilt() &&
+    pyramid.GetGLApi() == impl.GL.get() && pyramid.GetTotal() > 0)
+  {
+    const int width = std::max(1,
+      static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[2]) / frame.SampleDistance)));
+    const int height = std::max(1,
+      static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[3]) / frame.SampleDistance)));
+    if (width < frame.Viewport[2] || height < frame.Viewport[3])
+    {
+      return this->RenderReduced(pyramid, frame, width, height, stats, error);
+    }
+  }
   if (!pyramid.IsBuilt())
   {
     error = "the pyramid is not built";
@@ -608,6 +686,12 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
     return false;
   }
   impl.SetUniforms(*program, pyramid, frame, v);
+  impl.LastTranslucent = v.Translucent;
+  if (v.Translucent && impl.WriteTranslucentDepth)
+  {
+    f.DepthMask(GL_TRUE);
+    f.DepthFunc(GL_ALWAYS);
+  }
 
   // 5. Draw the cells, through the first-hit pass or in one.
   if (v.FirstHit)
@@ -631,6 +715,89 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
   }
   stats.PointFootprint = v.Points;
   stats.FirstHit = v.FirstHit;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool IsosurfaceRendererGL::RenderReduced(const HistoPyramidGL& pyramid,
+  const IsosurfaceFrame& frame, int width, int height, IsosurfaceFrameStats& stats,
+  std::string& error)
+{
+  Internals& impl = *this->Impl;
+  const GLApi& gl = *impl.GL;
+  const GLApi::Functions& f = gl.F();
+  ScopedGLState saved(gl, 2);
+  GLint hostFramebuffer = 0;
+  f.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &hostFramebuffer);
+  gl.TakeErrors();
+  const std::string problem = impl.PrepareReduced(width, height);
+  f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(hostFramebuffer));
+  IsosurfaceFrame reduced = frame;
+  reduced.SampleDistance = 1.0f;
+  if (!problem.empty())
+  {
+    return this->Render(pyramid, reduced, stats, error); // every pixel: the same surfaces
+  }
+
+  // Pass 1: the whole frame into the reduced target, cleared to no surface,
+  // as into a host's framebuffer of that size with GL_LESS.
+  f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, impl.ReducedFBO.Get());
+  f.Disable(GL_SCISSOR_TEST);
+  f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  f.DepthMask(GL_TRUE);
+  const GLfloat clearColor[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
+  const GLfloat one = 1.0f;
+  f.ClearBufferfv(GL_COLOR, 0, clearColor);
+  f.ClearBufferfv(GL_DEPTH, 0, &one);
+  f.DepthFunc(GL_LESS);
+  reduced.Viewport[0] = 0;
+  reduced.Viewport[1] = 0;
+  reduced.Viewport[2] = width;
+  reduced.Viewport[3] = height;
+  impl.WriteTranslucentDepth = true;
+  const bool drawn = this->Render(pyramid, reduced, stats, error);
+  impl.WriteTranslucentDepth = false;
+  f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(hostFramebuffer));
+  if (!drawn)
+  {
+    return false;
+  }
+
+  // Pass 2: up to the host's viewport with the host's depth test.
+  saved.RestoreDepthFunc();
+  Program* upsample = impl.Programs.Get(
+    gl, "", shaders::HistoPyramidFullScreen_vs, shaders::HistoPyramidUpsample_fs, error);
+  if (!upsample)
+  {
+    error = "the sample-distance shader does not build: " + error;
+    return false;
+  }
+  f.Enable(GL_DEPTH_TEST);
+  SetSurfacePassBlending(gl, impl.LastTranslucent);
+  upsample->Use();
+  BindTextureUnit(gl, 0, GL_TEXTURE_2D, impl.ReducedColor.Get());
+  BindTextureUnit(gl, 1, GL_TEXTURE_2D, impl.ReducedDepth.Get());
+  upsample->Set("reducedColor", 0);
+  upsample->Set("reducedDepth", 1);
+  const float viewport[4] = { static_cast<float>(frame.Viewport[0]),
+    static_cast<float>(frame.Viewport[1]), static_cast<float>(frame.Viewport[2]),
+    static_cast<float>(frame.Viewport[3]) };
+  upsample->Set4f("viewport", viewport);
+  upsample->Set2i("reducedSize", width, height);
+  if (!impl.VertexArray)
+  {
+    impl.VertexArray = Name(gl, NameKind::VertexArray);
+  }
+  f.BindVertexArray(impl.VertexArray.Get());
+  f.Viewport(frame.Viewport[0], frame.Viewport[1], frame.Viewport[2], frame.Viewport[3]);
+  f.DrawArrays(GL_TRIANGLES, 0, 3);
+  const std::string errors = gl.TakeErrors();
+  if (!errors.empty())
+  {
+    error = "drawing the isosurfaces at a sample distance failed: " + errors;
+    return false;
+  }
+  stats.SampleDistance = frame.SampleDistance;
   return true;
 }
 

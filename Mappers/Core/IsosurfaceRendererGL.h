@@ -51,6 +51,16 @@
  * HistoPyramidGL::BindWalk()), draw the cells (through the first-hit pass
  * or in one).
  *
+ * A frame with an image sample distance above 1
+ * (IsosurfaceFrame::SampleDistance, a host's interactive frames) runs all of
+ * this into the renderer's reduced target (the viewport divided by the
+ * distance, colour and a depth texture), then draws that up to the viewport
+ * (HistoPyramidUpsample_fs.glsl: each window pixel takes its reduced pixel's
+ * colour and depth, with the host's depth test; premultiplied "over" for
+ * translucent surfaces, whose reduced pass keeps the nearest hit's depth).
+ * The still frame (distance 1) does not touch the reduced target. Where
+ * the target cannot be made, the frame is drawn at every pixel instead.
+ *
  * Hosts do not call the renderer: IsosurfaceScene does.
  *
  * The renderer draws into the framebuffer bound when Render() is called,
@@ -82,6 +92,7 @@ struct IsosurfaceFrameStats
   std::uint64_t Primitives = 0;
   bool PointFootprint = false; ///< points (else quads over the box)
   bool FirstHit = false;       ///< drawn through the first-hit pass
+  float SampleDistance = 1.0f; ///< image sample distance drawn at (1: every pixel)
 };
 
 class IsosurfaceRendererGL
@@ -101,13 +112,17 @@ public:
   bool Render(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
     IsosurfaceFrameStats& stats, std::string& error);
 
-  /// Bytes of the first-hit pass's buffers (0 until one is drawn).
+  /// Bytes of the first-hit pass's buffers and the reduced target (0 until one is drawn).
   std::uint64_t GetFrameBufferBytes() const;
 
   /// Frees every GL object (the context must be current).
   void Release();
 
 private:
+  // The frame drawn into the reduced target of width x height, then up to its viewport.
+  bool RenderReduced(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame, int width,
+    int height, IsosurfaceFrameStats& stats, std::string& error);
+
   struct Internals;
   std::unique_ptr<Internals> Impl;
 };

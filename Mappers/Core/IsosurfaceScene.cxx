@@ -230,6 +230,7 @@ bool IsosurfaceScene::Render(const IsosurfaceFrame& frame, std::string& error)
   stats.Primitives = 0;
   stats.PointFootprint = false;
   stats.FirstHit = false;
+  stats.SampleDistance = 1.0f;
   if (!this->Update(error))
   {
     return false;
@@ -248,6 +249,7 @@ bool IsosurfaceScene::Render(const IsosurfaceFrame& frame, std::string& error)
   stats.Primitives = frameStats.Primitives;
   stats.PointFootprint = frameStats.PointFootprint;
   stats.FirstHit = frameStats.FirstHit;
+  stats.SampleDistance = frameStats.SampleDistance;
   return true;
 }
 
@@ -255,6 +257,14 @@ bool IsosurfaceScene::Render(const IsosurfaceFrame& frame, std::string& error)
 const IsosurfaceSceneStats& IsosurfaceScene::GetStats() const
 {
   return this->Impl->Stats;
+}
+
+std::uint64_t IsosurfaceScene::GetActivePairs() const
+{
+  const Internals& impl = *this->Impl;
+  return impl.Pyramid && impl.Pyramid->IsBuilt() && !impl.BuiltValues.empty()
+    ? impl.Pyramid->GetTotal()
+    : 0;
 }
 
 std::uint64_t IsosurfaceScene::GetGPUMemoryBytes() const

@@ -121,6 +121,13 @@ public:
    */
   bool Render(const IsosurfaceFrame& frame, std::string& error);
 
+  /**
+   * The active cell-isovalue pairs of the built pyramid (0 before a build):
+   * the primitives the next Render() draws, known after Update() and before
+   * the frame, which is when a host chooses its sample distance.
+   */
+  std::uint64_t GetActivePairs() const;
+
   /// What the scene did (see IsosurfaceSceneStats).
   const IsosurfaceSceneStats& GetStats() const;
 

@@ -24,7 +24,14 @@
 // --together 1: one rotation scene per window and method with all the
 // isovalues at once (the demo's skin over bone): the first at --opacity, the
 // others opaque; FlyingEdges extracts them all. The sweep is unchanged.
-//     [--images DIR]
+//     [--images DIR] [--interactive-budget SECONDS]
+// --interactive-budget S (> 0): after each "hp" rotation, the same number of
+// frames again as interactive renders (the window's DesiredUpdateRate 1000:
+// under a second allocated, as in ParaView's interactive renders) with the
+// mapper's InteractiveFrameBudget S; an "interactive" record has their
+// median, the sample distances chosen, and the frame-time model's predicted
+// against measured seconds of each frame it chose (its first frames, before
+// any interactive frame was observed, included).
 #include "MedicalTestUtilities.h"
 #include "vtkHistoPyramidIsoMapper.h"
 #include "vtkMedicalPhantomSource.h"
@@ -84,6 +91,7 @@ struct Options
   double Opacity = 1.0; // of every isovalue (< 1: the mapper's translucent mode)
   double Zoom = 1.0;    // camera zoom after the reset (close zooms: the quad footprints)
   bool Together = false; // rotation with all isovalues in one scene
+  double InteractiveBudget = 0.0; // > 0: also interactive rotation frames of "hp" (issue 30)
   std::string ImageDir;
 };
 
@@ -154,6 +162,8 @@ bool Parse(int argc, char* argv[], Options& opt)
       opt.Opacity = std::min(1.0, std::max(0.01, std::stod(value)));
     else if (name == "--zoom")
       opt.Zoom = std::max(1e-3, std::stod(value));
+    else if (name == "--interactive-budget")
+      opt.InteractiveBudget = std::max(0.0, std::stod(value));
     else if (name == "--together")
       opt.Together = std::stoi(value) != 0;
     else if (name == "--images")
@@ -797,6 +807,63 @@ int main(int argc, char* argv[])
               scene.FlyingEdges->GetOutput()->GetActualMemorySize() / 1024.0);
           }
           r.Print();
+          if (scene.HistoPyramid && opt.InteractiveBudget > 0.0)
+          {
+            vtkHistoPyramidIsoMapper* hp = scene.HistoPyramid;
+            hp->SetInteractiveFrameBudget(opt.InteractiveBudget);
+            scene.Window->SetDesiredUpdateRate(1000.0);
+            std::vector<double> frameTimes, distances, predicted, measured, errors, levels;
+            int within = 0;
+            int triangleFrames = 0;
+            for (int f = 0; f < opt.Frames; ++f)
+            {
+              scene.Rotate(1.0);
+              frameTimes.push_back(scene.Frame());
+              distances.push_back(hp->GetLastSampleDistance());
+              levels.push_back(hp->GetLastLevel());
+              triangleFrames +=
+                hp->GetLastRenderPath() == vtkHistoPyramidIsoMapper::FallbackPath ? 1 : 0;
+              predicted.push_back(hp->GetLastPredictedSeconds());
+              measured.push_back(hp->GetLastMeasuredSeconds());
+              const double error =
+                std::abs(predicted.back() - measured.back()) / std::max(measured.back(), 1e-9);
+              errors.push_back(error);
+              within += error <= 0.25 ? 1 : 0;
+            }
+            scene.Window->SetDesiredUpdateRate(0.0001);
+            const double stillAfter = scene.Frame();
+            const Stats is = Summarise(frameTimes);
+            Record("interactive")
+              .Add("input", opt.Input)
+              .Add("window", windowText)
+              .Add("iso", iso)
+              .Add("isovalues", static_cast<double>(isos.size()))
+              .Add("opacity", SurfaceOpacity)
+              .Add("budget_s", opt.InteractiveBudget)
+              .Add("frames", opt.Frames)
+              .Add("still_median_s", s.Median)
+              .Add("median_s", is.Median)
+              .Add("min_s", is.Min)
+              .Add("distance_median", Summarise(distances).Median)
+              .Add("distance_min", Summarise(distances).Min)
+              .Add("distance_max", *std::max_element(distances.begin(), distances.end()))
+              .Add("level_min", *std::min_element(levels.begin(), levels.end()))
+              .Add("level_median", Summarise(levels).Median)
+              .Add("triangle_frames", static_cast<double>(triangleFrames))
+              .Add("predicted_median_s", Summarise(predicted).Median)
+              .Add("measured_median_s", Summarise(measured).Median)
+              .Add("error_median", Summarise(errors).Median)
+              .Add("within_25", static_cast<double>(within) / std::max(1, opt.Frames))
+              .Add("still_after_s", stillAfter)
+              .Add("still_after_distance", hp->GetLastSampleDistance())
+              .Print();
+            std::printf("%s %s interactive (budget %g s): median %.4f s against still %.4f s, "
+                        "sample distance median %g, predicted/measured median %.4f/%.4f s, "
+                        "%.0f%% of frames predicted within 25%%\n",
+              opt.Input.c_str(), windowText.c_str(), opt.InteractiveBudget, is.Median, s.Median,
+              Summarise(distances).Median, Summarise(predicted).Median, Summarise(measured).Median,
+              100.0 * within / std::max(1, opt.Frames));
+          }
           std::printf("%s %s %s iso %g: %d frames, median %.4f s (%.1f fps), min %.4f s, "
                       "total %.1f s, %.0f elements, path %s\n",
             opt.Input.c_str(), windowText.c_str(), scene.Label.c_str(), iso, opt.Frames,

@@ -1,0 +1,313 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// vtkHistoPyramidIsoMapper's interactive frames (InteractiveAdjust), on the
+// phantom's skin over bone, opaque and with translucent skin (0.3):
+//
+// 1. Still renders (the window's default DesiredUpdateRate: hours per frame)
+//    draw every pixel, and a still render after interactive ones is the same
+//    image, pixel for pixel, as the one before them.
+// 2. An interactive render (DesiredUpdateRate 1000: a millisecond for the
+//    window) with a budget between the frame-time model's predictions for
+//    distances 1 and 8 draws at a distance above 1 predicted within it. With
+//    a tiny budget and InteractiveTriangleLevels off it draws at the coarsest
+//    distance (8) and says so (GetLastSampleDistance, GetLastInteractive,
+//    predicted and measured seconds); its image covers about the same pixels
+//    as the still one (the reduced target drawn up to the viewport), differs
+//    from it, and keeps the depth test: an opaque plane in front of the
+//    volume's left part stays unchanged. With the triangle levels on (the
+//    default) a tiny budget draws a coarser Block LOD level's triangles.
+// 3. With a budget of 1000 s the interactive render draws every pixel (the
+//    still image); with InteractiveFrameBudget 0 the allocated render time
+//    is the budget; with InteractiveAdjust off interactive renders are the
+//    still image.
+// 4. The CPU fallback (ForceCPUFallback): an interactive render with a tiny
+//    budget draws a coarser Block LOD level with fewer triangles, the still
+//    render after it level 3 and the same image as before.
+// GPU path needed for 1-3 (a machine without it skips, 125).
+#include "IsoMapperTestScenes.h"
+#include "MedicalTestUtilities.h"
+
+#include "vtkActor.h"
+#include "vtkCamera.h"
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkPlaneSource.h"
+#include "vtkPointData.h"
+#include "vtkPolyDataMapper.h"
+#include "vtkProperty.h"
+#include "vtkRenderWindow.h"
+#include "vtkRenderer.h"
+#include "vtkUnsignedCharArray.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace
+{
+using medical_test::Check;
+constexpr int Size = 300;
+constexpr double StillRate = 0.0001;       // vtkRenderWindow's default
+constexpr double InteractiveRate = 1000.0; // a millisecond for the whole window
+
+struct Scene
+{
+  vtkNew<vtkRenderWindow> Window;
+  vtkNew<vtkRenderer> Renderer;
+  vtkNew<vtkHistoPyramidIsoMapper> Mapper;
+  vtkSmartPointer<vtkVolume> Volume;
+
+  Scene(vtkImageData* image, const std::vector<iso_test::Look>& looks)
+  {
+    this->Window->SetSize(Size, Size);
+    this->Window->SetMultiSamples(0);
+    this->Volume = iso_test::MakeVolume(image, looks, this->Mapper);
+    this->Renderer->SetBackground(0.0, 0.0, 0.0);
+    this->Renderer->AddVolume(this->Volume);
+    // An opaque red plane in front of the volume's left part (between the
+    // camera and the volume): no surface may be drawn over it.
+    vtkNew<vtkPlaneSource> plane;
+    // (The phantom spans 0..200 on every axis.)
+    plane->SetOrigin(20.0, 40.0, 230.0);
+    plane->SetPoint1(80.0, 40.0, 230.0);
+    plane->SetPoint2(20.0, 160.0, 230.0);
+    vtkNew<vtkPolyDataMapper> planeMapper;
+    planeMapper->SetInputConnection(plane->GetOutputPort());
+    vtkNew<vtkActor> planeActor;
+    planeActor->SetMapper(planeMapper);
+    planeActor->GetProperty()->SetColor(1.0, 0.0, 0.0);
+    planeActor->GetProperty()->SetLighting(false);
+    this->Renderer->AddActor(planeActor);
+    vtkCamera* camera = this->Renderer->GetActiveCamera();
+    camera->SetFocalPoint(100.0, 100.0, 100.0);
+    camera->SetPosition(100.0, 100.0, 700.0);
+    camera->SetViewUp(0.0, 1.0, 0.0);
+    camera->SetViewAngle(30.0);
+    camera->SetClippingRange(200.0, 1000.0);
+    this->Window->AddRenderer(this->Renderer);
+  }
+
+  std::vector<unsigned char> Render(double rate)
+  {
+    this->Window->SetDesiredUpdateRate(rate);
+    this->Window->Render();
+    vtkNew<vtkUnsignedCharArray> rgb;
+    this->Window->GetPixelData(0, 0, Size - 1, Size - 1, 1, rgb);
+    return std::vector<unsigned char>(rgb->GetPointer(0), rgb->GetPointer(0) + 3 * Size * Size);
+  }
+};
+
+int Covered(const std::vector<unsigned char>& rgb)
+{
+  int covered = 0;
+  for (std::size_t p = 0; p < rgb.size(); p += 3)
+  {
+    covered += (rgb[p] | rgb[p + 1] | rgb[p + 2]) != 0 ? 1 : 0;
+  }
+  return covered;
+}
+
+// Pixels of the plane (pure red) in `rgb`.
+int PlanePixels(const std::vector<unsigned char>& rgb)
+{
+  int red = 0;
+  for (std::size_t p = 0; p < rgb.size(); p += 3)
+  {
+    red += (rgb[p] == 255 && rgb[p + 1] == 0 && rgb[p + 2] == 0) ? 1 : 0;
+  }
+  return red;
+}
+
+std::string Describe(vtkHistoPyramidIsoMapper* mapper)
+{
+  char text[256];
+  std::snprintf(text, sizeof(text),
+    "path %s, interactive %d, sample distance %g, level %d, predicted %.4f s, measured %.4f s",
+    mapper->GetLastRenderPathAsString(), mapper->GetLastInteractive() ? 1 : 0,
+    mapper->GetLastSampleDistance(), mapper->GetLastLevel(), mapper->GetLastPredictedSeconds(),
+    mapper->GetLastMeasuredSeconds());
+  return text;
+}
+
+void CheckGPUScene(
+  vtkImageData* phantom, const std::vector<iso_test::Look>& looks, const std::string& name)
+{
+  Scene scene(phantom, looks);
+  vtkHistoPyramidIsoMapper* mapper = scene.Mapper;
+  Check(mapper->GetInteractiveAdjust() && mapper->GetInteractiveFrameBudget() == 0.1,
+    name + ": InteractiveAdjust on and a 0.1 s budget by default");
+
+  // Still frames: every pixel, timed and predicted.
+  scene.Render(StillRate);
+  const std::vector<unsigned char> still = scene.Render(StillRate);
+  std::printf("%s still: %s\n", name.c_str(), Describe(mapper).c_str());
+  Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
+      !mapper->GetLastInteractive() && mapper->GetLastSampleDistance() == 1.0 &&
+      mapper->GetLastLevel() == 3,
+    name + ": a still render draws every pixel of the full level");
+  Check(mapper->GetLastMeasuredSeconds() > 0.0 && mapper->GetLastPredictedSeconds() > 0.0,
+    name + ": a still frame is timed and predicted");
+  const int stillCovered = Covered(still);
+  const int stillPlane = PlanePixels(still);
+  Check(stillCovered > Size * Size / 10 && stillPlane > 1000,
+    name + ": the still frame shows the surfaces and the plane");
+
+  // Interactive, a budget between the model's predictions for distances 1
+  // and 8 (so far it has seen only still frames): a distance above 1, one
+  // predicted within the budget, on the GPU path.
+  const bool translucent = looks.front().Opacity < 1.0;
+  const std::uint64_t primitives = mapper->GetNumberOfPrimitives();
+  auto predict = [&](double distance)
+  {
+    mediso::FrameWork work;
+    work.Method = mediso::FrameMethod::CellRasterisation;
+    work.Primitives = primitives;
+    work.Pixels = mediso::FrameTimeModel::ShadedPixels(Size, Size, distance);
+    work.Translucent = translucent;
+    return mapper->GetFrameTimeModel().Predict(work);
+  };
+  Check(
+    predict(1.0) > predict(8.0), name + ": the model predicts a coarser distance to be cheaper");
+  const double between = std::sqrt(predict(1.0) * predict(8.0));
+  mapper->SetInteractiveFrameBudget(between);
+  scene.Render(InteractiveRate);
+  std::printf(
+    "%s interactive, budget %.4f s: %s\n", name.c_str(), between, Describe(mapper).c_str());
+  Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
+      mapper->GetLastInteractive() && mapper->GetLastSampleDistance() > 1.0 &&
+      mapper->GetGPUStats().SampleDistance > 1.0f && mapper->GetLastPredictedSeconds() <= between,
+    name + ": an interactive render draws at the finest distance predicted within the budget");
+
+  // A tiny budget with the triangle levels off: the GPU path's coarsest
+  // distance, drawn up to the viewport.
+  mapper->SetInteractiveFrameBudget(1e-7);
+  mapper->InteractiveTriangleLevelsOff();
+  std::vector<unsigned char> interactive;
+  for (int frame = 0; frame < 3; ++frame)
+  {
+    interactive = scene.Render(InteractiveRate);
+  }
+  std::printf(
+    "%s interactive, tiny budget, GPU only: %s\n", name.c_str(), Describe(mapper).c_str());
+  Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
+      mapper->GetLastInteractive() && mapper->GetLastSampleDistance() == 8.0,
+    name + ": a tiny budget without triangle levels draws the coarsest distance, 8");
+  Check(mapper->GetLastPredictedSeconds() > 1e-7 && mapper->GetLastMeasuredSeconds() > 0.0,
+    name + ": it says what was predicted and measured");
+  Check(interactive != still, name + ": the interactive image differs from the still one");
+  const int interactiveCovered = Covered(interactive);
+  std::printf("%s: covered pixels still %d, interactive %d; plane %d, %d\n", name.c_str(),
+    stillCovered, interactiveCovered, stillPlane, PlanePixels(interactive));
+  Check(std::abs(interactiveCovered - stillCovered) < stillCovered / 10,
+    name + ": the interactive frame covers the still frame's pixels within 10%");
+  Check(PlanePixels(interactive) == stillPlane && PlanePixels(interactive) > 0,
+    name + ": the plane in front keeps every pixel (the reduced surfaces' depth is tested)");
+
+  // The same with the triangle levels (the default): a coarser Block LOD
+  // level's triangles, which are what fits a tiny budget best.
+  mapper->InteractiveTriangleLevelsOn();
+  std::vector<unsigned char> triangles;
+  for (int frame = 0; frame < 2; ++frame)
+  {
+    triangles = scene.Render(InteractiveRate);
+  }
+  std::printf("%s interactive, tiny budget: %s, %llu triangles\n", name.c_str(),
+    Describe(mapper).c_str(),
+    static_cast<unsigned long long>(mapper->GetNumberOfFallbackTriangles()));
+  Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::FallbackPath &&
+      mapper->GetFallbackReason().empty() && mapper->GetLastLevel() < 3 &&
+      mapper->GetNumberOfFallbackTriangles() > 0,
+    name + ": a tiny budget draws a coarser Block LOD level's triangles (no fallback reason)");
+  Check(PlanePixels(triangles) == stillPlane &&
+      std::abs(Covered(triangles) - stillCovered) < stillCovered / 10,
+    name + ": they cover the still pixels within 10%, behind the plane");
+
+  // A still render after the interactive ones: the same image.
+  const std::vector<unsigned char> after = scene.Render(StillRate);
+  Check(after == still && mapper->GetLastSampleDistance() == 1.0,
+    name + ": a still render after interactive ones is pixel-identical to the one before");
+
+  // A generous budget: the finest distance, the still image.
+  mapper->SetInteractiveFrameBudget(1000.0);
+  const std::vector<unsigned char> generous = scene.Render(InteractiveRate);
+  Check(mapper->GetLastInteractive() && mapper->GetLastSampleDistance() == 1.0 && generous == still,
+    name + ": an interactive render within a 1000 s budget draws every pixel");
+
+  // Budget 0: the prop's allocated render time (a millisecond over the
+  // window's props) is the budget.
+  mapper->SetInteractiveFrameBudget(0.0);
+  scene.Render(1.0e6);
+  Check(mapper->GetLastInteractive() &&
+      (mapper->GetLastSampleDistance() > 1.0 || mapper->GetLastLevel() < 3),
+    name + ": budget 0 takes the allocated render time (a microsecond: a coarser frame)");
+
+  // InteractiveAdjust off: interactive renders are the still image, untimed.
+  mapper->SetInteractiveFrameBudget(1e-7);
+  mapper->InteractiveAdjustOff();
+  const std::vector<unsigned char> off = scene.Render(InteractiveRate);
+  Check(!mapper->GetLastInteractive() && mapper->GetLastSampleDistance() == 1.0 && off == still &&
+      mapper->GetLastMeasuredSeconds() == 0.0,
+    name + ": InteractiveAdjust off draws interactive renders at full quality");
+}
+} // namespace
+
+int TestHistoPyramidIsoMapperInteractive(int, char*[])
+{
+  using namespace iso_test;
+  auto phantom = Phantom(96);
+  const Look skin{ -500.0, { 0.93, 0.75, 0.62 }, 1.0 };
+  const Look skinGlass{ -500.0, { 0.93, 0.75, 0.62 }, 0.3 };
+  const Look bone{ 400.0, { 0.97, 0.95, 0.88 }, 1.0 };
+
+  // 4. The CPU fallback: a coarser level while interactive (no GPU needed).
+  {
+    vtkNew<vtkImageData> own; // changed below
+    own->DeepCopy(phantom);
+    Scene scene(own, { skinGlass, bone });
+    vtkHistoPyramidIsoMapper* mapper = scene.Mapper;
+    mapper->ForceCPUFallbackOn();
+    scene.Render(StillRate);
+    const std::vector<unsigned char> still = scene.Render(StillRate);
+    const std::uint64_t fullTriangles = mapper->GetNumberOfFallbackTriangles();
+    std::printf("fallback still: %s, %llu triangles\n", Describe(mapper).c_str(),
+      static_cast<unsigned long long>(fullTriangles));
+    Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::FallbackPath &&
+        mapper->GetLastLevel() == 3 && mapper->GetLastSampleDistance() == 1.0,
+      "fallback: a still render draws level 3");
+    mapper->SetInteractiveFrameBudget(1e-7);
+    scene.Render(InteractiveRate);
+    std::printf("fallback interactive: %s, %llu triangles\n", Describe(mapper).c_str(),
+      static_cast<unsigned long long>(mapper->GetNumberOfFallbackTriangles()));
+    Check(mapper->GetLastInteractive() && mapper->GetLastLevel() < 3 &&
+        mapper->GetNumberOfFallbackTriangles() < fullTriangles &&
+        mapper->GetNumberOfFallbackTriangles() > 0,
+      "fallback: an interactive render with a tiny budget draws a coarser level, fewer triangles");
+    const std::vector<unsigned char> after = scene.Render(StillRate);
+    Check(mapper->GetLastLevel() == 3 && mapper->GetNumberOfFallbackTriangles() == fullTriangles &&
+        after == still,
+      "fallback: the still render after it draws level 3, the same image");
+    // New values in the same array: the levels kept for the old ones are not drawn.
+    vtkDataArray* values = own->GetPointData()->GetScalars();
+    for (vtkIdType i = 0; i < values->GetNumberOfTuples() / 2; ++i)
+    {
+      values->SetTuple1(i, -1000.0);
+    }
+    values->Modified();
+    scene.Render(InteractiveRate);
+    const std::vector<unsigned char> changed = scene.Render(StillRate);
+    Check(mapper->GetLastLevel() == 3 && mapper->GetNumberOfFallbackTriangles() != fullTriangles &&
+        changed != still,
+      "fallback: new values in the array draw new surfaces (no level kept from the old ones)");
+  }
+
+  const int skip = ProbeOrSkip();
+  if (skip != 0)
+  {
+    const int fallback = medical_test::Finish("TestHistoPyramidIsoMapperInteractive: fallback");
+    return fallback != 0 ? fallback : skip;
+  }
+  CheckGPUScene(phantom, { skin, bone }, "opaque");
+  CheckGPUScene(phantom, { skinGlass, bone }, "translucent skin");
+  return medical_test::Finish("TestHistoPyramidIsoMapperInteractive");
+}
