@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "pqBlockLODLevelWidget.h"
 
+#include "pqMedicalHistogramWidget.h"
 #include "vtkCommand.h"
 #include "vtkEventQtSlotConnect.h"
 #include "vtkSMPropertyGroup.h"
 #include "vtkSMPropertyHelper.h"
 #include "vtkSMProxy.h"
+#include "vtkSMSourceProxy.h"
 #include "vtkSMUncheckedPropertyHelper.h"
 
 #include <QCheckBox>
@@ -43,6 +45,7 @@ pqBlockLODLevelWidget::pqBlockLODLevelWidget(
   , MemoryBudget(new QDoubleSpinBox(this))
   , Table(new QTableWidget(NumberOfLevels, 5, this))
   , Caption(new QLabel(this))
+  , Histogram(new pqMedicalHistogramWidget(this))
   , Connections(vtkEventQtSlotConnect::New())
 {
   this->setObjectName("BlockLODLevels");
@@ -97,14 +100,19 @@ pqBlockLODLevelWidget::pqBlockLODLevelWidget(
 
   auto* layout = new QGridLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
-  layout->addWidget(this->AutoLOD, 0, 0, 1, 3);
-  layout->addWidget(new QLabel(tr("LOD"), this), 1, 0);
-  layout->addWidget(this->Level, 1, 1);
-  layout->addWidget(this->LevelNote, 1, 2);
-  layout->addWidget(new QLabel(tr("Memory Budget"), this), 2, 0);
-  layout->addWidget(this->MemoryBudget, 2, 1, 1, 2);
-  layout->addWidget(this->Table, 3, 0, 1, 3);
-  layout->addWidget(this->Caption, 4, 0, 1, 3);
+  auto* histogramCaption =
+    new QLabel(tr("Histogram (log scale): drag a marker to change that isovalue."), this);
+  histogramCaption->setObjectName("HistogramCaption");
+  layout->addWidget(histogramCaption, 0, 0, 1, 3);
+  layout->addWidget(this->Histogram, 1, 0, 1, 3);
+  layout->addWidget(this->AutoLOD, 2, 0, 1, 3);
+  layout->addWidget(new QLabel(tr("LOD"), this), 3, 0);
+  layout->addWidget(this->Level, 3, 1);
+  layout->addWidget(this->LevelNote, 3, 2);
+  layout->addWidget(new QLabel(tr("Memory Budget"), this), 4, 0);
+  layout->addWidget(this->MemoryBudget, 4, 1, 1, 2);
+  layout->addWidget(this->Table, 5, 0, 1, 3);
+  layout->addWidget(this->Caption, 6, 0, 1, 3);
   layout->setColumnStretch(2, 1);
 
   this->addPropertyLink(this->AutoLOD, "AutoLOD");
@@ -126,6 +134,68 @@ pqBlockLODLevelWidget::pqBlockLODLevelWidget(
   this->Connections->Connect(
     smproxy, vtkCommand::UpdateDataEvent, this, SLOT(pullEstimates()));
   this->pullEstimates();
+
+  // The histogram: the input's contoured array, the isovalues marked.
+  if (vtkSMProperty* contourValues = smproxy->GetProperty("ContourValues"))
+  {
+    this->addPropertyLink(this, "contourValues", SIGNAL(contourValuesChanged()), contourValues);
+  }
+  QObject::connect(this->Histogram, &pqMedicalHistogramWidget::markerReleased, this,
+    &pqBlockLODLevelWidget::setDraggedValue);
+  vtkSMPropertyHelper input(smproxy, "Input", /*quiet=*/true);
+  if (auto* source = vtkSMSourceProxy::SafeDownCast(input.GetAsProxy()))
+  {
+    this->Connections->Connect(source, vtkCommand::UpdateDataEvent, this, SLOT(updateHistogram()));
+  }
+  if (vtkSMProperty* array = smproxy->GetProperty("SelectInputScalars"))
+  {
+    this->Connections->Connect(array, vtkCommand::ModifiedEvent, this, SLOT(updateHistogram()));
+    this->Connections->Connect(
+      array, vtkCommand::UncheckedPropertyModifiedEvent, this, SLOT(updateHistogram()));
+  }
+  this->updateHistogram();
+}
+
+//------------------------------------------------------------------------------
+QList<QVariant> pqBlockLODLevelWidget::contourValues() const
+{
+  return this->ContourValues;
+}
+
+//------------------------------------------------------------------------------
+void pqBlockLODLevelWidget::setContourValues(const QList<QVariant>& values)
+{
+  this->ContourValues = values;
+  std::vector<double> marked;
+  for (const QVariant& value : values)
+  {
+    marked.push_back(value.toDouble());
+  }
+  // The filter draws no colours of its own: its markers in the highlight.
+  this->Histogram->setMarkers(
+    marked, std::vector<QColor>(marked.size(), this->palette().color(QPalette::Highlight)));
+}
+
+//------------------------------------------------------------------------------
+void pqBlockLODLevelWidget::setDraggedValue(int index, double value)
+{
+  if (index < 0 || index >= this->ContourValues.size())
+  {
+    return;
+  }
+  this->ContourValues[index] = value;
+  Q_EMIT this->contourValuesChanged();
+}
+
+//------------------------------------------------------------------------------
+void pqBlockLODLevelWidget::updateHistogram()
+{
+  vtkSMPropertyHelper input(this->proxy(), "Input", /*quiet=*/true);
+  // The array chosen in the panel, applied or not.
+  vtkSMUncheckedPropertyHelper array(this->proxy(), "SelectInputScalars", /*quiet=*/true);
+  const char* name = array.GetNumberOfElements() == 5 ? array.GetAsString(4) : nullptr;
+  this->Histogram->gatherHistogram(
+    vtkSMSourceProxy::SafeDownCast(input.GetAsProxy()), input.GetOutputPort(), name);
 }
 
 //------------------------------------------------------------------------------

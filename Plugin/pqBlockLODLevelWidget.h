@@ -15,6 +15,12 @@
  *   used marked. The estimates are information properties the filter fills
  *   when it runs, so the table changes after Apply.
  *
+ * Above them, the histogram of the array contoured (pqMedicalHistogramWidget,
+ * counted where the data lives) marks the filter's isovalues (ContourValues).
+ * Dragging a marker edits that isovalue as typing it in the Isosurfaces list
+ * would: on release, so the panel's Apply (or Auto Apply) runs the filter
+ * once per drag, not once per mouse move.
+ *
  * MB are 10^6 bytes, the unit of every memory property of the plugin.
  */
 #ifndef pqBlockLODLevelWidget_h
@@ -22,21 +28,33 @@
 
 #include "pqPropertyGroupWidget.h"
 
+#include <QList>
+#include <QVariant>
+
 class QCheckBox;
 class QDoubleSpinBox;
 class QLabel;
 class QSpinBox;
 class QTableWidget;
+class pqMedicalHistogramWidget;
 class vtkEventQtSlotConnect;
 
 class pqBlockLODLevelWidget : public pqPropertyGroupWidget
 {
   Q_OBJECT
+  /// The filter's isovalues (ContourValues), as the histogram marks them.
+  Q_PROPERTY(QList<QVariant> contourValues READ contourValues WRITE setContourValues)
   typedef pqPropertyGroupWidget Superclass;
 
 public:
   pqBlockLODLevelWidget(vtkSMProxy* proxy, vtkSMPropertyGroup* group, QWidget* parent = nullptr);
   ~pqBlockLODLevelWidget() override;
+
+  QList<QVariant> contourValues() const;
+  void setContourValues(const QList<QVariant>& values);
+
+Q_SIGNALS:
+  void contourValuesChanged();
 
 private Q_SLOTS:
   /// Pulls the estimates from the filter (after it ran), then updateEstimates().
@@ -45,6 +63,10 @@ private Q_SLOTS:
   void updateEstimates();
   /// Enables the level or the budget, as Auto LOD says.
   void updateEnabledState();
+  /// Counts the contoured array again (new data, another array).
+  void updateHistogram();
+  /// A marker released at a value: that isovalue changes (Apply runs it).
+  void setDraggedValue(int index, double value);
 
 private:
   Q_DISABLE_COPY(pqBlockLODLevelWidget)
@@ -55,6 +77,8 @@ private:
   QDoubleSpinBox* MemoryBudget;
   QTableWidget* Table;
   QLabel* Caption;
+  pqMedicalHistogramWidget* Histogram;
+  QList<QVariant> ContourValues;
   vtkEventQtSlotConnect* Connections;
 };
 

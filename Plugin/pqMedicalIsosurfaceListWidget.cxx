@@ -2,6 +2,7 @@
 #include "pqMedicalIsosurfaceListWidget.h"
 
 #include "pqApplicationCore.h"
+#include "pqMedicalHistogramWidget.h"
 #include "pqUndoStack.h"
 #include "pqView.h"
 #include "vtkCommand.h"
@@ -16,6 +17,8 @@
 #include "vtkSMPropertyHelper.h"
 #include "vtkSMProxy.h"
 #include "vtkSMSourceProxy.h"
+#include "vtkSMViewProxy.h"
+#include "vtkScalarsToColors.h"
 #if MEDISO_WITH_PYTHON
 #include "pqPythonManager.h"
 #endif
@@ -30,6 +33,7 @@
 #include <QPushButton>
 #include <QStyledItemDelegate>
 #include <QTableWidget>
+#include <QTimer>
 #include <QToolButton>
 #include <QVBoxLayout>
 
@@ -119,6 +123,8 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   , AddButton(new QToolButton(this))
   , RemoveButton(new QPushButton(tr("Remove"), this))
   , ColorEachSurface(new QCheckBox(tr("Color Each Surface"), this))
+  , Histogram(new pqMedicalHistogramWidget(this))
+  , PreviewTimer(new QTimer(this))
   , RangeWarning(new QLabel(this))
   , MeshButton(new QPushButton(tr("Make Mesh"), this))
   , Connections(vtkEventQtSlotConnect::New())
@@ -133,6 +139,16 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   this->MeshButton->setObjectName("MakeMesh");
 
   this->Table->setHorizontalHeaderLabels({ tr("Isovalue"), tr("Color"), tr("Opacity") });
+  this->Table->horizontalHeaderItem(ValueColumn)
+    ->setToolTip(tr("The value each surface is drawn at, in the array's units (Hounsfield units "
+                    "for a CT). Double-click to type one, or drag its marker in the histogram."));
+  this->Table->horizontalHeaderItem(ColorColumn)
+    ->setToolTip(tr("The color each surface is drawn in: its own with Color Each Surface "
+                    "checked, else the solid color (solid) or the color map at the isovalue "
+                    "(map). Double-click to choose one."));
+  this->Table->horizontalHeaderItem(OpacityColumn)
+    ->setToolTip(tr("Each surface's opacity, 0 (invisible) to 1 (opaque). Double-click to "
+                    "edit it."));
   this->Table->horizontalHeader()->setSectionResizeMode(ValueColumn, QHeaderView::Stretch);
   this->Table->horizontalHeader()->setSectionResizeMode(ColorColumn, QHeaderView::Fixed);
   this->Table->horizontalHeader()->setSectionResizeMode(OpacityColumn, QHeaderView::Stretch);
@@ -154,6 +170,19 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
        "opacity, or another value (the middle of the data range for the first row, else a "
        "tenth of the range above the last row). Double-click the new value to edit it."));
   auto* presets = new QMenu(this->AddButton);
+  presets->setToolTipsVisible(true);
+  // What each preset shows on a CT, in TissuePresets' order.
+  const QString presetTips[] = {
+    tr("The skin's outer surface, translucent. Stay above -600 HU: below, foam padding and "
+       "blankets show."),
+    tr("Muscle and brain, translucent, inside the skin."),
+    tr("Vessels filled with contrast agent (on a contrast-enhanced CT; without contrast this "
+       "value gives thin bone)."),
+    tr("Bone, opaque. Values from 1000 HU keep only dense cortical bone."),
+  };
+  static_assert(sizeof(presetTips) / sizeof(presetTips[0]) ==
+      sizeof(TissuePresets) / sizeof(TissuePresets[0]),
+    "a tooltip per preset");
   presets->setObjectName("Presets");
   for (int i = 0; i < static_cast<int>(sizeof(TissuePresets) / sizeof(TissuePresets[0])); ++i)
   {
@@ -162,11 +191,14 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
       QIcon(Swatch(QColor::fromRgbF(preset.Color[0], preset.Color[1], preset.Color[2]))),
       tr("%1 (%2 HU)").arg(tr(preset.Name)).arg(preset.Value));
     action->setObjectName(QString("Preset%1").arg(i));
+    action->setToolTip(presetTips[i]);
     QObject::connect(action, &QAction::triggered, this, [this, i]() { this->addPreset(i); });
   }
   presets->addSeparator();
   QAction* other = presets->addAction(tr("Other value"));
   other->setObjectName("OtherValue");
+  other->setToolTip(tr("A row in the next palette color: the middle of the data range for the "
+                       "first row, else a tenth of the range above the last row."));
   QObject::connect(other, &QAction::triggered, this, &pqMedicalIsosurfaceListWidget::addRow);
   this->AddButton->setMenu(presets);
   this->RemoveButton->setToolTip(
@@ -212,6 +244,7 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
   layout->addWidget(this->RangeLabel);
+  layout->addWidget(this->Histogram);
   layout->addWidget(this->Table);
   layout->addWidget(this->RangeWarning);
   layout->addLayout(buttons);
@@ -228,6 +261,17 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
     &pqMedicalIsosurfaceListWidget::updateTable);
   QObject::connect(this->ColorEachSurface, &QCheckBox::clicked, this,
     &pqMedicalIsosurfaceListWidget::colorsChanged);
+  QObject::connect(this->Histogram, &pqMedicalHistogramWidget::markerMoved, this,
+    &pqMedicalIsosurfaceListWidget::previewMarker);
+  QObject::connect(this->Histogram, &pqMedicalHistogramWidget::markerReleased, this,
+    &pqMedicalIsosurfaceListWidget::commitMarker);
+  QObject::connect(this->Histogram, &pqMedicalHistogramWidget::markerCancelled, this,
+    &pqMedicalIsosurfaceListWidget::cancelMarker);
+  // One preview render per pass of the event loop, however many moves came.
+  this->PreviewTimer->setSingleShot(true);
+  this->PreviewTimer->setInterval(0);
+  QObject::connect(this->PreviewTimer, &QTimer::timeout, this,
+    &pqMedicalIsosurfaceListWidget::renderPreview);
 
   vtkSMProperty* isovalues = smproxy->GetProperty("IsosurfaceValues");
   this->addPropertyLink(this, "values", SIGNAL(valuesChanged()), isovalues);
@@ -246,6 +290,13 @@ pqMedicalIsosurfaceListWidget::pqMedicalIsosurfaceListWidget(
   {
     this->Connections->Connect(colorArray, vtkCommand::ModifiedEvent, this, SLOT(updateRange()));
     this->Connections->Connect(colorArray, vtkCommand::ModifiedEvent, this, SLOT(updateTable()));
+  }
+  for (const char* name : { "LookupTable", "DiffuseColor" })
+  {
+    if (vtkSMProperty* drawn = smproxy->GetProperty(name))
+    {
+      this->Connections->Connect(drawn, vtkCommand::ModifiedEvent, this, SLOT(updateTable()));
+    }
   }
   this->updateRange();
   this->updateTable();
@@ -377,6 +428,8 @@ void pqMedicalIsosurfaceListWidget::updateTable()
 {
   this->Updating = true;
   const bool colorEach = this->ColorEachSurface->isChecked();
+  std::vector<double> values;
+  std::vector<QColor> colors;
   this->Table->setRowCount(static_cast<int>(this->Rows.size()));
   for (int i = 0; i < static_cast<int>(this->Rows.size()); ++i)
   {
@@ -386,10 +439,14 @@ void pqMedicalIsosurfaceListWidget::updateTable()
     this->Table->setItem(i, ValueColumn, value);
     auto* color = new QTableWidgetItem();
     color->setFlags(Qt::ItemIsSelectable | Qt::ItemIsEnabled);
+    const QColor drawn = this->drawnColor(row);
+    colors.push_back(drawn);
+    values.push_back(row.Value);
+    // The swatch is an icon: unlike a background, it shows in a selected row.
+    color->setData(Qt::DecorationRole, Swatch(drawn));
     if (colorEach)
     {
       color->setBackground(row.Color);
-      color->setData(Qt::DecorationRole, Swatch(row.Color));
       color->setToolTip(tr("Double-click to choose this surface's color"));
     }
     else
@@ -399,8 +456,11 @@ void pqMedicalIsosurfaceListWidget::updateTable()
       const char* name = colorArray.GetInputArrayNameToProcess();
       color->setText((name && name[0]) ? tr("map") : tr("solid"));
       color->setTextAlignment(Qt::AlignCenter);
-      color->setToolTip(tr("Double-click (or check Color Each Surface) to give this surface "
-                           "its own color"));
+      color->setToolTip((name && name[0])
+          ? tr("Drawn in the color map's color at the isovalue. Double-click (or check Color "
+               "Each Surface) to give this surface its own color")
+          : tr("Drawn in the display's solid color. Double-click (or check Color Each "
+               "Surface) to give this surface its own color"));
       color->setForeground(this->palette().color(QPalette::Disabled, QPalette::Text));
     }
     this->Table->setItem(i, ColorColumn, color);
@@ -423,8 +483,122 @@ void pqMedicalIsosurfaceListWidget::updateTable()
     this->Table->setItem(i, OpacityColumn, opacity);
   }
   this->RemoveButton->setEnabled(!this->Rows.empty());
+  this->Histogram->setMarkers(values, colors);
   this->Updating = false;
   this->updateWarning();
+}
+
+//------------------------------------------------------------------------------
+QColor pqMedicalIsosurfaceListWidget::drawnColor(const Row& row) const
+{
+  if (this->ColorEachSurface->isChecked())
+  {
+    return row.Color;
+  }
+  vtkSMProxy* display = this->proxy();
+  vtkSMPropertyHelper colorArray(display, "ColorArrayName", /*quiet=*/true);
+  const char* name = colorArray.GetInputArrayNameToProcess();
+  if (name && name[0])
+  {
+    // The map's colour at the isovalue, from the client's copy of the map
+    // (transfer functions live on the client too: the colour legend uses it).
+    vtkSMPropertyHelper map(display, "LookupTable", /*quiet=*/true);
+    vtkSMProxy* lut = map.GetAsProxy();
+    auto* colors = lut ? vtkScalarsToColors::SafeDownCast(lut->GetClientSideObject()) : nullptr;
+    if (colors && std::isfinite(row.Value))
+    {
+      double rgb[3];
+      colors->GetColor(row.Value, rgb);
+      return QColor::fromRgbF(rgb[0], rgb[1], rgb[2]);
+    }
+    return this->palette().color(QPalette::Disabled, QPalette::Text);
+  }
+  double rgb[3] = { 1.0, 1.0, 1.0 };
+  if (display->GetProperty("DiffuseColor"))
+  {
+    vtkSMPropertyHelper(display, "DiffuseColor").Get(rgb, 3);
+  }
+  return QColor::fromRgbF(std::min(1.0, std::max(0.0, rgb[0])),
+    std::min(1.0, std::max(0.0, rgb[1])), std::min(1.0, std::max(0.0, rgb[2])));
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::setValuesOutsideUndo(const std::vector<double>& values)
+{
+  const pqScopedUndoExclude outside;
+  vtkSMProxy* display = this->proxy();
+  vtkSMPropertyHelper(display, "IsosurfaceValues")
+    .Set(values.data(), static_cast<unsigned int>(values.size()));
+  display->UpdateVTKObjects();
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::previewMarker(int row, double value)
+{
+  if (row < 0 || row >= static_cast<int>(this->Rows.size()))
+  {
+    return;
+  }
+  if (this->BeforeDrag.empty())
+  {
+    this->BeforeDrag = vtkSMPropertyHelper(this->proxy(), "IsosurfaceValues").GetArray<double>();
+  }
+  this->Rows[static_cast<std::size_t>(row)].Value = value;
+  std::vector<double> values;
+  for (const Row& each : this->Rows)
+  {
+    values.push_back(each.Value);
+  }
+  this->setValuesOutsideUndo(values);
+  this->PreviewTimer->start();
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::renderPreview()
+{
+  pqView* view = this->view();
+  if (vtkSMViewProxy* viewProxy = view ? view->getViewProxy() : nullptr)
+  {
+    viewProxy->InteractiveRender();
+  }
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::commitMarker(int row, double value)
+{
+  this->PreviewTimer->stop();
+  if (!this->BeforeDrag.empty())
+  {
+    // The undo step must start from the values before the drag, not from the
+    // last preview.
+    const std::vector<double> before = this->BeforeDrag;
+    this->BeforeDrag.clear();
+    this->setValuesOutsideUndo(before);
+  }
+  if (row < 0 || row >= static_cast<int>(this->Rows.size()))
+  {
+    return;
+  }
+  // As a typed value: the panel applies it in one undo set and renders.
+  this->Rows[static_cast<std::size_t>(row)].Value = value;
+  this->rowsEdited();
+}
+
+//------------------------------------------------------------------------------
+void pqMedicalIsosurfaceListWidget::cancelMarker(int, double)
+{
+  this->PreviewTimer->stop();
+  if (this->BeforeDrag.empty())
+  {
+    return;
+  }
+  const std::vector<double> before = this->BeforeDrag;
+  this->BeforeDrag.clear();
+  this->setValuesOutsideUndo(before);
+  if (pqView* view = this->view())
+  {
+    view->render();
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -562,6 +736,16 @@ void pqMedicalIsosurfaceListWidget::updateRange()
   {
     array->GetComponentRange(0, this->Range);
     this->HasRange = this->Range[0] <= this->Range[1];
+  }
+  if (this->HasRange)
+  {
+    vtkSMPropertyHelper colorArray(this->proxy(), "ColorArrayName", /*quiet=*/true);
+    this->Histogram->gatherHistogram(
+      source, input.GetOutputPort(), colorArray.GetInputArrayNameToProcess());
+  }
+  else
+  {
+    this->Histogram->clearHistogram();
   }
   if (this->HasRange)
   {

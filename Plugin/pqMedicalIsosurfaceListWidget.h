@@ -28,6 +28,20 @@
  * the display's start (vtkSMMedicalIsosurfaceInitializationHelper): its
  * colours and opacities stay with the rows whatever values are typed.
  *
+ * Above the table, the array's histogram (pqMedicalHistogramWidget) marks
+ * each isovalue in the colour its surface is drawn in. Dragging a marker
+ * previews: each move sets IsosurfaceValues outside the undo stack and renders
+ * the view interactively (vtkSMViewProxy::InteractiveRender, so a
+ * representation's interactive levels apply), at most once per pass of the
+ * event loop. On release the property goes back to its value before the drag,
+ * still outside the undo stack, and the dragged value is then set through the
+ * panel like a typed one: one undo step per drag, from the old value to the
+ * new. Esc during the drag puts the old value back.
+ *
+ * The colour column always shows the colour a surface is drawn in, as an
+ * icon (visible in a selected row too): its own colour with Color Each
+ * Surface, else the solid colour or the colour map's colour at the value.
+ *
  * The Opacity column edits each row's own opacity and shows, after each
  * render, the opacity the surface is drawn with where that differs (the
  * colour map's opacity map, when its opacity mapping is on, and the
@@ -50,6 +64,8 @@
 #include <vector>
 
 class QCheckBox;
+class QTimer;
+class pqMedicalHistogramWidget;
 class QLabel;
 class QPushButton;
 class QToolButton;
@@ -102,6 +118,14 @@ private Q_SLOTS:
   void makeMesh();
   /// Rebuilds the table from Rows without signalling an edit.
   void updateTable();
+  /// A histogram marker dragged to a value: preview it.
+  void previewMarker(int row, double value);
+  /// A drag released at a value: one undoable change from the old value.
+  void commitMarker(int row, double value);
+  /// A drag abandoned: the old values back, rendered.
+  void cancelMarker(int row, double value);
+  /// Renders the preview (interactive render of the panel's view).
+  void renderPreview();
 
 private:
   Q_DISABLE_COPY(pqMedicalIsosurfaceListWidget)
@@ -119,6 +143,10 @@ private:
   static QColor defaultColor(int row);
 
   void appendRow(const Row& row);
+  /// The colour a row's surface is drawn in now (see the class comment).
+  QColor drawnColor(const Row& row) const;
+  /// Sets IsosurfaceValues itself (not through the panel), outside the undo stack.
+  void setValuesOutsideUndo(const std::vector<double>& values);
 
   std::vector<Row> Rows;
   std::vector<double> DrawnOpacities;
@@ -132,6 +160,10 @@ private:
   QToolButton* AddButton;
   QPushButton* RemoveButton;
   QCheckBox* ColorEachSurface;
+  pqMedicalHistogramWidget* Histogram;
+  QTimer* PreviewTimer;
+  /// IsosurfaceValues before the drag in progress (empty: no preview made).
+  std::vector<double> BeforeDrag;
   QLabel* RangeWarning;
   QPushButton* MeshButton;
   vtkEventQtSlotConnect* Connections;

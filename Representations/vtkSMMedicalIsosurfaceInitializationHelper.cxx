@@ -25,6 +25,31 @@ namespace
 {
 const double SkinAndBoneColors[] = { 0.93, 0.75, 0.62, 0.96, 0.94, 0.86 };
 const double SkinAndBoneOpacities[] = { 0.35, 1.0 };
+
+// The range and kind of a one-component point array of a source's output (the
+// active scalars for an empty or null name), from the client's data
+// information; false when there is no such array or its range is not finite.
+bool ArrayRange(vtkSMSourceProxy* source, unsigned int port, const char* arrayName,
+  double range[2], bool& integral)
+{
+  if (!source || port >= source->GetNumberOfOutputPorts())
+  {
+    return false;
+  }
+  vtkPVDataSetAttributesInformation* points =
+    source->GetDataInformation(port)->GetPointDataInformation();
+  vtkPVArrayInformation* array = arrayName && arrayName[0]
+    ? points->GetArrayInformation(arrayName)
+    : points->GetAttributeInformation(vtkDataSetAttributes::SCALARS);
+  if (!array || array->GetNumberOfComponents() != 1)
+  {
+    return false;
+  }
+  array->GetComponentRange(0, range);
+  const int type = array->GetDataType();
+  integral = type != VTK_FLOAT && type != VTK_DOUBLE;
+  return range[0] <= range[1];
+}
 }
 
 vtkStandardNewMacro(vtkSMMedicalIsosurfaceInitializationHelper);
@@ -87,23 +112,9 @@ bool vtkSMMedicalIsosurfaceInitializationHelper::StartValues(vtkSMSourceProxy* s
   unsigned int port, const char* arrayName, const std::vector<double>& hounsfield,
   std::vector<double>& values, bool* isHounsfield)
 {
-  if (!source || port >= source->GetNumberOfOutputPorts())
-  {
-    return false;
-  }
-  vtkPVDataSetAttributesInformation* points =
-    source->GetDataInformation(port)->GetPointDataInformation();
-  const bool named = arrayName && arrayName[0];
-  vtkPVArrayInformation* array = named
-    ? points->GetArrayInformation(arrayName)
-    : points->GetAttributeInformation(vtkDataSetAttributes::SCALARS);
-  if (!array || array->GetNumberOfComponents() != 1)
-  {
-    return false;
-  }
   double range[2];
-  array->GetComponentRange(0, range);
-  if (!(range[0] <= range[1]))
+  bool integral = false;
+  if (!ArrayRange(source, port, arrayName, range, integral))
   {
     return false;
   }
@@ -116,27 +127,18 @@ bool vtkSMMedicalIsosurfaceInitializationHelper::StartValues(vtkSMSourceProxy* s
     }
     return true;
   }
-  const int type = array->GetDataType();
-  const bool integral = type != VTK_FLOAT && type != VTK_DOUBLE;
-  const mediso::HistogramBins bins = mediso::HistogramBins::For(range[0], range[1], integral);
-  if (bins.Count == 0)
+  double low = 0.0;
+  double width = 1.0;
+  std::vector<double> gathered;
+  if (!GatherHistogram(source, port, arrayName, range, integral, low, width, gathered))
   {
     return false;
   }
-  vtkNew<vtkPVMedicalHistogramInformation> histogram;
-  histogram->SetPortNumber(static_cast<int>(port));
-  histogram->SetArrayName(named ? arrayName : "");
-  histogram->SetBins(bins.Low, bins.Width, static_cast<int>(bins.Count));
-  source->GatherInformation(histogram);
-  if (histogram->GetNumberOfBins() != static_cast<int>(bins.Count))
-  {
-    return false;
-  }
-  std::vector<std::uint64_t> counts(bins.Count);
-  for (std::size_t i = 0; i < bins.Count; ++i)
-  {
-    counts[i] = static_cast<std::uint64_t>(histogram->GetCount(static_cast<int>(i)));
-  }
+  mediso::HistogramBins bins;
+  bins.Low = low;
+  bins.Width = width;
+  bins.Count = gathered.size();
+  std::vector<std::uint64_t> counts(gathered.begin(), gathered.end());
   double threshold = 0.0;
   if (!mediso::OtsuThreshold(counts, bins, threshold))
   {
@@ -147,6 +149,43 @@ bool vtkSMMedicalIsosurfaceInitializationHelper::StartValues(vtkSMSourceProxy* s
   {
     *isHounsfield = false;
   }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkSMMedicalIsosurfaceInitializationHelper::GatherHistogram(vtkSMSourceProxy* source,
+  unsigned int port, const char* arrayName, double range[2], bool& integral, double& low,
+  double& width, std::vector<double>& counts)
+{
+  double arrayRange[2];
+  if (!ArrayRange(source, port, arrayName, arrayRange, integral))
+  {
+    return false;
+  }
+  const mediso::HistogramBins bins =
+    mediso::HistogramBins::For(arrayRange[0], arrayRange[1], integral);
+  if (bins.Count == 0)
+  {
+    return false;
+  }
+  vtkNew<vtkPVMedicalHistogramInformation> histogram;
+  histogram->SetPortNumber(static_cast<int>(port));
+  histogram->SetArrayName(arrayName && arrayName[0] ? arrayName : "");
+  histogram->SetBins(bins.Low, bins.Width, static_cast<int>(bins.Count));
+  source->GatherInformation(histogram);
+  if (histogram->GetNumberOfBins() != static_cast<int>(bins.Count))
+  {
+    return false;
+  }
+  counts.resize(bins.Count);
+  for (std::size_t i = 0; i < bins.Count; ++i)
+  {
+    counts[i] = histogram->GetCount(static_cast<int>(i));
+  }
+  range[0] = arrayRange[0];
+  range[1] = arrayRange[1];
+  low = bins.Low;
+  width = bins.Width;
   return true;
 }
 

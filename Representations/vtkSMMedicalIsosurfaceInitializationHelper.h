@@ -74,6 +74,19 @@ public:
   static bool StartValues(vtkSMSourceProxy* source, unsigned int port, const char* arrayName,
     const std::vector<double>& hounsfield, std::vector<double>& values, bool* isHounsfield);
 
+  /**
+   * The histogram of the same point array, counted where the data lives
+   * (vtkPVMedicalHistogramInformation, summed over the server's processes):
+   * the array's `range`, whether it holds integers (`integral`), the bins (the
+   * first at [low, low + width)) and one count per bin: one bin per integer for integer data of at most 256 values,
+   * else 256 equal bins over the range (mediso::HistogramBins). False, with
+   * nothing set, when there is no one-component point array with a finite
+   * range. The Otsu start above and the panels' histograms
+   * (pqMedicalHistogramWidget) both count with it.
+   */
+  static bool GatherHistogram(vtkSMSourceProxy* source, unsigned int port, const char* arrayName,
+    double range[2], bool& integral, double& low, double& width, std::vector<double>& counts);
+
 protected:
   vtkSMMedicalIsosurfaceInitializationHelper();
   ~vtkSMMedicalIsosurfaceInitializationHelper() override;

@@ -11,6 +11,10 @@ Environment (set by the driver, Testing/Python/TestMedicalIsosurfacesGUI.py):
                        "apply": the phantom shown as HistoPyramid Isosurface,
                        skin in pure red, selected: the driver's events add a
                        Block LOD Contour from the Filters menu and click Apply
+                       "ct-start", "ct-preset", "ct-drag": the head CT
+                       (MEDISO_GUI_DATA) shown as HistoPyramid Isosurface with
+                       nothing set (its start: skin over bone); the driver's
+                       events then add a preset, or drag a histogram marker
                        "mesh": the phantom as HistoPyramid Isosurface at -500,
                        400 and 5000 (outside the range: the panel's warning),
                        selected: the driver's events click Make Mesh; once the
@@ -18,11 +22,18 @@ Environment (set by the driver, Testing/Python/TestMedicalIsosurfacesGUI.py):
                        with "-mesh" appended
     MEDISO_GUI_STATUS  where to write what the proxies say, as JSON, once the
                        scene is set up (the driver waits for this file)
+    MEDISO_GUI_DATA    the head CT (.mha) for the "ct-" panels
+
+For the "ct-" panels, each change of the display's IsosurfaceValues and each
+render of the view that ends is appended to MEDISO_GUI_STATUS + ".log" (one
+JSON list a line: ["values", [...], time] or ["render", time]), so that the driver can tell
+a drag's previews, its one committed change, and what Undo and Redo give.
 
 The plugin is loaded by ParaView from PV_PLUGIN_PATH, as a user would.
 """
 import json
 import os
+import time
 
 from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 
@@ -34,7 +45,10 @@ view.OrientationAxesVisibility = 0
 view.UseColorPaletteForBackground = 0
 view.Background = [0.1, 0.1, 0.15]
 
-head = MedicalPhantom(Dimensions=[64, 64, 64], Spacing=[3.0, 3.0, 3.0])
+if panel.startswith("ct-"):
+    head = OpenDataFile(os.environ["MEDISO_GUI_DATA"])
+else:
+    head = MedicalPhantom(Dimensions=[64, 64, 64], Spacing=[3.0, 3.0, 3.0])
 display = Show(head, view)
 status = {"panel": panel}
 if panel == "representation":
@@ -83,6 +97,27 @@ elif panel == "apply":
     view.ResetCamera()
     Render(view)
     status.update({"head_visible": display.Visibility})
+    SetActiveSource(head)
+elif panel.startswith("ct-"):
+    # Nothing set: the display starts at skin and bone, and the list (once the
+    # panel shows it) gives them their colours.
+    display.SetRepresentationType("HistoPyramid Isosurface")
+    # The face, from the front and a little to the side (as Python/demo.py).
+    view.CameraPosition = [122.0 - 140.0, 122.0 + 400.0, 80.0 + 60.0]
+    view.CameraFocalPoint = [122.0, 122.0, 80.0]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
+    view.ResetCamera()
+    Render(view)
+    status.update({"isovalues": list(display.IsosurfaceValues)})
+    log_path = status_path + ".log"
+
+    def record(*entry):
+        with open(log_path, "a") as log:
+            log.write(json.dumps(list(entry) + [round(time.time(), 2)]) + "\n")
+
+    display.SMProxy.GetProperty("IsosurfaceValues").AddObserver(
+        "ModifiedEvent", lambda *_: record("values", list(display.IsosurfaceValues)))
+    view.SMProxy.AddObserver("EndEvent", lambda *_: record("render"))
     SetActiveSource(head)
 elif panel == "mesh":
     display.SetRepresentationType("HistoPyramid Isosurface")
