@@ -32,7 +32,9 @@ as its --script:
    the level is enabled and shows its setting, the budget disabled (QtTesting
    checks); then a click on the panel's "?" button, which must open ParaView's
    help window; the plugin's help collection (--qch) must hold the filter's and
-   the source's pages.
+   the source's pages, and the HistoPyramid Isosurface representation's page
+   with the paper, the fallback paragraph and every property (qthelp.py, as
+   TestPluginHelpCollection checks without the GUI).
 For 1 and 2, once the scene script has written its status (what the proxies
 say, checked here), the screen is captured (xwd) until two captures a second
 apart agree; the window's area above the status bar (which shows the memory in
@@ -49,7 +51,6 @@ import json
 import os
 import shutil
 import signal
-import sqlite3
 import subprocess
 import sys
 import time
@@ -104,6 +105,7 @@ if any(wanted(panel) for panel in CT_PANELS):
 CROP = (0, 0, 1400, 1020)  # x, y, width, height
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
+import qthelp  # noqa: E402  (Testing/Python/qthelp.py: the help collection's checks)
 
 check = Checks()
 
@@ -387,13 +389,11 @@ if wanted("help"):
     stop_paraview("help", process, log)
     check(opened, "help: the '?' button of Block LOD Contour opens ParaView's help window")
     if args.qch:
-        try:
-            pages = {row[0] for row in sqlite3.connect(args.qch).execute("SELECT Name FROM FileNameTable")}
-        except sqlite3.Error as error:
-            pages = set()
-            print("note: %s: %s" % (args.qch, error))
-        check({"filters.BlockLODContour.html", "sources.MedicalPhantom.html"} <= pages,
-              "help: the plugin's help collection holds its pages (%s)" % sorted(pages))
+        # The filter's and the source's pages, and the representation's page with
+        # its paper, fallback paragraph and every property (Testing/Python/qthelp.py).
+        pages = qthelp.check_collection(
+            check, args.qch, os.path.join(here, "..", "..", "Plugin", "MedicalIsosurfaces.xml"))
+        print("help: the plugin's help collection holds %s" % sorted(pages))
 
 # --- 4. the head CT: its start, a preset, a histogram drag (..._CT) ------------
 # The CT shown as HistoPyramid Isosurface with nothing set; the Properties panel
