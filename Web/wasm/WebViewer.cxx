@@ -8,7 +8,7 @@
  * the code the ParaView mapper and mediso-render run, on a WebGL2 context of a canvas, with the
  * functions Emscripten links in (GLFunctionList.h). JavaScript (Web/static/app.js) hands it the
  * volume once and then only parameters: isovalues, colours, the camera. WebViewer holds the
- * volume's placement and the camera; the core's scene rebuilds the pyramid only when the isovalues
+ * volume's placement and the camera (a PageCamera, as the main thread's ViewCamera does); the core's scene rebuilds the pyramid only when the isovalues
  * change.
  *
  * The CPU path, for clients whose GPU cannot afford the GPU path (a software
@@ -30,6 +30,7 @@
 #include "HistogramThreshold.h"
 #include "IsosurfaceScene.h"
 #include "MeshRenderer.h"
+#include "PageCamera.h"
 #include "PyramidLayout.h"
 #include "ScalarTypes.h"
 #include "SceneView.h"
@@ -59,6 +60,8 @@ namespace
 {
 using emscripten::val;
 using namespace mediso;
+using mediso::web::CountActivePairs;
+using mediso::web::PageCamera;
 
 /// A surface of the CPU path, as drawn.
 struct CPUSurface
@@ -110,35 +113,6 @@ void* LookUp(const char* name, void*)
   MEDISO_GL_FUNCTIONS(MEDISO_LOOK_UP)
 #undef MEDISO_LOOK_UP
   return nullptr;
-}
-
-std::vector<double> Doubles(const val& array)
-{
-  std::vector<double> out;
-  const int n = array["length"].as<int>();
-  for (int i = 0; i < n; ++i)
-  {
-    out.push_back(array[i].as<double>());
-  }
-  return out;
-}
-
-void Triple(const val& array, double out[3])
-{
-  for (int a = 0; a < 3; ++a)
-  {
-    out[a] = array[a].as<double>();
-  }
-}
-
-val TripleVal(const double v[3])
-{
-  val out = val::array();
-  for (int a = 0; a < 3; ++a)
-  {
-    out.call<void>("push", v[a]);
-  }
-  return out;
 }
 } // namespace
 
@@ -232,21 +206,17 @@ public:
     {
       return false;
     }
-    for (int a = 0; a < 3; ++a)
-    {
-      this->Placement.Dimensions[a] = dims[a].as<int>();
-      this->Placement.Spacing[a] = spacing[a].as<double>();
-      this->Placement.Origin[a] = origin[a].as<double>();
-    }
+    this->Viewpoint.SetPlacement(dims, spacing, origin);
+    const VolumePlacement& placement = this->Viewpoint.GetPlacement();
     this->Type = static_cast<ScalarType>(type);
     this->Data = reinterpret_cast<const void*>(bytes);
     emscripten_webgl_make_context_current(this->Context);
     VolumeDescription description;
     description.Type = this->Type;
     description.Data = this->Data;
-    std::copy(this->Placement.Dimensions, this->Placement.Dimensions + 3, description.Dims);
-    std::copy(this->Placement.Origin, this->Placement.Origin + 3, description.Origin);
-    std::copy(this->Placement.Spacing, this->Placement.Spacing + 3, description.Spacing);
+    std::copy(placement.Dimensions, placement.Dimensions + 3, description.Dims);
+    std::copy(placement.Origin, placement.Origin + 3, description.Origin);
+    std::copy(placement.Spacing, placement.Spacing + 3, description.Spacing);
     description.Stamp = ++this->VolumeStamp;
     std::string error;
     if (!this->Scene->SetVolume(description, error))
@@ -256,7 +226,7 @@ public:
     }
     this->CPU.SetVolume(description);
     this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
-    this->ResetCamera();
+    this->Viewpoint.ResetCamera();
     return true;
   }
 
@@ -378,62 +348,13 @@ public:
     return true;
   }
 
+  PageCamera& GetPageCamera() { return this->Viewpoint; }
+
   void Resize(int width, int height)
   {
-    this->Width = std::max(1, width);
-    this->Height = std::max(1, height);
-    emscripten_set_canvas_element_size(this->Canvas.c_str(), this->Width, this->Height);
-  }
-
-  void ResetCamera()
-  {
-    double bounds[6];
-    this->Placement.Bounds(bounds);
-    this->View = Camera();
-    this->View.Parallel = this->Parallel;
-    this->View.Reset(bounds, static_cast<double>(this->Width) / this->Height);
-  }
-  void Azimuth(double degrees) { this->View.Azimuth(degrees); }
-  void Elevation(double degrees)
-  {
-    this->View.Elevation(degrees);
-    this->View.OrthogonalizeViewUp();
-  }
-  void Zoom(double factor) { this->View.Zoom(factor); }
-  void Dolly(double factor) { this->View.Dolly(factor); }
-  void SetParallel(bool parallel)
-  {
-    this->Parallel = parallel;
-    this->View.Parallel = parallel;
-  }
-
-  /// {position, focalPoint, viewUp, viewAngle[, parallelScale]}
-  void SetView(const val& view)
-  {
-    double position[3], focal[3], up[3];
-    Triple(view["position"], position);
-    Triple(view["focalPoint"], focal);
-    Triple(view["viewUp"], up);
-    if (!view["viewAngle"].isUndefined())
-    {
-      this->View.ViewAngle = view["viewAngle"].as<double>();
-    }
-    if (!view["parallelScale"].isUndefined())
-    {
-      this->View.ParallelScale = view["parallelScale"].as<double>();
-    }
-    this->View.SetView(position, focal, up);
-  }
-
-  val GetView() const
-  {
-    val view = val::object();
-    view.set("position", TripleVal(this->View.Position));
-    view.set("focalPoint", TripleVal(this->View.FocalPoint));
-    view.set("viewUp", TripleVal(this->View.ViewUp));
-    view.set("viewAngle", this->View.ViewAngle);
-    view.set("parallelScale", this->View.ParallelScale);
-    return view;
+    this->Viewpoint.Resize(width, height);
+    emscripten_set_canvas_element_size(
+      this->Canvas.c_str(), this->Viewpoint.GetWidth(), this->Viewpoint.GetHeight());
   }
 
   void SetBackground(double r, double g, double b)
@@ -493,14 +414,18 @@ public:
         this->LastBuildMs = emscripten_get_now() - start;
       }
     }
+    Camera& camera = this->Viewpoint.GetCamera();
+    const VolumePlacement& placement = this->Viewpoint.GetPlacement();
+    const int canvasWidth = this->Viewpoint.GetWidth();
+    const int canvasHeight = this->Viewpoint.GetHeight();
     double bounds[6];
-    this->Placement.Bounds(bounds);
-    this->View.ResetClippingRange(bounds);
+    placement.Bounds(bounds);
+    camera.ResetClippingRange(bounds);
     // A sample distance above 1: the frame is drawn smaller, into Sampled, and scaled up below.
     const bool sampled = this->SampleDistance > 1.0 && this->PrepareSampled();
-    const int width = sampled ? this->SampledSize[0] : this->Width;
-    const int height = sampled ? this->SampledSize[1] : this->Height;
-    SetFrameView(this->Frame, this->View, this->Placement, width, height);
+    const int width = sampled ? this->SampledSize[0] : canvasWidth;
+    const int height = sampled ? this->SampledSize[1] : canvasHeight;
+    SetFrameView(this->Frame, camera, placement, width, height);
     f.BindFramebuffer(GL_FRAMEBUFFER, sampled ? this->Sampled.Get() : 0);
     f.Viewport(0, 0, width, height);
     f.Enable(GL_DEPTH_TEST);
@@ -525,9 +450,10 @@ public:
     // The CPU path's surfaces and the server's result, in world coordinates.
     if (this->Meshes->GetNumberOfMeshes() > 0)
     {
-      const double aspect = static_cast<double>(this->Width) / std::max(1, this->Height);
-      const matrix4::Matrix modelToView = matrix4::Multiply(this->View.ViewMatrix(), this->PlacementModel());
-      if (!this->Meshes->Render(this->Frame, modelToView, this->View.ProjectionMatrix(aspect), error))
+      const double aspect = static_cast<double>(canvasWidth) / std::max(1, canvasHeight);
+      const matrix4::Matrix modelToView =
+        matrix4::Multiply(camera.ViewMatrix(), this->PlacementModel());
+      if (!this->Meshes->Render(this->Frame, modelToView, camera.ProjectionMatrix(aspect), error))
       {
         this->LastError = error;
         return false;
@@ -537,8 +463,8 @@ public:
     {
       f.BindFramebuffer(GL_READ_FRAMEBUFFER, this->Sampled.Get());
       f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-      glBlitFramebuffer(0, 0, width, height, 0, 0, this->Width, this->Height, GL_COLOR_BUFFER_BIT,
-        GL_LINEAR);
+      glBlitFramebuffer(
+        0, 0, width, height, 0, 0, canvasWidth, canvasHeight, GL_COLOR_BUFFER_BIT, GL_LINEAR);
       f.BindFramebuffer(GL_FRAMEBUFFER, 0);
     }
     this->DrawnSampleDistance = sampled ? this->SampleDistance : 1.0;
@@ -642,7 +568,8 @@ public:
     stats.set("firstHit", this->Stats.FirstHit);
     stats.set("buildMs", this->LastBuildMs);
     stats.set("sampleDistance", this->DrawnSampleDistance);
-    stats.set("pixels", static_cast<double>(this->Width) * this->Height /
+    stats.set("pixels",
+      static_cast<double>(this->Viewpoint.GetWidth()) * this->Viewpoint.GetHeight() /
         (this->DrawnSampleDistance * this->DrawnSampleDistance));
     stats.set("frameMs", this->LastFrameMs);
     stats.set(
@@ -656,23 +583,8 @@ public:
   /// The CPU model's count of active (cell, isovalue) pairs (tests compare the GPU's with it).
   double CountOnCPU(const val& isovalues) const
   {
-    if (!this->Data)
-    {
-      return 0.0;
-    }
-    const std::vector<double> values = Doubles(isovalues);
-    std::uint64_t total = 0;
-    VisitScalarType(this->Type,
-      [&](auto tag)
-      {
-        using T = decltype(tag);
-        for (std::uint32_t n : HistoPyramid::CountCrossings(
-               static_cast<const T*>(this->Data), this->Placement.Dimensions, values))
-        {
-          total += n;
-        }
-      });
-    return static_cast<double>(total);
+    return CountActivePairs(
+      this->Type, this->Data, this->Viewpoint.GetPlacement().Dimensions, isovalues);
   }
 
 private:
@@ -683,7 +595,8 @@ private:
     FrameWork work;
     work.Method = this->CPUPath ? FrameMethod::Triangles : FrameMethod::CellRasterisation;
     work.Primitives = primitives;
-    work.Pixels = FrameTimeModel::ShadedPixels(this->Width, this->Height, sampleDistance);
+    work.Pixels = FrameTimeModel::ShadedPixels(
+      this->Viewpoint.GetWidth(), this->Viewpoint.GetHeight(), sampleDistance);
     work.Translucent = std::any_of(this->Frame.Surfaces.begin(), this->Frame.Surfaces.end(),
       [](const IsosurfaceLook& s) { return s.Opacity < 1.0f; });
     return work;
@@ -725,9 +638,10 @@ private:
   // sample distance; false when it cannot be made (the frame is then drawn in full).
   bool PrepareSampled()
   {
-    const int width = std::max(1, static_cast<int>(std::ceil(this->Width / this->SampleDistance)));
+    const int width =
+      std::max(1, static_cast<int>(std::ceil(this->Viewpoint.GetWidth() / this->SampleDistance)));
     const int height =
-      std::max(1, static_cast<int>(std::ceil(this->Height / this->SampleDistance)));
+      std::max(1, static_cast<int>(std::ceil(this->Viewpoint.GetHeight() / this->SampleDistance)));
     const GLApi::Functions& f = this->GL->F();
     if (this->Sampled && this->SampledSize[0] == width && this->SampledSize[1] == height)
     {
@@ -763,8 +677,8 @@ private:
   matrix4::Matrix PlacementModel() const
   {
     matrix4::Matrix m = matrix4::Identity();
-    const double* d = this->Placement.Direction;
-    const double* o = this->Placement.Origin;
+    const double* d = this->Viewpoint.GetPlacement().Direction;
+    const double* o = this->Viewpoint.GetPlacement().Origin;
     for (int r = 0; r < 3; ++r)
     {
       double shift = o[r];
@@ -845,14 +759,11 @@ private:
   std::string LastError;
   std::shared_ptr<const GLApi> GL;
   std::unique_ptr<IsosurfaceScene> Scene;
-  VolumePlacement Placement;
   ScalarType Type = ScalarType::Int16;
   const void* Data = nullptr;
-  Camera View;
-  bool Parallel = false;
+  PageCamera Viewpoint; // the volume's placement, the camera and the canvas's size
   IsosurfaceFrame Frame;
   IsosurfaceSceneStats Stats; // of the last frame the GPU path drew (zero otherwise)
-  int Width = 640, Height = 480;
   float Background[3] = { 0.1f, 0.12f, 0.16f };
   double LastBuildMs = 0.0, LastFrameMs = 0.0;
   double SampleDistance = 1.0, DrawnSampleDistance = 1.0;
@@ -989,22 +900,15 @@ EMSCRIPTEN_BINDINGS(mediso_web)
   emscripten::constant("BoneHounsfield", BoneHounsfield);
   emscripten::function("histogramBins", &HistogramBinsFor);
   emscripten::function("otsuThreshold", &Otsu);
-  emscripten::class_<WebViewer>("WebViewer")
-    .constructor<std::string>()
+  const emscripten::class_<WebViewer> viewer("WebViewer");
+  mediso::web::BindPageCamera(viewer);
+  viewer.constructor<std::string>()
     .function("ready", &WebViewer::Ready)
     .function("error", &WebViewer::GetError)
     .function("info", &WebViewer::Info)
     .function("setVolume", &WebViewer::SetVolume)
     .function("setSurfaces", &WebViewer::SetSurfaces)
     .function("resize", &WebViewer::Resize)
-    .function("resetCamera", &WebViewer::ResetCamera)
-    .function("azimuth", &WebViewer::Azimuth)
-    .function("elevation", &WebViewer::Elevation)
-    .function("zoom", &WebViewer::Zoom)
-    .function("dolly", &WebViewer::Dolly)
-    .function("setParallel", &WebViewer::SetParallel)
-    .function("setView", &WebViewer::SetView)
-    .function("getView", &WebViewer::GetView)
     .function("setBackground", &WebViewer::SetBackground)
     .function("setMaterial", &WebViewer::SetMaterial)
     .function("render", &WebViewer::Render)

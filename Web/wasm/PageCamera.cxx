@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "PageCamera.h"
+
+#include "HistoPyramid.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+namespace mediso
+{
+namespace web
+{
+namespace
+{
+using emscripten::val;
+
+void Triple(const val& array, double out[3])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    out[a] = array[a].as<double>();
+  }
+}
+
+val TripleVal(const double v[3])
+{
+  val out = val::array();
+  for (int a = 0; a < 3; ++a)
+  {
+    out.call<void>("push", v[a]);
+  }
+  return out;
+}
+} // namespace
+
+void PageCamera::SetPlacement(const val& dims, const val& spacing, const val& origin)
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    this->Placement.Dimensions[a] = dims[a].as<int>();
+    this->Placement.Spacing[a] = spacing[a].as<double>();
+    this->Placement.Origin[a] = origin[a].as<double>();
+  }
+}
+
+void PageCamera::Resize(int width, int height)
+{
+  this->Width = std::max(1, width);
+  this->Height = std::max(1, height);
+}
+
+void PageCamera::ResetCamera()
+{
+  double bounds[6];
+  this->Placement.Bounds(bounds);
+  this->View = Camera();
+  this->View.Parallel = this->Parallel;
+  this->View.Reset(bounds, static_cast<double>(this->Width) / this->Height);
+}
+
+void PageCamera::Elevation(double degrees)
+{
+  this->View.Elevation(degrees);
+  this->View.OrthogonalizeViewUp();
+}
+
+void PageCamera::SetParallel(bool parallel)
+{
+  this->Parallel = parallel;
+  this->View.Parallel = parallel;
+}
+
+void PageCamera::SetView(const val& view)
+{
+  double position[3], focal[3], up[3];
+  Triple(view["position"], position);
+  Triple(view["focalPoint"], focal);
+  Triple(view["viewUp"], up);
+  if (!view["viewAngle"].isUndefined())
+  {
+    this->View.ViewAngle = view["viewAngle"].as<double>();
+  }
+  if (!view["parallelScale"].isUndefined())
+  {
+    this->View.ParallelScale = view["parallelScale"].as<double>();
+  }
+  this->View.SetView(position, focal, up);
+}
+
+val PageCamera::GetView() const
+{
+  val view = val::object();
+  view.set("position", TripleVal(this->View.Position));
+  view.set("focalPoint", TripleVal(this->View.FocalPoint));
+  view.set("viewUp", TripleVal(this->View.ViewUp));
+  view.set("viewAngle", this->View.ViewAngle);
+  view.set("parallelScale", this->View.ParallelScale);
+  return view;
+}
+
+double CountActivePairs(ScalarType type, const void* data, const int dims[3], const val& isovalues)
+{
+  if (!data || ScalarTypeSize(type) == 0)
+  {
+    return 0.0;
+  }
+  std::vector<double> values;
+  const int n = isovalues["length"].as<int>();
+  for (int i = 0; i < n; ++i)
+  {
+    values.push_back(isovalues[i].as<double>());
+  }
+  std::uint64_t total = 0;
+  VisitScalarType(type,
+    [&](auto tag)
+    {
+      using T = decltype(tag);
+      for (std::uint32_t count :
+        HistoPyramid::CountCrossings(static_cast<const T*>(data), dims, values))
+      {
+        total += count;
+      }
+    });
+  return static_cast<double>(total);
+}
+
+} // namespace web
+} // namespace mediso
