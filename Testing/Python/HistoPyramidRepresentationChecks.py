@@ -48,6 +48,24 @@ def make_view(size=SIZE):
     return view
 
 
+def show_at(source, isovalues=(SKIN, BONE), eye=(0.0, 1.0, 0.0)):
+    """`source` (updated here) shown as the representation at `isovalues` in a test view looking
+    at its centre from `eye` (an offset from the centre; anterior is +y), head up (+z), the camera
+    reset to the bounds. Returns (view, display)."""
+    source.UpdatePipeline()
+    view = make_view()
+    display = Show(source, view)
+    display.SetRepresentationType(REPRESENTATION)
+    display.IsosurfaceValues = list(isovalues)
+    bounds = source.GetDataInformation().GetBounds()
+    centre = [(bounds[2 * i] + bounds[2 * i + 1]) / 2.0 for i in range(3)]
+    view.CameraFocalPoint = centre
+    view.CameraPosition = [centre[i] + eye[i] for i in range(3)]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
+    view.ResetCamera()
+    return view, display
+
+
 def make_scene(source):
     """Render view + the source shown as the HistoPyramid Isosurface representation."""
     view = make_view()

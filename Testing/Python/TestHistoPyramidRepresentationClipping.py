@@ -35,18 +35,9 @@ name = "TestHistoPyramidRepresentationClipping" + ("Fallback" if args.expect_fal
 
 LoadPlugin(args.plugin, ns=globals())
 phantom = MedicalPhantom(Dimensions=[64, 64, 64], Spacing=[3.0, 3.0, 3.0])
-phantom.UpdatePipeline()
-
-view = hp.make_view()
-display = Show(phantom, view)
-display.SetRepresentationType(hp.REPRESENTATION)
-display.IsosurfaceValues = [hp.SKIN, hp.BONE]
+view, display = hp.show_at(phantom, eye=(-0.4, 1.0, 0.3))
 bounds = phantom.GetDataInformation().GetBounds()
-centre = [(bounds[2 * i] + bounds[2 * i + 1]) / 2.0 for i in range(3)]
-view.CameraFocalPoint = centre
-view.CameraPosition = [centre[0] - 0.4, centre[1] + 1.0, centre[2] + 0.3]
-view.CameraViewUp = [0.0, 0.0, 1.0]
-view.ResetCamera()
+centre = list(view.CameraFocalPoint)
 
 
 def shot(step):

@@ -32,17 +32,7 @@ name = "TestHistoPyramidRepresentationOpacityMapping" + ("Fallback" if args.expe
 
 LoadPlugin(args.plugin, ns=globals())
 phantom = MedicalPhantom(Dimensions=[64, 64, 64], Spacing=[3.0, 3.0, 3.0])
-phantom.UpdatePipeline()
-view = hp.make_view()
-display = Show(phantom, view)
-display.SetRepresentationType(hp.REPRESENTATION)
-display.IsosurfaceValues = [hp.SKIN]
-bounds = phantom.GetDataInformation().GetBounds()
-centre = [(bounds[2 * i] + bounds[2 * i + 1]) / 2.0 for i in range(3)]
-view.CameraFocalPoint = centre
-view.CameraPosition = [centre[0], centre[1] + 1.0, centre[2]]
-view.CameraViewUp = [0.0, 0.0, 1.0]
-view.ResetCamera()
+view, display = hp.show_at(phantom, isovalues=(hp.SKIN,))
 
 ColorBy(display, ("POINTS", "HU"))
 display.RescaleTransferFunctionToDataRange(False, True)
