@@ -221,6 +221,30 @@ else:
         "estimated_seconds": list(contour.GetProperty("EstimatedSeconds")),
         "triangles": contour.GetDataInformation().GetNumberOfCells(),
     })
+    log_path = status_path + ".log"
+
+    def record_render(caller, event):
+        # What each render drew: every visible Block LOD Contour display, as
+        # [registered (the filter) or not (a drag's preview), isovalues, LOD,
+        # cells drawn], and the undo stack's size, so the driver can tell the
+        # histogram drag's preview and that it left no undo step.
+        drawn = []
+        for representation in view.Representations:
+            source = getattr(representation, "Input", None)
+            if (source is None or representation.GetPropertyValue("Visibility") != 1
+                    or source.SMProxy.GetXMLName() != "BlockLODContour"):
+                continue
+            info = representation.SMProxy.GetRepresentedDataInformation()
+            drawn.append([source.SMProxy.GetSessionProxyManager().GetProxyName("sources", source.SMProxy)
+                          is not None, list(source.GetPropertyValue("ContourValues")),
+                          source.GetPropertyValue("LOD"),
+                          info.GetNumberOfCells() if info else 0])
+        undo = servermanager.vtkSMProxyManager.GetProxyManager().GetUndoStackBuilder()
+        undo_sets = undo.GetUndoStack().GetNumberOfUndoSets() if undo and undo.GetUndoStack() else -1
+        with open(log_path, "a") as log:
+            log.write(json.dumps(["render", drawn, undo_sets, round(time.time(), 2)]) + "\n")
+
+    view.SMProxy.AddObserver("EndEvent", record_render)
     SetActiveSource(contour)
 
 with open(status_path + ".part", "w") as f:

@@ -178,6 +178,14 @@ def wait_for(path, process, seconds):
     return None
 
 
+def read_log(path):
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        # Each entry ends with the time it was written (for reading by eye).
+        return [json.loads(line)[:-1] for line in f if line.strip()]
+
+
 def stop_paraview(panel, process, log, expected=None):
     """Kill paraview (SIGKILL: nothing more to print) and check what it printed: no error or
     warning, except one warning containing `expected` (and its VTK header line) when given."""
@@ -441,9 +449,12 @@ if wanted("help"):
     events[:0] = ['<pqevent object="%s/Histogram" command="mousePress" arguments="1,1,0,348,30" />' % levels,
                '<pqevent object="%s/Histogram" command="mouseMove" arguments="1,0,0,300,30" />' % levels,
                '<pqevent object="%s/Histogram" command="mouseMove" arguments="1,0,0,250,30" />' % levels,
+               '<pqevent object="pqClientMainWindow" command="pause" arguments="1000" />',
+               '<pqcheck object="%s" property="previewing" arguments="true" />' % levels,
                '<pqcheck object="pqClientMainWindow/propertiesDock/propertiesPanel/Accept" '
                'property="enabled" arguments="false" />',
                '<pqevent object="%s/Histogram" command="mouseRelease" arguments="1,0,0,250,30" />' % levels,
+               '<pqcheck object="%s" property="previewing" arguments="false" />' % levels,
                '<pqcheck object="%s/Histogram" property="markerValues" arguments="1" />' % levels,
                '<pqcheck object="pqClientMainWindow/propertiesDock/propertiesPanel/Accept" '
                'property="enabled" arguments="true" />']
@@ -459,6 +470,24 @@ if wanted("help"):
                               capture_output=True, text=True)
         opened = info.returncode == 0 and "IsViewable" in info.stdout
     stop_paraview("help", process, log)
+    # The drag's preview, from the renders the scene logged: during the drag a
+    # Block LOD Contour that is not the filter (unregistered), at the preview's
+    # level, with bone's value dragged below 400, drew triangles in place of the
+    # filter's display; after the release the filter's display alone again.
+    logged = [entry[1:] for entry in read_log(status_path + ".log") if entry[0] == "render"]
+    renders = [drawn for drawn, _ in logged]
+    undo_sets = sorted(set(sets for _, sets in logged))
+    previews = [drawn for drawn in renders
+                if any(not registered for registered, _, _, _ in drawn)]
+    check(any(len(drawn) == 1 and drawn[0][2] == 1 and len(drawn[0][1]) == 1
+              and 0.0 < drawn[0][1][0] < 400.0 and drawn[0][3] > 100 for drawn in previews),
+          "help: dragging the histogram's marker rendered a preview (LOD 1, the dragged value, "
+          "triangles) in place of the filter's display (%s)" % previews[-3:])
+    check(bool(renders) and renders[-1] == [[True, [400.0], 1, status["triangles"]]] if status else False,
+          "help: after the release the filter's display is back alone, unchanged until Apply (%s)"
+          % renders[-1:])
+    # The drag (an unapplied edit) and its preview add no undo step.
+    check(len(undo_sets) == 1, "help: the undo stack kept its size through the drag (%s)" % undo_sets)
     check(opened, "help: the '?' button of Block LOD Contour opens ParaView's help window")
     if args.qch:
         try:
@@ -491,14 +520,6 @@ def histogram_x(value):
     dock's width in Testing/Data/GUI/ParaView5.11.0.ini."""
     side = 5.5
     return side + (value - CT_RANGE[0]) / (CT_RANGE[1] - CT_RANGE[0]) * (HISTOGRAM_WIDTH - 2 * side)
-
-
-def read_log(path):
-    if not os.path.exists(path):
-        return []
-    with open(path) as f:
-        # Each entry ends with the time it was written (for reading by eye).
-        return [json.loads(line)[:-1] for line in f if line.strip()]
 
 
 def wait_for_log(path, done, seconds):
