@@ -71,7 +71,7 @@ import HistoPyramidRepresentationChecks as hp
 DEFAULT_PANELS = ["representation", "blocklod", "start", "apply", "mesh", "clip", "help"]
 # How long the clip session's events wait before turning the plane on (the
 # driver captures the unclipped view meanwhile).
-CLIP_PAUSE_MS = 10000
+CLIP_PAUSE_MS = 15000
 CLIP_SCROLL_Y = 400
 CT_PANELS = ["ct-start", "ct-preset", "ct-drag"]
 parser = argparse.ArgumentParser()
