@@ -2,13 +2,20 @@
 #include "pqBlockLODLevelWidget.h"
 
 #include "pqMedicalHistogramWidget.h"
+#include "pqUndoStack.h"
+#include "pqView.h"
 #include "vtkCommand.h"
 #include "vtkEventQtSlotConnect.h"
 #include "vtkSMPropertyGroup.h"
 #include "vtkSMPropertyHelper.h"
+#include "vtkSMPropertyIterator.h"
 #include "vtkSMProxy.h"
+#include "vtkSMRepresentationProxy.h"
+#include "vtkSMSessionProxyManager.h"
 #include "vtkSMSourceProxy.h"
 #include "vtkSMUncheckedPropertyHelper.h"
+#include "vtkSMViewProxy.h"
+#include "vtkSmartPointer.h"
 
 #include <QCheckBox>
 #include <QDoubleSpinBox>
@@ -20,6 +27,9 @@
 #include <QSignalBlocker>
 #include <QSpinBox>
 #include <QTableWidget>
+#include <QTimer>
+
+#include <vector>
 
 namespace
 {
@@ -46,6 +56,7 @@ pqBlockLODLevelWidget::pqBlockLODLevelWidget(
   , Table(new QTableWidget(NumberOfLevels, 5, this))
   , Caption(new QLabel(this))
   , Histogram(new pqMedicalHistogramWidget(this))
+  , PreviewTimer(new QTimer(this))
   , Connections(vtkEventQtSlotConnect::New())
 {
   this->setObjectName("BlockLODLevels");
@@ -142,6 +153,15 @@ pqBlockLODLevelWidget::pqBlockLODLevelWidget(
   }
   QObject::connect(this->Histogram, &pqMedicalHistogramWidget::markerReleased, this,
     &pqBlockLODLevelWidget::setDraggedValue);
+  QObject::connect(this->Histogram, &pqMedicalHistogramWidget::markerMoved, this,
+    &pqBlockLODLevelWidget::previewDraggedValue);
+  QObject::connect(this->Histogram, &pqMedicalHistogramWidget::markerCancelled, this,
+    &pqBlockLODLevelWidget::endPreview);
+  // One preview per pass of the event loop, however many moves came.
+  this->PreviewTimer->setSingleShot(true);
+  this->PreviewTimer->setInterval(0);
+  QObject::connect(
+    this->PreviewTimer, &QTimer::timeout, this, &pqBlockLODLevelWidget::renderPreview);
   vtkSMPropertyHelper input(smproxy, "Input", /*quiet=*/true);
   if (auto* source = vtkSMSourceProxy::SafeDownCast(input.GetAsProxy()))
   {
@@ -177,8 +197,129 @@ void pqBlockLODLevelWidget::setContourValues(const QList<QVariant>& values)
 }
 
 //------------------------------------------------------------------------------
+void pqBlockLODLevelWidget::previewDraggedValue(int index, double value)
+{
+  if (index < 0 || index >= this->ContourValues.size())
+  {
+    return;
+  }
+  if (!this->PreviewSource)
+  {
+    pqView* view = this->view();
+    vtkSMViewProxy* viewProxy = view ? view->getViewProxy() : nullptr;
+    vtkSMProxy* filter = this->proxy();
+    vtkSMSessionProxyManager* pxm = filter->GetSessionProxyManager();
+    vtkSMPropertyHelper input(filter, "Input", /*quiet=*/true);
+    if (!viewProxy || !pxm || !input.GetAsProxy())
+    {
+      return;
+    }
+    auto* source =
+      vtkSMSourceProxy::SafeDownCast(pxm->NewProxy(filter->GetXMLGroup(), filter->GetXMLName()));
+    if (!source)
+    {
+      return;
+    }
+    // Neither the preview nor hiding the filter's display is a step to undo.
+    const pqScopedUndoExclude outside;
+    // The filter as applied (its input, options), the array the panel shows.
+    vtkSmartPointer<vtkSMPropertyIterator> properties;
+    properties.TakeReference(filter->NewPropertyIterator());
+    for (properties->Begin(); !properties->IsAtEnd(); properties->Next())
+    {
+      vtkSMProperty* property = properties->GetProperty();
+      vtkSMProperty* copy = source->GetProperty(properties->GetKey());
+      if (copy && !property->GetInformationOnly())
+      {
+        copy->Copy(property);
+      }
+    }
+    vtkSMUncheckedPropertyHelper array(filter, "SelectInputScalars", /*quiet=*/true);
+    if (array.GetNumberOfElements() == 5 && array.GetAsString(4))
+    {
+      vtkSMPropertyHelper(source, "SelectInputScalars").Set(4, array.GetAsString(4));
+    }
+    vtkSMPropertyHelper(source, "AutoLOD").Set(0);
+    vtkSMPropertyHelper(source, "LOD").Set(PreviewLevel);
+    source->UpdateVTKObjects();
+    vtkSMRepresentationProxy* representation = viewProxy->CreateDefaultRepresentation(source, 0);
+    if (!representation)
+    {
+      source->Delete();
+      return;
+    }
+    vtkSMPropertyHelper(representation, "Input").Set(source, 0);
+    representation->UpdateVTKObjects();
+    vtkSMPropertyHelper(viewProxy, "Representations").Add(representation);
+    viewProxy->UpdateVTKObjects();
+    // The filter's own surface (if applied and shown) would hide the preview.
+    vtkSMProxy* own = viewProxy->FindRepresentation(vtkSMSourceProxy::SafeDownCast(filter), 0);
+    if (own && vtkSMPropertyHelper(own, "Visibility", /*quiet=*/true).GetAsInt() == 1)
+    {
+      vtkSMPropertyHelper(own, "Visibility").Set(0);
+      own->UpdateVTKObjects();
+      this->HiddenRepresentation = own;
+      own->Register(nullptr);
+    }
+    this->PreviewSource = source;
+    this->PreviewRepresentation = representation;
+    this->PreviewView = viewProxy;
+    viewProxy->Register(nullptr);
+  }
+  std::vector<double> values;
+  for (const QVariant& each : this->ContourValues)
+  {
+    values.push_back(each.toDouble());
+  }
+  values[static_cast<std::size_t>(index)] = value;
+  vtkSMPropertyHelper(this->PreviewSource, "ContourValues")
+    .Set(values.data(), static_cast<unsigned int>(values.size()));
+  this->PreviewTimer->start();
+}
+
+//------------------------------------------------------------------------------
+void pqBlockLODLevelWidget::renderPreview()
+{
+  if (this->PreviewSource && this->PreviewView)
+  {
+    const pqScopedUndoExclude outside;
+    this->PreviewSource->UpdateVTKObjects();
+    this->PreviewView->StillRender();
+  }
+}
+
+//------------------------------------------------------------------------------
+void pqBlockLODLevelWidget::endPreview()
+{
+  this->PreviewTimer->stop();
+  if (!this->PreviewSource)
+  {
+    return;
+  }
+  const pqScopedUndoExclude outside;
+  vtkSMViewProxy* viewProxy = this->PreviewView;
+  vtkSMPropertyHelper(viewProxy, "Representations").Remove(this->PreviewRepresentation);
+  viewProxy->UpdateVTKObjects();
+  if (this->HiddenRepresentation)
+  {
+    vtkSMPropertyHelper(this->HiddenRepresentation, "Visibility").Set(1);
+    this->HiddenRepresentation->UpdateVTKObjects();
+    this->HiddenRepresentation->UnRegister(nullptr);
+    this->HiddenRepresentation = nullptr;
+  }
+  this->PreviewRepresentation->Delete();
+  this->PreviewRepresentation = nullptr;
+  this->PreviewSource->Delete();
+  this->PreviewSource = nullptr;
+  this->PreviewView = nullptr;
+  viewProxy->StillRender();
+  viewProxy->UnRegister(nullptr);
+}
+
+//------------------------------------------------------------------------------
 void pqBlockLODLevelWidget::setDraggedValue(int index, double value)
 {
+  this->endPreview();
   if (index < 0 || index >= this->ContourValues.size())
   {
     return;
@@ -216,6 +357,7 @@ void pqBlockLODLevelWidget::pullEstimates()
 //------------------------------------------------------------------------------
 pqBlockLODLevelWidget::~pqBlockLODLevelWidget()
 {
+  this->endPreview();
   this->Connections->Disconnect();
   this->Connections->Delete();
 }

@@ -20,6 +20,11 @@ Environment (set by the driver, Testing/Python/TestMedicalIsosurfacesGUI.py):
                        selected: the driver's events click Make Mesh; once the
                        mesh is drawn, what it is goes to MEDISO_GUI_STATUS
                        with "-mesh" appended
+    "clip":            the phantom as HistoPyramid Isosurface, skin opaque over
+                       bone, its Clip Plane through the centre facing the
+                       camera but off, selected: the driver's events check its
+                       checkbox in the panel; the first frame drawn with the
+                       plane on is reported in MEDISO_GUI_STATUS + "-clip"
     MEDISO_GUI_STATUS  where to write what the proxies say, as JSON, once the
                        scene is set up (the driver waits for this file)
     MEDISO_GUI_DATA    the head CT (.mha) for the "ct-" panels
@@ -160,6 +165,40 @@ elif panel == "mesh":
     # The button runs medical_isosurfaces.MakeMeshFromView, whose last step renders.
     view.SMProxy.AddObserver("EndEvent", mesh_drawn)
     SetActiveSource(head)
+elif panel == "clip":
+    # Skin opaque over bone, seen from the front; the clipping plane set
+    # through the phantom's centre, facing the camera (Invert: the front half
+    # goes), but off: the driver's events turn it on in the panel.
+    display.SetRepresentationType("HistoPyramid Isosurface")
+    display.IsosurfaceValues = [-500.0, 400.0]
+    display.HistoPyramidColorEachSurface = 1
+    display.HistoPyramidSurfaceColors = [0.93, 0.75, 0.62, 0.96, 0.94, 0.86]
+    display.HistoPyramidSurfaceOpacities = [1.0, 1.0]
+    display.HistoPyramidClipPlaneOrigin = [94.5, 94.5, 94.5]
+    display.HistoPyramidClipPlaneNormal = [0.0, -1.0, 0.0]
+    view.CameraPosition = [94.5, -300.0, 94.5]
+    view.CameraFocalPoint = [94.5, 94.5, 94.5]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
+    view.ResetCamera()
+    Render(view)
+    status.update({"clip_plane": display.HistoPyramidClipPlane,
+                   "isovalues": list(display.IsosurfaceValues)})
+
+    def clipped_drawn(caller, event):
+        if display.HistoPyramidClipPlane != 1 or os.path.exists(status_path + "-clip"):
+            return
+        with open(status_path + "-clip.part", "w") as f:
+            json.dump({"clip_plane": display.HistoPyramidClipPlane,
+                       "origin": list(display.HistoPyramidClipPlaneOrigin),
+                       "normal": list(display.HistoPyramidClipPlaneNormal),
+                       "invert": display.HistoPyramidClipPlaneInvert,
+                       "time": time.time()}, f, indent=1)
+        os.replace(status_path + "-clip.part", status_path + "-clip")
+
+    # The first frame drawn with the plane on (the checkbox applies at once,
+    # as display properties do, and renders).
+    view.SMProxy.AddObserver("EndEvent", clipped_drawn)
+    SetActiveSource(head)
 else:
     Hide(head, view)
     contour = BlockLODContour(Input=head, ContourBy=["POINTS", "HU"], Isosurfaces=[400.0], LOD=1)
@@ -182,6 +221,30 @@ else:
         "estimated_seconds": list(contour.GetProperty("EstimatedSeconds")),
         "triangles": contour.GetDataInformation().GetNumberOfCells(),
     })
+    log_path = status_path + ".log"
+
+    def record_render(caller, event):
+        # What each render drew: every visible Block LOD Contour display, as
+        # [registered (the filter) or not (a drag's preview), isovalues, LOD,
+        # cells drawn], and the undo stack's size, so the driver can tell the
+        # histogram drag's preview and that it left no undo step.
+        drawn = []
+        for representation in view.Representations:
+            source = getattr(representation, "Input", None)
+            if (source is None or representation.GetPropertyValue("Visibility") != 1
+                    or source.SMProxy.GetXMLName() != "BlockLODContour"):
+                continue
+            info = representation.SMProxy.GetRepresentedDataInformation()
+            drawn.append([source.SMProxy.GetSessionProxyManager().GetProxyName("sources", source.SMProxy)
+                          is not None, list(source.GetPropertyValue("ContourValues")),
+                          source.GetPropertyValue("LOD"),
+                          info.GetNumberOfCells() if info else 0])
+        undo = servermanager.vtkSMProxyManager.GetProxyManager().GetUndoStackBuilder()
+        undo_sets = undo.GetUndoStack().GetNumberOfUndoSets() if undo and undo.GetUndoStack() else -1
+        with open(log_path, "a") as log:
+            log.write(json.dumps(["render", drawn, undo_sets, round(time.time(), 2)]) + "\n")
+
+    view.SMProxy.AddObserver("EndEvent", record_render)
     SetActiveSource(contour)
 
 with open(status_path + ".part", "w") as f:

@@ -5,7 +5,7 @@
                                           [--panels NAME ...] [--data MHA]
 
 Starts the `paraview` executable once per session --panels names (by default
-the phantom's six below; TestMedicalIsosurfacesGUI_CT names the head CT's
+the phantom's seven below; TestMedicalIsosurfacesGUI_CT names the head CT's
 ct-start, ct-preset and ct-drag), each with a fresh home holding
 Testing/Data/GUI/ParaView5.11.0.ini (no welcome dialog, a left dock wide enough
 to read), the plugin on PV_PLUGIN_PATH, and Testing/Python/MedicalIsosurfacesGUIScene.py
@@ -27,6 +27,11 @@ as its --script:
    Block LOD Contour of the drawn values at Auto LOD's level, each surface's
    name, colour and opacity, the phantom hidden (the representation's one
    warning about 5000 is expected in the log);
+2d. "clip": the phantom as HistoPyramid Isosurface, skin opaque over bone, the
+   representation's clipping plane through the centre but off; recorded events
+   check Clip Plane in the panel: bone-coloured pixels where the unclipped view
+   (captured first) showed skin, and the window against the baseline
+   TestMedicalIsosurfacesGUI-clip.png beside --baseline;
 3. "help": as 2, then recorded events: with Auto LOD the level control is
    disabled and shows the level used, the budget enabled; Auto LOD unchecked,
    the level is enabled and shows its setting, the budget disabled (QtTesting
@@ -64,7 +69,11 @@ import HistoPyramidRepresentationChecks as hp
 
 # The sessions: the plugin's panels on the phantom (TestMedicalIsosurfacesGUI)
 # and the head CT's start, a preset and a histogram drag (..._CT).
-DEFAULT_PANELS = ["representation", "blocklod", "start", "apply", "mesh", "help"]
+DEFAULT_PANELS = ["representation", "blocklod", "start", "apply", "mesh", "clip", "help"]
+# How long the clip session's events wait before turning the plane on (the
+# driver captures the unclipped view meanwhile).
+CLIP_PAUSE_MS = 15000
+CLIP_SCROLL_Y = 400
 CT_PANELS = ["ct-start", "ct-preset", "ct-drag"]
 parser = argparse.ArgumentParser()
 parser.add_argument("--paraview", required=True)
@@ -74,7 +83,7 @@ parser.add_argument("--baseline", required=True)
 parser.add_argument("--out", required=True)
 parser.add_argument("--qch", help="the plugin's built help collection")
 parser.add_argument("--panels", nargs="+", default=DEFAULT_PANELS,
-                    help="the sessions to run (default: the phantom's six; the CT's: " + " ".join(CT_PANELS) + ")")
+                    help="the sessions to run (default: the phantom's seven; the CT's: " + " ".join(CT_PANELS) + ")")
 parser.add_argument("--data", help="the head CT (.mha) for the ct- panels (default: the data cache's)")
 args = parser.parse_args()
 
@@ -169,6 +178,14 @@ def wait_for(path, process, seconds):
                 return json.load(f)
         time.sleep(0.5)
     return None
+
+
+def read_log(path):
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        # Each entry ends with the time it was written (for reading by eye).
+        return [json.loads(line)[:-1] for line in f if line.strip()]
 
 
 def stop_paraview(panel, process, log, expected=None):
@@ -344,6 +361,71 @@ if wanted("mesh"):
               == [0.93, 0.75, 0.62, 0.4, 0.96, 0.94, 0.86, 1.0],
               "mesh: each surface's name, colour and opacity carried (%s)" % mesh_status)
 
+# --- 2d. the clip plane, turned on in the panel --------------------------------
+# The phantom as HistoPyramid Isosurface, skin opaque over bone, seen from the
+# front; the representation's Clip Plane set through the centre facing the
+# camera (Invert: the front half goes) but off. The screen is captured (skin
+# only: no bone-coloured pixels), then the recorded events check the plane's
+# checkbox in the Properties panel (its display section applies at once) and
+# hide the plane widget (its translucent plane would tint the view); the cut
+# then shows bone inside the skin, where the unclipped view showed skin. The
+# clipped window is compared with the baseline TestMedicalIsosurfacesGUI-clip.png
+# next to --baseline (at most 0.5% of the pixels off by more than 40).
+DISPLAY_PANEL = ("pqClientMainWindow/propertiesDock/propertiesPanel/scrollArea/qt_scrollarea_viewport/"
+                 "scrollAreaWidgetContents/DisplayFrame/ProxyPanel")
+
+
+def bone_and_skin(screen):
+    """The view's pixels in bone's colour (0.96, 0.94, 0.86 shaded: grey-white,
+    red and blue close) and in skin's (0.93, 0.75, 0.62: red well above blue),
+    as two masks."""
+    pixels = screen[210:1010, 570:1390].astype(int)
+    redness = pixels[:, :, 0] - pixels[:, :, 2]
+    return (pixels[:, :, 0] > 90) & (redness < 25), (pixels[:, :, 0] > 100) & (redness > 40)
+
+
+clip_screen = None
+if wanted("clip"):
+    # The pause leaves the driver time to capture the unclipped view first.
+    clip_events = "\n".join([
+        '<pqevent object="pqClientMainWindow" command="pause" arguments="%d" />' % CLIP_PAUSE_MS,
+        '<pqevent object="%s/HistoPyramidClipPlane/CheckBox" command="set_boolean" arguments="true" />'
+        % DISPLAY_PANEL,
+        '<pqcheck object="%s/HistoPyramidClipPlane/CheckBox" property="checked" arguments="true" />'
+        % DISPLAY_PANEL,
+        '<pqevent object="%s/InteractivePlane/show3DWidget" command="set_boolean" arguments="false" />'
+        % DISPLAY_PANEL,
+        # The panel scrolled to the plane's group and its checkbox.
+        '<pqevent object="pqClientMainWindow/propertiesDock/propertiesPanel/scrollArea/'
+        'qt_scrollarea_vcontainer/1QScrollBar0" command="set_int" arguments="%d" />' % CLIP_SCROLL_Y])
+    process, status_path, log = start_paraview("clip", clip_events)
+    status = wait_for(status_path, process, 120)
+    time.sleep(3.0)
+    unclipped_screen = stable_screen() if status else None
+    unclipped_at = time.time()
+    clip_status = wait_for(status_path + "-clip", process, 90) if status else None
+    if clip_status:
+        wait_for_playback(log, 60)
+        time.sleep(2.0)
+        clip_screen = stable_screen()
+    stop_paraview("clip", process, log)
+    if check(status is not None and unclipped_screen is not None and clip_status is not None,
+             "clip: the scene ran and the panel's checkbox turned the clip plane on (%s)" % clip_status):
+        check(status["clip_plane"] == 0 and unclipped_at < clip_status["time"],
+              "clip: the unclipped view was captured before the plane was turned on (%.1f s before; "
+              "raise CLIP_PAUSE_MS if not)" % (clip_status["time"] - unclipped_at))
+        check(clip_status["clip_plane"] == 1 and clip_status["origin"] == [94.5, 94.5, 94.5]
+              and clip_status["normal"] == [0.0, -1.0, 0.0] and clip_status["invert"] == 1,
+              "clip: the plane on, through the centre, facing the camera (%s)" % clip_status)
+        write_png(os.path.join(args.out, NAME + "-unclipped.png"), unclipped_screen)
+        bone_before, skin_before = bone_and_skin(unclipped_screen)
+        bone_after, _ = bone_and_skin(clip_screen)
+        uncovered = int((bone_after & skin_before).sum())
+        print("clip: %d pixels of bone colour where the unclipped view showed skin" % uncovered)
+        check(int(bone_before.sum()) < 200 and uncovered > 5000,
+              "clip: bone shows inside the cut skin (%d pixels of bone colour where the unclipped view "
+              "showed skin; %d of bone colour before the cut)" % (uncovered, int(bone_before.sum())))
+
 # --- 3. the "?" button opens the plugin's documentation ----------------------
 # Before the click, the level-of-detail controls: with Auto LOD the level is
 # disabled and shows the level used (2), the budget enabled; unchecked, the
@@ -369,9 +451,12 @@ if wanted("help"):
     events[:0] = ['<pqevent object="%s/Histogram" command="mousePress" arguments="1,1,0,348,30" />' % levels,
                '<pqevent object="%s/Histogram" command="mouseMove" arguments="1,0,0,300,30" />' % levels,
                '<pqevent object="%s/Histogram" command="mouseMove" arguments="1,0,0,250,30" />' % levels,
+               '<pqevent object="pqClientMainWindow" command="pause" arguments="1000" />',
+               '<pqcheck object="%s" property="previewing" arguments="true" />' % levels,
                '<pqcheck object="pqClientMainWindow/propertiesDock/propertiesPanel/Accept" '
                'property="enabled" arguments="false" />',
                '<pqevent object="%s/Histogram" command="mouseRelease" arguments="1,0,0,250,30" />' % levels,
+               '<pqcheck object="%s" property="previewing" arguments="false" />' % levels,
                '<pqcheck object="%s/Histogram" property="markerValues" arguments="1" />' % levels,
                '<pqcheck object="pqClientMainWindow/propertiesDock/propertiesPanel/Accept" '
                'property="enabled" arguments="true" />']
@@ -387,6 +472,24 @@ if wanted("help"):
                               capture_output=True, text=True)
         opened = info.returncode == 0 and "IsViewable" in info.stdout
     stop_paraview("help", process, log)
+    # The drag's preview, from the renders the scene logged: during the drag a
+    # Block LOD Contour that is not the filter (unregistered), at the preview's
+    # level, with bone's value dragged below 400, drew triangles in place of the
+    # filter's display; after the release the filter's display alone again.
+    logged = [entry[1:] for entry in read_log(status_path + ".log") if entry[0] == "render"]
+    renders = [drawn for drawn, _ in logged]
+    undo_sets = sorted(set(sets for _, sets in logged))
+    previews = [drawn for drawn in renders
+                if any(not registered for registered, _, _, _ in drawn)]
+    check(any(len(drawn) == 1 and drawn[0][2] == 1 and len(drawn[0][1]) == 1
+              and 0.0 < drawn[0][1][0] < 400.0 and drawn[0][3] > 100 for drawn in previews),
+          "help: dragging the histogram's marker rendered a preview (LOD 1, the dragged value, "
+          "triangles) in place of the filter's display (%s)" % previews[-3:])
+    check(bool(renders) and renders[-1] == [[True, [400.0], 1, status["triangles"]]] if status else False,
+          "help: after the release the filter's display is back alone, unchanged until Apply (%s)"
+          % renders[-1:])
+    # The drag (an unapplied edit) and its preview add no undo step.
+    check(len(undo_sets) == 1, "help: the undo stack kept its size through the drag (%s)" % undo_sets)
     check(opened, "help: the '?' button of Block LOD Contour opens ParaView's help window")
     if args.qch:
         # The filter's and the source's pages, and the representation's page with
@@ -417,14 +520,6 @@ def histogram_x(value):
     dock's width in Testing/Data/GUI/ParaView5.11.0.ini."""
     side = 5.5
     return side + (value - CT_RANGE[0]) / (CT_RANGE[1] - CT_RANGE[0]) * (HISTOGRAM_WIDTH - 2 * side)
-
-
-def read_log(path):
-    if not os.path.exists(path):
-        return []
-    with open(path) as f:
-        # Each entry ends with the time it was written (for reading by eye).
-        return [json.loads(line)[:-1] for line in f if line.strip()]
 
 
 def wait_for_log(path, done, seconds):
@@ -574,6 +669,8 @@ def compare_with_baseline(image, baseline_path, name):
 if representation_screen is not None and blocklod_screen is not None:
     compare_with_baseline(numpy.concatenate([representation_screen, blocklod_screen], axis=1),
                           args.baseline, NAME)
+if clip_screen is not None:
+    compare_with_baseline(clip_screen, os.path.splitext(args.baseline)[0] + "-clip.png", NAME + "-clip")
 if all(ct_screens.get(panel) is not None for panel in CT_PANELS):
     compare_with_baseline(numpy.concatenate([ct_screens[panel] for panel in CT_PANELS], axis=1),
                           args.baseline, NAME)
