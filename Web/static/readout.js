@@ -9,27 +9,40 @@ import { $, state } from "./state.js";
 const FPS_WINDOW_MS = 2000;
 
 /**
- * Frames per second: the frames drawn over the last FPS_WINDOW_MS (or since the first frame,
- * when that is sooner) divided by that time: a rate, not one frame's inverse, and 0 when nothing
- * has been drawn for the whole window.
+ * Frames per second: the frames drawn in the FPS_WINDOW_MS before the last frame (or since the
+ * first frame, when that is sooner) divided by that time: a rate over the last frames, not one
+ * frame's inverse. It is measured up to the last frame, so a view at rest keeps the rate of the
+ * frames it last drew rather than falling towards 0; `idle` says whether nothing has been drawn
+ * for a whole window.
  */
 export function fps(now = performance.now()) {
   const times = state.frameTimes;
   if (!times.length) {
     return 0;
   }
-  const from = Math.max(now - FPS_WINDOW_MS, times[0].at - times[0].ms);
-  const drawn = times.filter((f) => f.at > from && f.at <= now).length;
-  return now > from ? drawn / ((now - from) / 1000) : 0;
+  const last = times[times.length - 1].at;
+  const from = Math.max(last - FPS_WINDOW_MS, times[0].at - times[0].ms);
+  const drawn = times.filter((f) => f.at > from && f.at <= last).length;
+  return last > from ? drawn / ((last - from) / 1000) : 0;
+}
+
+function idle(now = performance.now()) {
+  const times = state.frameTimes;
+  return !times.length || now - times[times.length - 1].at > FPS_WINDOW_MS;
+}
+
+function fpsText() {
+  return fps().toFixed(1) + " fps" + (idle() ? " (last frames; at rest)" : "");
 }
 
 export function updateReadout() {
   const rows = [
     ["path", state.path.toUpperCase() + (state.reason ? " (" + state.reason + ")" : "")],
-    ["frames per second", fps().toFixed(1)],
+    ["frames per second", fpsText()],
     ["threads", String(state.threads)],
-    state.remote ? ["last isovalue change", state.lastChangeMs.toFixed(1) + " ms to the first frame, " +
-      state.lastRefinedMs.toFixed(1) + " ms to the full level"]
+    !(state.lastChangeMs > 0) ? ["last isovalue change", "none yet"]
+      : state.remote ? ["last isovalue change", state.lastChangeMs.toFixed(1) + " ms to the first frame, " +
+        state.lastRefinedMs.toFixed(1) + " ms to the full level"]
       : ["last isovalue change", state.lastChangeMs.toFixed(1) + " ms (change + frame)"],
     state.path === "gpu" ? ["primitives", String(state.primitives)]
                          : ["triangles", String(state.triangles) + " (level " + state.cpuLevel +
@@ -45,7 +58,7 @@ export function updateReadout() {
     tr.children[1].textContent = v;
     return tr;
   }));
-  $("overlay").textContent = fps().toFixed(1) + " fps";
+  $("overlay").textContent = fpsText();
 }
 
 /** The dataset's line: name, size, type, bytes and range. */

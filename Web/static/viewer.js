@@ -75,7 +75,7 @@ export async function startViewer(canvas, probe) {
       "): the page waits for each extraction and frame.";
   }
   state.viewer.resize(canvas.width, canvas.height);
-  // The frame rate decays to what it is when nothing is drawn.
+  // The readout says when the view has come to rest.
   setInterval(() => state.frameTimes.length && updateReadout(), 1000);
   if (!state.viewer.ready()) {
     return false;
