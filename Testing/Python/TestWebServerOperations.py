@@ -54,19 +54,11 @@ def reference_counts(level):
 
 
 def edges(polydata):
-    """(boundary edges, non-manifold edges) of a surface."""
-    from vtkmodules.vtkFiltersCore import vtkFeatureEdges
-    counts = []
-    for boundary in (True, False):
-        f = vtkFeatureEdges()
-        f.SetInputData(polydata)
-        f.SetBoundaryEdges(boundary)
-        f.SetNonManifoldEdges(not boundary)
-        f.FeatureEdgesOff()
-        f.ManifoldEdgesOff()
-        f.Update()
-        counts.append(f.GetOutput().GetNumberOfCells())
-    return tuple(counts)
+    """(boundary edges, non-manifold edges) of a surface: the server's own count (vtkFeatureEdges),
+    the one its mesh report gives."""
+    sys.path.insert(0, os.path.join(webserver.ROOT, "Python"))
+    from serve_operations import edge_counts
+    return tuple(edge_counts(polydata))
 
 
 def read_back(path, fmt):
