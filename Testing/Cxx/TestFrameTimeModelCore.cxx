@@ -4,6 +4,7 @@
 // from frames that vary all three counts, recency, non-negativity, Choose, and
 // bad input (never NaN, never a negative time, never an empty choice).
 #include "FrameTimeModel.h"
+#include "MedicalTestUtilities.h"
 
 #include <cmath>
 #include <cstdint>
@@ -14,12 +15,7 @@
 
 namespace
 {
-int failures = 0;
-void Check(bool ok, const std::string& what)
-{
-  std::printf("%s: %s\n", ok ? "ok" : "FAILED", what.c_str());
-  failures += ok ? 0 : 1;
-}
+using medical_test::Check;
 
 std::string Number(double value)
 {
@@ -256,6 +252,5 @@ int main()
       "Reset forgets every frame");
   }
 
-  std::printf("%d failure(s)\n", failures);
-  return failures == 0 ? 0 : 1;
+  return medical_test::Finish("passed");
 }

@@ -3,6 +3,7 @@
 // chosen, and Otsu's threshold of synthetic bimodal histograms (values worked
 // out by hand from the between-class variance).
 #include "HistogramThreshold.h"
+#include "MedicalTestUtilities.h"
 
 #include <cmath>
 #include <cstdint>
@@ -12,12 +13,7 @@
 
 namespace
 {
-int failures = 0;
-void Check(bool ok, const std::string& what)
-{
-  std::printf("%s: %s\n", ok ? "ok" : "FAILED", what.c_str());
-  failures += ok ? 0 : 1;
-}
+using medical_test::Check;
 
 std::string Number(double value)
 {
@@ -118,6 +114,5 @@ int main()
       "a constant volume has no threshold");
   }
 
-  std::printf("%s\n", failures ? "FAILED" : "passed");
-  return failures ? 1 : 0;
+  return medical_test::Finish("passed");
 }
