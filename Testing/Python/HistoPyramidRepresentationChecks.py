@@ -7,6 +7,7 @@ process that rendered, and image checks on saved screenshots.
 """
 import argparse
 import os
+import sys
 
 from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 from paraview.modules.vtkRemotingCore import vtkPVSession
@@ -64,6 +65,22 @@ def show_at(source, isovalues=(SKIN, BONE), eye=(0.0, 1.0, 0.0)):
     view.CameraViewUp = [0.0, 0.0, 1.0]
     view.ResetCamera()
     return view, display
+
+
+def first_render(view, display, check, expect_fallback):
+    """The scene's first render: with the fallback expected (MEDISO_DISABLE_GPU_PATH), exactly
+    one warning naming it; else none at all, and the test skipped (exit 125) where the GPU path
+    cannot run."""
+    _, output = captured(lambda: Render(view))
+    if expect_fallback:
+        check(output.count("Warning") == 1 and "MEDISO_DISABLE_GPU_PATH" in output,
+              "one warning naming MEDISO_DISABLE_GPU_PATH (got %r)" % output.strip()[:300])
+        return
+    info = render_info(display)
+    if info["path"] == "fallback":
+        print("SKIP: the GPU path is not available here: %s" % info["reason"])
+        sys.exit(125)
+    check(output.strip() == "", "no warning or error (got %r)" % output.strip()[:300])
 
 
 def make_scene(source):

@@ -74,16 +74,7 @@ check(box_group is not None and box_group.GetPanelWidget() == "InteractiveBox",
       "CroppingOrigin and CroppingScale are edited with the box widget")
 
 # 2. The uncropped image.
-_, first_output = hp.captured(lambda: Render(view))
-if args.expect_fallback:
-    check(first_output.count("Warning") == 1 and "MEDISO_DISABLE_GPU_PATH" in first_output,
-          "one warning naming MEDISO_DISABLE_GPU_PATH (got %r)" % first_output.strip()[:300])
-else:
-    info = hp.render_info(display)
-    if info["path"] == "fallback":
-        print("SKIP: the GPU path is not available here: %s" % info["reason"])
-        sys.exit(125)
-    check(first_output.strip() == "", "no warning or error (got %r)" % first_output.strip()[:300])
+hp.first_render(view, display, check, args.expect_fallback)
 whole = shot("uncropped")
 check(hp.render_info(display)["path"] == expected_path, "uncropped: path %r" % expected_path)
 

@@ -52,16 +52,7 @@ def dominant(patch, channel, what):
 
 # 1. A fresh display has no colour array: Solid Color, white by default.
 check(display.ColorArrayName[1] == "", "a fresh display colours nothing (Solid Color)")
-_, first_output = hp.captured(lambda: Render(view))
-if args.expect_fallback:
-    check(first_output.count("Warning") == 1 and "MEDISO_DISABLE_GPU_PATH" in first_output,
-          "one warning naming MEDISO_DISABLE_GPU_PATH (got %r)" % first_output.strip()[:300])
-else:
-    info = hp.render_info(display)
-    if info["path"] == "fallback":
-        print("SKIP: the GPU path is not available here: %s" % info["reason"])
-        sys.exit(125)
-    check(first_output.strip() == "", "no warning or error (got %r)" % first_output.strip()[:300])
+hp.first_render(view, display, check, args.expect_fallback)
 info = hp.render_info(display)
 check(info["path"] == expected_path, "path %r (expected %r)" % (info["path"], expected_path))
 patch, covered = look("solid_white")
