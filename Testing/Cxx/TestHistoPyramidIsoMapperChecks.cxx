@@ -54,6 +54,7 @@
 #include "HistoPyramid.h"
 #include "IsoMapperTestScenes.h"
 #include "MedicalTestUtilities.h"
+#include "RenderTestUtilities.h"
 #include "vtkMedicalGLCapabilities.h"
 
 #include "vtkActor.h"
@@ -312,40 +313,8 @@ void Memory()
     "renders again after a release");
 }
 
-// Compares two RGB images: share of the pixels covered by either that both
-// cover, and the mean colour difference over the pixels both cover.
-struct ImageAgreement
-{
-  int Either = 0;
-  double Agreement = 0.0;
-  double MeanDifference = 255.0;
-};
-
-ImageAgreement Compare(const std::vector<unsigned char>& a, const std::vector<unsigned char>& b)
-{
-  int either = 0, both = 0, disagree = 0;
-  double diff = 0.0;
-  for (std::size_t p = 0; p + 2 < a.size() && p + 2 < b.size(); p += 3)
-  {
-    const bool ca = a[p] > 0 || a[p + 1] > 0 || a[p + 2] > 0;
-    const bool cb = b[p] > 0 || b[p + 1] > 0 || b[p + 2] > 0;
-    either += ca || cb;
-    disagree += ca != cb;
-    if (ca && cb)
-    {
-      ++both;
-      for (int c = 0; c < 3; ++c)
-      {
-        diff += std::abs(static_cast<int>(a[p + c]) - static_cast<int>(b[p + c]));
-      }
-    }
-  }
-  ImageAgreement result;
-  result.Either = either;
-  result.Agreement = either ? 1.0 - static_cast<double>(disagree) / either : 0.0;
-  result.MeanDifference = both ? diff / (3.0 * both) : 255.0;
-  return result;
-}
+using medical_test::ImageAgreement;
+using medical_test::CompareImages;
 
 // How RenderPixels() lights: shaded, or flat (ambient 1, diffuse and
 // specular 0: each surface in its own colour, so that a pixel's colour
@@ -400,7 +369,7 @@ std::vector<unsigned char> CompareWithCPU(const std::string& name, vtkImageData*
         (pass == 0 ? vtkHistoPyramidIsoMapper::GPUPath : vtkHistoPyramidIsoMapper::FallbackPath),
       name + ": path " + mapper->GetLastRenderPathAsString());
   }
-  const ImageAgreement a = Compare(pixels[0], pixels[1]);
+  const ImageAgreement a = CompareImages(pixels[0], pixels[1]);
   std::printf("%s: %d pixels covered by either, masks agree on %.2f%%, mean colour difference "
               "%.2f\n",
     name.c_str(), a.Either, 100.0 * a.Agreement, a.MeanDifference);
@@ -486,7 +455,7 @@ void CompareFootprints(const std::string& name, vtkImageData* image,
       name + ": drawn on the GPU with " + (footprint ? "points" : "boxes") + " (got " +
         mapper->GetLastRenderPathAsString() + ", " + mapper->GetLastFootprintAsString() + ")");
   }
-  const ImageAgreement a = Compare(pixels[0], pixels[1]);
+  const ImageAgreement a = CompareImages(pixels[0], pixels[1]);
   std::printf("%s: %d pixels covered by either, masks agree on %.3f%%, mean colour difference "
               "%.3f\n",
     name.c_str(), a.Either, 100.0 * a.Agreement, a.MeanDifference);

@@ -181,60 +181,22 @@ std::vector<unsigned char> RenderReference(vtkImageData* image, vtkImageData* co
   return Pixels(window);
 }
 
-struct Agreement
-{
-  int Either = 0;
-  double Masks = 0.0;
-  double MeanDifference = 255.0;
-  int Differing = 0; // pixels whose colour differs by more than 24 in a channel
-};
-
-Agreement Compare(const std::vector<unsigned char>& a, const std::vector<unsigned char>& b)
-{
-  int either = 0, both = 0, disagree = 0, differing = 0;
-  double diff = 0.0;
-  for (std::size_t p = 0; p + 2 < a.size() && p + 2 < b.size(); p += 3)
-  {
-    const bool ca = a[p] > 0 || a[p + 1] > 0 || a[p + 2] > 0;
-    const bool cb = b[p] > 0 || b[p + 1] > 0 || b[p + 2] > 0;
-    either += ca || cb;
-    disagree += ca != cb;
-    int largest = 0;
-    for (int c = 0; c < 3; ++c)
-    {
-      largest = std::max(largest, std::abs(int(a[p + c]) - int(b[p + c])));
-    }
-    differing += largest > 24;
-    if (ca && cb)
-    {
-      ++both;
-      for (int c = 0; c < 3; ++c)
-      {
-        diff += std::abs(int(a[p + c]) - int(b[p + c]));
-      }
-    }
-  }
-  Agreement r;
-  r.Either = either;
-  r.Masks = either ? 1.0 - double(disagree) / either : 0.0;
-  r.MeanDifference = both ? diff / (3.0 * both) : 255.0;
-  r.Differing = differing;
-  return r;
-}
+using medical_test::ImageAgreement;
+using medical_test::CompareImages;
 
 void ExpectAgree(
   const std::string& name, const std::vector<unsigned char>& a, const std::vector<unsigned char>& b)
 {
-  const Agreement r = Compare(a, b);
+  const ImageAgreement r = CompareImages(a, b);
   std::printf("%s: %d pixels covered by either, masks agree on %.2f%%, mean colour difference "
               "%.2f, %d pixels differ by more than 24\n",
-    name.c_str(), r.Either, 100.0 * r.Masks, r.MeanDifference, r.Differing);
+    name.c_str(), r.Either, 100.0 * r.Agreement, r.MeanDifference, r.Differing);
   Check(r.Either > 5000, name + ": the surfaces cover a good part of the image");
-  Check(r.Masks >= 0.985, name + ": covered pixels agree");
+  Check(r.Agreement >= 0.985, name + ": covered pixels agree");
   // Both images hold the same surfaces, so the outline of the cut is what
   // the masks can differ by: exact cuts differ on ~0.04% of the pixels, a cut
   // along whole cells (the plane's cells skipped, no cut inside them) on ~1.1%.
-  Check(r.Masks >= 0.997, name + ": the cut lies where the plane is");
+  Check(r.Agreement >= 0.997, name + ": the cut lies where the plane is");
   Check(r.MeanDifference <= 12.0, name + ": colours agree");
 }
 
@@ -275,7 +237,7 @@ int TestHistoPyramidIsoMapperClipping(int argc, char* argv[])
   ExpectAgree("GPU plane vs BlockLODContour + vtkClipPolyData", gpuPlane, reference);
   ExpectAgree("fallback plane vs BlockLODContour + vtkClipPolyData", cpuPlane, reference);
   const auto gpuWhole = RenderMapper(phantom, opaque, Cut(), false, "GPU unclipped");
-  const Agreement change = Compare(gpuWhole, gpuPlane);
+  const ImageAgreement change = CompareImages(gpuWhole, gpuPlane);
   std::printf("the plane changes %d pixels of the unclipped image\n", change.Differing);
   Check(change.Differing > 5000, "the plane changes the image (the bone shows through the cut)");
 
@@ -310,7 +272,7 @@ int TestHistoPyramidIsoMapperClipping(int argc, char* argv[])
   std::uint64_t primitives = 1;
   const auto nothing =
     RenderMapper(phantom, opaque, all, false, "everything clipped", nullptr, &primitives);
-  Check(Compare(nothing, nothing).Either == 0 && primitives == 0,
+  Check(CompareImages(nothing, nothing).Either == 0 && primitives == 0,
     "a plane that removes the whole volume draws nothing");
   Cut fence = crop;
   fence.CropFlags = VTK_CROP_FENCE;
@@ -318,7 +280,7 @@ int TestHistoPyramidIsoMapperClipping(int argc, char* argv[])
   const auto uncropped = RenderMapper(phantom, opaque, fence, false, "fence flags", &warnings);
   Check(warnings == 1,
     "unsupported cropping flags: one warning (got " + std::to_string(warnings) + ")");
-  Check(Compare(uncropped, gpuWhole).Differing == 0, "unsupported cropping flags: drawn uncropped");
+  Check(CompareImages(uncropped, gpuWhole).Differing == 0, "unsupported cropping flags: drawn uncropped");
 
   // 5. The baseline: four panels.
   vtkNew<vtkRenderWindow> window;
