@@ -9,7 +9,7 @@
 // The camera is in patient space (LPS millimetres, orientation.js), so that a link means the same
 // view of the same scan whatever the module's scene frame.
 
-import { lpsFromScenePoint, lpsFromSceneVector, sceneView, vec } from "./orientation.js";
+import { lpsFromDrawnPoint, lpsFromDrawnVector, sceneView, vec } from "./orientation.js";
 import { state } from "./state.js";
 
 const PATHS = ["auto", "gpu", "cpu"];
@@ -89,8 +89,8 @@ export function linkedView(camera) {
 export function writeLink() {
   const iso = state.surfaces.map((s) => number(s.value) + "," + hex(s.color) + "," + number(s.opacity));
   const v = state.viewer.getView();
-  const cam = [...lpsFromScenePoint(v.position), ...lpsFromScenePoint(v.focalPoint),
-    ...lpsFromSceneVector(v.viewUp), v.viewAngle].map(number);
+  const cam = [...lpsFromDrawnPoint(v.position), ...lpsFromDrawnPoint(v.focalPoint),
+    ...lpsFromDrawnVector(v.viewUp), v.viewAngle].map(number);
   return "#iso=" + iso.join(";") + "&cam=" + cam.join(",") + "&path=" + state.requestedPath;
 }
 
