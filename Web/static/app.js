@@ -30,6 +30,7 @@ import { drawHistogram, histogramInfo, setupHistogram } from "./histogram.js";
 import { setupPresets } from "./presets.js";
 import { fps, showDataset, unsupported, updateReadout } from "./readout.js";
 import { $, params, state } from "./state.js";
+import { drawCrosshair3D, setupCrosshair3D } from "./crosshair3d.js";
 import { crosshairInfo, drawSlices, pick, setCrosshair, setSliceWindow, setupSlices, slicesInfo }
   from "./slices.js";
 import { replaceSurfaces, setupSurfaceList } from "./surfaces.js";
@@ -94,6 +95,11 @@ async function start() {
   setupPresets((surfaces) => replaceSurfaces(surfaces, false));
   setupHistogram();
   setupSlices(histogramInfo());
+  setupCrosshair3D(canvas, scheduleLink);
+  afterFrame.push(drawCrosshair3D);
+  if (link.crosshair) {
+    setCrosshair(link.crosshair);
+  }
   let drawnKey = "";
   afterFrame.push(() => {
     const key = JSON.stringify([state.surfaces, state.level]);

@@ -279,6 +279,7 @@ export function setCrosshair(p) {
   const idx = indexOf(p).map((x, a) => Math.min(state.grid.dims[a] - 1, Math.max(0, x)));
   crosshair = pointOf(idx);
   drawSlices();
+  document.dispatchEvent(new CustomEvent("mediso:crosshair")); // the 3D view's cross, the URL
 }
 
 // The first point along the ray from the camera through (x, y) (CSS pixels of the 3D canvas)
