@@ -9,14 +9,15 @@
 //   volume.js       the counted requests and the volume, fetched once per level
 //   path.js         the GPU or the CPU path, and the level of the volume each can afford
 //   viewer.js       the WebAssembly module, its viewer, the frames; the facts the module states
-//   interaction.js  mouse, wheel and keys on the canvas (turn, pan, zoom at the cursor, reset)
+//   interaction.js  mouse, wheel, two fingers and keys on the canvas (turn, pan, zoom at the cursor, reset)
 //   orientation.js  patient space (LPS): the views, the orientation marker, getView().world
-//   link.js         the surfaces, camera and path in the URL's fragment
+//   link.js         the surfaces, camera, crosshair and path in the URL's fragment
 //   surfaces.js     the surface list
 //   readout.js      the stats, the notes, and why the page cannot run
 //   operations.js   the "On the server" panel
 //   ply.js          the server's surfaces, read
 //   slices.js       the axial, coronal and sagittal views: window, crosshair, contours
+//   crosshair3d.js  the crosshair drawn over the 3D view
 //   histogram.js    the volume's histogram, its isovalue markers dragged
 //   presets.js      the first surfaces (Hounsfield units or Otsu), the CT presets
 
