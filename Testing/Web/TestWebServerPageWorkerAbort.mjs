@@ -9,7 +9,9 @@
 //   counts it, the obsolete surface is never shown at a finer level, and the worker draws the newer
 //   change without waiting for the old refinement's end;
 // - the newer change ends at level 3 with the triangles of level 3 on the main-thread page (the
-//   same core, not in a worker).
+//   same core, not in a worker);
+// - without the generation word (?abort=0, as on a page that is not cross-origin isolated),
+//   stats() says a refinement runs to its end, and it does.
 import { Checks, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
 
 const checks = new Checks();
@@ -95,6 +97,36 @@ for (const mode of ["", "&threads=0"]) {
     s.triangles === reference.triangles && s.triangles > 0,
     name + ": the newer change ends at level 3 with " + s.triangles + " triangles (" +
     reference.triangles + " at level 3 on the main thread)");
+  await page.context().close();
+}
+
+// Without the word (?abort=0, as where the page is not cross-origin isolated): stats() says a
+// refinement runs to its end, and the superseded change's refinement does (no abort counted).
+{
+  const page = await open("&path=cpu&frameBudget=1&abort=0");
+  await page.evaluate(() => window.mediso.setCPULevel(-1));
+  await page.evaluate(() => window.mediso.setSurfaces([{ value: 300, color: [1, 1, 1], opacity: 1 }]));
+  const s0 = await stats(page);
+  checks.check(s0.abortable === false && /runs to its end/.test(s0.abortNote),
+    "without the word, stats() says a refinement runs to its end: " + JSON.stringify(s0.abortNote));
+  const before = (await frames(page)).length;
+  await page.evaluate(async () => {
+    const box = document.querySelector("#surfaces .isovalue");
+    box.value = "250";
+    box.dispatchEvent(new Event("input"));
+    await new Promise((resolve) => setTimeout(resolve, 1000));
+    box.value = "350";
+    box.dispatchEvent(new Event("input"));
+  });
+  await page.waitForFunction(() => {
+    const f = window.mediso.frames();
+    return f.length && f[f.length - 1].values[0] === 350 && f[f.length - 1].settled;
+  }, null, { timeout: 120000 });
+  const steps = (await frames(page)).slice(before);
+  const s = await stats(page);
+  checks.check(s.refinementsAborted === 0 && steps.some((f) => f.values[0] === 250 && f.cpuLevel === 3),
+    "without the word nothing is aborted and the older change was refined (" +
+    JSON.stringify(steps.map((f) => [f.values, f.cpuLevel, f.settled])) + ")");
   await page.context().close();
 }
 

@@ -221,10 +221,7 @@ window.mediso = {
     // refinements a newer change stopped while they ran, and whether it can (docs/web.md)
     refinementsAborted: state.refinementsAborted,
     abortable: state.abortable,
-    abortNote: !state.remote ? "" : state.abortable
-      ? "A newer change stops a refinement that is running."
-      : "A refinement that has begun runs to its end: the page is not cross-origin isolated " +
-        "(no SharedArrayBuffer to tell the worker of a newer change).",
+    abortNote: state.abortNote,
     lastRefinedMs: state.lastRefinedMs,
     sampleDistance: state.sampleDistance,
     frameNote: state.frameNote,

@@ -44,6 +44,7 @@ let volumeBytes = 0; // the pointer of the volume in this module's memory
 // SharedArrayBuffer): a refinement begun then runs to its end.
 let generationWord = null;
 let aborted = 0;
+let abortNote = ""; // what stats() says about it
 
 // The frame budget of interactive frames and of a change's first frame (the page's
 // ?frameBudget=MS, else 100 ms), and how long a coarse frame waits before its refinement starts,
@@ -69,7 +70,7 @@ async function init(m) {
     budgetSeconds = m.budgetMs / 1000;
   }
   viewer = new M.WebViewer("#view");
-  shareGeneration(m.slowExtractionMs);
+  shareGeneration(m.abort !== false, m.slowExtractionMs);
   post({ op: "ready", ok: viewer.ready(), error: viewer.error(), info: viewer.info(),
     generation: generationWord });
 }
@@ -77,9 +78,14 @@ async function init(m) {
 // The generation word: in the threaded module's (shared) memory, where the module reads it from
 // any of its threads; else, where this worker may make a SharedArrayBuffer, one of its own,
 // which the one-thread module reads on this thread (self.medisoGenerationWord).
-// `slowExtractionMs`: the page's ?slowExtraction= test hook (WebViewer.setSlowExtraction).
-function shareGeneration(slowExtractionMs) {
+// `abort` false: none (the page's ?abort=0, to measure without it); `slowExtractionMs`: the
+// page's ?slowExtraction= test hook (WebViewer.setSlowExtraction).
+function shareGeneration(abort, slowExtractionMs) {
   const address = viewer.ready() ? viewer.generationWord() : 0;
+  if (!abort) {
+    abortNote = "A refinement that has begun runs to its end (asked for by ?abort=0).";
+    return;
+  }
   if (address && M.HEAPU8.buffer instanceof SharedArrayBuffer) {
     generationWord = new Int32Array(M.HEAPU8.buffer, address, 1);
   } else if (!address && self.crossOriginIsolated && typeof SharedArrayBuffer === "function") {
@@ -89,6 +95,9 @@ function shareGeneration(slowExtractionMs) {
   if (generationWord && slowExtractionMs > 0) {
     viewer.setSlowExtraction(slowExtractionMs);
   }
+  abortNote = generationWord ? "A newer change stops a refinement that is running."
+    : "A refinement that has begun runs to its end: the page is not cross-origin isolated " +
+      "(no SharedArrayBuffer to tell the worker of a newer change).";
 }
 
 function schedule() {
@@ -133,6 +142,7 @@ function draw(frame, level, distance) {
   stats.refinementsSkipped = skipped;
   stats.refinementsAborted = aborted;
   stats.abortable = !!generationWord;
+  stats.abortNote = abortNote;
   stats.budgetMs = 1000 * budgetSeconds;
   return stats;
 }
