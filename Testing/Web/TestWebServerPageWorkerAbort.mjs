@@ -3,8 +3,9 @@
 // The worker), in Chromium (SwiftShader), in the threaded module (the generation word in its
 // shared memory) and the one-thread one (?threads=0: a SharedArrayBuffer of the worker's):
 // - ?frameBudget=1 draws a change at level 0 first; ?slowExtraction=MS makes the refinement that
-//   follows last at least MS (its abort poll waits, still watching), so that the newer change
-//   surely finds it running, whatever the machine's speed;
+//   follows last at least MS (it waits, still watching, in its plan, or with &slowPass=2 before
+//   it writes the surface), so that the newer change surely finds it running in that pass,
+//   whatever the machine's speed;
 // - the newer change, typed into the isovalue box while it runs, stops it: stats().refinementsAborted
 //   counts it, the obsolete surface is never shown at a finer level, and the worker draws the newer
 //   change without waiting for the old refinement's end;
@@ -35,8 +36,9 @@ await main.evaluate(() => window.mediso.setCPULevel(3));
 const reference = await main.evaluate(() =>
   window.mediso.setSurfaces([{ value: 350, color: [1, 1, 1], opacity: 1 }]));
 
-for (const mode of ["", "&threads=0"]) {
-  const name = mode ? "one-thread module" : "threaded module";
+const MODES = { "threaded module": "", "one-thread module": "&threads=0",
+  "threaded module, aborted while writing the surface": "&slowPass=2" };
+for (const [name, mode] of Object.entries(MODES)) {
   const page = await open("&path=cpu&frameBudget=1&slowExtraction=" + SLOW_MS + mode);
   await page.evaluate(() => window.mediso.setCPULevel(-1));
   // One surface, as on the main thread; resolves once it is refined (the hook's time).

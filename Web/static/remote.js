@@ -23,9 +23,9 @@ export class RemoteViewer {
    * Starts the worker on `canvas` (its control handed over for good) with the module `M` of
    * this thread (the camera, the CPU model's count); `threads`: the worker loads the threaded
    * module; `budgetMs`: the frame budget (0: the worker's); `abort`: false to let a running
-   * refinement run to its end; `slowExtractionMs`: a test hook (render-worker.js). Resolves to the viewer, or rejects.
+   * refinement run to its end; `slowExtractionMs`, `slowPass`: a test hook (render-worker.js). Resolves to the viewer, or rejects.
    */
-  static async start(canvas, M, { threads, budgetMs, abort, slowExtractionMs }, onFrame) {
+  static async start(canvas, M, { threads, budgetMs, abort, slowExtractionMs, slowPass }, onFrame) {
     const worker = new Worker("static/render-worker.js");
     const offscreen = canvas.transferControlToOffscreen();
     const viewer = new RemoteViewer(worker, M, onFrame);
@@ -33,7 +33,8 @@ export class RemoteViewer {
     const ready = await new Promise((resolve, reject) => {
       viewer.onReady = resolve;
       worker.onerror = (e) => reject(new Error("the render worker failed: " + (e.message || "no reason given")));
-      worker.postMessage({ op: "init", canvas: offscreen, base, threads, budgetMs, abort, slowExtractionMs },
+      worker.postMessage({ op: "init", canvas: offscreen, base, threads, budgetMs, abort, slowExtractionMs,
+        slowPass },
         [offscreen]);
     });
     viewer.readyState = ready;

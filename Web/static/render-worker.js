@@ -70,7 +70,7 @@ async function init(m) {
     budgetSeconds = m.budgetMs / 1000;
   }
   viewer = new M.WebViewer("#view");
-  shareGeneration(m.abort !== false, m.slowExtractionMs);
+  shareGeneration(m.abort !== false, m.slowExtractionMs, m.slowPass);
   post({ op: "ready", ok: viewer.ready(), error: viewer.error(), info: viewer.info(),
     generation: generationWord });
 }
@@ -79,8 +79,8 @@ async function init(m) {
 // any of its threads; else, where this worker may make a SharedArrayBuffer, one of its own,
 // which the one-thread module reads on this thread (self.medisoGenerationWord).
 // `abort` false: none (the page's ?abort=0, to measure without it); `slowExtractionMs`: the
-// page's ?slowExtraction= test hook (WebViewer.setSlowExtraction).
-function shareGeneration(abort, slowExtractionMs) {
+// page's ?slowExtraction=MS&slowPass=P test hook (WebViewer.setSlowExtraction).
+function shareGeneration(abort, slowExtractionMs, slowPass) {
   const address = viewer.ready() ? viewer.generationWord() : 0;
   if (!abort) {
     abortNote = "A refinement that has begun runs to its end (asked for by ?abort=0).";
@@ -93,7 +93,7 @@ function shareGeneration(abort, slowExtractionMs) {
     self.medisoGenerationWord = generationWord;
   }
   if (generationWord && slowExtractionMs > 0) {
-    viewer.setSlowExtraction(slowExtractionMs);
+    viewer.setSlowExtraction(slowExtractionMs, slowPass || 1);
   }
   abortNote = generationWord ? "A newer change stops a refinement that is running."
     : "A refinement that has begun runs to its end: the page is not cross-origin isolated " +

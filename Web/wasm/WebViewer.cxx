@@ -301,11 +301,17 @@ public:
   bool Aborted() const { return this->LastAborted; }
 
   /**
-   * A test hook (the page's ?slowExtraction=MS): a watched extraction lasts
-   * at least `ms`, its abort poll waiting until then, so that a test can
-   * supersede it without depending on the machine's speed. 0: off.
+   * A test hook (the page's ?slowExtraction=MS&slowPass=P): a watched
+   * extraction lasts at least `ms`, waiting (still watching) in pass `pass`
+   * until then: 1, the plan (its abort poll), or 2, the surface's writing
+   * (before its first batch of blocks), so that a test can supersede it in
+   * either pass without depending on the machine's speed. 0 ms: off.
    */
-  void SetSlowExtraction(double ms) { this->SlowExtractionMs = std::isfinite(ms) ? std::max(0.0, ms) : 0.0; }
+  void SetSlowExtraction(double ms, int pass)
+  {
+    this->SlowExtractionMs = std::isfinite(ms) ? std::max(0.0, ms) : 0.0;
+    this->SlowPass = pass == 2 ? 2 : 1;
+  }
 
   /// The estimator's table for the current isovalues: per level, triangles, MB and seconds.
   val Estimates()
@@ -748,8 +754,12 @@ private:
 
   // The CPU path's ParallelFor: over the machine's threads (threaded module) or this one.
   // A watched extraction's ranges are cut into batches of blocks: the core polls its abort
-  // once per range it is handed, so a batch bounds how long an obsolete pass runs on.
-  void RunPass(std::int64_t begin, std::int64_t end, const RangeBody& body) const
+  // once per range it is handed (pass 1), so a batch bounds how long an obsolete pass runs on.
+  // Pass 2 (writing a surface, after the level is planned) takes no abort in the core: there
+  // the batches themselves stop once the extraction is obsolete, the surface is left partial,
+  // and the core's check after it stops the update; UpdateCPUSurfaces then empties the cache,
+  // which holds that partial surface.
+  void RunPass(std::int64_t begin, std::int64_t end, const RangeBody& body)
   {
 #ifdef MEDISO_WEB_THREADS
     const ParallelFor run = ThreadedFor;
@@ -762,11 +772,22 @@ private:
       return;
     }
     constexpr std::int64_t BlocksPerPoll = 256;
+    const bool stoppable = this->Generating;
     run(begin, end,
-      [&body](std::int64_t a, std::int64_t b)
+      [this, &body, stoppable](std::int64_t a, std::int64_t b)
       {
         for (std::int64_t c = a; c < b; c += BlocksPerPoll)
         {
+          while (stoppable && this->SlowPass == 2 &&
+            emscripten_get_now() - this->WatchStart < this->SlowExtractionMs &&
+            this->PageGeneration() == this->WatchedGeneration)
+          {
+          }
+          if (stoppable && this->PageGeneration() != this->WatchedGeneration)
+          {
+            this->SkippedBatches = true;
+            return;
+          }
           body(c, std::min(b, c + BlocksPerPoll));
         }
       });
@@ -785,15 +806,19 @@ private:
   // The core's abort for a watched extraction begun at `start` (ms): true once the page's
   // generation moved on. Polled from the pass's threads; with the test hook, each poll first
   // waits (still watching) until the extraction is SlowExtractionMs old.
-  UpdateHooks AbortHooks(double start) const
+  UpdateHooks AbortHooks(double start)
   {
     UpdateHooks hooks;
+    this->Generating = false;
+    this->SkippedBatches = false;
     if (!this->Watching)
     {
       return hooks;
     }
+    hooks.Planned = [this](int) { this->Generating = true; };
     const int generation = this->WatchedGeneration;
-    const double slowMs = this->SlowExtractionMs;
+    const double slowMs = this->SlowPass == 1 ? this->SlowExtractionMs : 0.0;
+    this->WatchStart = start;
     hooks.PollAbort = [this, generation, slowMs, start]()
     {
       while (slowMs > 0.0 && emscripten_get_now() - start < slowMs)
@@ -828,8 +853,13 @@ private:
     this->LastAborted = false;
     const SurfacesUpdate update =
       this->CPU.Update(values, choice, CPUSurfaceMaker(), this->AbortHooks(start));
+    this->Generating = false;
     if (update.Status == SurfacesUpdate::Outcome::Aborted)
     {
+      if (this->SkippedBatches)
+      {
+        this->CPU.ClearCache(); // a surface left partial was cached (RunPass)
+      }
       this->LastAborted = true; // not an error: the worker goes on to the newer change
       return false;
     }
@@ -921,6 +951,10 @@ private:
   int WatchedGeneration = 0;
   bool LastAborted = false;
   double SlowExtractionMs = 0.0;
+  int SlowPass = 1;
+  double WatchStart = 0.0;
+  bool Generating = false;                  // the watched update is past its plan (pass 2)
+  std::atomic<bool> SkippedBatches{ false }; // RunPass left a surface partial
 };
 
 namespace
