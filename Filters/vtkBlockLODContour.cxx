@@ -694,6 +694,39 @@ double vtkBlockLODContour::EstimateSeconds(double isovalue, int level)
 }
 
 //------------------------------------------------------------------------------
+double* vtkBlockLODContour::GetCurrentEstimatedSeconds()
+{
+  const int n = this->ContourValues->GetNumberOfContours();
+  for (int level = 0; level < 4; ++level)
+  {
+    double sum = n > 0 ? 0.0 : -1.0;
+    for (int i = 0; i < n && sum >= 0.0; ++i)
+    {
+      const double seconds = this->EstimateSeconds(this->ContourValues->GetValue(i), level);
+      sum = seconds < 0.0 ? -1.0 : sum + seconds;
+    }
+    this->CurrentEstimatedSeconds[level] = sum;
+  }
+  return this->CurrentEstimatedSeconds;
+}
+
+double* vtkBlockLODContour::GetCurrentEstimatedMegabytes()
+{
+  const int n = this->ContourValues->GetNumberOfContours();
+  for (int level = 0; level < 4; ++level)
+  {
+    double sum = n > 0 ? 0.0 : -1.0;
+    for (int i = 0; i < n && sum >= 0.0; ++i)
+    {
+      const double mb = this->EstimateMegabytes(this->ContourValues->GetValue(i), level);
+      sum = mb < 0.0 ? -1.0 : sum + mb;
+    }
+    this->CurrentEstimatedMegabytes[level] = sum;
+  }
+  return this->CurrentEstimatedMegabytes;
+}
+
+//------------------------------------------------------------------------------
 int vtkBlockLODContour::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
@@ -762,7 +795,14 @@ void vtkBlockLODContour::Execute(
   choice.BudgetBytes = this->MemoryBudget * BytesPerMB;
   mediso::UpdateHooks hooks;
   hooks.PollAbort = [this]() { return this->GetAbortExecute() != 0; };
-  hooks.CheckAbort = [this]() { return this->CheckAbort(); };
+  // A progress event between steps (each isovalue's plan, each surface) lets an observer
+  // that watches for a newer request (medical_isosurfaces.RefineAfterChange, the GUI's abort
+  // button) set AbortExecute while the update runs; the core then stops between blocks.
+  hooks.CheckAbort = [this]()
+  {
+    this->UpdateProgress(this->GetProgress());
+    return this->CheckAbort();
+  };
   hooks.Planned = [this, &values](int level)
   {
     this->ChosenLevel = level;

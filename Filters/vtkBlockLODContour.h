@@ -258,6 +258,19 @@ public:
    */
   vtkGetMacro(LastEstimateMethod, int);
 
+  ///@{
+  /**
+   * Estimates per level (0..3) for the isovalues set now, all of them
+   * together, on the volume of the last update: what an update would cost
+   * before it runs (an isovalue change answered at a coarse level first,
+   * medical_isosurfaces.RefineAfterChange, reads them as information
+   * properties). Each call estimates anew (no extraction is run); -1 for a
+   * level when there is no estimate (no update yet, no isovalue).
+   */
+  double* GetCurrentEstimatedSeconds() VTK_SIZEHINT(4);
+  double* GetCurrentEstimatedMegabytes() VTK_SIZEHINT(4);
+  ///@}
+
   /**
    * Level used by the last execution (-1 before any, or when nothing was made).
    */
@@ -342,6 +355,8 @@ protected:
   double EstimatedTriangles[4] = { 0, 0, 0, 0 };
   double EstimatedMegabytes[4] = { 0, 0, 0, 0 };
   double EstimatedSeconds[4] = { 0, 0, 0, 0 };
+  double CurrentEstimatedSeconds[4] = { -1, -1, -1, -1 };
+  double CurrentEstimatedMegabytes[4] = { -1, -1, -1, -1 };
   vtkIdType NumberOfExtractions = 0;
   vtkIdType NumberOfCacheHits = 0;
   vtkIdType NumberOfBlockRangeComputations = 0;

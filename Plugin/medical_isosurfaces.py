@@ -12,9 +12,20 @@ like any filter. What is not a proxy lives here:
     each triangle's surface index and colour (cell data ``SurfaceIndex``, ``SurfaceColor``)
     and each surface's name, value and colour (field data). The panel's *Make Mesh* button
     runs this function.
+
+``RefineAfterChange(contour, view=None, frame_budget=0.1)``
+    isovalue changes of a Block LOD Contour answered coarse first, then refined (issue 30):
+    ``change(values, newer=None)`` draws the new isovalues at once at the finest level whose
+    extraction the filter's estimator fits in ``frame_budget`` seconds, then updates the filter
+    at the level the user set (Auto LOD's memory choice, or LOD) and draws that, unless
+    ``newer()``, polled at the filter's progress events (builtin session), says a newer change
+    is waiting: the refinement is then aborted (the filter's AbortExecute) and counted, and the
+    coarse answer stays shown. ParaView 5.11's update is synchronous: the refinement blocks the
+    caller while it runs (docs/blocklod.md).
 """
 
 import math
+import time
 
 from paraview import servermanager, simple
 from paraview.vtk import vtkDataSetAttributes
@@ -149,3 +160,120 @@ def _make_mesh_for_panel(display_id, view_id):
         return servermanager._getPyProxy(found) if found is not None else None
 
     return MakeMeshFromView(proxy(display_id), proxy(view_id))
+
+
+class RefineAfterChange:
+    """Answers an isovalue change of a Block LOD Contour at a coarse level first, then refines it
+    to the level the user set (see the module's description; docs/blocklod.md, Answering an
+    isovalue change coarse first).
+
+    ``contour``: a BlockLODContour proxy; its AutoLOD, LOD and MemoryBudget as they are now give
+    the refinement's level (the helper restores them after each first answer). ``view``: the
+    view that shows it (default: the active view). ``frame_budget``: the seconds the first
+    answer's extraction may take, as the filter's estimator predicts them for the new isovalues
+    (its CurrentEstimatedSeconds: 0 for a cached surface; its cost model learns from the
+    filter's updates); the drawing is not in that prediction.
+
+    ``change(values, newer=None)`` returns ``{"values", "first_level", "first_seconds",
+    "level", "seconds", "aborted", "note", "first_note"}``: the level the first render drew and
+    the seconds from the change to it, the level reached and the seconds to it (the first's when
+    the first answer is already at the user's level; None when aborted), what the view shows
+    now and what the first answer said (a coarse one says so). ``newer`` is polled at the
+    refinement's progress events, which needs the filter in this process (a builtin session);
+    in client/server it is not polled and the refinement runs to its end. ``refinements`` and
+    ``refinements_aborted`` count the refinements begun and those a newer change stopped.
+    """
+
+    def __init__(self, contour, view=None, frame_budget=0.1):
+        self.contour = contour
+        self.view = view or simple.GetActiveView()
+        self.frame_budget = float(frame_budget)
+        self.auto_lod = int(contour.AutoLOD)
+        self.lod = int(contour.LOD)
+        self.refinements = 0
+        self.refinements_aborted = 0
+        self.last = None
+
+    def _estimates(self, name):
+        self.contour.UpdatePropertyInformation()
+        return [float(x) for x in self.contour.GetProperty(name)]
+
+    def levels(self):
+        """For the isovalues set now: (the refinement's level, the first answer's level, its
+        predicted seconds). The refinement's: LOD, or with Auto LOD the finest level whose
+        estimated surfaces fit the Memory Budget (the choice the filter makes; 0 when none does).
+        The first answer's: the finest at or below it whose estimated extraction fits the frame
+        budget (level 0 when none does)."""
+        megabytes = self._estimates("CurrentEstimatedMB")
+        seconds = self._estimates("CurrentEstimatedSeconds")
+        if min(seconds) < 0 or min(megabytes) < 0:
+            return self.lod, self.lod, -1.0  # no estimate (no update yet): no coarse answer
+        memory = self.lod
+        if self.auto_lod:
+            budget = float(self.contour.MemoryBudget)
+            memory = next((l for l in range(3, 0, -1) if megabytes[l] <= budget), 0)
+        first = next((l for l in range(memory, -1, -1) if seconds[l] <= self.frame_budget), 0)
+        return memory, first, seconds[first]
+
+    def change(self, values, newer=None):
+        start = time.perf_counter()
+        values = [float(v) for v in values]
+        self.contour.Isosurfaces = values
+        memory, first, predicted = self.levels()
+        if first >= memory:
+            self._restore()
+        else:
+            self.contour.AutoLOD = 0
+            self.contour.LOD = first
+        simple.Render(self.view)
+        first_seconds = time.perf_counter() - start
+        shown = self._chosen_level()
+        result = {"values": values, "first_level": shown, "first_seconds": first_seconds,
+                  "level": shown, "seconds": first_seconds, "aborted": False,
+                  "predicted_seconds": predicted, "note": "", "first_note": ""}
+        self.last = result
+        if first >= memory:
+            return result
+        result["note"] = result["first_note"] = (
+            "First answer: level %d (level %d's extraction is predicted over %g s); refining."
+            % (shown, memory, self.frame_budget))
+        # The refinement: the user's level, with the newer change polled at the filter's
+        # progress events; a true answer sets AbortExecute, which the filter honours between
+        # chunks of blocks and between surfaces.
+        self.refinements += 1
+        self._restore()
+        found = self.contour.GetClientSideObject()
+        stopped = []
+
+        def poll(algorithm, event):
+            if newer is not None and not stopped and newer():
+                stopped.append(True)
+                algorithm.SetAbortExecute(1)
+
+        tag = found.AddObserver("ProgressEvent", poll) if found is not None else None
+        try:
+            self.contour.UpdatePipeline()
+        finally:
+            if tag is not None:
+                found.RemoveObserver(tag)
+        if stopped:
+            found.SetAbortExecute(0)
+            self.refinements_aborted += 1
+            # The aborted update left the output empty: back to the level shown, so that any
+            # render before the newer change's draws the first answer again (from the cache).
+            self.contour.AutoLOD = 0
+            self.contour.LOD = shown
+            result.update(level=shown, seconds=None, aborted=True,
+                          note="Level %d: its refinement was aborted by a newer change." % shown)
+            return result
+        simple.Render(self.view)
+        result.update(level=self._chosen_level(), seconds=time.perf_counter() - start, note="")
+        return result
+
+    def _chosen_level(self):
+        self.contour.UpdatePropertyInformation()
+        return int(self.contour.GetProperty("ChosenLevel")[0])
+
+    def _restore(self):
+        self.contour.AutoLOD = self.auto_lod
+        self.contour.LOD = self.lod

@@ -225,6 +225,10 @@ window.mediso = {
     interactive: state.interactive,
     settled: state.settled,
     refinementsSkipped: state.refinementsSkipped,
+    // refinements a newer change stopped while they ran, and whether it can (docs/web.md)
+    refinementsAborted: state.refinementsAborted,
+    abortable: state.abortable,
+    abortNote: state.abortNote,
     lastRefinedMs: state.lastRefinedMs,
     sampleDistance: state.sampleDistance,
     frameNote: state.frameNote,

@@ -22,9 +22,10 @@ export class RemoteViewer {
   /**
    * Starts the worker on `canvas` (its control handed over for good) with the module `M` of
    * this thread (the camera, the CPU model's count); `threads`: the worker loads the threaded
-   * module; `budgetMs`: the frame budget (0: the worker's). Resolves to the viewer, or rejects.
+   * module; `budgetMs`: the frame budget (0: the worker's); `abort`: false to let a running
+   * refinement run to its end; `slowExtractionMs`, `slowPass`: a test hook (render-worker.js). Resolves to the viewer, or rejects.
    */
-  static async start(canvas, M, { threads, budgetMs }, onFrame) {
+  static async start(canvas, M, { threads, budgetMs, abort, slowExtractionMs, slowPass }, onFrame) {
     const worker = new Worker("static/render-worker.js");
     const offscreen = canvas.transferControlToOffscreen();
     const viewer = new RemoteViewer(worker, M, onFrame);
@@ -32,9 +33,12 @@ export class RemoteViewer {
     const ready = await new Promise((resolve, reject) => {
       viewer.onReady = resolve;
       worker.onerror = (e) => reject(new Error("the render worker failed: " + (e.message || "no reason given")));
-      worker.postMessage({ op: "init", canvas: offscreen, base, threads, budgetMs }, [offscreen]);
+      worker.postMessage({ op: "init", canvas: offscreen, base, threads, budgetMs, abort, slowExtractionMs,
+        slowPass },
+        [offscreen]);
     });
     viewer.readyState = ready;
+    viewer.generation = ready.generation || null;
     return viewer;
   }
 
@@ -51,6 +55,10 @@ export class RemoteViewer {
     this.answers = new Map(); // id -> resolve
     this.volume = null; // {type, pointer, dims}: the main thread's copy (this module's memory)
     this.lastDrawn = 0; // the newest frame id the worker answered
+    // The worker's generation word (render-worker.js; null where the page is not cross-origin
+    // isolated) and the isovalues of the last frame asked for.
+    this.generation = null;
+    this.sentKey = "";
     worker.onmessage = (e) => this.receive(e.data);
   }
 
@@ -169,10 +177,25 @@ export class RemoteViewer {
   frame(interactive = false) {
     const id = this.nextId++;
     this.worker.postMessage({ op: "frame", id, surfaces: this.surfaces, view: this.camera.getView(),
-      interactive });
+      interactive, generation: this.nextGeneration(interactive) });
     const first = new Promise((resolve) => this.waiting.push({ id, settled: false, resolve }));
     const settled = new Promise((resolve) => this.waiting.push({ id, settled: true, resolve }));
     return { id, first, settled };
+  }
+
+  /**
+   * The generation of a frame asked for now: new isovalues or a drag frame make the refinement
+   * the worker may be running obsolete, so the word moves on at once, before the frame's
+   * message, and the worker's extraction stops without waiting for that message.
+   */
+  nextGeneration(interactive) {
+    const key = JSON.stringify(this.surfaces.map((s) => s.value));
+    const obsoletes = interactive || key !== this.sentKey;
+    this.sentKey = key;
+    if (!this.generation) {
+      return 0;
+    }
+    return obsoletes ? Atomics.add(this.generation, 0, 1) + 1 : Atomics.load(this.generation, 0);
   }
 
   render() {

@@ -11,8 +11,8 @@
 //   {op: "call", method, args, id?}                      a WebViewer call; with id, its answer
 //   {op: "volume", type, bytes, dims, spacing, origin}   the volume's values (transferred)
 //   {op: "mesh", points, triangles, color, opacity}      a surface the server made
-//   {op: "frame", id, surfaces, view, interactive}       the frame wanted now
-// Messages out: {op: "ready", ok, error, info}, {op: "answer", id, value},
+//   {op: "frame", id, surfaces, view, interactive, generation}  the frame wanted now
+// Messages out: {op: "ready", ok, error, info, generation}, {op: "answer", id, value},
 //   {op: "frame", id, stats, settled}, {op: "error", message}.
 //
 // Frames. Only the newest frame wanted is drawn: messages that arrived while a frame was drawn
@@ -20,7 +20,9 @@
 // path, with the estimator choosing the level (setCPULevel(-1)), a new set of isovalues is drawn
 // first at the finest level whose predicted frame fits the frame budget, and refined to the
 // level the memory budget allows in a later task, which a newer change makes obsolete: the
-// refinement is then skipped (counted in stats.refinementsSkipped). During a drag
+// refinement is then skipped (counted in stats.refinementsSkipped); one already running is
+// aborted where the page is cross-origin isolated (the generation word, below; counted in
+// stats.refinementsAborted), else it runs to its end. During a drag
 // (interactive: true) the same coarse level is drawn; the still frame after it is the full one.
 "use strict";
 
@@ -34,6 +36,15 @@ let path = "gpu";
 let shownKey = ""; // the isovalues of the last frame drawn
 let skipped = 0;
 let volumeBytes = 0; // the pointer of the volume in this module's memory
+
+// The generation word (an Int32Array of one, shared with the page's main thread, which adds one
+// to it on every new set of isovalues and every drag frame before it sends the frame): a running
+// refinement whose frame's generation is no longer the word's is obsolete, and the module's
+// abort stops it between blocks. null where the page is not cross-origin isolated (no
+// SharedArrayBuffer): a refinement begun then runs to its end.
+let generationWord = null;
+let aborted = 0;
+let abortNote = ""; // what stats() says about it
 
 // The frame budget of interactive frames and of a change's first frame (the page's
 // ?frameBudget=MS, else 100 ms), and how long a coarse frame waits before its refinement starts,
@@ -59,7 +70,34 @@ async function init(m) {
     budgetSeconds = m.budgetMs / 1000;
   }
   viewer = new M.WebViewer("#view");
-  post({ op: "ready", ok: viewer.ready(), error: viewer.error(), info: viewer.info() });
+  shareGeneration(m.abort !== false, m.slowExtractionMs, m.slowPass);
+  post({ op: "ready", ok: viewer.ready(), error: viewer.error(), info: viewer.info(),
+    generation: generationWord });
+}
+
+// The generation word: in the threaded module's (shared) memory, where the module reads it from
+// any of its threads; else, where this worker may make a SharedArrayBuffer, one of its own,
+// which the one-thread module reads on this thread (self.medisoGenerationWord).
+// `abort` false: none (the page's ?abort=0, to measure without it); `slowExtractionMs`: the
+// page's ?slowExtraction=MS&slowPass=P test hook (WebViewer.setSlowExtraction).
+function shareGeneration(abort, slowExtractionMs, slowPass) {
+  const address = viewer.ready() ? viewer.generationWord() : 0;
+  if (!abort) {
+    abortNote = "A refinement that has begun runs to its end (asked for by ?abort=0).";
+    return;
+  }
+  if (address && M.HEAPU8.buffer instanceof SharedArrayBuffer) {
+    generationWord = new Int32Array(M.HEAPU8.buffer, address, 1);
+  } else if (!address && self.crossOriginIsolated && typeof SharedArrayBuffer === "function") {
+    generationWord = new Int32Array(new SharedArrayBuffer(4));
+    self.medisoGenerationWord = generationWord;
+  }
+  if (generationWord && slowExtractionMs > 0) {
+    viewer.setSlowExtraction(slowExtractionMs, slowPass || 1);
+  }
+  abortNote = generationWord ? "A newer change stops a refinement that is running."
+    : "A refinement that has begun runs to its end: the page is not cross-origin isolated " +
+      "(no SharedArrayBuffer to tell the worker of a newer change).";
 }
 
 function schedule() {
@@ -102,6 +140,9 @@ function draw(frame, level, distance) {
   stats.ms = ms;
   stats.values = frame.surfaces.map((s) => s.value);
   stats.refinementsSkipped = skipped;
+  stats.refinementsAborted = aborted;
+  stats.abortable = !!generationWord;
+  stats.abortNote = abortNote;
   stats.budgetMs = 1000 * budgetSeconds;
   return stats;
 }
@@ -167,11 +208,32 @@ function refineNow() {
   }
   const { id, frame } = refine;
   refine = null;
-  const stats = draw(frame, -1, 1);
+  const stats = drawWatched(frame);
+  if (!stats) {
+    return; // obsolete: the newer frame's message is next
+  }
   stats.interactive = false;
   stats.settled = true;
   stats.note = "";
   post({ op: "frame", id, stats });
+}
+
+// A refinement's frame drawn with the module watching the generation word: null when a newer
+// change made it obsolete while it ran (its extraction stopped, nothing drawn: the coarse frame
+// stays on the canvas until the newer change's).
+function drawWatched(frame) {
+  const watch = !!generationWord && path === "cpu";
+  viewer.watchGeneration(watch, watch ? frame.generation | 0 : 0);
+  try {
+    const stats = draw(frame, -1, 1);
+    if (!stats.ok && viewer.aborted()) {
+      ++aborted;
+      return null;
+    }
+    return stats;
+  } finally {
+    viewer.watchGeneration(false, 0);
+  }
 }
 
 self.onmessage = async (event) => {

@@ -63,6 +63,9 @@ export const state = Object.seal({
   interactive: false, // the last frame was a drag's (a coarser level)
   settled: true, // the last frame is at the full level
   refinementsSkipped: 0, // refinements a newer change made obsolete
+  refinementsAborted: 0, // refinements a newer change stopped while they ran
+  abortable: false, // the worker can stop a running refinement (cross-origin isolated)
+  abortNote: "", // the worker's word on it
   lastRefinedMs: 0, // the last change to its full-level frame
   sampleDistance: 1, // the GPU path's image sample distance of the last frame
   frameNote: "", // why the last frame is coarser than the full one ("" when it is not)

@@ -64,7 +64,10 @@ export async function startViewer(canvas, probe) {
   }
   if (inWorker) {
     state.viewer = await RemoteViewer.start(canvas, state.module,
-      { threads: state.threads > 1, budgetMs: Number(params.get("frameBudget")) || 0 }, frameAnswered);
+      { threads: state.threads > 1, budgetMs: Number(params.get("frameBudget")) || 0,
+        abort: params.get("abort") !== "0", slowExtractionMs: Number(params.get("slowExtraction")) || 0,
+        slowPass: Number(params.get("slowPass")) || 1 },
+      frameAnswered);
     state.remote = true;
     state.rendererNote = "Drawn in a worker (OffscreenCanvas): turning, typing and the panel do " +
       "not wait for an extraction or a frame.";
@@ -141,6 +144,9 @@ function recordFrame(ms, stats) {
   state.interactive = !!stats.interactive;
   state.settled = stats.settled !== false;
   state.refinementsSkipped = stats.refinementsSkipped || 0;
+  state.refinementsAborted = stats.refinementsAborted || 0;
+  state.abortable = !!stats.abortable;
+  state.abortNote = stats.abortNote || "";
   state.sampleDistance = stats.sampleDistance || 1;
   state.frameNote = stats.note || "";
   state.frameLog.push({ id: stats.id, values: stats.values, cpuLevel: stats.cpuLevel,

@@ -44,7 +44,9 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <memory>
@@ -55,6 +57,16 @@ namespace mediso_web
 {
 extern const int MarchingCubesCases[256][16];
 }
+
+#ifndef MEDISO_WEB_THREADS
+// The one-thread module's memory is not shared: the page's generation word is a
+// SharedArrayBuffer of the worker's own (render-worker.js sets self.medisoGenerationWord),
+// read here on the worker's thread, the only one that polls.
+EM_JS(int, mediso_page_generation, (), {
+  const word = self.medisoGenerationWord;
+  return word ? Atomics.load(word, 0) : 0;
+});
+#endif
 
 namespace
 {
@@ -251,6 +263,54 @@ public:
   void SetSampleDistance(double distance)
   {
     this->SampleDistance = std::isfinite(distance) ? std::max(1.0, std::min(8.0, distance)) : 1.0;
+  }
+
+  /**
+   * Where the page's generation word lives in this module's memory (a byte
+   * address), or 0 when the module's memory is not shared (the one-thread
+   * module: the worker then keeps the word in a SharedArrayBuffer of its own,
+   * self.medisoGenerationWord). The page's main thread adds one to the word
+   * on every change that makes a running refinement obsolete (new isovalues,
+   * a drag), before it sends the frame; the worker reads it through this
+   * module (docs/web.md, The worker).
+   */
+  double GenerationWord()
+  {
+#ifdef MEDISO_WEB_THREADS
+    return static_cast<double>(reinterpret_cast<std::uintptr_t>(&this->Generation));
+#else
+    return 0.0;
+#endif
+  }
+
+  /**
+   * With `watch`, the CPU path's extractions of the next frames stop as soon
+   * as the page's generation word is no longer `generation` (the core's
+   * abort, polled between blocks of a pass and between surfaces): Render()
+   * then returns false and Aborted() is true, nothing is drawn, and what was
+   * on the canvas stays. The worker watches its refinements only: a first
+   * answer or a drag's frame is always drawn.
+   */
+  void WatchGeneration(bool watch, int generation)
+  {
+    this->Watching = watch;
+    this->WatchedGeneration = generation;
+  }
+
+  /// True when the last Render() stopped because a newer change made it obsolete.
+  bool Aborted() const { return this->LastAborted; }
+
+  /**
+   * A test hook (the page's ?slowExtraction=MS&slowPass=P): a watched
+   * extraction lasts at least `ms`, waiting (still watching) in pass `pass`
+   * until then: 1, the plan (its abort poll), or 2, the surface's writing
+   * (before its first batch of blocks), so that a test can supersede it in
+   * either pass without depending on the machine's speed. 0 ms: off.
+   */
+  void SetSlowExtraction(double ms, int pass)
+  {
+    this->SlowExtractionMs = std::isfinite(ms) ? std::max(0.0, ms) : 0.0;
+    this->SlowPass = pass == 2 ? 2 : 1;
   }
 
   /// The estimator's table for the current isovalues: per level, triangles, MB and seconds.
@@ -692,6 +752,88 @@ private:
     return m;
   }
 
+  // The CPU path's ParallelFor: over the machine's threads (threaded module) or this one.
+  // A watched extraction's ranges are cut into batches of blocks: the core polls its abort
+  // once per range it is handed (pass 1), so a batch bounds how long an obsolete pass runs on.
+  // Pass 2 (writing a surface, after the level is planned) takes no abort in the core: there
+  // the batches themselves stop once the extraction is obsolete, the surface is left partial,
+  // and the core's check after it stops the update; UpdateCPUSurfaces then empties the cache,
+  // which holds that partial surface.
+  void RunPass(std::int64_t begin, std::int64_t end, const RangeBody& body)
+  {
+#ifdef MEDISO_WEB_THREADS
+    const ParallelFor run = ThreadedFor;
+#else
+    const ParallelFor run = SerialFor;
+#endif
+    if (!this->Watching)
+    {
+      run(begin, end, body);
+      return;
+    }
+    constexpr std::int64_t BlocksPerPoll = 256;
+    const bool stoppable = this->Generating;
+    run(begin, end,
+      [this, &body, stoppable](std::int64_t a, std::int64_t b)
+      {
+        for (std::int64_t c = a; c < b; c += BlocksPerPoll)
+        {
+          while (stoppable && this->SlowPass == 2 &&
+            emscripten_get_now() - this->WatchStart < this->SlowExtractionMs &&
+            this->PageGeneration() == this->WatchedGeneration)
+          {
+          }
+          if (stoppable && this->PageGeneration() != this->WatchedGeneration)
+          {
+            this->SkippedBatches = true;
+            return;
+          }
+          body(c, std::min(b, c + BlocksPerPoll));
+        }
+      });
+  }
+
+  // The page's generation word as it is now (see GenerationWord()).
+  int PageGeneration() const
+  {
+#ifdef MEDISO_WEB_THREADS
+    return this->Generation.load(std::memory_order_relaxed);
+#else
+    return mediso_page_generation();
+#endif
+  }
+
+  // The core's abort for a watched extraction begun at `start` (ms): true once the page's
+  // generation moved on. Polled from the pass's threads; with the test hook, each poll first
+  // waits (still watching) until the extraction is SlowExtractionMs old.
+  UpdateHooks AbortHooks(double start)
+  {
+    UpdateHooks hooks;
+    this->Generating = false;
+    this->SkippedBatches = false;
+    if (!this->Watching)
+    {
+      return hooks;
+    }
+    hooks.Planned = [this](int) { this->Generating = true; };
+    const int generation = this->WatchedGeneration;
+    const double slowMs = this->SlowPass == 1 ? this->SlowExtractionMs : 0.0;
+    this->WatchStart = start;
+    hooks.PollAbort = [this, generation, slowMs, start]()
+    {
+      while (slowMs > 0.0 && emscripten_get_now() - start < slowMs)
+      {
+        if (this->PageGeneration() != generation)
+        {
+          return true;
+        }
+      }
+      return this->PageGeneration() != generation;
+    };
+    hooks.CheckAbort = hooks.PollAbort;
+    return hooks;
+  }
+
   // The CPU path: the surfaces unit makes or finds each surface at the
   // level requested, or the estimator's within the budget (a guide here:
   // level 0 when nothing fits, said in the error); uploaded when it changed.
@@ -708,7 +850,19 @@ private:
     choice.BudgetBinds = false;
     this->CPU.SetCacheLimit(std::max(this->Budget / 4.0, 0.0));
     const double start = emscripten_get_now();
-    const SurfacesUpdate update = this->CPU.Update(values, choice, CPUSurfaceMaker());
+    this->LastAborted = false;
+    const SurfacesUpdate update =
+      this->CPU.Update(values, choice, CPUSurfaceMaker(), this->AbortHooks(start));
+    this->Generating = false;
+    if (update.Status == SurfacesUpdate::Outcome::Aborted)
+    {
+      if (this->SkippedBatches)
+      {
+        this->CPU.ClearCache(); // a surface left partial was cached (RunPass)
+      }
+      this->LastAborted = true; // not an error: the worker goes on to the newer change
+      return false;
+    }
     if (update.OverBudget)
     {
       this->LastError = "not even level 0 of these isosurfaces fits the memory budget (" +
@@ -777,13 +931,10 @@ private:
   // The CPU path.
   bool CPUPath = false;
   // Its own cost model: this page's updates give the estimator's seconds.
-#ifdef MEDISO_WEB_THREADS
-  BlockLODSurfaces<CPUSurfaceRef> CPU{ mediso_web::MarchingCubesCases, ThreadedFor,
+  BlockLODSurfaces<CPUSurfaceRef> CPU{ mediso_web::MarchingCubesCases,
+    [this](std::int64_t begin, std::int64_t end, const RangeBody& body)
+    { this->RunPass(begin, end, body); },
     std::make_shared<SharedCostModel>(), CPULayout };
-#else
-  BlockLODSurfaces<CPUSurfaceRef> CPU{ mediso_web::MarchingCubesCases, SerialFor,
-    std::make_shared<SharedCostModel>(), CPULayout };
-#endif
   std::vector<SurfaceKey> ShownKeys = std::vector<SurfaceKey>(MaximumIsovalues, SurfaceKey{ NAN, -1 });
   std::uint64_t VolumeStamp = 0;
   int RequestedLevel = -1;
@@ -791,6 +942,19 @@ private:
   double Budget = 1e9;
   double ShownTriangles = 0.0;
   std::unique_ptr<web::MeshRenderer> Meshes;
+
+  // The abort of an obsolete extraction (WatchGeneration()).
+#ifdef MEDISO_WEB_THREADS
+  std::atomic<std::int32_t> Generation{ 0 }; // the page's word, written by its main thread
+#endif
+  bool Watching = false;
+  int WatchedGeneration = 0;
+  bool LastAborted = false;
+  double SlowExtractionMs = 0.0;
+  int SlowPass = 1;
+  double WatchStart = 0.0;
+  bool Generating = false;                  // the watched update is past its plan (pass 2)
+  std::atomic<bool> SkippedBatches{ false }; // RunPass left a surface partial
 };
 
 namespace
@@ -922,5 +1086,9 @@ EMSCRIPTEN_BINDINGS(mediso_web)
     .function("chooseFrame", &WebViewer::ChooseFrame)
     .function("estimates", &WebViewer::Estimates)
     .function("setResultMesh", &WebViewer::SetResultMesh)
-    .function("clearResultMesh", &WebViewer::ClearResultMesh);
+    .function("clearResultMesh", &WebViewer::ClearResultMesh)
+    .function("generationWord", &WebViewer::GenerationWord)
+    .function("watchGeneration", &WebViewer::WatchGeneration)
+    .function("aborted", &WebViewer::Aborted)
+    .function("setSlowExtraction", &WebViewer::SetSlowExtraction);
 }
