@@ -4,6 +4,7 @@
 #include "BlockLODSurfaces.h"
 #include "ProcessMemory.h"
 
+#include "vtkAOSDataArrayTemplate.h"
 #include "vtkCellArray.h"
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
@@ -38,6 +39,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <mutex>
@@ -198,44 +200,145 @@ void SharedTriangleOffsets::Release(void* pointer)
   }
 }
 
-// VTK's arrays report a failed allocation and stay empty (they do not throw):
-// Valid() is false then.
-SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const mediso::SurfaceLayout& layout)
+// Memory of the surfaces the cache drops during one update, for the update's
+// new surfaces (SurfaceMaker::Recycle in BlockLODSurfaces.h). A fresh output
+// buffer costs a page fault and a page the kernel zeroes per 4 KB: on a noisy
+// MRI with half its blocks active that is a third of a warm change, and
+// vtkFlyingEdges3D pays it too. Once the cache is full, as while an isovalue
+// is dragged, every new surface makes it drop the oldest: its buffers, resized
+// with realloc (which keeps their mapped pages: mremap for large blocks), take
+// the new surface's values instead of being unmapped while fresh ones fault
+// in. Only buffers that nothing outside the dropped surface holds are taken
+// (a shallow copy shares the arrays, or their vtkPoints and vtkCellArray); the
+// shared triangle offsets never are. What the update does not use is freed
+// with the pool, at the update's end.
+class SpareBuffers
 {
+public:
+  SpareBuffers() = default;
+  SpareBuffers(const SpareBuffers&) = delete;
+  SpareBuffers& operator=(const SpareBuffers&) = delete;
+  ~SpareBuffers()
+  {
+    for (const Buffer& b : this->Buffers)
+    {
+      free(b.Pointer);
+    }
+  }
+
+  // Takes the buffers of a dropped surface that only it holds.
+  void Take(vtkPolyData* surface)
+  {
+    if (!surface || surface->GetReferenceCount() != 1)
+    {
+      return;
+    }
+    vtkPoints* points = surface->GetPoints();
+    if (points && points->GetReferenceCount() == 1)
+    {
+      this->TakeArray(points->GetData());
+    }
+    for (vtkDataSetAttributes* attributes :
+      { static_cast<vtkDataSetAttributes*>(surface->GetPointData()),
+        static_cast<vtkDataSetAttributes*>(surface->GetCellData()) })
+    {
+      for (int a = 0; a < attributes->GetNumberOfArrays(); ++a)
+      {
+        this->TakeArray(attributes->GetAbstractArray(a));
+      }
+    }
+    vtkCellArray* polys = surface->GetPolys();
+    if (polys && polys->GetReferenceCount() == 1)
+    {
+      this->TakeArray(polys->GetConnectivityArray());
+    }
+  }
+
+  // Gives `array` `tuples` tuples, in a spare buffer when one is big enough
+  // (or, the largest, at least half as big: realloc keeps its pages and adds
+  // the rest); the values are left unset, as SetNumberOfTuples leaves them.
+  template <typename ArrayT>
+  void Size(ArrayT* array, vtkIdType tuples)
+  {
+    using ValueT = typename ArrayT::ValueType;
+    const vtkIdType values = tuples * array->GetNumberOfComponents();
+    const std::size_t bytes = static_cast<std::size_t>(values) * sizeof(ValueT);
+    // The smallest spare that fits, else the largest that is half as big.
+    const std::size_t none = this->Buffers.size();
+    std::size_t fitting = none, largest = none;
+    for (std::size_t b = 0; b < this->Buffers.size(); ++b)
+    {
+      const std::size_t has = this->Buffers[b].Bytes;
+      if (has >= bytes)
+      {
+        fitting = fitting == none || has < this->Buffers[fitting].Bytes ? b : fitting;
+      }
+      else if (2 * has >= bytes)
+      {
+        largest = largest == none || has > this->Buffers[largest].Bytes ? b : largest;
+      }
+    }
+    const std::size_t best = fitting != none ? fitting : largest;
+    if (values > 0 && best != none)
+    {
+      if (void* memory = realloc(this->Buffers[best].Pointer, bytes))
+      {
+        this->Buffers.erase(this->Buffers.begin() + static_cast<std::ptrdiff_t>(best));
+        array->SetArray(static_cast<ValueT*>(memory), values, 0, ArrayT::VTK_DATA_ARRAY_FREE);
+        return;
+      }
+    }
+    array->SetNumberOfTuples(tuples);
+  }
+
+private:
+  struct Buffer
+  {
+    void* Pointer;
+    std::size_t Bytes;
+  };
+
+  void TakeArray(vtkAbstractArray* array)
+  {
+    if (array && array->GetReferenceCount() == 1)
+    {
+      this->TakeAs<float>(array) || this->TakeAs<int>(array) || this->TakeAs<vtkTypeInt64>(array);
+    }
+  }
+
+  // The arrays of the filter's surfaces are allocated by vtkBuffer with malloc
+  // (or by Size() above): their memory may be realloc'ed and freed here.
+  template <typename ValueT>
+  bool TakeAs(vtkAbstractArray* array)
+  {
+    auto* typed = vtkAOSDataArrayTemplate<ValueT>::FastDownCast(array);
+    if (!typed)
+    {
+      return false;
+    }
+    ValueT* memory = typed->GetPointer(0);
+    const vtkIdType size = typed->GetSize();
+    if (memory && size > 0)
+    {
+      typed->SetArray(memory, size, 1); // the array no longer frees it
+      this->Buffers.push_back(Buffer{ memory, static_cast<std::size_t>(size) * sizeof(ValueT) });
+    }
+    return true;
+  }
+
+  std::vector<Buffer> Buffers;
+};
+
+// VTK's arrays report a failed allocation and stay empty (they do not throw):
+// Valid() is false then. `spares` (may be null): memory to reuse, the largest
+// array (the connectivity) served first.
+SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles,
+  const mediso::SurfaceLayout& layout, SpareBuffers* spares = nullptr)
+{
+  SpareBuffers none;
+  SpareBuffers& memory = spares ? *spares : none;
   SurfaceArrays out;
   out.Surface = vtkSmartPointer<vtkPolyData>::New();
-  vtkNew<vtkFloatArray> coords;
-  coords->SetNumberOfComponents(3);
-  coords->SetNumberOfTuples(points);
-  out.Points = coords->GetPointer(0);
-  vtkNew<vtkPoints> pts;
-  pts->SetData(coords);
-  out.Surface->SetPoints(pts);
-  if (layout.Normals)
-  {
-    vtkNew<vtkFloatArray> normals;
-    normals->SetName("Normals");
-    normals->SetNumberOfComponents(3);
-    normals->SetNumberOfTuples(points);
-    out.Normals = normals->GetPointer(0);
-    out.Surface->GetPointData()->SetNormals(normals);
-  }
-  if (layout.Scalars)
-  {
-    vtkNew<vtkFloatArray> scalars;
-    scalars->SetName("Isovalue");
-    scalars->SetNumberOfTuples(points);
-    out.Scalars = scalars->GetPointer(0);
-    out.Surface->GetPointData()->SetScalars(scalars);
-  }
-  if (layout.BlockIds)
-  {
-    vtkNew<vtkIntArray> ids;
-    ids->SetName("BlockId");
-    ids->SetNumberOfTuples(triangles);
-    out.BlockIds = reinterpret_cast<std::int32_t*>(ids->GetPointer(0));
-    out.Surface->GetCellData()->AddArray(ids);
-  }
   vtkNew<vtkCellArray> polys;
   const bool small =
     layout.IdBytesFor(static_cast<double>(points), static_cast<double>(triangles)) == 4;
@@ -255,7 +358,7 @@ SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const
     vtkSmartPointer<vtkTypeInt32Array> offsets =
       offsetsFor(static_cast<vtkTypeInt32Array*>(nullptr));
     vtkNew<vtkTypeInt32Array> connectivity;
-    connectivity->SetNumberOfValues(3 * triangles);
+    memory.Size(connectivity.Get(), 3 * triangles);
     out.Connectivity32 = connectivity->GetPointer(0);
     polys->SetData(offsets, connectivity);
   }
@@ -264,12 +367,44 @@ SurfaceArrays AllocateSurface(std::int64_t points, std::int64_t triangles, const
     vtkSmartPointer<vtkTypeInt64Array> offsets =
       offsetsFor(static_cast<vtkTypeInt64Array*>(nullptr));
     vtkNew<vtkTypeInt64Array> connectivity;
-    connectivity->SetNumberOfValues(3 * triangles);
+    memory.Size(connectivity.Get(), 3 * triangles);
     // vtkTypeInt64 is long long, std::int64_t long: same 64-bit representation.
     out.Connectivity64 = reinterpret_cast<std::int64_t*>(connectivity->GetPointer(0));
     polys->SetData(offsets, connectivity);
   }
   out.Surface->SetPolys(polys);
+  vtkNew<vtkFloatArray> coords;
+  coords->SetNumberOfComponents(3);
+  memory.Size(coords.Get(), points);
+  out.Points = coords->GetPointer(0);
+  vtkNew<vtkPoints> pts;
+  pts->SetData(coords);
+  out.Surface->SetPoints(pts);
+  if (layout.Normals)
+  {
+    vtkNew<vtkFloatArray> normals;
+    normals->SetName("Normals");
+    normals->SetNumberOfComponents(3);
+    memory.Size(normals.Get(), points);
+    out.Normals = normals->GetPointer(0);
+    out.Surface->GetPointData()->SetNormals(normals);
+  }
+  if (layout.Scalars)
+  {
+    vtkNew<vtkFloatArray> scalars;
+    scalars->SetName("Isovalue");
+    memory.Size(scalars.Get(), points);
+    out.Scalars = scalars->GetPointer(0);
+    out.Surface->GetPointData()->SetScalars(scalars);
+  }
+  if (layout.BlockIds)
+  {
+    vtkNew<vtkIntArray> ids;
+    ids->SetName("BlockId");
+    memory.Size(ids.Get(), triangles);
+    out.BlockIds = reinterpret_cast<std::int32_t*>(ids->GetPointer(0));
+    out.Surface->GetCellData()->AddArray(ids);
+  }
   return out;
 }
 
@@ -561,15 +696,18 @@ struct vtkBlockLODContour::vtkInternals
   }
 
   // How the filter's output arrays are made from the core's plans.
+  // `spares`: where the surfaces the cache drops leave their memory (lives
+  // for the update).
   static mediso::SurfaceMaker<vtkSmartPointer<vtkPolyData>> Maker(
-    const mediso::SurfaceLayout& layout)
+    const mediso::SurfaceLayout& layout, SpareBuffers* spares)
   {
     mediso::SurfaceMaker<vtkSmartPointer<vtkPolyData>> maker;
-    maker.Allocate = [layout](const mediso::SurfaceKey&, std::int64_t points,
+    maker.Recycle = [spares](vtkSmartPointer<vtkPolyData>& evicted) { spares->Take(evicted); };
+    maker.Allocate = [layout, spares](const mediso::SurfaceKey&, std::int64_t points,
                        std::int64_t triangles, vtkSmartPointer<vtkPolyData>& surface,
                        mediso::SurfaceTarget& target)
     {
-      SurfaceArrays arrays = AllocateSurface(points, triangles, layout);
+      SurfaceArrays arrays = AllocateSurface(points, triangles, layout, spares);
       if (!Valid(arrays, points, triangles))
       {
         return false;
@@ -809,8 +947,9 @@ void vtkBlockLODContour::Execute(
     this->ReportEstimates(values[0]);
     this->UpdateProgress(0.5);
   };
+  SpareBuffers spares;
   const mediso::SurfacesUpdate update =
-    in.Surfaces.Update(values, choice, vtkInternals::Maker(layout), hooks);
+    in.Surfaces.Update(values, choice, vtkInternals::Maker(layout, &spares), hooks);
   this->NumberOfExtractions += update.Extractions;
   this->NumberOfCacheHits += update.CacheHits;
   this->ReportUpdate(update);
@@ -1297,10 +1436,11 @@ bool vtkBlockLODContour::GenerateLevel(int level, vtkPolyData* output)
   mediso::LevelChoice choice;
   choice.Level = level;
   mediso::UpdateHooks hooks;
+  SpareBuffers spares;
   try
   {
     const mediso::SurfacesUpdate update =
-      in.Surfaces.Update(in.LastValues, choice, vtkInternals::Maker(layout), hooks);
+      in.Surfaces.Update(in.LastValues, choice, vtkInternals::Maker(layout, &spares), hooks);
     this->NumberOfExtractions += update.Extractions;
     this->NumberOfCacheHits += update.CacheHits;
     if (update.Status != mediso::SurfacesUpdate::Outcome::Done)

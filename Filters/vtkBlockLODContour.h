@@ -35,6 +35,9 @@
  * -# Cache. Each (isovalue, level) surface is kept after extraction, within
  *    CacheMemoryLimit (least recently used surfaces go first). Asking again
  *    for a cached pair costs no extraction (see GetNumberOfExtractions()).
+ *    A surface the cache drops to make room lends its memory to the new one
+ *    when nothing else holds its arrays, so that changes with a full cache
+ *    (an isovalue dragged) write into pages already mapped.
  * -# Estimates. EstimateTriangles()/EstimateMegabytes()/EstimateSeconds()
  *    predict a pair's output before extracting it (BlockLODEstimator.h).
  *    Exact for a cached or planned pair, and for a new pair whose active

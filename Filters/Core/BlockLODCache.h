@@ -70,8 +70,11 @@ public:
   }
 
   /// Drops least recently used pairs, except those in `keep`, until the cache
-  /// holds at most `limitBytes`. Returns the dropped keys in the order dropped.
-  std::vector<SurfaceKey> Evict(double limitBytes, const std::vector<SurfaceKey>& keep = {})
+  /// holds at most `limitBytes`. Returns the dropped keys in the order dropped;
+  /// their surfaces are moved to `surfaces` when given (a host may reuse
+  /// their memory), else destroyed.
+  std::vector<SurfaceKey> Evict(double limitBytes, const std::vector<SurfaceKey>& keep = {},
+    std::vector<Surface>* surfaces = nullptr)
   {
     std::vector<SurfaceKey> dropped;
     for (auto it = this->Order.begin(); this->Total > limitBytes && it != this->Order.end();)
@@ -82,6 +85,10 @@ public:
         continue;
       }
       dropped.push_back(it->Key);
+      if (surfaces)
+      {
+        surfaces->push_back(std::move(it->Value));
+      }
       this->Total -= it->Bytes;
       this->Index.erase(it->Key);
       it = this->Order.erase(it);

@@ -153,6 +153,14 @@ struct SurfaceMaker
   /// Optional: the bytes the cache counts for a surface (default: the
   /// layout's bytes of its counts).
   std::function<double(const Surface& surface)> Bytes;
+  /// Optional (used only without Bytes): a surface the cache drops to make
+  /// room for the next one, offered just before that one is allocated, so
+  /// that Allocate may reuse its memory (pages already mapped: no fresh page
+  /// faults) instead of the process freeing it and faulting new pages in. The
+  /// host may move the surface out; what it leaves is destroyed when the
+  /// update's surfaces are made. With it the cache evicts before each new
+  /// surface instead of after all of them: the same pairs go, earlier.
+  std::function<void(Surface& evicted)> Recycle;
 };
 
 /// Checks an update's hosts may give.
@@ -317,10 +325,17 @@ bool BlockLODSurfaces<Surface>::Generate(const std::vector<double>& values, int 
   const SurfaceMaker<Surface>& maker, const UpdateHooks& hooks, SurfacesUpdate& update)
 {
   std::vector<SurfaceKey> used;
+  for (double v : values)
+  {
+    used.push_back(SurfaceKey{ v, level });
+  }
+  // Surfaces dropped to make room, offered to the host's Recycle; destroyed
+  // (whatever the host left of them) when this returns.
+  std::vector<Surface> evicted;
+  const bool recycle = maker.Recycle && !maker.Bytes && this->CacheLimit > 0;
   for (std::size_t i = 0; i < values.size(); ++i)
   {
-    const SurfaceKey key{ values[i], level };
-    used.push_back(key);
+    const SurfaceKey key = used[i];
     if (Surface* cached = this->Cache.Find(key))
     {
       ++update.CacheHits;
@@ -335,6 +350,18 @@ bool BlockLODSurfaces<Surface>::Generate(const std::vector<double>& values, int 
     if (!this->Fits(bytes, what, update))
     {
       return false;
+    }
+    if (recycle)
+    {
+      // What the eviction after the last surface would drop, dropped before
+      // this one is allocated (the update's pairs are kept either way, and
+      // the least recently used go first in both).
+      const std::size_t first = evicted.size();
+      this->Cache.Evict(this->CacheLimit - bytes, used, &evicted);
+      for (std::size_t e = first; e < evicted.size(); ++e)
+      {
+        maker.Recycle(evicted[e]);
+      }
     }
     Surface surface{};
     try

@@ -8,17 +8,21 @@
 //   computed afresh from the values, for one isovalue, for two merged into one
 //   output, and for a surface served from the cache;
 // - the triangle offsets (one run shared by every surface) are 0, 3, 6, ...,
-//   and a cell added to one output leaves every other surface's offsets alone.
+//   and a cell added to one output leaves every other surface's offsets alone;
+// - with a full cache (a drag), every output equals a fresh filter's, and an
+//   earlier output held downstream keeps its values (its memory not reused).
 #include "MedicalTestUtilities.h"
 #include "vtkBlockLODContour.h"
 #include "vtkMedicalPhantomSource.h"
 
 #include "vtkCellArray.h"
+#include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkInformation.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
+#include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSMPTools.h"
 
@@ -83,6 +87,26 @@ void CheckOutput(vtkPolyData* pd, const std::string& label)
 }
 
 // Offsets 0, 3, 6, ... of a triangle surface.
+// Every value of two arrays (of any type) equal, bit for bit.
+bool SameValues(vtkDataArray* a, vtkDataArray* b)
+{
+  return a && b && a->GetDataType() == b->GetDataType() &&
+    a->GetNumberOfValues() == b->GetNumberOfValues() &&
+    std::memcmp(a->GetVoidPointer(0), b->GetVoidPointer(0),
+      static_cast<std::size_t>(a->GetNumberOfValues()) * a->GetDataTypeSize()) == 0;
+}
+
+// Points, normals, scalars, block ids and triangles equal.
+bool SameSurface(vtkPolyData* a, vtkPolyData* b)
+{
+  return a->GetNumberOfPoints() > 0 &&
+    SameValues(a->GetPoints()->GetData(), b->GetPoints()->GetData()) &&
+    SameValues(a->GetPointData()->GetNormals(), b->GetPointData()->GetNormals()) &&
+    SameValues(a->GetPointData()->GetScalars(), b->GetPointData()->GetScalars()) &&
+    SameValues(a->GetCellData()->GetArray("BlockId"), b->GetCellData()->GetArray("BlockId")) &&
+    SameValues(a->GetPolys()->GetConnectivityArray(), b->GetPolys()->GetConnectivityArray());
+}
+
 bool TriangleOffsets(vtkCellArray* polys)
 {
   vtkDataArray* offsets = polys->GetOffsetsArray();
@@ -162,6 +186,48 @@ int TestBlockLODContourOutput(int, char*[])
   lod->Update();
   Check(lod->GetNumberOfCacheHits() > 0, "the last update was served from the cache");
   CheckOutput(lod->GetOutput(), "cache hit");
+
+  // Changes with a full cache, as while an isovalue is dragged: the surfaces
+  // the cache drops lend their memory to the new ones. Every output equals a
+  // fresh filter's, and an earlier output still held downstream (a shallow
+  // copy: its arrays shared) is never written into.
+  {
+    auto make = [&phantom](double iso)
+    {
+      auto f = vtkSmartPointer<vtkBlockLODContour>::New();
+      f->SetInputConnection(phantom->GetOutputPort());
+      f->SetValue(0, iso);
+      f->ComputeScalarsOn();
+      f->GenerateBlockIdsOn();
+      return f;
+    };
+    vtkSmartPointer<vtkBlockLODContour> drag = make(390.0);
+    drag->Update();
+    // Room for about two surfaces.
+    drag->SetCacheMemoryLimit(2.5 * drag->GetOutput()->GetActualMemorySize() * 1024.0 / 1.0e6);
+    vtkNew<vtkPolyData> held, snapshot;
+    bool same = true;
+    for (int k = 0; k < 12; ++k)
+    {
+      // Bone and skin in turn: surfaces of different sizes (buffers grown and
+      // shrunk).
+      const double iso = (k % 2 ? -500.0 : 400.0) + 7.0 * k;
+      drag->SetValue(0, iso);
+      drag->Update();
+      vtkSmartPointer<vtkBlockLODContour> fresh = make(iso);
+      fresh->Update();
+      same = same && SameSurface(drag->GetOutput(), fresh->GetOutput());
+      if (k == 1)
+      {
+        held->ShallowCopy(drag->GetOutput());
+        snapshot->DeepCopy(drag->GetOutput());
+      }
+    }
+    Check(drag->GetNumberOfCacheHits() == 0 && drag->GetCacheMegabytes() > 0,
+      "a drag of new isovalues");
+    Check(same, "with a full cache every output equals a fresh filter's");
+    Check(SameSurface(held, snapshot), "an output held downstream is never reused");
+  }
 
   return medical_test::Finish("vtkBlockLODContour output: all checks passed");
 }

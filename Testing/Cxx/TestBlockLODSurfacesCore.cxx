@@ -12,7 +12,10 @@
 //   a budget below level 0 makes nothing (binding) or level 0 (guiding);
 // - the cache limit evicts the least recently used pairs, never the current
 //   ones; a new volume empties it; a host that cannot allocate, or aborts,
-//   ends the update with nothing made.
+//   ends the update with nothing made;
+// - a host that recycles the surfaces the cache drops: the same pairs are
+//   cached as without it, each dropped surface offered once, before the
+//   allocation that needs its room.
 #include "BlockLODSurfaces.h"
 #include "FanCaseTable.h"
 #include "MedicalTestUtilities.h"
@@ -318,6 +321,85 @@ void TestFailures()
       planned == -1 && maker.Allocations == 0,
     "an abort after the first plan stops before any surface");
 }
+
+// A host that recycles (SurfaceMaker::Recycle): the cache keeps the same pairs
+// as without it (the same ones go, only earlier), and each dropped surface is
+// offered once, before the allocation that needs its room.
+void TestRecycle()
+{
+  const int n = 40;
+  const std::vector<float> values = Field(n, 12.0, 0.5);
+  Surfaces plain(medical_test::FanCases.Cases, mediso::SerialFor, nullptr);
+  Surfaces recycling(medical_test::FanCases.Cases, mediso::SerialFor, nullptr);
+  plain.SetVolume(Describe(values, n, 1));
+  recycling.SetVolume(Describe(values, n, 1));
+  Maker maker;
+  std::vector<std::string> events; // "A" an allocation, "R" a surface offered
+  std::vector<MeshRef> offered;
+  mediso::SurfaceMaker<MeshRef> withRecycle = maker.Make();
+  const auto allocate = withRecycle.Allocate;
+  withRecycle.Allocate = [&](const mediso::SurfaceKey& key, std::int64_t points,
+                           std::int64_t triangles, MeshRef& mesh, mediso::SurfaceTarget& target)
+  {
+    events.push_back("A");
+    return allocate(key, points, triangles, mesh, target);
+  };
+  withRecycle.Recycle = [&](MeshRef& evicted)
+  {
+    events.push_back("R");
+    offered.push_back(std::move(evicted)); // the host takes it
+  };
+  // A limit of about two and a half surfaces; updates of one and of two
+  // isovalues.
+  plain.SetCacheLimit(1e9);
+  plain.Update({ 0.0 }, Fixed(3), maker.Make());
+  const double limit = 2.5 * plain.GetCacheBytes();
+  plain.ClearCache();
+  plain.SetCacheLimit(limit);
+  recycling.SetCacheLimit(limit);
+  const std::vector<std::vector<double>> updates = { { 0.0 }, { 1.0 }, { 2.0 }, { 3.0, 4.0 },
+    { 1.0, 5.0 }, { 6.0 }, { 5.0 }, { 7.0, 8.0 }, { 0.0 } };
+  std::vector<double> all;
+  bool same = true, offeredFirst = true;
+  std::size_t dropped = 0;
+  for (const std::vector<double>& isovalues : updates)
+  {
+    const std::size_t before = recycling.GetCacheSize();
+    events.clear();
+    const mediso::SurfacesUpdate a = plain.Update(isovalues, Fixed(3), maker.Make());
+    const mediso::SurfacesUpdate b = recycling.Update(isovalues, Fixed(3), withRecycle);
+    same = same && a.Status == Outcome::Done && b.Status == Outcome::Done &&
+      a.Extractions == b.Extractions && a.CacheHits == b.CacheHits &&
+      plain.GetCacheSize() == recycling.GetCacheSize() &&
+      plain.GetCacheBytes() == recycling.GetCacheBytes();
+    all.insert(all.end(), isovalues.begin(), isovalues.end());
+    for (double v : all)
+    {
+      same = same && plain.IsCached({ v, 3 }) == recycling.IsCached({ v, 3 });
+    }
+    dropped += before + b.Extractions - recycling.GetCacheSize();
+    // Offers only come just before an allocation.
+    for (std::size_t e = 0; e < events.size(); ++e)
+    {
+      offeredFirst = offeredFirst && (events[e] == "A" || (e + 1 < events.size()));
+    }
+  }
+  Check(same, "with Recycle the cache holds the same pairs after every update");
+  Check(dropped > 0 && offered.size() == dropped,
+    "every dropped surface is offered once (" + Num(offered.size()) + " of " + Num(dropped) + ")");
+  bool whole = true;
+  for (const MeshRef& mesh : offered)
+  {
+    whole = whole && mesh && !mesh->Triangles.empty();
+  }
+  Check(whole && offeredFirst, "the offered surfaces are whole, offered before an allocation");
+
+  // No room needed, nothing offered.
+  const std::size_t offers = offered.size();
+  recycling.SetCacheLimit(1e9);
+  recycling.Update({ 9.0 }, Fixed(3), withRecycle);
+  Check(offered.size() == offers, "a cache with room offers nothing");
+}
 } // namespace
 
 int main()
@@ -326,5 +408,6 @@ int main()
   TestAutoLevel();
   TestRetryLower();
   TestFailures();
+  TestRecycle();
   return medical_test::Finish("TestBlockLODSurfacesCore passed");
 }
