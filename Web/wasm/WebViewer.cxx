@@ -18,9 +18,18 @@
  * fits in the client's budget; surfaces are cached per (isovalue, level) and
  * drawn as triangles (MeshRenderer). A surface the server made is drawn beside
  * either path.
+ *
+ * Streaming (the CPU path; docs/web.md, Streaming): the page gives the
+ * server's level 0 as a coarse volume of its own (SetCoarseVolume) and the
+ * full level's buffer, then writes the bricks into the buffer as they arrive
+ * (WriteBrick: BrickGrid's bricks, the buffer's BlockLOD ranges completed for
+ * them). Each surface the page names in SetCoarseValues is drawn from the
+ * coarse volume (at its own full resolution); the others, whose bricks have
+ * all arrived, from the buffer at level 3.
  */
 #include "BlockLOD.h"
 #include "BlockLODSurfaces.h"
+#include "BrickGrid.h"
 #include "Camera.h"
 #include "FrameTimeModel.h"
 #include "GLApiFunctions.h"
@@ -323,6 +332,94 @@ public:
     this->Meshes->Clear(ResultSlot);
   }
 
+  /// Streaming: the server's level 0 (`bytes` kept alive by the caller, as
+  /// for SetVolume), drawn for the isovalues named in SetCoarseValues; a null
+  /// `bytes` forgets it.
+  bool SetCoarseVolume(int type, std::uintptr_t bytes, const val& dims, const val& spacing,
+    const val& origin)
+  {
+    this->CoarseData = reinterpret_cast<const void*>(bytes);
+    VolumeDescription description;
+    description.Type = static_cast<ScalarType>(type);
+    description.Data = this->CoarseData;
+    for (int a = 0; a < 3; ++a)
+    {
+      description.Dims[a] = bytes ? dims[a].as<int>() : 0;
+      description.Spacing[a] = bytes ? spacing[a].as<double>() : 1.0;
+      description.Origin[a] = bytes ? origin[a].as<double>() : 0.0;
+    }
+    description.Stamp = ++this->VolumeStamp;
+    this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
+    if (!bytes)
+    {
+      this->Coarse.ClearCache();
+      return true;
+    }
+    return this->Coarse.SetVolume(description);
+  }
+
+  /**
+   * Streaming begins on the volume given to SetVolume (its buffer, whose
+   * values arrive as bricks of `brickPoints` points a side, a multiple of 8):
+   * no brick is resident.
+   */
+  bool BeginStreaming(int brickPoints)
+  {
+    const int* dims = this->Viewpoint.GetPlacement().Dimensions;
+    this->Bricks = BrickGrid(dims, brickPoints);
+    if (!this->Bricks.IsValid() || !this->Data)
+    {
+      this->LastError = "bricks of " + std::to_string(brickPoints) + " points cannot stream this volume";
+      return false;
+    }
+    this->CPU.BeginStreaming();
+    this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
+    return true;
+  }
+
+  /**
+   * A brick's owned points (`values` in the module's memory, x fastest, as
+   * the server sent them) written into the buffer; the blocks they complete
+   * get their ranges. False for a brick id outside the grid.
+   */
+  bool WriteBrick(double brick, std::uintptr_t values)
+  {
+    const auto id = static_cast<std::int64_t>(brick);
+    int extent[6];
+    this->Bricks.OwnedPoints(id, extent);
+    if (!this->CPU.GetVolume().IsStreaming() ||
+      !mediso::WriteBrick(this->Bricks, id, extent, ScalarTypeSize(this->Type),
+        reinterpret_cast<const void*>(values), const_cast<void*>(this->Data)))
+    {
+      this->LastError = "brick " + std::to_string(id) + " is not one of this volume's";
+      return false;
+    }
+    const int first[3] = { extent[0], extent[2], extent[4] };
+    const int last[3] = { extent[1], extent[3], extent[5] };
+    this->CPU.RegionArrived(first, last);
+    return true;
+  }
+
+  /// Streaming ends (every brick arrived): the coarse volume is forgotten and
+  /// the CPU path chooses its levels again.
+  void EndStreaming()
+  {
+    this->CPU.EndStreaming();
+    this->CoarseValues.clear();
+    this->SetCoarseVolume(0, 0, val::undefined(), val::undefined(), val::undefined());
+  }
+
+  /// The isovalues drawn from the coarse volume (their bricks are not all resident).
+  void SetCoarseValues(const val& values)
+  {
+    this->CoarseValues.clear();
+    const int n = values["length"].as<int>();
+    for (int i = 0; i < n; ++i)
+    {
+      this->CoarseValues.push_back(values[i].as<double>());
+    }
+  }
+
   /// The isosurfaces: [{value, color: [r, g, b], opacity}], at most 8.
   bool SetSurfaces(const val& surfaces)
   {
@@ -577,6 +674,18 @@ public:
     stats.set("frameBufferBytes",
       this->Scene ? static_cast<double>(this->Scene->GetFrameBufferBytes()) : 0.0);
     stats.set("error", this->LastError);
+    // Per surface of the last CPU frame, in the order drawn (IsosurfaceScene::Normalize's): its
+    // isovalue, whether it came from the coarse volume (streaming), and its triangles.
+    val values = val::array(), coarse = val::array(), triangles = val::array();
+    for (std::size_t i = 0; i < this->SlotCoarse.size(); ++i)
+    {
+      values.call<void>("push", this->SlotValues[i]);
+      coarse.call<void>("push", static_cast<bool>(this->SlotCoarse[i]));
+      triangles.call<void>("push", this->SlotTriangles[i]);
+    }
+    stats.set("surfaceValues", values);
+    stats.set("coarse", coarse);
+    stats.set("surfaceTriangles", triangles);
     return stats;
   }
 
@@ -697,18 +806,29 @@ private:
   // level 0 when nothing fits, said in the error); uploaded when it changed.
   bool UpdateCPUSurfaces()
   {
-    std::vector<double> values;
+    // Streaming: the surfaces named coarse come from the coarse volume, the others from the
+    // buffer at level 3 (its coarse copies would read bricks not yet there).
+    const bool streaming = this->CPU.GetVolume().IsStreaming();
+    std::vector<double> values, fine, coarse;
+    std::vector<char> isCoarse;
     for (const IsosurfaceLook& s : this->Frame.Surfaces)
     {
+      const bool c = streaming && this->CoarseData &&
+        std::find(this->CoarseValues.begin(), this->CoarseValues.end(), s.Value) !=
+          this->CoarseValues.end();
       values.push_back(s.Value);
+      isCoarse.push_back(c);
+      (c ? coarse : fine).push_back(s.Value);
     }
     LevelChoice choice;
-    choice.Level = this->RequestedLevel < 0 ? LevelChoice::Auto : this->RequestedLevel;
+    choice.Level = streaming ? NumberOfLevels - 1
+      : this->RequestedLevel < 0 ? LevelChoice::Auto
+                                 : this->RequestedLevel;
     choice.BudgetBytes = this->Budget;
     choice.BudgetBinds = false;
     this->CPU.SetCacheLimit(std::max(this->Budget / 4.0, 0.0));
     const double start = emscripten_get_now();
-    const SurfacesUpdate update = this->CPU.Update(values, choice, CPUSurfaceMaker());
+    const SurfacesUpdate update = this->CPU.Update(fine, choice, CPUSurfaceMaker());
     if (update.OverBudget)
     {
       this->LastError = "not even level 0 of these isosurfaces fits the memory budget (" +
@@ -721,23 +841,48 @@ private:
         : "the extraction stopped";
       return false;
     }
-    this->CPU.RecordCost(update, (emscripten_get_now() - start) / 1000.0);
+    if (!streaming)
+    {
+      this->CPU.RecordCost(update, (emscripten_get_now() - start) / 1000.0);
+    }
+    std::vector<CPUSurfaceRef> coarseSurfaces;
+    if (!coarse.empty())
+    {
+      LevelChoice whole;
+      whole.Level = NumberOfLevels - 1;
+      this->Coarse.SetCacheLimit(std::max(this->Budget / 16.0, 0.0));
+      const SurfacesUpdate c = this->Coarse.Update(coarse, whole, CPUSurfaceMaker());
+      if (c.Status != SurfacesUpdate::Outcome::Done)
+      {
+        this->LastError = c.Status == SurfacesUpdate::Outcome::OutOfMemory
+          ? c.Message
+          : "the extraction stopped";
+        return false;
+      }
+      coarseSurfaces = this->Coarse.GetSurfaces();
+    }
     // No isovalues: the level the choice would give for nothing, as before any surface.
-    this->CPULevel = !values.empty() ? update.Level
-      : this->RequestedLevel < 0     ? NumberOfLevels - 1
-                                     : this->RequestedLevel;
+    this->CPULevel = !fine.empty() ? update.Level
+      : streaming || this->RequestedLevel < 0 ? NumberOfLevels - 1
+                                              : this->RequestedLevel;
     const std::vector<CPUSurfaceRef>& surfaces = this->CPU.GetSurfaces();
     this->ShownTriangles = 0.0;
+    this->SlotValues = values;
+    this->SlotCoarse.assign(isCoarse.begin(), isCoarse.end());
+    this->SlotTriangles.assign(values.size(), 0.0);
+    std::size_t nextFine = 0, nextCoarse = 0;
     for (int slot = 0; slot < MaximumIsovalues; ++slot)
     {
-      if (slot >= static_cast<int>(surfaces.size()))
+      if (slot >= static_cast<int>(values.size()))
       {
         this->Meshes->Clear(slot);
         this->ShownKeys[slot] = SurfaceKey{ NAN, -1 };
         continue;
       }
-      const SurfaceKey key{ values[slot], update.Level };
-      const CPUSurface& surface = *surfaces[slot];
+      // A coarse surface's key: a level no fine one has.
+      const bool c = isCoarse[slot] != 0;
+      const SurfaceKey key{ values[slot], c ? -2 : update.Level };
+      const CPUSurface& surface = c ? *coarseSurfaces[nextCoarse++] : *surfaces[nextFine++];
       if (!(this->ShownKeys[slot] == key))
       {
         this->MeshesUploaded = true;
@@ -748,7 +893,8 @@ private:
       }
       const IsosurfaceLook& look = this->Frame.Surfaces[slot];
       this->Meshes->SetLook(slot, look.Color, look.Opacity, true);
-      this->ShownTriangles += static_cast<double>(surface.Triangles.size() / 3);
+      this->SlotTriangles[slot] = static_cast<double>(surface.Triangles.size() / 3);
+      this->ShownTriangles += this->SlotTriangles[slot];
     }
     return true;
   }
@@ -785,6 +931,21 @@ private:
     std::make_shared<SharedCostModel>(), CPULayout };
 #endif
   std::vector<SurfaceKey> ShownKeys = std::vector<SurfaceKey>(MaximumIsovalues, SurfaceKey{ NAN, -1 });
+  // Streaming: the server's level 0 and its surfaces, the bricks of the buffer, the isovalues
+  // drawn from level 0, and per slot of the last frame whether it was and its triangles.
+#ifdef MEDISO_WEB_THREADS
+  BlockLODSurfaces<CPUSurfaceRef> Coarse{ mediso_web::MarchingCubesCases, ThreadedFor, nullptr,
+    CPULayout };
+#else
+  BlockLODSurfaces<CPUSurfaceRef> Coarse{ mediso_web::MarchingCubesCases, SerialFor, nullptr,
+    CPULayout };
+#endif
+  const void* CoarseData = nullptr;
+  BrickGrid Bricks;
+  std::vector<double> CoarseValues;
+  std::vector<double> SlotValues;
+  std::vector<char> SlotCoarse;
+  std::vector<double> SlotTriangles;
   std::uint64_t VolumeStamp = 0;
   int RequestedLevel = -1;
   int CPULevel = 3;
@@ -922,5 +1083,10 @@ EMSCRIPTEN_BINDINGS(mediso_web)
     .function("chooseFrame", &WebViewer::ChooseFrame)
     .function("estimates", &WebViewer::Estimates)
     .function("setResultMesh", &WebViewer::SetResultMesh)
-    .function("clearResultMesh", &WebViewer::ClearResultMesh);
+    .function("clearResultMesh", &WebViewer::ClearResultMesh)
+    .function("setCoarseVolume", &WebViewer::SetCoarseVolume)
+    .function("beginStreaming", &WebViewer::BeginStreaming)
+    .function("writeBrick", &WebViewer::WriteBrick)
+    .function("endStreaming", &WebViewer::EndStreaming)
+    .function("setCoarseValues", &WebViewer::SetCoarseValues);
 }
