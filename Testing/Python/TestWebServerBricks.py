@@ -7,7 +7,9 @@ force here; the bricks, fetched in batches in an order that is not the volume's,
 together, are the level's values exactly, every point sent once; their bytes on the wire, with
 level 0's, are at most 1.05x the whole level's from /api/volume (1.10x at level 3, where
 13 of the 77 points per axis are a partial brick); bad requests get 400, a wrong
-token 403. The ranges against the C++ core's ComputeBrickRanges are checked in Chromium
+token 403. On the head CT (when Python/fetch_data.py has fetched it), the bricks and level 0 are at
+most 1.05x its whole level on the wire (the phantom, a smooth synthetic volume that gzip shrinks
+19-fold whole, costs more in bricks: docs/web.md, Streaming). The ranges against the C++ core's ComputeBrickRanges are checked in Chromium
 (TestWebServerPageStream), where the module is.
 """
 import asyncio
@@ -110,5 +112,34 @@ async def main():
             checks(r.status == 403, "without the token: 403 (%d)" % r.status)
 
 
+async def ct_bytes(ct):
+    """The head CT's bricks, 8 to a request, with level 0, against its whole level: at most 1.05x."""
+    async with aiohttp.ClientSession(auto_decompress=False) as http:
+        async with http.get(ct.url("/api/datasets")) as r:
+            d = (await r.json())["datasets"][0]
+        sizes = {}
+        for k in (3, 0):
+            async with http.get(ct.url("/api/volume/%s?level=%d" % (d["id"], k))) as r:
+                sizes[k] = len(await r.read())
+        async with http.get(ct.url("/api/bricks/%s?level=3" % d["id"])) as r:
+            n = len((await r.json())["ranges"])
+        wire = 0
+        for i in range(0, n, 8):
+            ids = ",".join(map(str, range(i, min(n, i + 8))))
+            async with http.get(ct.url("/api/bricks/%s?level=3&ids=%s" % (d["id"], ids))) as r:
+                wire += len(await r.read())
+        checks(wire + sizes[0] <= 1.05 * sizes[3],
+               "the head CT: %d bricks (%d bytes) and level 0 (%d) are %.3fx its whole level (%d), "
+               "at most 1.05x" % (n, wire, sizes[0], (wire + sizes[0]) / sizes[3], sizes[3]))
+
+
 asyncio.run(main())
-checks.finish(server)
+servers = [server]
+ct_file = webserver.data_cache() / "ct_head.mha"
+if ct_file.is_file():
+    servers.append(webserver.Server([str(ct_file)]))
+    asyncio.run(ct_bytes(servers[-1]))
+else:
+    print("note: the head CT is not fetched (python3 Python/fetch_data.py): its bricks' bytes are "
+          "not measured")
+checks.finish(*servers)
