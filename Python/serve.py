@@ -399,7 +399,8 @@ def make_app(args, datasets, operations):
     app.router.add_get("/api/datasets", list_datasets)
     app.router.add_get("/api/volume/{ident}", volume)
     app.router.add_get("/api/bricks/{ident}", serve_bricks.handler(
-        lambda request: request.app[STATE].by_id.get(request.match_info["ident"])))
+        lambda request: request.app[STATE].by_id.get(request.match_info["ident"]),
+        not_modified, VOLUME_CACHE_CONTROL))
     app.router.add_get("/api/result/{rid}", result)
     app.router.add_get("/api/status", status)
     app.router.add_get("/api/ws", websocket)

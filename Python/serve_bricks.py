@@ -13,7 +13,8 @@ point once.
   GET /api/bricks/<id>?level=k             the manifest (JSON)
   GET /api/bricks/<id>?level=k&ids=3,4,9    those bricks' owned points, each x fastest, one
                                             after the other in the order asked, byte-shuffled
-                                            together like /api/volume and gzip'd
+                                            together like /api/volume and gzip'd; kept by the
+                                            browser and revalidated (ETag) like /api/volume
 """
 import asyncio
 import gzip
@@ -25,6 +26,7 @@ from serve_messages import LEVEL_STRIDES
 BRICK_POINTS = 64  # points a side of a brick: a multiple of BlockLOD's 8 (BrickGrid)
 APRON = 1          # the page's gradients read one point more on each side
 MAX_IDS = 4096     # bricks in one request
+ENCODING = "bricks-shuffle-gzip6"  # part of a brick request's ETag
 
 
 def brick_counts(shape):
@@ -106,9 +108,14 @@ def parse_ids(text, count):
     return ids
 
 
-def handler(find):
-    """The route's handler; `find(request)` gives the request's dataset or None."""
+def handler(find, not_modified, cache_control):
+    """The route's handler; `find(request)` gives the request's dataset or None. Bricks are kept
+    by the browser and revalidated like /api/volume (docs/web.md, Caching): `not_modified(request,
+    etag, modified)` and `cache_control` are serve.py's; the ETag is the dataset's fingerprint,
+    the level, the ids and the encoding, so a page that asks for one brick a request finds each
+    again after a reload."""
     manifests = {}  # (dataset id, level) -> future of the manifest
+    fingerprints = {}  # dataset id -> future of its fingerprint
 
     async def bricks(request):
         d = find(request)
@@ -128,10 +135,16 @@ def handler(find):
         if "ids" not in request.query:
             return web.json_response(m, headers={"Cache-Control": "no-store"})
         ids = parse_ids(request.query["ids"], len(m["ranges"]))
+        if d.ident not in fingerprints:
+            fingerprints[d.ident] = loop.run_in_executor(None, d.fingerprint)
+        digest = await asyncio.shield(fingerprints[d.ident])
+        validators = {"ETag": '"%s-%d-b%s-%s"' % (digest, k, "_".join(map(str, ids)), ENCODING),
+                      "Cache-Control": cache_control}
+        if not_modified(request, validators["ETag"], d.modified):
+            return web.Response(status=304, headers=validators)
         body = await loop.run_in_executor(None, encode, d, k, ids)
-        return web.Response(body=body, headers={
+        return web.Response(body=body, headers=dict(validators, **{
             "Content-Encoding": "gzip", "Content-Type": "application/octet-stream",
-            "Cache-Control": "no-store", "X-Mediso-Type": d.type,
-            "X-Mediso-Bricks": ",".join(map(str, ids))})
+            "X-Mediso-Type": d.type, "X-Mediso-Bricks": ",".join(map(str, ids))}))
 
     return bricks

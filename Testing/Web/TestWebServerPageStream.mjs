@@ -10,7 +10,8 @@
 // - whenFull() resolves with every surface at level 3 (before the whole level has come, where
 //   the surface needs fewer bricks), then received reaches 1; the bytes of level 0 and the bricks
 //   on the wire are at most 1.05x the whole level's;
-// - after the end, a change sends nothing.
+// - after the end, the manifest's brick ranges are the cores' ComputeBrickRanges over the level
+//   received, and a change sends nothing.
 import { mkdtempSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
@@ -108,6 +109,13 @@ await page.waitForFunction(() => window.mediso.stats().received === 1, null, { t
 checks.check((await page.evaluate(() => window.mediso.stats())).levels.join() === "3",
   "the whole level received, the surface still at level 3");
 const log = await page.evaluate(() => window.mediso.frames());
+{
+  const ranges = await page.evaluate(() => window.mediso.brickRanges());
+  const same = ranges && ranges.server.length === ranges.core.length && ranges.server.every((r, i) =>
+    (r === null && ranges.core[i] === null) || (r && ranges.core[i] && r[0] === ranges.core[i][0] && r[1] === ranges.core[i][1]));
+  checks.check(same && ranges.server.length === 64, "the manifest's " + (ranges ? ranges.server.length : 0) +
+    " brick ranges (the server's numpy) are the cores' ComputeBrickRanges over the level received");
+}
 
 // The dense triangles of each value at level 3 and at level 0 (each a page of today's whole fetch).
 const dense = { 0: {}, 3: {} };

@@ -37,7 +37,7 @@ import { replaceSurfaces, setupSurfaceList } from "./surfaces.js";
 import { afterFrame, change, clearMesh, drawn, fitCanvas, renderNow, requestFrame, showMesh, startViewer }
   from "./viewer.js";
 import { countBytes, request, requestJSON, sessionToken } from "./volume.js";
-import { setupStream, streamInfo, whenFull } from "./stream.js";
+import { brickRanges, setupStream, streamInfo, whenFull } from "./stream.js";
 
 async function start() {
   const probe = document.createElement("canvas").getContext("webgl2");
@@ -260,6 +260,8 @@ window.mediso = {
   },
   // Streaming (tests): the bricks asked for so far and the bricks `values` need; null after it.
   streamInfo: (values) => streamInfo(values),
+  // After a stream (tests): {server, core}: the manifest's brick ranges and the cores'.
+  brickRanges: () => brickRanges(),
   // The last frames drawn, oldest first (tests: a drag's levels, a refinement's steps).
   frames: () => state.frameLog.map((f) => Object.assign({}, f)),
   async setPath(path) {

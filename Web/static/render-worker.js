@@ -219,6 +219,11 @@ self.onmessage = async (event) => {
       }
     } else if (m.op === "volume") {
       streaming = false;
+      if (coarseBytes) {
+        viewer.setCoarseVolume(0, 0, [], [], []);
+        M._free(coarseBytes);
+        coarseBytes = 0;
+      }
       if (volumeBytes) {
         M._free(volumeBytes);
       }

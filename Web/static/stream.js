@@ -3,7 +3,7 @@
 // not wait for the whole level. It fetches the server's level 0 (1/512 of the points) and draws
 // every surface from it at once, then fetches the full level's bricks (/api/bricks, the cores'
 // BrickGrid bricks; the brick size is the server's manifest's) a few requests at a time, the
-// bricks the current isovalues need first, writes each into the full level's buffer (allocated
+// bricks the current isovalues need first (one a request, kept by the browser), writes each into the full level's buffer (allocated
 // once, in this thread's module and in the worker's, where WebViewer.writeBrick completes the
 // BlockLOD ranges of what arrived) and draws each surface at the full level as soon as every
 // brick it needs is there. What goes up is the list of bricks; every point comes once.
@@ -18,9 +18,10 @@ import { params, state } from "./state.js";
 import { afterFrame, beforeFrame, renderNow } from "./viewer.js";
 import { fetchLevel, request, requestJSON, typedValues, unshuffle } from "./volume.js";
 
-// Raw bytes of bricks asked for in one request, and requests in flight at once.
-const BATCH_BYTES = 1e6;
-const IN_FLIGHT = 3;
+// Requests in flight at once (a browser opens 6 connections to a host over HTTP/1.1). Each asks
+// for one brick: its URL is then the same at every load, so the browser keeps it and a reload
+// revalidates it (304) instead of fetching it again.
+const IN_FLIGHT = 6;
 
 /** Whether the page streams level `level` on `path` (?stream=0: the whole level at once). */
 export function canStream(path, level) {
@@ -112,44 +113,19 @@ export async function startStream(level) {
   fetchMore();
 }
 
-// The next request's bricks: those the current isovalues need first, then the rest in order.
+// The next brick: one the current isovalues need first, else the next in order.
 function nextBatch(s) {
-  const order = [];
-  const taken = new Set();
   for (const v of currentValues()) {
     for (const id of needed(s, v)) {
-      if (s.pending.has(id) && !taken.has(id)) {
-        taken.add(id);
-        order.push(id);
+      if (s.pending.has(id)) {
+        s.pending.delete(id);
+        return [id];
       }
     }
   }
-  const batch = [];
-  let bytes = 0;
-  const take = (id) => {
-    if (batch.length && bytes + s.manifest.bytes[id] > BATCH_BYTES) {
-      return false;
-    }
-    batch.push(id);
-    bytes += s.manifest.bytes[id];
-    return true;
-  };
-  for (const id of order) {
-    if (!take(id)) {
-      break;
-    }
-  }
-  if (batch.length === order.length) {
-    for (const id of s.pending) {
-      if (!taken.has(id) && !take(id)) {
-        break;
-      }
-    }
-  }
-  for (const id of batch) {
-    s.pending.delete(id);
-  }
-  return batch;
+  const id = s.pending.values().next().value;
+  s.pending.delete(id);
+  return [id];
 }
 
 function fetchMore() {
@@ -186,7 +162,7 @@ function writeHere(s, id, brick) {
 
 async function fetchBatch(s, ids) {
   const { body } = await request("/api/bricks/" + state.dataset.id + "?level=" + s.level +
-    "&ids=" + ids.join(","));
+    "&ids=" + ids.join(","), "no-cache");
   if (state.stream !== s) {
     return; // another volume since
   }
@@ -219,8 +195,25 @@ async function fetchBatch(s, ids) {
   fetchMore();
 }
 
+// The last stream's manifest and type (brickRanges, after the end).
+let lastStream = null;
+
+/**
+ * For tests, after the end: the manifest's brick ranges (the server's, numpy) and the cores'
+ * (ComputeBrickRanges over the page's copy of the level, through the module), or null.
+ */
+export function brickRanges() {
+  const s = lastStream;
+  if (!s || state.stream) {
+    return null;
+  }
+  return { server: s.manifest.ranges, core: state.module.brickRanges(s.type.value, state.volumePointer,
+    s.dims, s.manifest.brick, s.manifest.apron) };
+}
+
 // Every brick is here: the viewer's buffer is the full level, the page's copy too.
 function finish(s) {
+  lastStream = s;
   state.viewer.endStream();
   const bytes = state.module.HEAPU8.slice(state.volumePointer,
     state.volumePointer + s.type.bytes * s.dims[0] * s.dims[1] * s.dims[2]);

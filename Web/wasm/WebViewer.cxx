@@ -227,6 +227,7 @@ public:
     std::copy(placement.Origin, placement.Origin + 3, description.Origin);
     std::copy(placement.Spacing, placement.Spacing + 3, description.Spacing);
     description.Stamp = ++this->VolumeStamp;
+    this->Described = description;
     std::string error;
     if (!this->Scene->SetVolume(description, error))
     {
@@ -404,6 +405,14 @@ public:
   /// the CPU path chooses its levels again.
   void EndStreaming()
   {
+    // The GPU path's texture was uploaded from the empty buffer: a new stamp uploads the values.
+    this->Described.Stamp = ++this->VolumeStamp;
+    emscripten_webgl_make_context_current(this->Context);
+    std::string error;
+    if (!this->Scene->SetVolume(this->Described, error))
+    {
+      this->LastError = error;
+    }
     this->CPU.EndStreaming();
     this->CoarseValues.clear();
     this->SetCoarseVolume(0, 0, val::undefined(), val::undefined(), val::undefined());
@@ -941,6 +950,7 @@ private:
     CPULayout };
 #endif
   const void* CoarseData = nullptr;
+  VolumeDescription Described; // the volume as SetVolume described it (EndStreaming uploads it again)
   BrickGrid Bricks;
   std::vector<double> CoarseValues;
   std::vector<double> SlotValues;
@@ -1018,6 +1028,35 @@ val GPUVolume(int type, const val& dims)
 // into these bins, and the module says whether the range is Hounsfield units
 // and where Otsu's threshold lies.
 
+/// The cores' brick ranges (BrickGrid.h, ComputeBrickRanges) of a volume of
+/// ScalarType `type` at `bytes` in the module's memory: [[min, max] or null
+/// per brick, x fastest]. The page's test compares them with the server's
+/// manifest, which computes them with numpy.
+val BrickRanges(int type, std::uintptr_t bytes, const val& dims, int brickPoints, int apron)
+{
+  int points[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    points[a] = dims[a].as<int>();
+  }
+  const BrickGrid grid(points, brickPoints);
+  val out = val::array();
+  for (const BrickRange& r : ComputeBrickRanges(grid, static_cast<ScalarType>(type),
+         reinterpret_cast<const void*>(bytes), apron, SerialFor))
+  {
+    if (r.Min > r.Max)
+    {
+      out.call<void>("push", val::null());
+      continue;
+    }
+    val pair = val::array();
+    pair.call<void>("push", r.Min);
+    pair.call<void>("push", r.Max);
+    out.call<void>("push", pair);
+  }
+  return out;
+}
+
 /// The bins the first isovalue's rule counts a range in: {low, width, count}.
 val HistogramBinsFor(double min, double max, bool integral)
 {
@@ -1060,6 +1099,7 @@ EMSCRIPTEN_BINDINGS(mediso_web)
   emscripten::constant("SkinHounsfield", SkinHounsfield);
   emscripten::constant("BoneHounsfield", BoneHounsfield);
   emscripten::function("histogramBins", &HistogramBinsFor);
+  emscripten::function("brickRanges", &BrickRanges);
   emscripten::function("otsuThreshold", &Otsu);
   const emscripten::class_<WebViewer> viewer("WebViewer");
   mediso::web::BindPageCamera(viewer);
