@@ -135,8 +135,12 @@ function fetchMore() {
     s.requested.push({ ids: batch, values: currentValues() });
     ++s.inFlight;
     fetchBatch(s, batch).catch((error) => {
-      s.error = error.message;
-      console.error("streaming: " + error.message);
+      // Said in the readout; the surfaces that need the brick stay at level 0.
+      s.error = "brick " + batch.join(", ") + ": " + error.message;
+      --s.inFlight;
+      console.error("streaming: " + s.error);
+      updateReadout();
+      fetchMore();
     });
   }
 }
@@ -280,7 +284,8 @@ export function streamNote() {
     return "";
   }
   return Math.round(100 * state.received) + "% of level " + state.stream.level + " received; " +
-    "surfaces at level " + levels + " (level 0 is the coarse one, every 8th point)";
+    "surfaces at level " + levels + " (level 0 is the coarse one, every 8th point)" +
+    (state.stream.error ? "; not received: " + state.stream.error : "");
 }
 
 /** For tests: the bricks asked for so far ([{ids, values}]), and the bricks values need. */
