@@ -16,7 +16,7 @@ import { drawnLevel } from "./path.js";
 import { updateReadout } from "./readout.js";
 import { params, state } from "./state.js";
 import { afterFrame, beforeFrame, renderNow } from "./viewer.js";
-import { fetchLevel, request, requestJSON, typedValues, unshuffle } from "./volume.js";
+import { fetchLevel, loadVolume, request, requestJSON, typedValues, unshuffle } from "./volume.js";
 
 // Requests in flight at once (a browser opens 6 connections to a host over HTTP/1.1). Each asks
 // for one brick: its URL is then the same at every load, so the browser keeps it and a reload
@@ -73,12 +73,17 @@ function ready(s, v) {
 
 /**
  * Starts streaming level `level`: level 0 and the manifest are fetched and handed to the viewer
- * (the first frame can then be drawn); the bricks follow in the background.
+ * (the first frame can then be drawn); the bricks follow in the background. A level of one brick
+ * is fetched whole instead.
  */
 export async function startStream(level) {
   const d = state.dataset;
   state.stream = null;
   const manifest = await requestJSON("/api/bricks/" + d.id + "?level=" + level);
+  if (manifest.ranges.length < 2) {
+    await loadVolume(level); // one brick: nothing comes sooner by streaming it
+    return;
+  }
   const coarse = await fetchLevel(0);
   const type = coarse.type;
   const dims = manifest.dims;
