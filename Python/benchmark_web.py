@@ -3,6 +3,7 @@
 
     python3 Python/benchmark_web.py [--inputs ct,ct512] [--sweep 10] [--size 800x600] [--out FILE.md]
     python3 Python/benchmark_web.py --interactive [--inputs phantom:256,ct] [--paths cpu,gpu] [--before main]
+    python3 Python/benchmark_web.py --stream [--inputs ct,phantom:256] [--networks 30/40,loopback]
 
 In one headless Chromium (Debian's, software WebGL2: SwiftShader), on the same volume and canvas
 size: the page's GPU path (the core on WebGL2), its CPU path (the BlockLOD core in WebAssembly at
@@ -20,6 +21,12 @@ viewer in a worker), in one Chromium, on each path: the time from an isovalue ch
 visible frame and to the full level, the median frame of a mouse drag with its level or image
 sample distance, and the longest main-thread task (PerformanceObserver longtask) over the changes
 and the drag. Inputs: phantom:N (the plugin's phantom) or ct.
+
+--stream (issue 31): the page on the CPU path fetching its level whole (?stream=0) and streaming
+it (level 0, then the bricks the surfaces need first), each in a fresh browser context, in one
+Chromium, under each network (MBIT/LATENCY_MS through CDP's Network.emulateNetworkConditions, or
+loopback): the time to the first image, to the current surfaces at the full level, to the whole
+level, and the bytes on the wire.
 """
 import argparse
 import json
@@ -59,6 +66,11 @@ def parse_args(argv):
                         "left main, whose page takes this tree's WebAssembly module)")
     p.add_argument("--moves", type=int, default=30, help="--interactive: mouse moves of the drag")
     p.add_argument("--paths", default="cpu,gpu", help="--interactive: the page's paths to run")
+    p.add_argument("--stream", action="store_true",
+                   help="streaming against the whole level (issue 31): first image, full level, bytes")
+    p.add_argument("--networks", default="30/40,loopback",
+                   help="--stream: MBIT/LATENCY_MS or loopback, comma-separated")
+    p.add_argument("--repeats", type=int, default=1, help="--stream: runs of each page")
     return p.parse_args(argv)
 
 
@@ -252,8 +264,61 @@ def main_interactive(args, argv):
     return 0
 
 
+def main_stream(args, argv):
+    started = time.strftime("%Y-%m-%d %H:%M:%S")
+    load_before = load_average()
+    t0 = time.perf_counter()
+    networks = []
+    for n in args.networks.split(","):
+        if n == "loopback":
+            networks.append({"name": "loopback"})
+        else:
+            mbps, latency = n.split("/")
+            networks.append({"name": "%s Mbit/s, %s ms" % (mbps, latency), "mbps": float(mbps),
+                             "latencyMs": float(latency)})
+    lines = ["# The page streaming against the whole level (issue 31)", "",
+             "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv), "",
+             "| input | network | page | first image ms | surfaces at full level ms | whole level ms | bytes |",
+             "|---|---|---|---:|---:|---:|---:|"]
+    for name in args.inputs.split(","):
+        data = volume_path(name) if not name.startswith("phantom:") else name
+        work = os.path.join(args.work, "stream-" + name.replace(":", "-"))
+        os.makedirs(work, exist_ok=True)
+        server, url = start_server(ROOT, args, data)
+        try:
+            config_file = os.path.join(work, "config.json")
+            out_file = os.path.join(work, "result.json")
+            with open(config_file, "w") as f:
+                json.dump({"url": url, "size": [int(v) for v in args.size.split("x")],
+                           "networks": networks, "repeats": args.repeats}, f)
+            progress("%s: whole and streamed, %s" % (name, args.networks))
+            subprocess.run(["node", os.path.join(WEB, "bench-stream.mjs"), config_file, out_file],
+                           check=True, cwd=WEB, timeout=3600)
+            with open(out_file) as f:
+                runs = json.load(f)["runs"]
+        finally:
+            server.kill()
+        for network in networks:
+            for mode in ("whole", "stream"):
+                rs = [r for r in runs if r["network"] == network["name"] and r["mode"] == mode]
+                med = lambda key: statistics.median(r[key] for r in rs)  # noqa: E731
+                lines.append("| %s | %s | %s | %.0f | %.0f | %.0f | %d |" % (
+                    name, network["name"], "whole level (`?stream=0`)" if mode == "whole" else "**streaming**",
+                    med("firstMs"), med("fullMs"), med("wholeMs"), med("bytes")))
+    lines[3:3] = ["- Started %s, %.0f s; load average %s before, %s after; medians of %d" % (
+        started, time.perf_counter() - t0, load_before, load_average(), args.repeats),
+        "- Machine: nproc %d (%s); Chromium headless, SwiftShader; CPU path in the worker; canvas %s" % (
+        os.cpu_count() or 0, cpu_model(), args.size)]
+    write_report(lines, args.out)
+    return 0
+
+
 def main(argv):
     args = parse_args(argv)
+    if args.stream:
+        if args.inputs == "ct,ct512":
+            args.inputs = "ct,phantom:256"
+        return main_stream(args, argv)
     if args.interactive:
         if args.inputs == "ct,ct512":
             args.inputs = "phantom:256,ct"

@@ -41,6 +41,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 STATIC = os.path.join(ROOT, "Web", "static")
 sys.path.insert(0, HERE)
+import serve_bricks  # noqa: E402  (the bricks the page streams)
 import serve_operations  # noqa: E402  (the volumes' default, and the worker's program)
 from serve_jobs import (FORMATS, RESULT_GRACE_S, RESULTS_PER_SESSION, Operations,  # noqa: E402
                         Session, StartFailed, log)
@@ -397,6 +398,9 @@ def make_app(args, datasets, operations):
     app.router.add_static("/static", STATIC)
     app.router.add_get("/api/datasets", list_datasets)
     app.router.add_get("/api/volume/{ident}", volume)
+    app.router.add_get("/api/bricks/{ident}", serve_bricks.handler(
+        lambda request: request.app[STATE].by_id.get(request.match_info["ident"]),
+        not_modified, VOLUME_CACHE_CONTROL))
     app.router.add_get("/api/result/{rid}", result)
     app.router.add_get("/api/status", status)
     app.router.add_get("/api/ws", websocket)

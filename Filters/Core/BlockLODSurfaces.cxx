@@ -61,6 +61,28 @@ bool BlockLODSurfacesBase::SetVolume(const VolumeDescription& description)
   return true;
 }
 
+void BlockLODSurfacesBase::BeginStreaming()
+{
+  this->Volume.BeginStreaming();
+  this->Estimator.Reset();
+  this->Plans.clear();
+}
+
+std::int64_t BlockLODSurfacesBase::RegionArrived(const int first[3], const int last[3])
+{
+  const std::int64_t completed = this->Volume.RegionArrived(first, last);
+  this->Estimator.Reset();
+  this->Plans.clear();
+  return completed;
+}
+
+void BlockLODSurfacesBase::EndStreaming()
+{
+  this->Volume.EndStreaming();
+  this->Estimator.Reset();
+  this->Plans.clear();
+}
+
 void BlockLODSurfacesBase::SetLayout(const SurfaceLayout& layout)
 {
   if (layout != this->Layout)

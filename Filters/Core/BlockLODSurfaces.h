@@ -194,6 +194,15 @@ public:
   bool SetVolume(const VolumeDescription& description);
   const BlockLODVolume& GetVolume() const { return this->Volume; }
 
+  /// Streaming (BlockLODVolume's BeginStreaming, RegionArrived, EndStreaming):
+  /// each also forgets the estimator's counts and the plans, which read the
+  /// ranges. Cached surfaces stay: a host draws from a streaming volume only
+  /// the level-3 surfaces whose blocks are all resident, which later regions
+  /// do not change.
+  void BeginStreaming();
+  std::int64_t RegionArrived(const int first[3], const int last[3]);
+  void EndStreaming();
+
   /// The bytes of a surface in the host's layout; a change empties the cache.
   void SetLayout(const SurfaceLayout& layout);
   const SurfaceLayout& GetLayout() const { return this->Layout; }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace mediso
 {
@@ -40,6 +41,10 @@ struct BlockLODVolume::Typed
   // Counts on full-volume blocks.
   virtual BlockSums CountFull(const std::vector<std::int32_t>& blocks, double isovalue, int level,
     int auxLevel) = 0;
+  // The range of one block of the full volume (its points, as ComputeBlockRanges reads them).
+  virtual void BlockRange(std::int64_t block, BlockRanges& ranges) = 0;
+  // Forgets the coarse copies (the values they copied changed).
+  virtual void ForgetCoarseCopies() = 0;
   int CoarseCopies = 0; // made so far
 };
 
@@ -182,6 +187,57 @@ struct BlockLODVolume::TypedImpl : BlockLODVolume::Typed
     return CountBlocks(
       this->Full, this->FullRanges, this->Cases, blocks, isovalue, level, auxLevel, this->Parallel);
   }
+
+  void BlockRange(std::int64_t block, BlockRanges& ranges) override
+  {
+    const std::int64_t bx = block % ranges.Blocks[0];
+    const std::int64_t by = (block / ranges.Blocks[0]) % ranges.Blocks[1];
+    const std::int64_t bz = block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]);
+    const std::int64_t b[3] = { bx, by, bz };
+    int p0[3], p1[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      p0[a] = static_cast<int>(b[a]) * BlockCells;
+      p1[a] = std::min(p0[a] + BlockCells, this->Full.Dims[a] - 1);
+    }
+    const std::int64_t sx = this->Full.Dims[0];
+    const std::int64_t sxy = sx * this->Full.Dims[1];
+    double lo = std::numeric_limits<double>::infinity();
+    double hi = -std::numeric_limits<double>::infinity();
+    for (int z = p0[2]; z <= p1[2]; ++z)
+    {
+      for (int y = p0[1]; y <= p1[1]; ++y)
+      {
+        const T* row = this->Full.Data + z * sxy + y * sx;
+        for (int x = p0[0]; x <= p1[0]; ++x)
+        {
+          const double v = static_cast<double>(row[x]);
+          if (!std::isfinite(v))
+          {
+            ++(std::isnan(v) ? ranges.NaNCount : ranges.InfiniteCount);
+            continue;
+          }
+          lo = std::min(lo, v);
+          hi = std::max(hi, v);
+        }
+      }
+    }
+    ranges.Min[block] = lo;
+    ranges.Max[block] = hi;
+    if (lo <= hi)
+    {
+      ranges.ValueRange[0] = std::min(ranges.ValueRange[0], lo);
+      ranges.ValueRange[1] = std::max(ranges.ValueRange[1], hi);
+    }
+  }
+
+  void ForgetCoarseCopies() override
+  {
+    for (Coarse& c : this->Levels)
+    {
+      c = Coarse();
+    }
+  }
 };
 
 BlockLODVolume::BlockLODVolume(TriangleCaseTable cases, ParallelFor parallel)
@@ -194,6 +250,10 @@ BlockLODVolume::~BlockLODVolume() = default;
 
 void BlockLODVolume::Reset()
 {
+  this->Streaming = false;
+  this->ResidentRuns.clear();
+  this->ResidentBlocks.clear();
+  this->NumberOfResidentBlocks = 0;
   this->Valid = false;
   this->Impl.reset();
   this->ActiveLists.clear();
@@ -359,6 +419,141 @@ const std::vector<std::int32_t>& BlockLODVolume::ActiveBlocks(double isovalue)
   }
   this->ActiveLists.emplace_back(isovalue, ListActiveBlocks(this->Ranges, isovalue));
   return this->ActiveLists.back().second;
+}
+
+void BlockLODVolume::BeginStreaming()
+{
+  if (!this->Valid)
+  {
+    return;
+  }
+  this->Streaming = true;
+  for (int a = 0; a < 3; ++a)
+  {
+    this->Runs[a] = (this->Description.Dims[a] + BlockCells - 1) / BlockCells;
+  }
+  this->ResidentRuns.assign(
+    static_cast<std::size_t>(this->Runs[0]) * this->Runs[1] * this->Runs[2], 0);
+  this->ResidentBlocks.assign(static_cast<std::size_t>(this->Ranges.GetNumberOfBlocks()), 0);
+  this->NumberOfResidentBlocks = 0;
+  std::fill(this->Ranges.Min.begin(), this->Ranges.Min.end(), std::numeric_limits<double>::infinity());
+  std::fill(
+    this->Ranges.Max.begin(), this->Ranges.Max.end(), -std::numeric_limits<double>::infinity());
+  this->Ranges.NaNCount = this->Ranges.InfiniteCount = 0;
+  this->Ranges.ValueRange[0] = std::numeric_limits<double>::infinity();
+  this->Ranges.ValueRange[1] = -std::numeric_limits<double>::infinity();
+  this->ActiveLists.clear();
+  this->Impl->ForgetCoarseCopies();
+}
+
+std::int64_t BlockLODVolume::RegionArrived(const int first[3], const int last[3])
+{
+  if (!this->Streaming)
+  {
+    return 0;
+  }
+  // The runs the region covers whole, per axis: [r0, r1].
+  int r0[3], r1[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    const int n = this->Description.Dims[a];
+    const int lo = std::max(0, first[a]);
+    const int hi = std::min(n - 1, last[a]);
+    r0[a] = (lo + BlockCells - 1) / BlockCells;
+    r1[a] = hi == n - 1 ? this->Runs[a] - 1 : (hi + 1) / BlockCells - 1;
+    if (lo > hi || r0[a] > r1[a])
+    {
+      return 0;
+    }
+  }
+  for (int z = r0[2]; z <= r1[2]; ++z)
+  {
+    for (int y = r0[1]; y <= r1[1]; ++y)
+    {
+      for (int x = r0[0]; x <= r1[0]; ++x)
+      {
+        this->ResidentRuns[(static_cast<std::size_t>(z) * this->Runs[1] + y) * this->Runs[0] + x] =
+          1;
+      }
+    }
+  }
+  // Block b reads the points 8b - 1 .. 8b + 9 (its own and the gradient's), runs b - 1 .. b + 1:
+  // only the blocks next to the new runs can have been completed.
+  int b0[3], b1[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    b0[a] = std::max(0, r0[a] - 1);
+    b1[a] = std::min(this->Ranges.Blocks[a] - 1, r1[a] + 1);
+  }
+  auto readRuns = [this](int a, int b, int& lo, int& hi) {
+    const int n = this->Description.Dims[a];
+    lo = std::max(0, b * BlockCells - 1) / BlockCells;
+    hi = std::min(n - 1, b * BlockCells + BlockCells + 1) / BlockCells;
+  };
+  std::int64_t completed = 0;
+  for (int bz = b0[2]; bz <= b1[2]; ++bz)
+  {
+    for (int by = b0[1]; by <= b1[1]; ++by)
+    {
+      for (int bx = b0[0]; bx <= b1[0]; ++bx)
+      {
+        const std::int64_t block =
+          (static_cast<std::int64_t>(bz) * this->Ranges.Blocks[1] + by) * this->Ranges.Blocks[0] +
+          bx;
+        if (this->ResidentBlocks[block])
+        {
+          continue;
+        }
+        int lo[3], hi[3];
+        const int b[3] = { bx, by, bz };
+        for (int a = 0; a < 3; ++a)
+        {
+          readRuns(a, b[a], lo[a], hi[a]);
+        }
+        bool resident = true;
+        for (int z = lo[2]; z <= hi[2] && resident; ++z)
+        {
+          for (int y = lo[1]; y <= hi[1] && resident; ++y)
+          {
+            for (int x = lo[0]; x <= hi[0] && resident; ++x)
+            {
+              resident =
+                this->ResidentRuns[(static_cast<std::size_t>(z) * this->Runs[1] + y) * this->Runs[0] +
+                  x] != 0;
+            }
+          }
+        }
+        if (resident)
+        {
+          this->Impl->BlockRange(block, this->Ranges);
+          this->ResidentBlocks[block] = 1;
+          ++completed;
+        }
+      }
+    }
+  }
+  this->NumberOfResidentBlocks += completed;
+  this->ActiveLists.clear();
+  this->Impl->ForgetCoarseCopies();
+  return completed;
+}
+
+void BlockLODVolume::EndStreaming()
+{
+  if (!this->Streaming)
+  {
+    return;
+  }
+  this->Streaming = false;
+  this->ResidentRuns.clear();
+  this->ResidentBlocks.clear();
+  this->ActiveLists.clear();
+  this->Impl->ForgetCoarseCopies();
+}
+
+std::int64_t BlockLODVolume::GetNumberOfResidentBlocks() const
+{
+  return this->Streaming ? this->NumberOfResidentBlocks : this->Ranges.GetNumberOfBlocks();
 }
 
 } // namespace mediso

@@ -23,6 +23,16 @@
  * CountSample() count a level exactly, or on a spread sample of active
  * blocks, for the estimator (BlockLODEstimator.h).
  *
+ * Streaming (a host whose values arrive region by region, as the web page's
+ * bricks do): after BeginStreaming() no block of the full volume is resident
+ * and its range is empty, so no pass visits it; RegionArrived() marks points
+ * as holding their values, and each block whose every read point (its own
+ * points and the gradient's one more on each side) is then resident gets its
+ * range from the values, once. A surface at level 3 is then exactly the
+ * dense volume's wherever the blocks that can cut it are resident (their
+ * neighbours included); the coarse copies read every point, so a host draws
+ * levels 0-2 of a streaming volume only after EndStreaming().
+ *
  * The marching-cubes case table is data the host passes (BlockLOD.h,
  * TriangleCaseTable), and every pass runs through the host's ParallelFor.
  */
@@ -132,6 +142,26 @@ public:
   /// isovalues).
   const std::vector<std::int32_t>& ActiveBlocks(double isovalue);
 
+  /// Streaming (see the file's description): from now on no point is
+  /// resident; every block's range is empty until RegionArrived() completes
+  /// what it reads. Forgets the active lists and the coarse copies.
+  void BeginStreaming();
+  /// The points first..last (inclusive, per axis) now hold their values.
+  /// Residency is kept per run of BlockCells points along each axis (run r:
+  /// points 8r .. 8r + 7), so a region covers a run only when it covers all
+  /// of it (the volume's last run may be shorter). The blocks this completes
+  /// get their ranges (the ranges' value range and missing counts grow with
+  /// them); the active lists and coarse copies are forgotten. Returns the
+  /// number of blocks that became resident; 0 when not streaming or for a
+  /// region outside the volume.
+  std::int64_t RegionArrived(const int first[3], const int last[3]);
+  /// Ends streaming: the ranges stay as they are (exact once every point
+  /// arrived); coarse copies are made again on use.
+  void EndStreaming();
+  bool IsStreaming() const { return this->Streaming; }
+  /// Blocks whose ranges are known (every block when not streaming).
+  std::int64_t GetNumberOfResidentBlocks() const;
+
 private:
   struct Typed;
   template <typename T>
@@ -144,6 +174,12 @@ private:
   BlockRanges Ranges;
   std::unique_ptr<Typed> Impl;
   std::vector<std::pair<double, std::vector<std::int32_t>>> ActiveLists;
+  // Streaming: the resident runs of points (x fastest) and the blocks whose ranges are known.
+  bool Streaming = false;
+  int Runs[3] = { 0, 0, 0 };
+  std::vector<std::uint8_t> ResidentRuns;
+  std::vector<std::uint8_t> ResidentBlocks;
+  std::int64_t NumberOfResidentBlocks = 0;
 };
 
 } // namespace mediso

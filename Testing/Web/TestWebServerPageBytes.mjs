@@ -3,7 +3,9 @@
 // included): the page fetches the volume once, in at most 0.6x its raw bytes, and then 20
 // isovalue changes, 5 colour and opacity changes and 5 camera changes send and receive nothing
 // at all: no request, no WebSocket frame, 0 bytes; the page's own readout agrees. A reload then
-// revalidates the volume (304) instead of fetching it again. On the server's default dataset:
+// revalidates the volume (304) instead of fetching it again. Where the page streams (level 0,
+// then the bricks: docs/web.md, Streaming), each brick comes once, the whole within 0.6x, the
+// changes come after the last brick, and the reload revalidates the bricks too. On the server's default dataset:
 // the head CT when it is fetched, else the phantom (said).
 import { Checks, countWire, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
 
@@ -14,17 +16,28 @@ const context = await browser.newContext({ viewport: { width: 1280, height: 800 
 const page = await context.newPage();
 const wire = await countWire(context, page);
 await openPage(page, server);
+// Where the page streams (docs/web.md, Streaming: level 0, then the level's bricks), until the
+// whole level has arrived.
+const received = () => page.waitForFunction(() => window.mediso.stats().received === 1, null,
+  { timeout: 300000 });
+await received();
 
 const dataset = (await (await fetch(server.api("/api/datasets"))).json()).datasets[0];
 console.log("dataset: " + dataset.name + " " + dataset.dims.join("x") + " " + dataset.type +
   (dataset.name.startsWith("MedicalPhantom") ? " (the head CT is not fetched: the phantom)" : ""));
 const volumes = [...wire.responses.values()].filter((r) => r.url.includes("/api/volume/"));
-checks.check(volumes.length === 1, "the volume is fetched once (" + volumes.length + ")");
-for (const v of volumes) {
-  const raw = Number(v.headers["x-mediso-raw-bytes"] || v.headers["X-Mediso-Raw-Bytes"]);
-  checks.check(v.encodedDataLength > 0 && v.encodedDataLength <= 0.6 * raw,
-    "the volume crossed in " + v.encodedDataLength + " bytes with its headers, " +
-    (v.encodedDataLength / raw).toFixed(3) + "x its " + raw + " raw bytes (at most 0.6x)");
+const bricks = [...wire.responses.values()].filter((r) => /\/api\/bricks\/[^?]*\?.*ids=/.test(r.url));
+checks.check(volumes.length === 1, "the volume (streamed: its level 0) is fetched once (" + volumes.length + ")");
+const brickIds = bricks.map((r) => new URL(r.url).searchParams.get("ids"));
+checks.check(new Set(brickIds).size === brickIds.length, "each brick is fetched once (" + brickIds.length + " bricks)");
+{
+  const level = (await page.evaluate(() => window.mediso.stats())).level;
+  const raw = dataset.levels[level].bytes;
+  const crossed = [...volumes, ...bricks].reduce((a, r) => a + r.encodedDataLength, 0);
+  checks.check(crossed > 0 && crossed <= 0.6 * raw,
+    "the volume crossed in " + crossed + " bytes with their headers (" + (bricks.length ? "level 0 and " +
+    bricks.length + " bricks" : "one request") + "), " + (crossed / raw).toFixed(3) + "x its " + raw +
+    " raw bytes (at most 0.6x)");
 }
 // The page is ES modules (app.js imports the others): a browser runs a module script only when
 // it comes with a JavaScript MIME type.
@@ -85,6 +98,7 @@ const kept = new Set(wire.responses.keys());
 await page.reload({ waitUntil: "commit" });
 await page.waitForFunction(() => window.mediso !== undefined, null, { timeout: 120000 });
 await page.evaluate(() => window.mediso.ready);
+await received();
 const again = [...wire.responses.entries()].filter(([id, r]) => !kept.has(id) &&
   r.url.includes("/api/volume/")).map(([, r]) => r);
 const stats2 = await page.evaluate(() => window.mediso.stats());
@@ -93,6 +107,11 @@ const stats2 = await page.evaluate(() => window.mediso.stats());
 checks.check(again.length === 1 && again[0].encodedDataLength > 0 && again[0].encodedDataLength < 2000,
   "after a reload the volume is revalidated, not sent: " + again.map((r) => "status " + r.status +
     " as Chrome reports it, " + r.encodedDataLength + " bytes on the wire").join("; "));
+const bricksAgain = [...wire.responses.entries()].filter(([id, r]) => !kept.has(id) &&
+  /\/api\/bricks\/[^?]*\?.*ids=/.test(r.url)).map(([, r]) => r);
+checks.check(bricksAgain.every((r) => r.encodedDataLength < 2000),
+  "... and so are the bricks (" + bricksAgain.length + ", at most " +
+  Math.max(0, ...bricksAgain.map((r) => r.encodedDataLength)) + " bytes each on the wire)");
 checks.check((stats2.primitives || stats2.triangles) > 0 && stats2.bytesReceived < 0.05 * dataset.bytes,
   "... the page draws it from the browser's copy and counts " + stats2.bytesReceived +
   " B received (the volume's raw bytes: " + dataset.bytes + ")");

@@ -20,6 +20,7 @@
 //   crosshair3d.js  the crosshair drawn over the 3D view
 //   histogram.js    the volume's histogram, its isovalue markers dragged
 //   presets.js      the first surfaces (Hounsfield units or Otsu), the CT presets
+//   stream.js       level 0 first, then the full level's bricks (CPU path, in the worker)
 
 import { interact } from "./interaction.js";
 import { linkedView, readLink, scheduleLink } from "./link.js";
@@ -38,6 +39,7 @@ import { replaceSurfaces, setupSurfaceList } from "./surfaces.js";
 import { afterFrame, change, clearMesh, drawn, fitCanvas, renderNow, requestFrame, showMesh, startViewer }
   from "./viewer.js";
 import { countBytes, request, requestJSON, sessionToken } from "./volume.js";
+import { brickRanges, setupStream, streamInfo, whenFull } from "./stream.js";
 
 async function start() {
   const probe = document.createElement("canvas").getContext("webgl2");
@@ -73,6 +75,7 @@ async function start() {
     state.requestedPath = link.path;
   }
   fitCanvas(canvas);
+  setupStream();
   await applyPath();
   if (link.camera) {
     state.viewer.setView(linkedView(link.camera));
@@ -242,6 +245,15 @@ window.mediso = {
     buildMs: state.buildMs,
     bytesSent: state.bytesSent,
     bytesReceived: state.bytesReceived,
+    // each surface's level of the whole volume (0 while drawn from the streamed level 0), and
+    // the fraction of the level's bytes received (stream.js; 1 once it came whole)
+    levels: [...state.surfaceLevels],
+    // each current surface's triangles as drawn (CPU path)
+    surfaceTriangles: state.surfaces.map((s) => {
+      const drawn = (state.viewer && state.viewer.stats()) || {};
+      return (drawn.surfaceTriangles || [])[(drawn.surfaceValues || []).indexOf(s.value)];
+    }),
+    received: state.stream ? state.received : 1,
     view: state.viewer ? state.viewer.getView() : null,
     info: state.viewer ? state.viewer.info() : null,
   }),
@@ -252,6 +264,15 @@ window.mediso = {
     await drawn();
     return window.mediso.stats();
   },
+  // Resolves with the stats when every current surface is drawn at the full level (streaming).
+  async whenFull() {
+    await whenFull();
+    return window.mediso.stats();
+  },
+  // Streaming (tests): the bricks asked for so far and the bricks `values` need; null after it.
+  streamInfo: (values) => streamInfo(values),
+  // After a stream (tests): {server, core}: the manifest's brick ranges and the cores'.
+  brickRanges: () => brickRanges(),
   // The last frames drawn, oldest first (tests: a drag's levels, a refinement's steps).
   frames: () => state.frameLog.map((f) => Object.assign({}, f)),
   async setPath(path) {

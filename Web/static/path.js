@@ -6,6 +6,7 @@
 import { showPathNote } from "./readout.js";
 import { $, state } from "./state.js";
 import { loadVolume } from "./volume.js";
+import { canStream, startStream, stopStream } from "./stream.js";
 
 // The CPU path keeps the volume within 1 / CPU_VOLUME_SHARE of the budget: its surfaces and
 // their cache take the rest.
@@ -72,10 +73,14 @@ export async function applyPath() {
   showPathNote(choice.path, choice.why, choice.level.why);
   $("path").value = state.requestedPath;
   state.viewer.setPath(choice.path);
-  if (!state.volumePointer || state.level !== choice.level.level) {
-    await loadVolume(choice.level.level);
+  if (!state.volumePointer || (state.level !== choice.level.level && !state.stream) ||
+      (state.stream && (state.stream.level !== choice.level.level || choice.path !== "cpu"))) {
+    stopStream();
+    // Streamed (stream.js: level 0 first, then the bricks) where the path allows it.
+    await (canStream(choice.path, choice.level.level) && !state.volumePointer
+      ? startStream(choice.level.level) : loadVolume(choice.level.level));
   }
-  const volumeBytes = state.dataset.levels[state.level].bytes;
+  const volumeBytes = state.dataset.levels[state.stream ? state.stream.level : state.level].bytes;
   state.viewer.setBudget(Math.max(0, budgetMB * 1e6 - volumeBytes));
 }
 

@@ -4,6 +4,7 @@
 // of the page, why it cannot run here. It reads the state and changes none of it.
 
 import { $, state } from "./state.js";
+import { streamNote } from "./stream.js";
 
 // The window of the frame rate, ms.
 const FPS_WINDOW_MS = 2000;
@@ -48,6 +49,7 @@ export function updateReadout() {
                          : ["triangles", String(state.triangles) + " (level " + state.cpuLevel +
                            (state.interactive ? ", while dragging" : state.settled ? "" : ", refining") + ")"],
     ...(state.frameNote ? [["this frame", state.frameNote]] : []),
+    ...(state.stream ? [["streaming", streamNote()]] : []),
     ["bytes received", state.bytesReceived.toLocaleString()],
     ["bytes sent", state.bytesSent.toLocaleString()],
   ];

@@ -128,6 +128,29 @@ export class RemoteViewer {
     return true;
   }
 
+  /**
+   * Streaming (stream.js): the full level's buffer at `pointer` in this thread's module (its
+   * bricks written as they come), and level 0 as the coarse volume; the worker allocates its own
+   * buffer. Resolves to "" or why the worker refused.
+   */
+  beginStream({ type, pointer, dims, spacing, origin, brick, coarse }) {
+    this.volume = { type, pointer, dims: [...dims] };
+    this.camera.setVolume(dims, spacing, origin);
+    const id = this.nextId++;
+    const uploaded = new Promise((resolve) => this.answers.set(id, resolve));
+    const bytes = coarse.bytes.slice();
+    this.worker.postMessage({ op: "stream", id, type, dims, spacing, origin, brick,
+      coarse: { bytes: bytes.buffer, dims: coarse.dims, spacing: coarse.spacing, origin: coarse.origin } },
+    [bytes.buffer]);
+    return uploaded;
+  }
+  /** Bricks [{id, bytes (an ArrayBuffer of its owned points, transferred)}] for the worker's buffer. */
+  writeBricks(list) {
+    this.worker.postMessage({ op: "bricks", list }, list.map((b) => b.bytes));
+  }
+  endStream() { this.worker.postMessage({ op: "streamEnd" }); }
+  setCoarseValues(values) { this.call("setCoarseValues", values); }
+
   setSurfaces(surfaces) {
     this.surfaces = surfaces.map((s) => ({ value: s.value, color: [...s.color], opacity: s.opacity }));
     return true;

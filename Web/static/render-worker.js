@@ -11,6 +11,8 @@
 //   {op: "call", method, args, id?}                      a WebViewer call; with id, its answer
 //   {op: "volume", type, bytes, dims, spacing, origin}   the volume's values (transferred)
 //   {op: "mesh", points, triangles, color, opacity}      a surface the server made
+//   {op: "stream", type, dims, spacing, origin, brick, coarse}, {op: "bricks", list},
+//   {op: "streamEnd"}                                    streaming (stream.js, startStream here)
 //   {op: "frame", id, surfaces, view, interactive, generation}  the frame wanted now
 // Messages out: {op: "ready", ok, error, info, generation}, {op: "answer", id, value},
 //   {op: "frame", id, stats, settled}, {op: "error", message}.
@@ -36,6 +38,8 @@ let path = "gpu";
 let shownKey = ""; // the isovalues of the last frame drawn
 let skipped = 0;
 let volumeBytes = 0; // the pointer of the volume in this module's memory
+let streaming = false; // stream.js's bricks are arriving: each surface at level 0 or 3, no coarse first answer
+let coarseBytes = 0; // the pointer of the streamed level 0
 
 // The generation word (an Int32Array of one, shared with the page's main thread, which adds one
 // to it on every new set of isovalues and every drag frame before it sends the frame): a running
@@ -166,7 +170,7 @@ function pump() {
       refine = null;
     }
     const auto = path === "cpu" && requestedLevel < 0;
-    const coarse = auto && (frame.interactive || key !== shownKey);
+    const coarse = auto && !streaming && (frame.interactive || key !== shownKey);
     let level = requestedLevel, distance = 1, note = "", choice = null;
     if (coarse || (path === "gpu" && frame.interactive)) {
       choice = choose(frame);
@@ -236,6 +240,30 @@ function drawWatched(frame) {
   }
 }
 
+// Streaming (stream.js): the full level's buffer, empty, as the viewer's volume, whose bricks
+// arrive later ({op: "bricks"}), and level 0 as its coarse volume.
+function startStream(m) {
+  for (const p of [volumeBytes, coarseBytes]) {
+    if (p) {
+      M._free(p);
+    }
+  }
+  const size = M.scalarTypes().find((t) => t.value === m.type).bytes;
+  const length = size * m.dims[0] * m.dims[1] * m.dims[2];
+  volumeBytes = M._malloc(length);
+  M.HEAPU8.fill(0, volumeBytes, volumeBytes + length);
+  const coarse = new Uint8Array(m.coarse.bytes);
+  coarseBytes = M._malloc(coarse.length);
+  M.HEAPU8.set(coarse, coarseBytes);
+  let ok = viewer.setVolume(m.type, volumeBytes, m.dims, m.spacing, m.origin) &&
+    viewer.beginStreaming(m.brick) &&
+    viewer.setCoarseVolume(m.type, coarseBytes, m.coarse.dims, m.coarse.spacing, m.coarse.origin);
+  streaming = ok;
+  shownKey = "";
+  refine = null;
+  post({ op: "answer", id: m.id, value: ok ? "" : viewer.stats().error || "the volume cannot be streamed" });
+}
+
 self.onmessage = async (event) => {
   const m = event.data;
   try {
@@ -252,6 +280,12 @@ self.onmessage = async (event) => {
         post({ op: "answer", id: m.id, value });
       }
     } else if (m.op === "volume") {
+      streaming = false;
+      if (coarseBytes) {
+        viewer.setCoarseVolume(0, 0, [], [], []);
+        M._free(coarseBytes);
+        coarseBytes = 0;
+      }
       if (volumeBytes) {
         M._free(volumeBytes);
       }
@@ -262,6 +296,23 @@ self.onmessage = async (event) => {
       shownKey = "";
       refine = null;
       post({ op: "answer", id: m.id, value: ok ? "" : viewer.stats().error || "the volume cannot be uploaded" });
+    } else if (m.op === "stream") {
+      startStream(m);
+    } else if (m.op === "bricks") {
+      for (const brick of m.list) {
+        const bytes = new Uint8Array(brick.bytes);
+        const at = M._malloc(bytes.length);
+        M.HEAPU8.set(bytes, at);
+        viewer.writeBrick(brick.id, at);
+        M._free(at);
+      }
+    } else if (m.op === "streamEnd") {
+      viewer.endStreaming();
+      streaming = false;
+      if (coarseBytes) {
+        M._free(coarseBytes);
+        coarseBytes = 0;
+      }
     } else if (m.op === "mesh") {
       const points = M._malloc(m.points.byteLength);
       const triangles = M._malloc(m.triangles.byteLength);

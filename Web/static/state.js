@@ -69,5 +69,11 @@ export const state = Object.seal({
   lastRefinedMs: 0, // the last change to its full-level frame
   sampleDistance: 1, // the GPU path's image sample distance of the last frame
   frameNote: "", // why the last frame is coarser than the full one ("" when it is not)
+  // stream.js (docs/web.md, Streaming): the stream of the full level's bricks (null when the
+  // volume came whole), each drawn surface's level of the whole volume, and the fraction of the
+  // level's bytes received.
+  stream: null,
+  surfaceLevels: [],
+  received: 0,
   frameLog: [], // the last 200 frames: [{values, cpuLevel, triangles, primitives, sampleDistance, interactive, settled, ms, predictedMs}]
 });

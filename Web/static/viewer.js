@@ -129,6 +129,8 @@ export function fitCanvas(canvas) {
 
 /** Called after every frame with the module's view (the orientation marker). */
 export const afterFrame = [];
+/** Called before every frame is asked for (stream.js: the surfaces drawn from level 0). */
+export const beforeFrame = [];
 
 // A frame drawn: its time and what it drew, into the state and the readout.
 function recordFrame(ms, stats) {
@@ -151,7 +153,9 @@ function recordFrame(ms, stats) {
   state.frameNote = stats.note || "";
   state.frameLog.push({ id: stats.id, values: stats.values, cpuLevel: stats.cpuLevel,
     triangles: stats.triangles, primitives: stats.primitives, sampleDistance: state.sampleDistance,
-    interactive: state.interactive, settled: state.settled, ms, predictedMs: stats.predictedMs || 0 });
+    interactive: state.interactive, settled: state.settled, ms, predictedMs: stats.predictedMs || 0,
+    surfaceValues: stats.surfaceValues || [], coarse: stats.coarse || [],
+    surfaceTriangles: stats.surfaceTriangles || [] });
   if (state.frameLog.length > 200) {
     state.frameLog.shift();
   }
@@ -178,6 +182,9 @@ export function renderNow(interactive = false) {
   const viewer = state.viewer;
   // A surface hidden (the source of a server result shown, operations.js) is not drawn.
   viewer.setSurfaces(state.surfaces.filter((s) => !s.hidden));
+  for (const call of beforeFrame) {
+    call();
+  }
   if (state.remote) {
     latest = viewer.frame(interactive);
     return latest;

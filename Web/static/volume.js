@@ -84,8 +84,11 @@ function typedValues(bytes, typeName) {
   return new Typed(copy.buffer, copy.byteOffset, copy.length / Typed.BYTES_PER_ELEMENT);
 }
 
-/** Fetches level `level` of the dataset and gives it to the viewer (the module's memory). */
-export async function loadVolume(level) {
+/**
+ * Fetches level `level` of the dataset: {type (the module's {name, value, bytes}), dims, spacing,
+ * origin, bytes (un-shuffled), values (a typed array over them)}.
+ */
+export async function fetchLevel(level) {
   const d = state.dataset;
   const { response, body } = await request("/api/volume/" + d.id + "?level=" + level, "no-cache");
   const typeName = response.headers.get("X-Mediso-Type");
@@ -97,7 +100,16 @@ export async function loadVolume(level) {
   const spacing = response.headers.get("X-Mediso-Spacing").split(",").map(Number);
   const origin = response.headers.get("X-Mediso-Origin").split(",").map(Number);
   const bytes = unshuffle(new Uint8Array(body), type.bytes);
-  state.values = typedValues(bytes, typeName);
+  return { type, dims, spacing, origin, bytes, values: typedValues(bytes, typeName) };
+}
+
+/** Byte-shuffled values of `size` bytes back in order, and their typed view (stream.js). */
+export { unshuffle, typedValues };
+
+/** Fetches level `level` of the dataset and gives it to the viewer (the module's memory). */
+export async function loadVolume(level) {
+  const { type, dims, spacing, origin, bytes, values } = await fetchLevel(level);
+  state.values = values;
   state.grid = { dims, spacing, origin };
   const M = state.module;
   const pointerBefore = state.volumePointer;

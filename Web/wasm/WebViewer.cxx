@@ -18,9 +18,18 @@
  * fits in the client's budget; surfaces are cached per (isovalue, level) and
  * drawn as triangles (MeshRenderer). A surface the server made is drawn beside
  * either path.
+ *
+ * Streaming (the CPU path; docs/web.md, Streaming): the page gives the
+ * server's level 0 as a coarse volume of its own (SetCoarseVolume) and the
+ * full level's buffer, then writes the bricks into the buffer as they arrive
+ * (WriteBrick: BrickGrid's bricks, the buffer's BlockLOD ranges completed for
+ * them). Each surface the page names in SetCoarseValues is drawn from the
+ * coarse volume (at its own full resolution); the others, whose bricks have
+ * all arrived, from the buffer at level 3.
  */
 #include "BlockLOD.h"
 #include "BlockLODSurfaces.h"
+#include "BrickGrid.h"
 #include "Camera.h"
 #include "FrameTimeModel.h"
 #include "GLApiFunctions.h"
@@ -230,6 +239,7 @@ public:
     std::copy(placement.Origin, placement.Origin + 3, description.Origin);
     std::copy(placement.Spacing, placement.Spacing + 3, description.Spacing);
     description.Stamp = ++this->VolumeStamp;
+    this->Described = description;
     std::string error;
     if (!this->Scene->SetVolume(description, error))
     {
@@ -381,6 +391,102 @@ public:
   {
     emscripten_webgl_make_context_current(this->Context);
     this->Meshes->Clear(ResultSlot);
+  }
+
+  /// Streaming: the server's level 0 (`bytes` kept alive by the caller, as
+  /// for SetVolume), drawn for the isovalues named in SetCoarseValues; a null
+  /// `bytes` forgets it.
+  bool SetCoarseVolume(int type, std::uintptr_t bytes, const val& dims, const val& spacing,
+    const val& origin)
+  {
+    this->CoarseData = reinterpret_cast<const void*>(bytes);
+    VolumeDescription description;
+    description.Type = static_cast<ScalarType>(type);
+    description.Data = this->CoarseData;
+    for (int a = 0; a < 3; ++a)
+    {
+      description.Dims[a] = bytes ? dims[a].as<int>() : 0;
+      description.Spacing[a] = bytes ? spacing[a].as<double>() : 1.0;
+      description.Origin[a] = bytes ? origin[a].as<double>() : 0.0;
+    }
+    description.Stamp = ++this->VolumeStamp;
+    this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
+    if (!bytes)
+    {
+      this->Coarse.ClearCache();
+      return true;
+    }
+    return this->Coarse.SetVolume(description);
+  }
+
+  /**
+   * Streaming begins on the volume given to SetVolume (its buffer, whose
+   * values arrive as bricks of `brickPoints` points a side, a multiple of 8):
+   * no brick is resident.
+   */
+  bool BeginStreaming(int brickPoints)
+  {
+    const int* dims = this->Viewpoint.GetPlacement().Dimensions;
+    this->Bricks = BrickGrid(dims, brickPoints);
+    if (!this->Bricks.IsValid() || !this->Data)
+    {
+      this->LastError = "bricks of " + std::to_string(brickPoints) + " points cannot stream this volume";
+      return false;
+    }
+    this->CPU.BeginStreaming();
+    this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
+    return true;
+  }
+
+  /**
+   * A brick's owned points (`values` in the module's memory, x fastest, as
+   * the server sent them) written into the buffer; the blocks they complete
+   * get their ranges. False for a brick id outside the grid.
+   */
+  bool WriteBrick(double brick, std::uintptr_t values)
+  {
+    const auto id = static_cast<std::int64_t>(brick);
+    int extent[6];
+    this->Bricks.OwnedPoints(id, extent);
+    if (!this->CPU.GetVolume().IsStreaming() ||
+      !mediso::WriteBrick(this->Bricks, id, extent, ScalarTypeSize(this->Type),
+        reinterpret_cast<const void*>(values), const_cast<void*>(this->Data)))
+    {
+      this->LastError = "brick " + std::to_string(id) + " is not one of this volume's";
+      return false;
+    }
+    const int first[3] = { extent[0], extent[2], extent[4] };
+    const int last[3] = { extent[1], extent[3], extent[5] };
+    this->CPU.RegionArrived(first, last);
+    return true;
+  }
+
+  /// Streaming ends (every brick arrived): the coarse volume is forgotten and
+  /// the CPU path chooses its levels again.
+  void EndStreaming()
+  {
+    // The GPU path's texture was uploaded from the empty buffer: a new stamp uploads the values.
+    this->Described.Stamp = ++this->VolumeStamp;
+    emscripten_webgl_make_context_current(this->Context);
+    std::string error;
+    if (!this->Scene->SetVolume(this->Described, error))
+    {
+      this->LastError = error;
+    }
+    this->CPU.EndStreaming();
+    this->CoarseValues.clear();
+    this->SetCoarseVolume(0, 0, val::undefined(), val::undefined(), val::undefined());
+  }
+
+  /// The isovalues drawn from the coarse volume (their bricks are not all resident).
+  void SetCoarseValues(const val& values)
+  {
+    this->CoarseValues.clear();
+    const int n = values["length"].as<int>();
+    for (int i = 0; i < n; ++i)
+    {
+      this->CoarseValues.push_back(values[i].as<double>());
+    }
   }
 
   /// The isosurfaces: [{value, color: [r, g, b], opacity}], at most 8.
@@ -637,6 +743,18 @@ public:
     stats.set("frameBufferBytes",
       this->Scene ? static_cast<double>(this->Scene->GetFrameBufferBytes()) : 0.0);
     stats.set("error", this->LastError);
+    // Per surface of the last CPU frame, in the order drawn (IsosurfaceScene::Normalize's): its
+    // isovalue, whether it came from the coarse volume (streaming), and its triangles.
+    val values = val::array(), coarse = val::array(), triangles = val::array();
+    for (std::size_t i = 0; i < this->SlotCoarse.size(); ++i)
+    {
+      values.call<void>("push", this->SlotValues[i]);
+      coarse.call<void>("push", static_cast<bool>(this->SlotCoarse[i]));
+      triangles.call<void>("push", this->SlotTriangles[i]);
+    }
+    stats.set("surfaceValues", values);
+    stats.set("coarse", coarse);
+    stats.set("surfaceTriangles", triangles);
     return stats;
   }
 
@@ -839,20 +957,31 @@ private:
   // level 0 when nothing fits, said in the error); uploaded when it changed.
   bool UpdateCPUSurfaces()
   {
-    std::vector<double> values;
+    // Streaming: the surfaces named coarse come from the coarse volume, the others from the
+    // buffer at level 3 (its coarse copies would read bricks not yet there).
+    const bool streaming = this->CPU.GetVolume().IsStreaming();
+    std::vector<double> values, fine, coarse;
+    std::vector<char> isCoarse;
     for (const IsosurfaceLook& s : this->Frame.Surfaces)
     {
+      const bool c = streaming && this->CoarseData &&
+        std::find(this->CoarseValues.begin(), this->CoarseValues.end(), s.Value) !=
+          this->CoarseValues.end();
       values.push_back(s.Value);
+      isCoarse.push_back(c);
+      (c ? coarse : fine).push_back(s.Value);
     }
     LevelChoice choice;
-    choice.Level = this->RequestedLevel < 0 ? LevelChoice::Auto : this->RequestedLevel;
+    choice.Level = streaming ? NumberOfLevels - 1
+      : this->RequestedLevel < 0 ? LevelChoice::Auto
+                                 : this->RequestedLevel;
     choice.BudgetBytes = this->Budget;
     choice.BudgetBinds = false;
     this->CPU.SetCacheLimit(std::max(this->Budget / 4.0, 0.0));
     const double start = emscripten_get_now();
     this->LastAborted = false;
     const SurfacesUpdate update =
-      this->CPU.Update(values, choice, CPUSurfaceMaker(), this->AbortHooks(start));
+      this->CPU.Update(fine, choice, CPUSurfaceMaker(), this->AbortHooks(start));
     this->Generating = false;
     if (update.Status == SurfacesUpdate::Outcome::Aborted)
     {
@@ -875,23 +1004,48 @@ private:
         : "the extraction stopped";
       return false;
     }
-    this->CPU.RecordCost(update, (emscripten_get_now() - start) / 1000.0);
+    if (!streaming)
+    {
+      this->CPU.RecordCost(update, (emscripten_get_now() - start) / 1000.0);
+    }
+    std::vector<CPUSurfaceRef> coarseSurfaces;
+    if (!coarse.empty())
+    {
+      LevelChoice whole;
+      whole.Level = NumberOfLevels - 1;
+      this->Coarse.SetCacheLimit(std::max(this->Budget / 16.0, 0.0));
+      const SurfacesUpdate c = this->Coarse.Update(coarse, whole, CPUSurfaceMaker());
+      if (c.Status != SurfacesUpdate::Outcome::Done)
+      {
+        this->LastError = c.Status == SurfacesUpdate::Outcome::OutOfMemory
+          ? c.Message
+          : "the extraction stopped";
+        return false;
+      }
+      coarseSurfaces = this->Coarse.GetSurfaces();
+    }
     // No isovalues: the level the choice would give for nothing, as before any surface.
-    this->CPULevel = !values.empty() ? update.Level
-      : this->RequestedLevel < 0     ? NumberOfLevels - 1
-                                     : this->RequestedLevel;
+    this->CPULevel = !fine.empty() ? update.Level
+      : streaming || this->RequestedLevel < 0 ? NumberOfLevels - 1
+                                              : this->RequestedLevel;
     const std::vector<CPUSurfaceRef>& surfaces = this->CPU.GetSurfaces();
     this->ShownTriangles = 0.0;
+    this->SlotValues = values;
+    this->SlotCoarse.assign(isCoarse.begin(), isCoarse.end());
+    this->SlotTriangles.assign(values.size(), 0.0);
+    std::size_t nextFine = 0, nextCoarse = 0;
     for (int slot = 0; slot < MaximumIsovalues; ++slot)
     {
-      if (slot >= static_cast<int>(surfaces.size()))
+      if (slot >= static_cast<int>(values.size()))
       {
         this->Meshes->Clear(slot);
         this->ShownKeys[slot] = SurfaceKey{ NAN, -1 };
         continue;
       }
-      const SurfaceKey key{ values[slot], update.Level };
-      const CPUSurface& surface = *surfaces[slot];
+      // A coarse surface's key: a level no fine one has.
+      const bool c = isCoarse[slot] != 0;
+      const SurfaceKey key{ values[slot], c ? -2 : update.Level };
+      const CPUSurface& surface = c ? *coarseSurfaces[nextCoarse++] : *surfaces[nextFine++];
       if (!(this->ShownKeys[slot] == key))
       {
         this->MeshesUploaded = true;
@@ -902,7 +1056,8 @@ private:
       }
       const IsosurfaceLook& look = this->Frame.Surfaces[slot];
       this->Meshes->SetLook(slot, look.Color, look.Opacity, true);
-      this->ShownTriangles += static_cast<double>(surface.Triangles.size() / 3);
+      this->SlotTriangles[slot] = static_cast<double>(surface.Triangles.size() / 3);
+      this->ShownTriangles += this->SlotTriangles[slot];
     }
     return true;
   }
@@ -936,6 +1091,22 @@ private:
     { this->RunPass(begin, end, body); },
     std::make_shared<SharedCostModel>(), CPULayout };
   std::vector<SurfaceKey> ShownKeys = std::vector<SurfaceKey>(MaximumIsovalues, SurfaceKey{ NAN, -1 });
+  // Streaming: the server's level 0 and its surfaces, the bricks of the buffer, the isovalues
+  // drawn from level 0, and per slot of the last frame whether it was and its triangles.
+#ifdef MEDISO_WEB_THREADS
+  BlockLODSurfaces<CPUSurfaceRef> Coarse{ mediso_web::MarchingCubesCases, ThreadedFor, nullptr,
+    CPULayout };
+#else
+  BlockLODSurfaces<CPUSurfaceRef> Coarse{ mediso_web::MarchingCubesCases, SerialFor, nullptr,
+    CPULayout };
+#endif
+  const void* CoarseData = nullptr;
+  VolumeDescription Described; // the volume as SetVolume described it (EndStreaming uploads it again)
+  BrickGrid Bricks;
+  std::vector<double> CoarseValues;
+  std::vector<double> SlotValues;
+  std::vector<char> SlotCoarse;
+  std::vector<double> SlotTriangles;
   std::uint64_t VolumeStamp = 0;
   int RequestedLevel = -1;
   int CPULevel = 3;
@@ -1021,6 +1192,35 @@ val GPUVolume(int type, const val& dims)
 // into these bins, and the module says whether the range is Hounsfield units
 // and where Otsu's threshold lies.
 
+/// The cores' brick ranges (BrickGrid.h, ComputeBrickRanges) of a volume of
+/// ScalarType `type` at `bytes` in the module's memory: [[min, max] or null
+/// per brick, x fastest]. The page's test compares them with the server's
+/// manifest, which computes them with numpy.
+val BrickRanges(int type, std::uintptr_t bytes, const val& dims, int brickPoints, int apron)
+{
+  int points[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    points[a] = dims[a].as<int>();
+  }
+  const BrickGrid grid(points, brickPoints);
+  val out = val::array();
+  for (const BrickRange& r : ComputeBrickRanges(grid, static_cast<ScalarType>(type),
+         reinterpret_cast<const void*>(bytes), apron, SerialFor))
+  {
+    if (r.Min > r.Max)
+    {
+      out.call<void>("push", val::null());
+      continue;
+    }
+    val pair = val::array();
+    pair.call<void>("push", r.Min);
+    pair.call<void>("push", r.Max);
+    out.call<void>("push", pair);
+  }
+  return out;
+}
+
 /// The bins the first isovalue's rule counts a range in: {low, width, count}.
 val HistogramBinsFor(double min, double max, bool integral)
 {
@@ -1063,6 +1263,7 @@ EMSCRIPTEN_BINDINGS(mediso_web)
   emscripten::constant("SkinHounsfield", SkinHounsfield);
   emscripten::constant("BoneHounsfield", BoneHounsfield);
   emscripten::function("histogramBins", &HistogramBinsFor);
+  emscripten::function("brickRanges", &BrickRanges);
   emscripten::function("otsuThreshold", &Otsu);
   const emscripten::class_<WebViewer> viewer("WebViewer");
   mediso::web::BindPageCamera(viewer);
@@ -1090,5 +1291,10 @@ EMSCRIPTEN_BINDINGS(mediso_web)
     .function("generationWord", &WebViewer::GenerationWord)
     .function("watchGeneration", &WebViewer::WatchGeneration)
     .function("aborted", &WebViewer::Aborted)
-    .function("setSlowExtraction", &WebViewer::SetSlowExtraction);
+    .function("setSlowExtraction", &WebViewer::SetSlowExtraction)
+    .function("setCoarseVolume", &WebViewer::SetCoarseVolume)
+    .function("beginStreaming", &WebViewer::BeginStreaming)
+    .function("writeBrick", &WebViewer::WriteBrick)
+    .function("endStreaming", &WebViewer::EndStreaming)
+    .function("setCoarseValues", &WebViewer::SetCoarseValues);
 }
