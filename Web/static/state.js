@@ -65,6 +65,7 @@ export const state = Object.seal({
   refinementsSkipped: 0, // refinements a newer change made obsolete
   lastRefinedMs: 0, // the last change to its full-level frame
   sampleDistance: 1, // the GPU path's image sample distance of the last frame
+  gpuLevel: 3, // the GPU path's volume level of the last frame (3: the volume; 2, 1: sampled)
   frameNote: "", // why the last frame is coarser than the full one ("" when it is not)
   frameLog: [], // the last 200 frames: [{values, cpuLevel, triangles, primitives, sampleDistance, interactive, settled, ms, predictedMs}]
 });

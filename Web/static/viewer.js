@@ -142,9 +142,11 @@ function recordFrame(ms, stats) {
   state.settled = stats.settled !== false;
   state.refinementsSkipped = stats.refinementsSkipped || 0;
   state.sampleDistance = stats.sampleDistance || 1;
+  state.gpuLevel = stats.gpuLevel ?? state.facts.levels.count - 1;
   state.frameNote = stats.note || "";
   state.frameLog.push({ id: stats.id, values: stats.values, cpuLevel: stats.cpuLevel,
     triangles: stats.triangles, primitives: stats.primitives, sampleDistance: state.sampleDistance,
+    gpuLevel: state.gpuLevel,
     interactive: state.interactive, settled: state.settled, ms, predictedMs: stats.predictedMs || 0 });
   if (state.frameLog.length > 200) {
     state.frameLog.shift();
