@@ -454,9 +454,6 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   }
   this->LastInteractive = interactive;
   const std::uint64_t fullPixels = mediso::FrameTimeModel::ShadedPixels(width, height, 1.0);
-  // Triangles of a Block LOD level: drawn, scaled from a level drawn, or
-  // (none drawn yet) from the GPU path's active pairs, about two triangles
-  // each at the full level.
   auto trianglesAt = [&](int level) { return impl.EstimatedTriangles(level); };
   auto gpuCandidate = [&](int level, float distance, std::uint64_t primitives)
   {
