@@ -60,6 +60,9 @@ constexpr float SampleDistances[] = { 1.0f, 1.5f, 2.0f, 2.5f, 3.0f, 4.0f, 5.0f, 
 // The full-resolution Block LOD level (vtkBlockLODContour's LOD 3: cubes of one voxel).
 constexpr int FullLevel = 3;
 
+// The coarse volume levels an interactive GPU frame chooses from, finest first (strides 2, 4).
+constexpr int VolumeLevels[] = { 2, 1 };
+
 using Clock = std::chrono::steady_clock;
 } // anonymous namespace
 
@@ -83,6 +86,8 @@ struct vtkHistoPyramidIsoMapper::Internals
   vtkMTimeType CountedStamp = 0;
   // Active pairs of the last GPU frame of these values and input (0: none yet).
   std::uint64_t Primitives = 0;
+  // The same for the coarse volume levels (index = level; 0: not drawn yet).
+  std::array<std::uint64_t, 4> LevelPairs = { { 0, 0, 0, 0 } };
 
   // Triangles of `level`: drawn, or scaled from the nearest level drawn
   // (a surface's triangles grow about 4x per finer level); 0 when none was.
@@ -99,6 +104,27 @@ struct vtkHistoPyramidIsoMapper::Internals
       }
     }
     return 0.0;
+  }
+
+  // Triangles of a Block LOD level: drawn, scaled from a level drawn, or
+  // (none drawn yet) from the GPU path's active pairs, about two triangles
+  // each at the full level.
+  std::uint64_t EstimatedTriangles(int level) const
+  {
+    const double drawn = this->TrianglesAt(level);
+    return static_cast<std::uint64_t>(
+      drawn > 0.0 ? drawn : 2.0 * static_cast<double>(this->Primitives) * std::pow(4.0, level - 3));
+  }
+
+  // Active pairs of a GPU volume level: drawn, else estimated from the full level's.
+  std::uint64_t EstimatedPairs(int level) const
+  {
+    const std::uint64_t drawn = this->LevelPairs[static_cast<std::size_t>(level)];
+    if (level == FullLevel)
+    {
+      return this->Primitives;
+    }
+    return drawn > 0 ? drawn : mediso::IsosurfaceScene::EstimateActivePairs(this->Primitives, level);
   }
 };
 
@@ -422,24 +448,17 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   {
     impl.LevelTriangles.fill(-1.0);
     impl.Primitives = 0;
+    impl.LevelPairs.fill(0);
     impl.CountedValues = drawnValues;
     impl.CountedStamp = scalars->GetMTime();
   }
   this->LastInteractive = interactive;
   const std::uint64_t fullPixels = mediso::FrameTimeModel::ShadedPixels(width, height, 1.0);
-  // Triangles of a Block LOD level: drawn, scaled from a level drawn, or
-  // (none drawn yet) from the GPU path's active pairs, about two triangles
-  // each at the full level.
-  auto trianglesAt = [&](int level)
-  {
-    const double drawn = impl.TrianglesAt(level);
-    return static_cast<std::uint64_t>(
-      drawn > 0.0 ? drawn : 2.0 * static_cast<double>(impl.Primitives) * std::pow(4.0, level - 3));
-  };
-  auto gpuCandidate = [&](float distance, std::uint64_t primitives)
+  auto trianglesAt = [&](int level) { return impl.EstimatedTriangles(level); };
+  auto gpuCandidate = [&](int level, float distance, std::uint64_t primitives)
   {
     mediso::FrameTimeModel::Candidate candidate;
-    candidate.Level = FullLevel;
+    candidate.Level = level;
     candidate.SampleDistance = distance;
     candidate.Work.Method = mediso::FrameMethod::CellRasterisation;
     candidate.Work.Primitives = primitives;
@@ -490,29 +509,23 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 
   // 5. An interactive frame whose GPU distances are all predicted over the
   //    budget (the primitives dominate: a coarser volume is needed) draws a
-  //    coarser Block LOD level's triangles instead, when one is predicted
-  //    to fit better. Needs the active pairs of a GPU frame of these values.
+  //    coarser level instead, when one is predicted to fit better: the GPU
+  //    path on a coarse volume level, or a Block LOD level's triangles.
+  //    Needs the active pairs of a GPU frame of these values.
   vtkOpenGLHistoPyramidIsosurfaces* gpu = impl.GPU;
-  if (interactive && this->InteractiveTriangleLevels && !this->ForceCPUFallback &&
-    impl.Primitives > 0 && this->LastGPUPathWorked)
+  int gpuLevel = FullLevel;
+  if (interactive && (this->InteractiveTriangleLevels || this->InteractiveVolumeLevels) &&
+    !this->ForceCPUFallback && impl.Primitives > 0 && this->LastGPUPathWorked)
   {
-    std::vector<mediso::FrameTimeModel::Candidate> candidates;
-    for (float distance : SampleDistances)
-    {
-      candidates.push_back(gpuCandidate(distance, impl.Primitives));
-    }
-    for (int level = FullLevel - 1; level >= 0; --level)
-    {
-      candidates.push_back(triangleCandidate(level));
-    }
     const mediso::FrameTimeModel::Candidate& chosen =
-      candidates[impl.Model.Choose(candidates, budget)];
+      this->ChooseInteractiveLevel(translucent, width, height, budget);
     if (chosen.Work.Method == mediso::FrameMethod::Triangles)
     {
       this->FallbackReason.clear();
       drawTriangles(chosen.Level);
       return;
     }
+    gpuLevel = chosen.Level;
   }
 
   // 6. The GPU path, or the fallback when it cannot run (said once, with the reason).
@@ -526,7 +539,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       std::vector<mediso::FrameTimeModel::Candidate> candidates;
       for (float distance : SampleDistances)
       {
-        candidates.push_back(gpuCandidate(distance, primitives));
+        candidates.push_back(gpuCandidate(gpuLevel, distance, primitives));
       }
       const std::size_t chosen = interactive ? impl.Model.Choose(candidates, budget) : 0;
       chosenWork = candidates[chosen].Work;
@@ -534,7 +547,8 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       return candidates[chosen].SampleDistance;
     };
   }
-  const std::uint64_t buildsBefore = gpu->GetStats().PyramidBuilds;
+  gpu->SetVolumeLevel(gpuLevel);
+  const std::uint64_t buildsBefore = gpu->GetStats().PyramidBuilds + gpu->GetStats().CoarseBuilds;
   const std::uint64_t uploadsBefore = gpu->GetStats().VolumeUploads;
   const Clock::time_point gpuStart = Clock::now();
   if (this->ForceCPUFallback)
@@ -550,16 +564,21 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     this->GPUStats = gpu->GetStats();
     this->LastFootprint = this->GPUStats.PointFootprint ? PointFootprint : BoxFootprint;
     this->LastSampleDistance = this->GPUStats.SampleDistance;
-    impl.Primitives = this->GPUStats.Primitives;
+    this->LastLevel = this->GPUStats.Level;
+    impl.Primitives = gpu->GetActivePairs(FullLevel);
+    impl.LevelPairs[static_cast<std::size_t>(this->GPUStats.Level)] = this->GPUStats.Primitives;
     if (adjust && this->GPUStats.Primitives > 0)
     {
       // Timed to the frame's end: a GL frame's calls return before its work is done.
       glFinish();
       this->LastMeasuredSeconds = std::chrono::duration<double>(Clock::now() - gpuStart).count();
-      const bool rebuilt = this->GPUStats.PyramidBuilds != buildsBefore ||
+      const bool rebuilt =
+        this->GPUStats.PyramidBuilds + this->GPUStats.CoarseBuilds != buildsBefore ||
         this->GPUStats.VolumeUploads != uploadsBefore;
+      // The first frame of each level, distance and translucency builds its program.
       const std::pair<int, bool> key(
-        static_cast<int>(std::lround(100.0 * this->LastSampleDistance)), chosenWork.Translucent);
+        1000 * this->LastLevel + static_cast<int>(std::lround(100.0 * this->LastSampleDistance)),
+        chosenWork.Translucent);
       if (!rebuilt && !impl.Warm.insert(key).second)
       {
         impl.Model.Observe(chosenWork, this->LastMeasuredSeconds);
@@ -597,6 +616,49 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 }
 
 //------------------------------------------------------------------------------
+mediso::FrameTimeModel::Candidate vtkHistoPyramidIsoMapper::ChooseInteractiveLevel(
+  bool translucent, int width, int height, double budget)
+{
+  // Finest first: the full volume at each sample distance, then per coarser
+  // level its GPU frames (InteractiveVolumeLevels) and its triangles
+  // (InteractiveTriangleLevels), level 0's triangles last.
+  Internals& impl = *this->Impl;
+  std::vector<mediso::FrameTimeModel::Candidate> candidates;
+  auto add = [&](int level, mediso::FrameMethod method, float distance)
+  {
+    mediso::FrameTimeModel::Candidate candidate;
+    candidate.Level = level;
+    candidate.SampleDistance = distance;
+    candidate.Work.Method = method;
+    candidate.Work.Primitives = method == mediso::FrameMethod::Triangles
+      ? impl.EstimatedTriangles(level)
+      : impl.EstimatedPairs(level);
+    candidate.Work.Pixels = mediso::FrameTimeModel::ShadedPixels(width, height, distance);
+    candidate.Work.Translucent = translucent;
+    candidates.push_back(candidate);
+  };
+  for (int level = FullLevel; level >= 0; --level)
+  {
+    const bool volumeLevel = level == FullLevel ||
+      (this->InteractiveVolumeLevels &&
+        std::find(std::begin(VolumeLevels), std::end(VolumeLevels), level) !=
+          std::end(VolumeLevels));
+    for (float distance : SampleDistances)
+    {
+      if (volumeLevel)
+      {
+        add(level, mediso::FrameMethod::CellRasterisation, distance);
+      }
+    }
+    if (level < FullLevel && this->InteractiveTriangleLevels)
+    {
+      add(level, mediso::FrameMethod::Triangles, 1.0f);
+    }
+  }
+  return candidates[impl.Model.Choose(candidates, budget)];
+}
+
+//------------------------------------------------------------------------------
 void vtkHistoPyramidIsoMapper::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
@@ -610,6 +672,7 @@ void vtkHistoPyramidIsoMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "InteractiveAdjust: " << this->InteractiveAdjust << "\n";
   os << indent << "InteractiveFrameBudget: " << this->InteractiveFrameBudget << "\n";
   os << indent << "InteractiveTriangleLevels: " << this->InteractiveTriangleLevels << "\n";
+  os << indent << "InteractiveVolumeLevels: " << this->InteractiveVolumeLevels << "\n";
   os << indent << "LastInteractive: " << this->LastInteractive << "\n";
   os << indent << "LastSampleDistance: " << this->LastSampleDistance << "\n";
   os << indent << "LastLevel: " << this->LastLevel << "\n";

@@ -77,15 +77,18 @@
  * with their depth), the CPU fallback at the finest Block LOD level
  * predicted within it. Where even the GPU path's coarsest distance is
  * predicted over the budget (its per-cell work dominates: the frame needs a
- * coarser volume), the frame draws the triangles of the finest coarser
- * Block LOD level predicted within it (level 0 when none is), the CPU
- * path's cached levels (InteractiveTriangleLevels; such a frame reports the
+ * coarser volume), the frame draws a coarser level, finest first, each at
+ * its finest distance predicted within the budget: the GPU path on the
+ * volume sampled at Block LOD level 2's or 1's stride (2 or 4: a coarse
+ * volume and pyramid the GPU core makes on the level's first frame;
+ * InteractiveVolumeLevels; the frame reports the "gpu" path and its level),
+ * else that level's Block LOD triangles, and level 0's last (the CPU path's
+ * cached levels, InteractiveTriangleLevels; such a frame reports the
  * "fallback" path with an empty FallbackReason). Other renders are full
  * quality, the same image as with InteractiveAdjust off. GetLastSampleDistance(), GetLastLevel(),
  * GetLastPredictedSeconds() and GetLastMeasuredSeconds() say what the last
  * frame did; frames are timed to their end (glFinish) while InteractiveAdjust
- * is on. The GPU path itself draws the full volume (level 3); coarser
- * volumes reach the screen through the Block LOD triangles.
+ * is on. Still frames of the GPU path draw the full volume (level 3).
  *
  * GPU memory: GetGPUMemoryBytes() (the volume texture plus about 0.16 bytes
  * per padded cell for the pyramid) stays the same across isovalue changes;
@@ -244,9 +247,24 @@ public:
 
   ///@{
   /**
+   * Let an interactive GPU frame whose sample distances are all predicted
+   * over the budget draw the GPU path on a coarser volume level: Block LOD
+   * level 2 or 1 (the volume sampled at stride 2 or 4, the points those
+   * levels' triangles are made from), whose coarse volume and pyramid the
+   * GPU core makes on the level's first frame (up to 1/8 + 1/64 more GPU
+   * memory). Candidates go finest first: a level's GPU frames before its
+   * triangles. Default on.
+   */
+  vtkSetMacro(InteractiveVolumeLevels, bool);
+  vtkGetMacro(InteractiveVolumeLevels, bool);
+  vtkBooleanMacro(InteractiveVolumeLevels, bool);
+  ///@}
+
+  ///@{
+  /**
    * What the last frame did: whether it was an interactive render, the image
    * sample distance (1: every pixel) and Block LOD level (3: full
-   * resolution; the GPU path always draws the full volume) it drew at, the
+   * resolution; on the GPU path, below 3, the coarse volume level) it drew at, the
    * seconds the frame-time model predicted for it and the seconds it took
    * (0 while InteractiveAdjust is off or nothing was drawn).
    */
@@ -377,6 +395,12 @@ private:
   vtkHistoPyramidIsoMapper(const vtkHistoPyramidIsoMapper&) = delete;
   void operator=(const vtkHistoPyramidIsoMapper&) = delete;
 
+  // An interactive GPU frame's level, method and sample distance: the first
+  // of the candidates, finest first, that the frame-time model predicts
+  // within `budget` (the last when none is).
+  mediso::FrameTimeModel::Candidate ChooseInteractiveLevel(
+    bool translucent, int width, int height, double budget);
+
   int LastRenderPath = NoPath;
   std::string FallbackReason;
   bool ForceCPUFallback = false;
@@ -386,6 +410,7 @@ private:
   bool InteractiveAdjust = true;
   double InteractiveFrameBudget = 0.1;
   bool InteractiveTriangleLevels = true;
+  bool InteractiveVolumeLevels = true;
   bool LastInteractive = false;
   double LastSampleDistance = 1.0;
   int LastLevel = 3;

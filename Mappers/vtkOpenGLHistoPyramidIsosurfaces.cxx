@@ -49,6 +49,7 @@ struct vtkOpenGLHistoPyramidIsosurfaces::Internals
   std::string Reason;
   mediso::IsosurfaceScene Scene{ ParallelFor };
   std::vector<Plane> ClipPlanes; // world coordinates
+  int VolumeLevel = 3;           // mediso::IsosurfaceFrame::Level of the next frame
 
   // Frees the scene's objects (the window's context must be current).
   void Release()
@@ -122,6 +123,18 @@ void vtkOpenGLHistoPyramidIsosurfaces::ReleaseGraphicsResources(vtkWindow* win)
 void vtkOpenGLHistoPyramidIsosurfaces::SetClipPlanes(const std::vector<Plane>& worldPlanes)
 {
   this->Impl->ClipPlanes = worldPlanes;
+}
+
+//------------------------------------------------------------------------------
+void vtkOpenGLHistoPyramidIsosurfaces::SetVolumeLevel(int level)
+{
+  this->Impl->VolumeLevel = level;
+}
+
+//------------------------------------------------------------------------------
+std::uint64_t vtkOpenGLHistoPyramidIsosurfaces::GetActivePairs(int level) const
+{
+  return this->Impl->Scene.GetActivePairs(level);
 }
 
 //------------------------------------------------------------------------------
@@ -214,7 +227,7 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
     looks.push_back(look);
   }
   impl.Scene.SetSurfaces(looks);
-  if (!impl.Scene.Update(reason))
+  if (!impl.Scene.Update(reason) || !impl.Scene.UpdateLevel(impl.VolumeLevel, reason))
   {
     return false;
   }
@@ -287,9 +300,10 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
   frame.AllowPointFootprint = allowPointFootprint;
   frame.FirstHitPass = firstHitPass;
   frame.ClipPlanes = PullBackPlanes(impl.ClipPlanes, indexToWorld);
+  frame.Level = impl.VolumeLevel;
   if (sampleDistance)
   {
-    frame.SampleDistance = sampleDistance(impl.Scene.GetActivePairs());
+    frame.SampleDistance = sampleDistance(impl.Scene.GetActivePairs(impl.VolumeLevel));
   }
 
   // 4. Draw.

@@ -78,6 +78,17 @@ public:
     vtkDataArray* scalars, const std::vector<Surface>& surfaces, bool allowPointFootprint,
     bool firstHitPass, const SampleDistanceChooser& sampleDistance, std::string& reason);
 
+  /**
+   * The volume level the next RenderIsosurfaces() draws (mediso::IsosurfaceFrame::Level):
+   * 3, the volume (the default); 2, 1 or 0, the volume sampled at Block LOD's stride 2, 4
+   * or 8, made and built by the scene on the level's first frame. The sample distance
+   * chooser is then given that level's active pairs.
+   */
+  void SetVolumeLevel(int level);
+
+  /// The active pairs of a level built for the last frame's surfaces (0 when not built).
+  std::uint64_t GetActivePairs(int level) const;
+
   /// A plane (a, b, c, d): the points where a x + b y + c z + d >= 0 are kept.
   using Plane = std::array<double, 4>;
 

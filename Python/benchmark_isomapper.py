@@ -85,6 +85,10 @@ def parse_args(argv):
     p.add_argument("--json", default="", help="write the raw records to this file")
     p.add_argument("--interactive-budget", type=float, default=0.0,
                    help="> 0: interactive rotation frames of hp with this budget (seconds)")
+    p.add_argument("--interactive-levels", default="volume,triangles",
+                   help="coarser levels interactive hp frames may take: volume (the GPU path on "
+                        "a coarse volume level), triangles (Block LOD triangles), both (default) "
+                        "or none")
     p.add_argument("--opacity", type=float, default=1.0,
                    help="opacity of the first isovalue (the others opaque)")
     p.add_argument("--together", action="store_true",
@@ -99,7 +103,8 @@ def run_input(args, name):
                "--isovalues=" + args.isovalues, "--methods", args.methods,
                "--rc-factors", args.rc_factors]
     if args.interactive_budget > 0:
-        command += ["--interactive-budget", str(args.interactive_budget)]
+        command += ["--interactive-budget", str(args.interactive_budget),
+                    "--interactive-levels", args.interactive_levels]
     if args.opacity != 1.0:
         command += ["--opacity", str(args.opacity)]
     if args.together:
@@ -226,8 +231,9 @@ def report(args, command, records, failed, started, wall, load_before, load_afte
                          "%.2f" % (r["median_s"] / r["still_median_s"]),
                          "%g (%g..%g)" % (r["distance_median"], r["distance_min"],
                                           r["distance_max"]),
-                         "%d; level median %g, min %g" % (r["triangle_frames"],
-                                                          r["level_median"], r["level_min"]),
+                         "%d; GPU volume level frames %d; level median %g, min %g"
+                         % (r["triangle_frames"], r.get("volume_level_frames", 0),
+                            r["level_median"], r["level_min"]),
                          "%s / %s" % (fmt_s(r["predicted_median_s"]),
                                       fmt_s(r["measured_median_s"])),
                          "%.0f%%" % (100.0 * r["error_median"]),

@@ -249,7 +249,9 @@ def main_interactive(args, argv):
             how = "-"
             if d.get("levels") is not None:
                 how = ("levels %s" % d["levels"]) if run["path"] == "cpu" else \
-                    ("distance %s" % ", ".join("%.2g" % s for s in d["sampleDistances"]))
+                    ("distance %s" % ", ".join("%.2g" % s for s in d["sampleDistances"]) +
+                     ("; volume level %s" % ", ".join(str(k) for k in d["gpuLevels"])
+                      if d.get("gpuLevels") else ""))
             lines.append("| %s | %s | %s | %.0f (%.0f) | %.0f | %.0f | %s | %s | %.0f |" % (
                 name, run["path"], run["page"], statistics.median(firsts), max(firsts),
                 statistics.median(fulls), d["frameMs"] or 0,

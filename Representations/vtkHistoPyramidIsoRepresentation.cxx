@@ -147,6 +147,18 @@ bool vtkHistoPyramidIsoRepresentation::GetInteractiveTriangleLevels()
 }
 
 //------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetInteractiveVolumeLevels(bool use)
+{
+  this->IsoMapper->SetInteractiveVolumeLevels(use);
+}
+
+//------------------------------------------------------------------------------
+bool vtkHistoPyramidIsoRepresentation::GetInteractiveVolumeLevels()
+{
+  return this->IsoMapper->GetInteractiveVolumeLevels();
+}
+
+//------------------------------------------------------------------------------
 double vtkHistoPyramidIsoRepresentation::GetLastInteractive()
 {
   return this->IsoMapper->GetLastInteractive() ? 1.0 : 0.0;

@@ -122,8 +122,9 @@ public:
    * SetInteractiveFrameBudget): during the view's interactive renders draw
    * within the budget (seconds; 0: the time the view allocates), at a coarser
    * image sample distance (GPU) or Block LOD level (fallback; also the GPU
-   * path's frames that no distance fits, with InteractiveTriangleLevels).
-   * Defaults on, 0.1 s, on.
+   * path's frames that no distance fits, with InteractiveTriangleLevels;
+   * before a level's triangles, the GPU path on the volume sampled at that
+   * level's stride, with InteractiveVolumeLevels). Defaults on, 0.1 s, on, on.
    */
   void SetInteractiveAdjust(bool adjust);
   bool GetInteractiveAdjust();
@@ -131,6 +132,8 @@ public:
   double GetInteractiveFrameBudget();
   void SetInteractiveTriangleLevels(bool use);
   bool GetInteractiveTriangleLevels();
+  void SetInteractiveVolumeLevels(bool use);
+  bool GetInteractiveVolumeLevels();
   ///@}
 
   ///@{

@@ -75,6 +75,13 @@ struct IsosurfaceFrame
   /// depth (interactive frames: about 1 / SampleDistance^2 of the fragment work). 1 (or
   /// anything not above 1) draws every pixel, the full-quality image.
   float SampleDistance = 1.0f;
+  /// The volume level drawn: 3 the volume itself; 2, 1 or 0 its samples at Block LOD's strides
+  /// 2, 4 or 8 (BlockLOD.h's LevelStride(), the samples of vtkBlockLODContour's levels), a
+  /// coarse volume with its own pyramid that IsosurfaceScene makes on the level's first frame
+  /// (interactive frames: about 1 / stride^2 of the primitives). Its cells are drawn
+  /// stride times larger, so the frame shows the exact trilinear surface of the coarse volume
+  /// where the level's cells are (see IsosurfaceScene::UpdateLevel()).
+  int Level = 3;
 
   /// The lights a program draws with (NumberOfLights within 0..MaximumLights): its
   /// MEDISO_LIGHTS, a constant of the program, since a software rasteriser runs every
@@ -98,6 +105,9 @@ struct IsosurfaceSceneStats
   /// IsosurfaceFrame::SampleDistance).
   float SampleDistance = 1.0f;
 
+  /// The volume level the last frame was drawn at (3: the volume; see IsosurfaceFrame::Level).
+  int Level = 3;
+
   ///@{
   /// The last pyramid build: seconds (its passes and the read-back of the total), the level-1
   /// tiles it drew (those whose value range holds an isovalue) and the volume's tiles.
@@ -114,6 +124,10 @@ struct IsosurfaceSceneStats
   std::uint64_t PyramidBuilds = 0;
   std::uint64_t VolumeUploads = 0;
   ///@}
+
+  /// Builds of a coarse level's pyramid so far (IsosurfaceFrame::Level below 3), the level's
+  /// sampling and upload included when it was the level's first.
+  std::uint64_t CoarseBuilds = 0;
 };
 
 } // namespace mediso

@@ -19,6 +19,15 @@
  *    when the surfaces' values or the volume changed since the last build.
  *    Camera moves reuse the uploaded volume and the built pyramid.
  *
+ * Interactive frames can draw a coarse level instead (IsosurfaceFrame::Level
+ * 2, 1 or 0): the volume sampled at Block LOD's strides 2, 4 or 8, the points
+ * vtkBlockLODContour's levels sample (MakeCoarseCopy() in BlockLOD.h), with
+ * its own texture and pyramid, made on the level's first frame and built
+ * again when the isovalues change (UpdateLevel()). On a software rasteriser
+ * the GPU path's frame is bound by its primitives (each walks the pyramid in
+ * the vertex stage), which a coarse level divides by about stride^2 where
+ * fewer pixels do not help.
+ *
  * These are the scene's one upload decision and one build decision, as
  * vtkOpenGLGPUVolumeRayCastMapper keeps one ShaderRebuildNeeded predicate;
  * GetStats() says what they did, in one structure the hosts forward whole.
@@ -88,7 +97,9 @@ public:
    * the current volume's (the rest of the description does not change the
    * GPU's copy). False, with the reason in @a error, when it cannot be
    * uploaded (over the context's texture limits, a GL failure); the scene
-   * then has no volume until one uploads.
+   * then has no volume until one uploads. The values stay the host's: they
+   * must stay valid while the scene holds the volume, since a coarse level
+   * (UpdateLevel()) is sampled from them on its first frame.
    */
   bool SetVolume(const VolumeDescription& volume, std::string& error);
   bool HasVolume() const;
@@ -113,6 +124,17 @@ public:
   bool Update(std::string& error);
 
   /**
+   * Update() for a volume level (IsosurfaceFrame::Level): 3 is Update();
+   * 2, 1 and 0 sample the volume at LevelStride(level) (the samples of Block
+   * LOD's level, the last point of each axis included), upload the samples
+   * as the level's own volume texture (once per volume) and build its
+   * pyramid when the surfaces' values changed since its last build. False,
+   * with the reason, for a level outside 0..3, without a volume, or when the
+   * upload or the build fails. Render() calls it for the frame's level.
+   */
+  bool UpdateLevel(int level, std::string& error);
+
+  /**
    * Update(), then draw the scene's surfaces for `frame` (its Surfaces are
    * ignored) into the bound draw framebuffer with the host's depth function.
    * No surfaces draw nothing. False, with the reason, when the update fails,
@@ -128,10 +150,24 @@ public:
    */
   std::uint64_t GetActivePairs() const;
 
+  /// The active pairs of a level's pyramid, built for the current surfaces (0 when not built).
+  std::uint64_t GetActivePairs(int level) const;
+
+  /**
+   * A level's active pairs before it is built, from the volume's: a surface
+   * crosses about 1 / stride^2 as many cells of stride^3 voxels (at least 1
+   * when the volume's are not 0). Hosts predict a coarse level's first frame with it.
+   */
+  static std::uint64_t EstimateActivePairs(std::uint64_t fullPairs, int level);
+
+  /// The points of a level's samples per axis (Block LOD's: every stride-th and the last).
+  static std::array<int, 3> LevelDimensions(const int points[3], int level);
+
   /// What the scene did (see IsosurfaceSceneStats).
   const IsosurfaceSceneStats& GetStats() const;
 
-  /// Bytes of GPU memory held now for the volume (its texture and the pyramid).
+  /// Bytes of GPU memory held now for the volume (its texture and the pyramid, with the coarse
+  /// levels made: at most 1/8 + 1/64 + 1/512 of the volume's).
   std::uint64_t GetGPUMemoryBytes() const;
 
   /// The volume texture's size in texels for a volume of `points` (4 points to a texel along x).

@@ -92,6 +92,9 @@ struct Options
   double Zoom = 1.0;    // camera zoom after the reset (close zooms: the quad footprints)
   bool Together = false; // rotation with all isovalues in one scene
   double InteractiveBudget = 0.0; // > 0: also interactive rotation frames of "hp" (issue 30)
+  // The coarser levels interactive frames may take: "volume" (InteractiveVolumeLevels),
+  // "triangles" (InteractiveTriangleLevels), both, or "none".
+  std::string InteractiveLevels = "volume,triangles";
   std::string ImageDir;
 };
 
@@ -164,6 +167,8 @@ bool Parse(int argc, char* argv[], Options& opt)
       opt.Zoom = std::max(1e-3, std::stod(value));
     else if (name == "--interactive-budget")
       opt.InteractiveBudget = std::max(0.0, std::stod(value));
+    else if (name == "--interactive-levels")
+      opt.InteractiveLevels = value;
     else if (name == "--together")
       opt.Together = std::stoi(value) != 0;
     else if (name == "--images")
@@ -811,10 +816,14 @@ int main(int argc, char* argv[])
           {
             vtkHistoPyramidIsoMapper* hp = scene.HistoPyramid;
             hp->SetInteractiveFrameBudget(opt.InteractiveBudget);
+            hp->SetInteractiveVolumeLevels(opt.InteractiveLevels.find("volume") != std::string::npos);
+            hp->SetInteractiveTriangleLevels(
+              opt.InteractiveLevels.find("triangles") != std::string::npos);
             scene.Window->SetDesiredUpdateRate(1000.0);
             std::vector<double> frameTimes, distances, predicted, measured, errors, levels;
             int within = 0;
             int triangleFrames = 0;
+            int volumeLevelFrames = 0;
             for (int f = 0; f < opt.Frames; ++f)
             {
               scene.Rotate(1.0);
@@ -823,6 +832,10 @@ int main(int argc, char* argv[])
               levels.push_back(hp->GetLastLevel());
               triangleFrames +=
                 hp->GetLastRenderPath() == vtkHistoPyramidIsoMapper::FallbackPath ? 1 : 0;
+              volumeLevelFrames +=
+                hp->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath && hp->GetLastLevel() < 3
+                ? 1
+                : 0;
               predicted.push_back(hp->GetLastPredictedSeconds());
               measured.push_back(hp->GetLastMeasuredSeconds());
               const double error =
@@ -850,6 +863,7 @@ int main(int argc, char* argv[])
               .Add("level_min", *std::min_element(levels.begin(), levels.end()))
               .Add("level_median", Summarise(levels).Median)
               .Add("triangle_frames", static_cast<double>(triangleFrames))
+              .Add("volume_level_frames", static_cast<double>(volumeLevelFrames))
               .Add("predicted_median_s", Summarise(predicted).Median)
               .Add("measured_median_s", Summarise(measured).Median)
               .Add("error_median", Summarise(errors).Median)

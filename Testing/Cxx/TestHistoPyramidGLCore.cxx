@@ -7,11 +7,86 @@
 //  - exit 125 (skip), printing "SKIP: <reason>", where no such EGL context
 //    can be made;
 //  - exit 1 on any mismatch.
+// Also the scene's coarse volume levels (IsosurfaceScene::UpdateLevel()):
+// at Block LOD levels 0, 1 and 2 the pyramid's total equals the CPU model's
+// count on that level's samples (MakeCoarseCopy, odd sizes: a shorter last
+// cell on some axes), each level is built once per set of isovalues and again
+// after a change, and a level outside 0..3 is refused with a reason.
 #include "HeadlessContext.h"
 #include "HistoPyramidGLChecks.h"
 
+#include "BlockLOD.h"
+#include "IsosurfaceScene.h"
+
 #include <cstring>
 #include <iostream>
+
+namespace
+{
+using medical_test::Check;
+
+void CheckCoarseLevels(const std::shared_ptr<const mediso::GLApi>& gl)
+{
+  const int dims[3] = { 45, 38, 29 };
+  const std::vector<std::int16_t> hu = pyramid_checks::MakePhantom(dims, 20.0, 7u);
+  mediso::IsosurfaceScene scene(nullptr);
+  scene.SetContext(gl);
+  mediso::VolumeDescription volume;
+  volume.Type = mediso::ScalarType::Int16;
+  volume.Data = hu.data();
+  std::copy(dims, dims + 3, volume.Dims);
+  std::string error;
+  Check(scene.SetVolume(volume, error), "coarse levels: the volume did not upload: " + error);
+  mediso::Volume<std::int16_t> full;
+  full.Data = hu.data();
+  std::copy(dims, dims + 3, full.Dims);
+  for (const std::vector<double>& isovalues :
+    std::vector<std::vector<double>>{ { -500.0 }, { -500.0, 300.0 } })
+  {
+    std::vector<mediso::IsosurfaceLook> looks(isovalues.size());
+    for (std::size_t i = 0; i < isovalues.size(); ++i)
+    {
+      looks[i].Value = isovalues[i];
+    }
+    scene.SetSurfaces(looks);
+    Check(scene.Update(error), "coarse levels: the full level did not build: " + error);
+    const std::uint64_t fullPairs = scene.GetActivePairs();
+    for (int level = 0; level < 3; ++level)
+    {
+      const std::uint64_t builds = scene.GetStats().CoarseBuilds;
+      const bool built = scene.UpdateLevel(level, error) && scene.UpdateLevel(level, error);
+      Check(built, "coarse level " + std::to_string(level) + " did not build: " + error);
+      Check(scene.GetStats().CoarseBuilds == builds + 1,
+        "coarse level " + std::to_string(level) + ": built once per set of isovalues");
+      std::vector<std::int16_t> samples;
+      const mediso::Volume<std::int16_t> coarse =
+        mediso::MakeCoarseCopy(full, level, samples, mediso::SerialFor);
+      const std::array<int, 3> expected = mediso::IsosurfaceScene::LevelDimensions(dims, level);
+      Check(std::equal(coarse.Dims, coarse.Dims + 3, expected.begin()),
+        "coarse level " + std::to_string(level) + ": LevelDimensions differs from Block LOD's");
+      std::uint64_t cpu = 0;
+      for (std::uint32_t c :
+        mediso::HistoPyramid::CountCrossings(samples.data(), coarse.Dims, isovalues))
+      {
+        cpu += c;
+      }
+      std::cout << "coarse level " << level << " (" << coarse.Dims[0] << "x" << coarse.Dims[1]
+                << "x" << coarse.Dims[2] << "), " << isovalues.size() << " isovalue(s): GPU "
+                << scene.GetActivePairs(level) << ", CPU " << cpu << " (full " << fullPairs
+                << ", estimate " << mediso::IsosurfaceScene::EstimateActivePairs(fullPairs, level)
+                << ")\n";
+      Check(scene.GetActivePairs(level) == cpu && cpu > 0 && cpu < fullPairs,
+        "coarse level " + std::to_string(level) +
+          ": the pyramid's total differs from the CPU model's count on the level's samples");
+    }
+  }
+  Check(scene.GetGPUMemoryBytes() >
+      mediso::IsosurfaceScene::EstimateGPUMemoryBytes(mediso::ScalarType::Int16, dims),
+    "coarse levels: their GPU memory is not counted");
+  Check(!scene.UpdateLevel(4, error) && !error.empty(), "coarse levels: level 4 is not refused");
+  scene.Release();
+}
+} // namespace
 
 int main(int argc, char* argv[])
 {
@@ -30,6 +105,7 @@ int main(int argc, char* argv[])
     return 125;
   }
   std::cout << "EGL platform: " << context->GetPlatform() << "\n";
+  CheckCoarseLevels(context->GetGLApi());
   return pyramid_checks::RunAll(context->GetGLApi(),
     es ? "TestHistoPyramidGLCore es passed" : "TestHistoPyramidGLCore gl passed");
 }

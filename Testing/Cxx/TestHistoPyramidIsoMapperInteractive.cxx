@@ -8,13 +8,18 @@
 // 2. An interactive render (DesiredUpdateRate 1000: a millisecond for the
 //    window) with a budget between the frame-time model's predictions for
 //    distances 1 and 8 draws at a distance above 1 predicted within it. With
-//    a tiny budget and InteractiveTriangleLevels off it draws at the coarsest
-//    distance (8) and says so (GetLastSampleDistance, GetLastInteractive,
-//    predicted and measured seconds); its image covers about the same pixels
-//    as the still one (the reduced target drawn up to the viewport), differs
-//    from it, and keeps the depth test: an opaque plane in front of the
-//    volume's left part stays unchanged. With the triangle levels on (the
-//    default) a tiny budget draws a coarser Block LOD level's triangles.
+//    a tiny budget and InteractiveTriangleLevels and InteractiveVolumeLevels
+//    off it draws at the coarsest distance (8) and says so
+//    (GetLastSampleDistance, GetLastInteractive, predicted and measured
+//    seconds); its image covers about the same pixels as the still one (the
+//    reduced target drawn up to the viewport), differs from it, and keeps the
+//    depth test: an opaque plane in front of the volume's left part stays
+//    unchanged. With the volume levels on (the default) a tiny budget draws
+//    the GPU path on a coarse volume level (Block LOD level 1, stride 4) and
+//    says so (GetLastLevel, the scene's stats), with as many primitives as
+//    the CPU model (mediso::HistoPyramid) counts on Block LOD's samples of
+//    that level, behind the plane. With the triangle levels on as well (the default) a tiny
+//    budget draws a coarser Block LOD level's triangles.
 // 3. With a budget of 1000 s the interactive render draws every pixel (the
 //    still image); with InteractiveFrameBudget 0 the allocated render time
 //    is the budget; with InteractiveAdjust off interactive renders are the
@@ -25,6 +30,9 @@
 // GPU path needed for 1-3 (a machine without it skips, 125).
 #include "IsoMapperTestScenes.h"
 #include "MedicalTestUtilities.h"
+
+#include "BlockLOD.h"     // MakeCoarseCopy, the samples of a level
+#include "HistoPyramid.h" // the CPU model's counts
 
 #include "vtkActor.h"
 #include "vtkCamera.h"
@@ -119,6 +127,30 @@ int PlanePixels(const std::vector<unsigned char>& rgb)
   return red;
 }
 
+// The CPU model's active (cell, isovalue) pairs on Block LOD's samples of `level`.
+std::uint64_t CountOnLevel(vtkImageData* image, const std::vector<double>& isovalues, int level)
+{
+  vtkDataArray* scalars = image->GetPointData()->GetScalars();
+  std::vector<double> values(static_cast<std::size_t>(scalars->GetNumberOfTuples()));
+  for (vtkIdType i = 0; i < scalars->GetNumberOfTuples(); ++i)
+  {
+    values[static_cast<std::size_t>(i)] = scalars->GetTuple1(i);
+  }
+  mediso::Volume<double> full;
+  full.Data = values.data();
+  image->GetDimensions(full.Dims);
+  std::vector<double> samples;
+  const mediso::Volume<double> coarse =
+    level < 3 ? mediso::MakeCoarseCopy(full, level, samples, mediso::SerialFor) : full;
+  std::uint64_t total = 0;
+  for (std::uint32_t count :
+    mediso::HistoPyramid::CountCrossings(coarse.Data, coarse.Dims, isovalues))
+  {
+    total += count;
+  }
+  return total;
+}
+
 std::string Describe(vtkHistoPyramidIsoMapper* mapper)
 {
   char text[256];
@@ -179,10 +211,12 @@ void CheckGPUScene(
       mapper->GetGPUStats().SampleDistance > 1.0f && mapper->GetLastPredictedSeconds() <= between,
     name + ": an interactive render draws at the finest distance predicted within the budget");
 
-  // A tiny budget with the triangle levels off: the GPU path's coarsest
-  // distance, drawn up to the viewport.
+  // A tiny budget with the triangle and volume levels off: the GPU path's
+  // coarsest distance, drawn up to the viewport.
   mapper->SetInteractiveFrameBudget(1e-7);
   mapper->InteractiveTriangleLevelsOff();
+  Check(mapper->GetInteractiveVolumeLevels(), name + ": InteractiveVolumeLevels on by default");
+  mapper->InteractiveVolumeLevelsOff();
   std::vector<unsigned char> interactive;
   for (int frame = 0; frame < 3; ++frame)
   {
@@ -203,6 +237,41 @@ void CheckGPUScene(
     name + ": the interactive frame covers the still frame's pixels within 10%");
   Check(PlanePixels(interactive) == stillPlane && PlanePixels(interactive) > 0,
     name + ": the plane in front keeps every pixel (the reduced surfaces' depth is tested)");
+
+  // The volume levels on: the GPU path on the coarsest volume level (Block
+  // LOD level 1: the volume sampled at stride 4), its primitives the CPU
+  // model's count on that level's samples.
+  mapper->InteractiveVolumeLevelsOn();
+  std::vector<double> isovalues;
+  for (const iso_test::Look& look : looks)
+  {
+    isovalues.push_back(look.Value);
+  }
+  vtkImageData* input = vtkImageData::SafeDownCast(mapper->GetInput());
+  const std::uint64_t coarseBuilds = mapper->GetGPUStats().CoarseBuilds;
+  std::vector<unsigned char> coarse;
+  for (int frame = 0; frame < 3; ++frame)
+  {
+    coarse = scene.Render(InteractiveRate);
+  }
+  std::printf("%s interactive, tiny budget, GPU volume levels: %s, %llu primitives (CPU model "
+              "at stride 4: %llu)\n",
+    name.c_str(),
+    Describe(mapper).c_str(),
+    static_cast<unsigned long long>(mapper->GetNumberOfPrimitives()),
+    static_cast<unsigned long long>(CountOnLevel(input, isovalues, 1)));
+  Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
+      mapper->GetLastInteractive() && mapper->GetLastLevel() == 1 &&
+      mapper->GetGPUStats().Level == 1,
+    name + ": a tiny budget draws the GPU path on the coarsest volume level (1) and says so");
+  Check(mapper->GetGPUStats().CoarseBuilds == coarseBuilds + 1,
+    name + ": the coarse level is built once for these isovalues, not per frame");
+  Check(mapper->GetNumberOfPrimitives() == CountOnLevel(input, isovalues, 1) &&
+      mapper->GetNumberOfPrimitives() > 0 && mapper->GetNumberOfPrimitives() < primitives / 4,
+    name + ": its primitives are the CPU model's count at stride 4, far fewer than the volume's");
+  Check(PlanePixels(coarse) == stillPlane &&
+      std::abs(Covered(coarse) - stillCovered) < stillCovered / 5,
+    name + ": the coarse level covers the still pixels within 20%, behind the plane");
 
   // The same with the triangle levels (the default): a coarser Block LOD
   // level's triangles, which are what fits a tiny budget best.

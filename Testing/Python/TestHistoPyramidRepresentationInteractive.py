@@ -8,8 +8,10 @@
   LastMeasuredSeconds) exist.
 - Still renders (the view's StillRender) draw every pixel of the full level, timed.
 - With a tiny budget, the view's InteractiveRender (a camera move) draws on the GPU path at a
-  sample distance above 1, and the information properties say so; the still render after it
-  is back at 1, and its screenshot equals the one before the interaction.
+  sample distance above 1 on a coarse volume level (HistoPyramidInteractiveVolumeLevels, on by
+  default: level 1, the volume sampled every 4th point), or on the full volume with the volume
+  levels off, and the information properties say so; the still render after it is back at 1
+  and level 3, and its screenshot equals the one before the interaction.
 - The CPU fallback (HistoPyramidForceCPUFallback) draws a coarser level during interaction
   and level 3 when still.
 - HistoPyramidInteractiveAdjust off: interactive renders at full quality.
@@ -33,12 +35,13 @@ view, display = hp.make_scene(phantom)
 INFO = ["HistoPyramidLastInteractive", "HistoPyramidLastSampleDistance", "HistoPyramidLastLevel",
         "HistoPyramidLastPredictedSeconds", "HistoPyramidLastMeasuredSeconds"]
 for name in ["HistoPyramidInteractiveAdjust", "HistoPyramidInteractiveFrameBudget",
-             "HistoPyramidInteractiveTriangleLevels"] + INFO:
+             "HistoPyramidInteractiveTriangleLevels", "HistoPyramidInteractiveVolumeLevels"] + INFO:
     check(display.GetProperty(name) is not None, "the display has %s" % name)
 check(display.HistoPyramidInteractiveAdjust == 1, "InteractiveAdjust is on by default")
 check(abs(display.HistoPyramidInteractiveFrameBudget - 0.1) < 1e-12,
       "InteractiveFrameBudget is 0.1 s by default")
 check(display.HistoPyramidInteractiveTriangleLevels == 1, "InteractiveTriangleLevels is on by default")
+check(display.HistoPyramidInteractiveVolumeLevels == 1, "InteractiveVolumeLevels is on by default")
 
 
 def last_frame():
@@ -79,6 +82,18 @@ check(moving["interactive"] == 1 and moving["distance"] == 8.0 and moving["path"
       "the coarsest sample distance, 8 (got %r)" % moving)
 check(moving["predicted"] > 0.0 and moving["measured"] > 0.0,
       "the interactive frame says what was predicted and measured (got %r)" % moving)
+check(moving["level"] == 1 and 0 < moving["primitives"] < still["primitives"],
+      "with the volume levels (default) it draws the GPU path on volume level 1, fewer "
+      "primitives than the still frame (got %r)" % moving)
+display.HistoPyramidInteractiveVolumeLevels = 0
+view.InteractiveRender()
+view.InteractiveRender()
+full_volume = last_frame()
+print("interactive, volume levels off:", full_volume)
+check(full_volume["path"] == "gpu" and full_volume["level"] == 3
+      and full_volume["distance"] == 8.0 and full_volume["primitives"] == still["primitives"],
+      "with the volume levels off it draws the full volume at distance 8 (got %r)" % full_volume)
+display.HistoPyramidInteractiveVolumeLevels = 1
 display.HistoPyramidInteractiveTriangleLevels = 1
 view.InteractiveRender()
 view.InteractiveRender()
@@ -91,7 +106,8 @@ check(coarse["interactive"] == 1 and coarse["path"] == "fallback" and coarse["re
 
 view.StillRender()
 after_info = last_frame()
-check(after_info["interactive"] == 0 and after_info["distance"] == 1.0,
+check(after_info["interactive"] == 0 and after_info["distance"] == 1.0
+      and after_info["level"] == 3,
       "the still render after the interaction draws every pixel (got %r)" % after_info)
 after = hp.screenshot(view, os.path.join(args.out, "InteractiveStillAfter.png"))
 check(hp.changed_fraction(before, after) == 0.0,

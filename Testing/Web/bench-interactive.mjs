@@ -65,6 +65,7 @@ for (const path of config.paths) {
       const drag = frames.filter((f) => f.interactive);
       run.drag = { frameMs: median(drag.map((f) => f.ms)), frames: drag.length, rate: drag.length / dragSeconds,
         levels: [...new Set(drag.map((f) => f.cpuLevel))], sampleDistances: [...new Set(drag.map((f) => f.sampleDistance))],
+        gpuLevels: [...new Set(drag.map((f) => f.gpuLevel).filter((k) => k !== undefined))],
         predictionError: median(drag.filter((f) => f.predictedMs > 0).map((f) => Math.abs(f.predictedMs - f.ms) / f.ms)) };
     } else {
       run.drag = { frameMs: median(sampled), frames: null, rate: null, levels: null, sampleDistances: [1] };

@@ -234,6 +234,7 @@ window.mediso = {
     abortNote: state.abortNote,
     lastRefinedMs: state.lastRefinedMs,
     sampleDistance: state.sampleDistance,
+    gpuLevel: state.gpuLevel,
     frameNote: state.frameNote,
     primitives: state.primitives,
     triangles: state.triangles,
@@ -257,7 +258,9 @@ window.mediso = {
     view: state.viewer ? state.viewer.getView() : null,
     info: state.viewer ? state.viewer.info() : null,
   }),
-  cpuCount: (values) => state.viewer.countOnCPU(values),
+  // the CPU model's count on the volume, or on its samples of volume level `level` (the GPU
+  // path's coarse levels: stats().gpuLevel)
+  cpuCount: (values, level = state.facts.levels.count - 1) => state.viewer.countOnCPU(values, level),
   // The stats once the newest frame asked for is drawn at its full level (with the viewer in a
   // worker, frames come after the change that asked for them; on the main thread, at once).
   async drawn() {

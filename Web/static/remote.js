@@ -228,8 +228,8 @@ export class RemoteViewer {
   stats() {
     return this.lastStats;
   }
-  countOnCPU(values) {
+  countOnCPU(values, level) {
     const v = this.volume;
-    return v ? this.M.countCrossings(v.type, v.pointer, v.dims, values) : 0;
+    return v ? this.M.countCrossings(v.type, v.pointer, v.dims, values, level) : 0;
   }
 }

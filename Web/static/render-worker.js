@@ -124,15 +124,17 @@ function keyOf(surfaces) {
   return JSON.stringify(surfaces.map((s) => s.value));
 }
 
-// Draws `frame` at CPU level `level` (-1: the estimator's within the memory budget) and sample
-// distance `distance`; the viewer's stats with the frame's time and what it was.
-function draw(frame, level, distance) {
+// Draws `frame` at CPU level `level` (-1: the estimator's within the memory budget), sample
+// distance `distance` and GPU volume level `gpuLevel` (the full volume when not given); the
+// viewer's stats with the frame's time and what it was.
+function draw(frame, level, distance, gpuLevel = M.NumberOfLevels - 1) {
   viewer.setSurfaces(frame.surfaces);
   viewer.setView(frame.view);
   if (path === "cpu") {
     viewer.setCPULevel(level);
   }
   viewer.setSampleDistance(distance);
+  viewer.setGPULevel(gpuLevel);
   const start = performance.now();
   const ok = viewer.render();
   if (ok) {
@@ -171,13 +173,15 @@ function pump() {
     }
     const auto = path === "cpu" && requestedLevel < 0;
     const coarse = auto && !streaming && (frame.interactive || key !== shownKey);
-    let level = requestedLevel, distance = 1, note = "", choice = null;
+    let level = requestedLevel, distance = 1, gpuLevel = M.NumberOfLevels - 1, note = "";
+    let choice = null;
     if (coarse || (path === "gpu" && frame.interactive)) {
       choice = choose(frame);
       level = path === "cpu" ? choice.level : requestedLevel;
       distance = path === "gpu" ? choice.sampleDistance : 1;
+      gpuLevel = path === "gpu" ? choice.level : gpuLevel;
     }
-    const stats = draw(frame, level, distance);
+    const stats = draw(frame, level, distance, gpuLevel);
     if (choice) {
       stats.predictedMs = choice.predictedMs;
       const over = "the full frame would take about " + Math.round(choice.fullMs) + " ms on this " +
@@ -185,8 +189,8 @@ function pump() {
       if (path === "cpu" && stats.cpuLevel < choice.memoryLevel) {
         note = (frame.interactive ? "While dragging" : "First answer") + ": level " + stats.cpuLevel +
           " (" + over + ")" + (frame.interactive ? "." : "; refining.");
-      } else if (path === "gpu" && distance > 1) {
-        note = "While dragging: one pixel in " + distance + " along each axis, scaled up (" + over + ").";
+      } else if (path === "gpu" && (distance > 1 || stats.gpuLevel < M.NumberOfLevels - 1)) {
+        note = "While dragging: " + gpuFrameNote(stats.gpuLevel, distance) + " (" + over + ").";
       }
     }
     shownKey = key;
@@ -200,6 +204,19 @@ function pump() {
     }
     post({ op: "frame", id: frame.id, stats });
   }
+}
+
+// What a coarse GPU frame drew: the volume level (every stride-th point) and the sample distance.
+function gpuFrameNote(gpuLevel, distance) {
+  const parts = [];
+  if (gpuLevel < M.NumberOfLevels - 1) {
+    parts.push("volume level " + gpuLevel + ", one point in " + M.levelStride(gpuLevel) +
+      " along each axis");
+  }
+  if (distance > 1) {
+    parts.push("one pixel in " + distance + " along each axis, scaled up");
+  }
+  return parts.join("; ");
 }
 
 // The full level owed after a coarse frame (skipped when a newer frame made it obsolete).

@@ -68,6 +68,7 @@ export const state = Object.seal({
   abortNote: "", // the worker's word on it
   lastRefinedMs: 0, // the last change to its full-level frame
   sampleDistance: 1, // the GPU path's image sample distance of the last frame
+  gpuLevel: 3, // the GPU path's volume level of the last frame (3: the volume; 2, 1: sampled)
   frameNote: "", // why the last frame is coarser than the full one ("" when it is not)
   // stream.js (docs/web.md, Streaming): the stream of the full level's bricks (null when the
   // volume came whole), each drawn surface's level of the whole volume, and the fraction of the

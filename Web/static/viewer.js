@@ -150,9 +150,11 @@ function recordFrame(ms, stats) {
   state.abortable = !!stats.abortable;
   state.abortNote = stats.abortNote || "";
   state.sampleDistance = stats.sampleDistance || 1;
+  state.gpuLevel = stats.gpuLevel ?? state.facts.levels.count - 1;
   state.frameNote = stats.note || "";
   state.frameLog.push({ id: stats.id, values: stats.values, cpuLevel: stats.cpuLevel,
     triangles: stats.triangles, primitives: stats.primitives, sampleDistance: state.sampleDistance,
+    gpuLevel: state.gpuLevel,
     interactive: state.interactive, settled: state.settled, ms, predictedMs: stats.predictedMs || 0,
     surfaceValues: stats.surfaceValues || [], coarse: stats.coarse || [],
     surfaceTriangles: stats.surfaceTriangles || [] });

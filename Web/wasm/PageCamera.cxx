@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "PageCamera.h"
 
+#include "BlockLOD.h"
 #include "HistoPyramid.h"
 
 #include <algorithm>
@@ -132,9 +133,10 @@ val PageCamera::GetView() const
   return view;
 }
 
-double CountActivePairs(ScalarType type, const void* data, const int dims[3], const val& isovalues)
+double CountActivePairs(
+  ScalarType type, const void* data, const int dims[3], const val& isovalues, int level)
 {
-  if (!data || ScalarTypeSize(type) == 0)
+  if (!data || ScalarTypeSize(type) == 0 || level < 0 || level >= NumberOfLevels)
   {
     return 0.0;
   }
@@ -149,8 +151,15 @@ double CountActivePairs(ScalarType type, const void* data, const int dims[3], co
     [&](auto tag)
     {
       using T = decltype(tag);
-      for (std::uint32_t count :
-        HistoPyramid::CountCrossings(static_cast<const T*>(data), dims, values))
+      Volume<T> volume;
+      volume.Data = static_cast<const T*>(data);
+      std::copy(dims, dims + 3, volume.Dims);
+      std::vector<T> samples;
+      if (level < NumberOfLevels - 1)
+      {
+        volume = MakeCoarseCopy(volume, level, samples, SerialFor);
+      }
+      for (std::uint32_t count : HistoPyramid::CountCrossings(volume.Data, volume.Dims, values))
       {
         total += count;
       }

@@ -43,8 +43,9 @@ private:
 };
 
 /// The CPU model's count of active (cell, isovalue) pairs of a volume of
-/// ScalarType `type` at `bytes` in the module's memory.
-double CountCrossings(int type, std::uintptr_t bytes, const val& dims, const val& isovalues)
+/// ScalarType `type` at `bytes` in the module's memory, on a level's samples (3: all).
+double CountCrossings(
+  int type, std::uintptr_t bytes, const val& dims, const val& isovalues, int level)
 {
   int points[3];
   for (int a = 0; a < 3; ++a)
@@ -52,7 +53,8 @@ double CountCrossings(int type, std::uintptr_t bytes, const val& dims, const val
     points[a] = dims[a].as<int>();
   }
   return mediso::web::CountActivePairs(
-    static_cast<mediso::ScalarType>(type), reinterpret_cast<const void*>(bytes), points, isovalues);
+    static_cast<mediso::ScalarType>(type), reinterpret_cast<const void*>(bytes), points, isovalues,
+    level);
 }
 } // namespace
 

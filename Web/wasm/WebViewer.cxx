@@ -323,6 +323,15 @@ public:
     this->SlowPass = pass == 2 ? 2 : 1;
   }
 
+  /**
+   * The GPU path's volume level of the next frames (IsosurfaceFrame::Level):
+   * 3 the volume; 2, 1 or 0 the volume sampled at Block LOD's stride 2, 4 or
+   * 8, a coarse volume and pyramid the scene makes on the level's first frame
+   * (about 1 / stride^2 of the primitives). The page's worker sets it for the
+   * frames of a drag (chooseFrame's level); 3 for still frames.
+   */
+  void SetGPULevel(int level) { this->GPULevel = std::max(0, std::min(NumberOfLevels - 1, level)); }
+
   /// The estimator's table for the current isovalues: per level, triangles, MB and seconds.
   val Estimates()
   {
@@ -566,16 +575,19 @@ public:
     }
     else if (!values.empty())
     {
-      // The scene builds only when the isovalues changed.
-      const std::uint64_t builds = this->Scene->GetStats().PyramidBuilds;
+      // The scene builds only when the isovalues changed (a coarse level: also on its first frame).
+      const auto builds = [this]()
+      { return this->Scene->GetStats().PyramidBuilds + this->Scene->GetStats().CoarseBuilds; };
+      const std::uint64_t before = builds();
       this->Scene->SetSurfaces(this->Frame.Surfaces);
+      this->Frame.Level = this->GPULevel;
       std::string error;
-      if (!this->Scene->Update(error))
+      if (!this->Scene->Update(error) || !this->Scene->UpdateLevel(this->GPULevel, error))
       {
         this->LastError = error;
         return false;
       }
-      if (this->Scene->GetStats().PyramidBuilds != builds)
+      if (builds() != before)
       {
         this->LastBuildMs = emscripten_get_now() - start;
       }
@@ -664,8 +676,10 @@ public:
    * {level, sampleDistance, predictedMs, fullMs} for the current isovalues.
    * CPU path: the finest level, at most the one the memory budget allows,
    * whose extraction and drawing fit (the coarsest when none does). GPU path:
-   * the smallest image sample distance whose frame fits (1 to 4), from the
-   * last frame's primitives. fullMs: the prediction of the full frame (level
+   * the full volume at the smallest image sample distance whose frame fits
+   * (1 to 4), else the coarse volume levels 2 and 1 (strides 2, 4) the same
+   * way, from each level's active pairs (estimated from the full level's
+   * before its first frame). fullMs: the prediction of the full frame (level
    * the memory allows, every pixel), which the page states when it is over.
    */
   val ChooseFrame(double budgetSeconds)
@@ -692,15 +706,8 @@ public:
     }
     else
     {
-      for (double distance : { 1.0, 1.5, 2.0, 3.0, 4.0 })
-      {
-        FrameTimeModel::Candidate c;
-        c.Level = NumberOfLevels - 1;
-        c.SampleDistance = static_cast<float>(distance);
-        c.Work = this->Work(this->Stats.Primitives, distance);
-        candidates.push_back(c);
-        extraSeconds.push_back(0.0);
-      }
+      this->AddGPUCandidates(candidates);
+      extraSeconds.resize(candidates.size(), 0.0);
     }
     std::size_t chosen = candidates.size() - 1;
     for (std::size_t i = 0; i < candidates.size(); ++i)
@@ -726,6 +733,7 @@ public:
   {
     val stats = val::object();
     stats.set("path", std::string(this->CPUPath ? "cpu" : "gpu"));
+    stats.set("gpuLevel", this->CPUPath ? NumberOfLevels - 1 : this->Stats.Level);
     stats.set("primitives", this->CPUPath ? 0.0 : static_cast<double>(this->Stats.Primitives));
     stats.set("triangles", this->CPUPath ? this->ShownTriangles : 0.0);
     stats.set("cpuLevel", this->CPULevel);
@@ -758,14 +766,37 @@ public:
     return stats;
   }
 
-  /// The CPU model's count of active (cell, isovalue) pairs (tests compare the GPU's with it).
-  double CountOnCPU(const val& isovalues) const
+  /// The CPU model's count of active (cell, isovalue) pairs on the samples of a volume level
+  /// (3: the volume; tests compare the GPU's with it, at the GPU path's level).
+  double CountOnCPU(const val& isovalues, int level) const
   {
     return CountActivePairs(
-      this->Type, this->Data, this->Viewpoint.GetPlacement().Dimensions, isovalues);
+      this->Type, this->Data, this->Viewpoint.GetPlacement().Dimensions, isovalues, level);
   }
 
 private:
+  // The GPU path's candidates, finest first: the full volume at each sample distance, then the
+  // coarse volume levels 2 and 1 the same way, each from its pyramid's active pairs when built
+  // for these surfaces, else estimated from the full level's (IsosurfaceScene).
+  void AddGPUCandidates(std::vector<FrameTimeModel::Candidate>& candidates) const
+  {
+    const std::uint64_t full = this->Scene ? this->Scene->GetActivePairs() : 0;
+    for (int level : { NumberOfLevels - 1, 2, 1 })
+    {
+      const std::uint64_t built = this->Scene ? this->Scene->GetActivePairs(level) : 0;
+      const std::uint64_t pairs =
+        built > 0 ? built : IsosurfaceScene::EstimateActivePairs(full, level);
+      for (double distance : { 1.0, 1.5, 2.0, 3.0, 4.0 })
+      {
+        FrameTimeModel::Candidate c;
+        c.Level = level;
+        c.SampleDistance = static_cast<float>(distance);
+        c.Work = this->Work(pairs, distance);
+        candidates.push_back(c);
+      }
+    }
+  }
+
   // The work of a frame of the current surfaces with `primitives` (triangles on the CPU path)
   // at an image sample distance.
   FrameWork Work(std::uint64_t primitives, double sampleDistance) const
@@ -1076,6 +1107,7 @@ private:
   float Background[3] = { 0.1f, 0.12f, 0.16f };
   double LastBuildMs = 0.0, LastFrameMs = 0.0;
   double SampleDistance = 1.0, DrawnSampleDistance = 1.0;
+  int GPULevel = NumberOfLevels - 1; // the GPU path's volume level (SetGPULevel)
   FrameTimeModel Times; // this client's frames: the time each level or sample distance takes
   double FrameStart = 0.0;
   bool FrameDrawn = false; // a frame was drawn since the last Finish
@@ -1284,6 +1316,7 @@ EMSCRIPTEN_BINDINGS(mediso_web)
     .function("setCPULevel", &WebViewer::SetCPULevel)
     .function("setBudget", &WebViewer::SetBudget)
     .function("setSampleDistance", &WebViewer::SetSampleDistance)
+    .function("setGPULevel", &WebViewer::SetGPULevel)
     .function("chooseFrame", &WebViewer::ChooseFrame)
     .function("estimates", &WebViewer::Estimates)
     .function("setResultMesh", &WebViewer::SetResultMesh)
