@@ -598,17 +598,55 @@ std::string IsosurfaceRendererGL::Internals::DrawFirstHit(
 }
 
 //------------------------------------------------------------------------------
+namespace
+{
+// `frame` in the index space of a piece whose cell (0, 0, 0) is cell `offset`
+// of the volume: its points move by -offset, so IndexToView gains the
+// translation and every clipping plane's constant its value at the offset.
+IsosurfaceFrame PieceFrame(const IsosurfaceFrame& frame, const int offset[3])
+{
+  IsosurfaceFrame local = frame;
+  for (int r = 0; r < 4; ++r)
+  {
+    local.IndexToView[4 * r + 3] += frame.IndexToView[4 * r] * offset[0] +
+      frame.IndexToView[4 * r + 1] * offset[1] + frame.IndexToView[4 * r + 2] * offset[2];
+  }
+  for (auto& plane : local.ClipPlanes)
+  {
+    plane[3] += plane[0] * offset[0] + plane[1] * offset[1] + plane[2] * offset[2];
+  }
+  return local;
+}
+} // namespace
+
 bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
   IsosurfaceFrameStats& stats, std::string& error)
 {
+  IsosurfacePiece piece;
+  piece.Pyramid = &pyramid;
+  return this->Render(std::vector<IsosurfacePiece>{ piece }, frame, stats, error);
+}
+
+bool IsosurfaceRendererGL::Render(const std::vector<IsosurfacePiece>& pieces,
+  const IsosurfaceFrame& frame, IsosurfaceFrameStats& stats, std::string& error)
+{
   Internals& impl = *this->Impl;
-  const GLApi& gl = *impl.GL;
-  const GLApi::Functions& f = gl.F();
   stats = IsosurfaceFrameStats();
+  bool ready = true;
+  std::uint64_t total = 0;
+  for (const IsosurfacePiece& piece : pieces)
+  {
+    if (!piece.Pyramid)
+    {
+      error = "a piece of the volume has no pyramid";
+      return false;
+    }
+    ready = ready && piece.Pyramid->IsBuilt() && piece.Pyramid->GetGLApi() == impl.GL.get();
+    total += piece.Pyramid->GetTotal();
+  }
   // An image sample distance above 1 that leaves fewer pixels: the reduced
   // target, then up to the viewport.
-  if (frame.SampleDistance > 1.0f && std::isfinite(frame.SampleDistance) && pyramid.IsBuilt() &&
-    pyramid.GetGLApi() == impl.GL.get() && pyramid.GetTotal() > 0)
+  if (frame.SampleDistance > 1.0f && std::isfinite(frame.SampleDistance) && ready && total > 0)
   {
     const int width = std::max(1,
       static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[2]) / frame.SampleDistance)));
@@ -616,9 +654,42 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
       static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[3]) / frame.SampleDistance)));
     if (width < frame.Viewport[2] || height < frame.Viewport[3])
     {
-      return this->RenderReduced(pyramid, frame, width, height, stats, error);
+      return this->RenderReduced(pieces, frame, width, height, stats, error);
     }
   }
+  // One volume: drawn as it is. Bricks: each in its own index space, in one pass.
+  if (pieces.size() == 1 && pieces[0].Offset[0] == 0 && pieces[0].Offset[1] == 0 &&
+    pieces[0].Offset[2] == 0)
+  {
+    return this->RenderPiece(*pieces[0].Pyramid, frame, stats, error);
+  }
+  for (const IsosurfacePiece& piece : pieces)
+  {
+    if (piece.Pyramid->IsBuilt() && piece.Pyramid->GetTotal() == 0)
+    {
+      continue; // nothing crosses in this brick
+    }
+    IsosurfaceFrame local = PieceFrame(frame, piece.Offset);
+    local.FirstHitPass = local.FirstHitPass && pieces.size() == 1;
+    IsosurfaceFrameStats drawn;
+    if (!this->RenderPiece(*piece.Pyramid, local, drawn, error))
+    {
+      return false;
+    }
+    stats.Primitives += drawn.Primitives;
+    stats.PointFootprint = stats.PointFootprint || drawn.PointFootprint;
+    stats.FirstHit = stats.FirstHit || drawn.FirstHit;
+  }
+  return true;
+}
+
+bool IsosurfaceRendererGL::RenderPiece(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
+  IsosurfaceFrameStats& stats, std::string& error)
+{
+  Internals& impl = *this->Impl;
+  const GLApi& gl = *impl.GL;
+  const GLApi::Functions& f = gl.F();
+  stats = IsosurfaceFrameStats();
   if (!pyramid.IsBuilt())
   {
     error = "the pyramid is not built";
@@ -719,7 +790,7 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
 }
 
 //------------------------------------------------------------------------------
-bool IsosurfaceRendererGL::RenderReduced(const HistoPyramidGL& pyramid,
+bool IsosurfaceRendererGL::RenderReduced(const std::vector<IsosurfacePiece>& pieces,
   const IsosurfaceFrame& frame, int width, int height, IsosurfaceFrameStats& stats,
   std::string& error)
 {
@@ -736,7 +807,7 @@ bool IsosurfaceRendererGL::RenderReduced(const HistoPyramidGL& pyramid,
   reduced.SampleDistance = 1.0f;
   if (!problem.empty())
   {
-    return this->Render(pyramid, reduced, stats, error); // every pixel: the same surfaces
+    return this->Render(pieces, reduced, stats, error); // every pixel: the same surfaces
   }
 
   // Pass 1: the whole frame into the reduced target, cleared to no surface,
@@ -755,7 +826,7 @@ bool IsosurfaceRendererGL::RenderReduced(const HistoPyramidGL& pyramid,
   reduced.Viewport[2] = width;
   reduced.Viewport[3] = height;
   impl.WriteTranslucentDepth = true;
-  const bool drawn = this->Render(pyramid, reduced, stats, error);
+  const bool drawn = this->Render(pieces, reduced, stats, error);
   impl.WriteTranslucentDepth = false;
   f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(hostFramebuffer));
   if (!drawn)
