@@ -347,8 +347,8 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
   stats.OverBudget = need > this->GetBudget();
   if (stats.OverBudget)
   {
-    error = this->BrickReason + ": it is kept as bricks, but the " +
-      std::to_string(active.size()) + " of its " + std::to_string(this->Grid.GetNumberOfBricks()) +
+    error = this->BrickReason + ": it is kept as bricks, but the " + std::to_string(active.size()) +
+      " of its " + std::to_string(this->Grid.GetNumberOfBricks()) +
       " bricks that the isovalues cross need " + Megabytes(need) +
       " of GPU memory, over the budget of " + Megabytes(this->GetBudget());
     return false;

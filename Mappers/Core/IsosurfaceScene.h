@@ -102,9 +102,11 @@ public:
   /**
    * Adopt a volume: uploaded when its Type, Data, Dims or Stamp differ from
    * the current volume's (the rest of the description does not change the
-   * GPU's copy). False, with the reason in @a error, when it cannot be
-   * uploaded (over the context's texture limits, a GL failure); the scene
-   * then has no volume until one uploads.
+   * GPU's copy). A volume over the texture limit or the GPU budget is
+   * adopted as bricks (its ranges computed, nothing uploaded until
+   * Update()). False, with the reason in @a error, when it cannot be
+   * uploaded (a GL failure, memory, a texture limit below the smallest
+   * brick); the scene then has no volume until one uploads.
    */
   bool SetVolume(const VolumeDescription& volume, std::string& error);
   bool HasVolume() const;
