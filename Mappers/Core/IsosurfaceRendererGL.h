@@ -67,9 +67,12 @@
  * offset in the volume's cell-index space. Each piece is drawn as above
  * with the frame moved into the piece's index space (its matrices and
  * clipping planes shifted by the offset), in the order given (the scene
- * passes a visibility order: back to front for translucent surfaces), and
- * in one pass: the first-hit pass's buffers follow the projection of one
- * volume, and the one pass draws the same image.
+ * passes a visibility order: nearest first, back to front for translucent
+ * surfaces). Opaque pieces drawn with points share one first-hit pass:
+ * buffers over the union of their projected rectangles, cleared once, every
+ * piece's cells drawn into them in that order (so each pixel's first hit is
+ * still the nearest), composited once; other pieces draw in one pass, and
+ * the depth test joins both.
  *
  * Hosts do not call the renderer: IsosurfaceScene does.
  *

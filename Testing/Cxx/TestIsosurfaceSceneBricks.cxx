@@ -258,6 +258,8 @@ void RunCases(const std::shared_ptr<const GLApi>& gl, Target& target, const std:
       name + ": several bricks, several active");
     Check(
       bricked.GetGPUMemoryBytes() <= bricked.GetGPUMemoryBudget(), name + ": within the budget");
+    Check(s.FirstHit == dense.GetStats().FirstHit,
+      name + ": the bricks take the first-hit pass where one texture does (one, shared)");
     CompareImages(a, b, name);
   }
   dense.Release();
