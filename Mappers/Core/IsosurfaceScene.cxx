@@ -337,6 +337,7 @@ bool IsosurfaceScene::Internals::AdoptBricks(
 bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values, std::string& error)
 {
   IsosurfaceSceneStats& stats = this->Stats;
+  this->Active.clear(); // until every active brick is built
   const std::vector<std::int64_t> active = ActiveBricks(this->Ranges, values);
   std::uint64_t need = 0;
   for (const std::int64_t brick : active)

@@ -2,16 +2,14 @@
 // IsosurfaceScene over a volume kept as bricks (issue 31), on an EGL context
 // of OpenGL ES 3.0 (the WebGL2 subset) or OpenGL 3.2 core, no VTK, no X:
 //   TestIsosurfaceSceneBricks es|gl
-// A noisy phantom of odd size drawn with a forced small texture limit and a
-// small GPU budget is kept as bricks and drawn on the GPU path with exactly
-// the primitives of the one-texture scene and of a brute-force count, and
-// images within the footprint tests' thresholds of the one-texture images
-// (one opaque surface, two, translucent over opaque, a clipping plane, a
-// parallel view, a sample distance of 2); float data with NaN values counts
-// the same; isovalue changes evict least recently used bricks within the
-// budget and still count exactly; active bricks over the budget fail with
-// that reason; the limits set back to the defaults give one texture again.
-// Exit 125 (skip) where no such context can be made.
+// A noisy phantom of odd size (and one whose last bricks own no cell) drawn with a forced small
+// texture limit and a small GPU budget is kept as bricks and drawn on the GPU path with exactly the
+// primitives of the one-texture scene and of a brute-force count, and images within the footprint
+// tests' thresholds of the one-texture images (one opaque surface, two, translucent over opaque, a
+// clipping plane, a parallel view, a sample distance of 2); float data with NaN values counts the
+// same; isovalue changes evict least recently used bricks within the budget and still count
+// exactly; active bricks over the budget fail with that reason; the limits set back to the defaults
+// give one texture again. Exit 125 (skip) where no such context can be made.
 #include "GLApi.h"
 #include "GLApiFunctions.h"
 #include "HeadlessContext.h"
@@ -300,6 +298,12 @@ int main(int argc, char* argv[])
     { "bone, sample distance 2", { bone }, 200, 30, false, {}, 2.0f },
   };
   RunCases(gl, target, phantom, dims, cases, "int16");
+  // Sizes whose last brick on an axis owns one plane of points and no cell (48 = 2 x 24).
+  {
+    const int edge[3] = { 49, 25, 49 };
+    RunCases(
+      gl, target, pyramid_checks::MakePhantom(edge, 40.0, 3), edge, { cases[1] }, "int16 49x25x49");
+  }
 
   // Float data with NaN values: cells with a NaN corner count nothing, in bricks too.
   {
