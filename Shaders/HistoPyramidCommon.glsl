@@ -82,8 +82,8 @@ uint bitCount8(int mask)
 }
 
 // Crossing mask of cell c (0 outside the owned cells, which lie in the real
-// cell grid, and, for float data, for a cell with a NaN corner), from its corner values v[0..7], corner
-// (dx, dy, dz) at index dx + 2 dy + 4 dz.
+// cell grid, and, for float data, for a cell with a NaN corner), from its
+// corner values v[0..7], corner (dx, dy, dz) at index dx + 2 dy + 4 dz.
 int cellMask(ivec3 c, VALUE_TYPE v[8])
 {
   if (any(lessThan(c, ownedCellsFirst)) || any(greaterThanEqual(c, ownedCellsEnd)))
