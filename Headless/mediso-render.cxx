@@ -12,8 +12,8 @@
  * Run with --help for the options.
  *
  * Exit status: 0 done; 2 bad options; 3 the volume cannot be read or is not
- * usable; 4 no usable OpenGL (no EGL display, too old a context, the volume
- * over the context's limits); 1 anything else that failed.
+ * usable; 4 no usable OpenGL (no EGL display, too old a context, the bricks
+ * the isovalues cross over the GPU budget); 1 anything else that failed.
  */
 #include "Camera.h"
 #include "GLApiFunctions.h"
@@ -92,6 +92,11 @@ The paper's protocol (prints a table):
 
 Context:
   --api es|gl           OpenGL ES 3.0 (the WebGL2 subset; default) or OpenGL 3.2 core
+  --max-texture-size N  use 3D textures of at most N texels a side (default: the
+                        context's GL_MAX_3D_TEXTURE_SIZE); a volume over it is kept
+                        as bricks, only those the isovalues cross on the GPU
+  --gpu-budget-mb M     GPU memory for the volume's textures and pyramids, in MB
+                        (default 1024); a volume over it is kept as bricks
 MEDISO_EGL_PLATFORM=surfaceless|device|default picks the EGL display.
 )";
 
@@ -117,6 +122,8 @@ struct Options
   int Rotate = 0;
   int Sweep = 0;
   bool ES = true;
+  int MaxTextureSize = 0;      // 0: the context's
+  std::uint64_t GPUBudget = 0; // bytes; 0: the scene's default
 };
 
 struct UsageError
@@ -358,6 +365,24 @@ Options Parse(int argc, char* argv[])
       }
       opt.ES = api == "es";
     }
+    else if (arg == "--max-texture-size")
+    {
+      const double n = Number(value("--max-texture-size"), "--max-texture-size");
+      if (n != std::floor(n) || n < 16 || n > 65536)
+      {
+        throw UsageError{ "--max-texture-size must be a whole number from 16 to 65536" };
+      }
+      opt.MaxTextureSize = static_cast<int>(n);
+    }
+    else if (arg == "--gpu-budget-mb")
+    {
+      const double mb = Number(value("--gpu-budget-mb"), "--gpu-budget-mb");
+      if (!(mb > 0.0) || mb > 1048576.0)
+      {
+        throw UsageError{ "--gpu-budget-mb must be a positive number of megabytes" };
+      }
+      opt.GPUBudget = static_cast<std::uint64_t>(mb * 1024.0 * 1024.0);
+    }
     else if (!arg.empty() && arg[0] == '-')
     {
       throw UsageError{ "unknown option " + arg };
@@ -443,6 +468,8 @@ public:
     , Scene(ThreadedFor)
   {
     this->Scene.SetContext(this->GL);
+    this->Scene.SetMaxTextureSize(options.MaxTextureSize);
+    this->Scene.SetGPUMemoryBudget(options.GPUBudget);
   }
 
   ~HeadlessView()
@@ -702,7 +729,8 @@ int Run(int argc, char* argv[])
     error = scene.Build(opt.Surfaces);
     if (!error.empty())
     {
-      return Fail(1, error);
+      // The bricks the isovalues cross over the GPU budget: the volume over the context's limits.
+      return Fail(scene.Scene.GetStats().OverBudget ? 4 : 1, opt.Input + ": " + error);
     }
     std::vector<double> frames;
     for (int i = 0; i < opt.Frames; ++i)
@@ -742,7 +770,10 @@ int Run(int argc, char* argv[])
            << ", \"volume_bytes\": " << image.Bytes.size()
            << ", \"footprint\": " << JsonString(stats.PointFootprint ? "points" : "boxes")
            << ", \"first_hit\": " << (stats.FirstHit ? "true" : "false")
-           << ", \"sample_distance\": " << stats.SampleDistance << "}";
+           << ", \"sample_distance\": " << stats.SampleDistance << ", \"bricks\": " << stats.Bricks
+           << ", \"brick_points\": " << stats.BrickPoints
+           << ", \"active_bricks\": " << stats.ActiveBricks
+           << ", \"resident_bricks\": " << stats.ResidentBricks << "}";
       std::printf("%s\n", json.str().c_str());
     }
   }

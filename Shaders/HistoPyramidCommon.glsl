@@ -22,6 +22,8 @@ uniform VALUE_SAMPLER volume;      // point values, 4 to a texel; read with texe
 uniform VALUE_TYPE thresholds[8];  // see above
 uniform int numberOfThresholds;    // 0 .. 8
 uniform ivec3 cellDimensions;      // real cells per axis (points - 1)
+uniform ivec3 ownedCellsFirst;     // the cells that count: [first, end) per axis (every cell,
+uniform ivec3 ownedCellsEnd;       // or those a brick owns: its apron is read, never counted)
 
 // The volume is stored 4 points to a texel along x: texel (i, j, k) holds
 // points (4 i + c, j, k) in component c, and the last texel of a row repeats
@@ -79,12 +81,12 @@ uint bitCount8(int mask)
   return bitCount8(uvec4(uint(mask), 0u, 0u, 0u)).x;
 }
 
-// Crossing mask of cell c (0 outside the real cell grid and, for float data,
-// for a cell with a NaN corner), from its corner values v[0..7], corner
-// (dx, dy, dz) at index dx + 2 dy + 4 dz.
+// Crossing mask of cell c (0 outside the owned cells, which lie in the real
+// cell grid, and, for float data, for a cell with a NaN corner), from its
+// corner values v[0..7], corner (dx, dy, dz) at index dx + 2 dy + 4 dz.
 int cellMask(ivec3 c, VALUE_TYPE v[8])
 {
-  if (any(greaterThanEqual(c, cellDimensions)))
+  if (any(lessThan(c, ownedCellsFirst)) || any(greaterThanEqual(c, ownedCellsEnd)))
   {
     return 0;
   }

@@ -70,6 +70,9 @@ struct HistoPyramidGL::Internals
   Name Volume;
   ScalarType Type = ScalarType::Float32;
   int Points[3] = { 0, 0, 0 };
+  // The cells that count: [OwnedFirst, OwnedEnd) per axis (every cell, or a brick's own).
+  int OwnedFirst[3] = { 0, 0, 0 };
+  int OwnedEnd[3] = { 0, 0, 0 };
   PyramidLayout Layout;
   // Per level-1 tile, the least and greatest value its cells read.
   VolumeTiles Tiles;
@@ -87,7 +90,8 @@ struct HistoPyramidGL::Internals
   Name TileBuffer;      // the level-1 pass's rectangles
   Name TileVertexArray; // with attribute 0 reading TileBuffer
   Name EmptyVertexArray;
-  ProgramCache Programs;
+  // Shared by the pyramids of one scene's bricks (ShareProgramsWith()).
+  std::shared_ptr<ProgramCache> Programs = std::make_shared<ProgramCache>();
 
   /// A stored level's atlas layout as the shaders take it: log2 of px, py, columns.
   std::array<int, 3> Shifts(int level) const;
@@ -130,6 +134,8 @@ void HistoPyramidGL::Internals::SetCommonUniforms(
   program.Set("numberOfThresholds", t.Count);
   const int cells[3] = { this->Points[0] - 1, this->Points[1] - 1, this->Points[2] - 1 };
   program.Set3i("cellDimensions", cells);
+  program.Set3i("ownedCellsFirst", this->OwnedFirst);
+  program.Set3i("ownedCellsEnd", this->OwnedEnd);
   switch (t.Kind)
   {
     case ValueKind::Signed:
@@ -160,7 +166,15 @@ void HistoPyramidGL::Internals::ReleaseAll()
   this->TileBuffer.Reset();
   this->TileVertexArray.Reset();
   this->EmptyVertexArray.Reset();
-  this->Programs.Clear();
+  // A cache shared with other pyramids stays theirs; this one lets go of it.
+  if (this->Programs.use_count() > 1)
+  {
+    this->Programs = std::make_shared<ProgramCache>();
+  }
+  else
+  {
+    this->Programs->Clear();
+  }
   this->Tiles.Clear();
   this->Points[0] = this->Points[1] = this->Points[2] = 0;
   this->Layout = PyramidLayout();
@@ -462,7 +476,29 @@ bool HistoPyramidGL::UploadVolume(ScalarType type, const void* values, const int
   impl.Layout = layout;
   impl.Parallel = run;
   std::copy(points, points + 3, impl.Points);
+  std::fill(impl.OwnedFirst, impl.OwnedFirst + 3, 0);
+  std::copy(cells, cells + 3, impl.OwnedEnd);
   return true;
+}
+
+void HistoPyramidGL::SetOwnedCells(const int first[3], const int end[3])
+{
+  Internals& impl = *this->Impl;
+  for (int a = 0; a < 3; ++a)
+  {
+    impl.OwnedFirst[a] = std::max(0, std::min(first[a], impl.Points[a] - 1));
+    impl.OwnedEnd[a] = std::max(impl.OwnedFirst[a], std::min(end[a], impl.Points[a] - 1));
+  }
+  impl.Built = false;
+  impl.Total = 0;
+}
+
+void HistoPyramidGL::ShareProgramsWith(const HistoPyramidGL& other)
+{
+  if (other.Impl->GL == this->Impl->GL)
+  {
+    this->Impl->Programs = other.Impl->Programs;
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -492,7 +528,7 @@ Program* HistoPyramidGL::Internals::Pass(
 {
   const Hooks hooks = this->CommonHooks();
   const std::string vs = std::strstr(vertex, "//MEDISO::HistoPyramidCommon") ? Compose(vertex, hooks) : vertex;
-  return this->Programs.Get(
+  return this->Programs->Get(
     *this->GL, this->Declarations() + defines, vs, Compose(fragment, hooks), error);
 }
 

@@ -109,6 +109,23 @@ public:
     const GLParallelFor& parallel, std::string& error);
 
   /**
+   * Count only the cells [first, end) per axis of the uploaded volume (cell
+   * indices; cut to the volume): the others count nothing, in the build and
+   * in the walk alike. A brick of a larger volume (IsosurfaceScene) is
+   * uploaded with the apron its cells and gradients read and counts only the
+   * cells it owns, so that no cell is drawn by two bricks. UploadVolume()
+   * resets it to every cell; it invalidates the pyramid.
+   */
+  void SetOwnedCells(const int first[3], const int end[3]);
+
+  /**
+   * Compile the build passes' programs once for several pyramids of one
+   * context (the bricks of one volume): this pyramid uses `other`'s program
+   * cache from now on (Release() lets go of it without freeing it).
+   */
+  void ShareProgramsWith(const HistoPyramidGL& other);
+
+  /**
    * Build the pyramid of the uploaded volume for 1 to MaximumIsovalues
    * isovalues (NaN ones count nothing) and read back the total.
    */

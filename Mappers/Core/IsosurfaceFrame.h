@@ -128,6 +128,18 @@ struct IsosurfaceSceneStats
   /// Builds of a coarse level's pyramid so far (IsosurfaceFrame::Level below 3), the level's
   /// sampling and upload included when it was the level's first.
   std::uint64_t CoarseBuilds = 0;
+  ///@{
+  /// A volume kept as bricks (IsosurfaceScene: over the texture limit or the GPU budget; none
+  /// for a volume in one texture): the brick edge in points, the bricks, those the last build's
+  /// isovalues cross, those resident on the GPU, and brick uploads so far. OverBudget: the last
+  /// build's active bricks alone exceed the GPU budget (its reason says so; hosts fall back).
+  int BrickPoints = 0;
+  std::uint64_t Bricks = 0;
+  std::uint64_t ActiveBricks = 0;
+  std::uint64_t ResidentBricks = 0;
+  std::uint64_t BrickUploads = 0;
+  bool OverBudget = false;
+  ///@}
 };
 
 } // namespace mediso

@@ -273,6 +273,10 @@ struct IsosurfaceRendererGL::Internals
   Name HitFBO, HitColor, HitDepth, HitFlag;
   int HitSize[2] = { 0, 0 };
   int HitRect[4] = { 0, 0, 0, 0 };
+  // Set while the pieces of a volume kept as bricks go through one first-hit
+  // pass: the buffers over all their rectangles are ready and cleared, each
+  // piece only draws its cells into them, and the hits are composited once.
+  bool SharedHit = false;
 
   // Reduced target of frames drawn at an image sample distance above 1.
   Name ReducedFBO, ReducedColor, ReducedDepth;
@@ -411,6 +415,8 @@ struct IsosurfaceRendererGL::Internals
     const FrameVariant& v);
   std::string DrawFirstHit(
     const FrameVariant& v, GLuint hostFramebuffer, const ScopedGLState& saved);
+  void ClearHits();
+  std::string CompositeHits();
 
   void DrawCells(bool points, std::uint64_t total)
   {
@@ -568,17 +574,34 @@ std::string IsosurfaceRendererGL::Internals::DrawFirstHit(
   // in drawing order (front to back: the nearest), and the test runs
   // before the fragment stage.
   f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, this->HitFBO.Get());
+  if (!this->SharedHit)
+  {
+    this->ClearHits();
+  }
+  f.DepthFunc(GL_LESS);
+  this->DrawCells(v.Points, v.Total);
+  f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, hostFramebuffer);
+  saved.RestoreDepthFunc();
+  return this->SharedHit ? "" : this->CompositeHits();
+}
+
+// The bound hit buffers cleared to no hit.
+void IsosurfaceRendererGL::Internals::ClearHits()
+{
+  const GLApi::Functions& f = this->GL->F();
   const GLfloat clearColor[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
   const GLfloat one = 1.0f;
   f.ClearBufferfv(GL_COLOR, 0, clearColor);
   f.ClearBufferfv(GL_DEPTH, 0, &one);
   // (Attachment 1 needs no clear: its texels are read only where a hit wrote them.)
-  f.DepthFunc(GL_LESS);
-  this->DrawCells(v.Points, v.Total);
-  // Pass 2: the hits into the host's framebuffer over HitRect, with the
-  // host's depth test.
-  f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, hostFramebuffer);
-  saved.RestoreDepthFunc();
+}
+
+// Pass 2: the hits into the bound (host's) framebuffer over HitRect, with the
+// depth test as it is set. "" or why not.
+std::string IsosurfaceRendererGL::Internals::CompositeHits()
+{
+  const GLApi& gl = *this->GL;
+  const GLApi::Functions& f = gl.F();
   std::string error;
   Program* composite = this->Programs.Get(
     gl, "", shaders::HistoPyramidFullScreen_vs, shaders::HistoPyramidComposite_fs, error);
@@ -598,17 +621,55 @@ std::string IsosurfaceRendererGL::Internals::DrawFirstHit(
 }
 
 //------------------------------------------------------------------------------
+namespace
+{
+// `frame` in the index space of a piece whose cell (0, 0, 0) is cell `offset`
+// of the volume: its points move by -offset, so IndexToView gains the
+// translation and every clipping plane's constant its value at the offset.
+IsosurfaceFrame PieceFrame(const IsosurfaceFrame& frame, const int offset[3])
+{
+  IsosurfaceFrame local = frame;
+  for (int r = 0; r < 4; ++r)
+  {
+    local.IndexToView[4 * r + 3] += frame.IndexToView[4 * r] * offset[0] +
+      frame.IndexToView[4 * r + 1] * offset[1] + frame.IndexToView[4 * r + 2] * offset[2];
+  }
+  for (auto& plane : local.ClipPlanes)
+  {
+    plane[3] += plane[0] * offset[0] + plane[1] * offset[1] + plane[2] * offset[2];
+  }
+  return local;
+}
+} // namespace
+
 bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
   IsosurfaceFrameStats& stats, std::string& error)
 {
+  IsosurfacePiece piece;
+  piece.Pyramid = &pyramid;
+  return this->Render(std::vector<IsosurfacePiece>{ piece }, frame, stats, error);
+}
+
+bool IsosurfaceRendererGL::Render(const std::vector<IsosurfacePiece>& pieces,
+  const IsosurfaceFrame& frame, IsosurfaceFrameStats& stats, std::string& error)
+{
   Internals& impl = *this->Impl;
-  const GLApi& gl = *impl.GL;
-  const GLApi::Functions& f = gl.F();
   stats = IsosurfaceFrameStats();
+  bool ready = true;
+  std::uint64_t total = 0;
+  for (const IsosurfacePiece& piece : pieces)
+  {
+    if (!piece.Pyramid)
+    {
+      error = "a piece of the volume has no pyramid";
+      return false;
+    }
+    ready = ready && piece.Pyramid->IsBuilt() && piece.Pyramid->GetGLApi() == impl.GL.get();
+    total += piece.Pyramid->GetTotal();
+  }
   // An image sample distance above 1 that leaves fewer pixels: the reduced
   // target, then up to the viewport.
-  if (frame.SampleDistance > 1.0f && std::isfinite(frame.SampleDistance) && pyramid.IsBuilt() &&
-    pyramid.GetGLApi() == impl.GL.get() && pyramid.GetTotal() > 0)
+  if (frame.SampleDistance > 1.0f && std::isfinite(frame.SampleDistance) && ready && total > 0)
   {
     const int width = std::max(1,
       static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[2]) / frame.SampleDistance)));
@@ -616,9 +677,120 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
       static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[3]) / frame.SampleDistance)));
     if (width < frame.Viewport[2] || height < frame.Viewport[3])
     {
-      return this->RenderReduced(pyramid, frame, width, height, stats, error);
+      return this->RenderReduced(pieces, frame, width, height, stats, error);
     }
   }
+  // One volume: drawn as it is. Bricks: each in its own index space, in one pass.
+  if (pieces.size() == 1 && pieces[0].Offset[0] == 0 && pieces[0].Offset[1] == 0 &&
+    pieces[0].Offset[2] == 0)
+  {
+    return this->RenderPiece(*pieces[0].Pyramid, frame, stats, error);
+  }
+  // The pieces that take the first-hit pass (opaque, points: wholly beyond
+  // the near plane) share one: buffers over the union of their projected
+  // rectangles, cleared once, their cells drawn in the pieces' order (front
+  // to back, so each pixel's first hit is still the nearest), composited
+  // once. Any other piece draws in one pass; the depth test joins both.
+  const GLApi& gl = *impl.GL;
+  const GLApi::Functions& f = gl.F();
+  int rect[4] = { 0, 0, 0, 0 };
+  bool shared = false;
+  if (frame.FirstHitPass && ready)
+  {
+    int lo[2] = { INT_MAX, INT_MAX }, hi[2] = { INT_MIN, INT_MIN };
+    for (const IsosurfacePiece& piece : pieces)
+    {
+      FrameVariant v;
+      if (piece.Pyramid->GetTotal() == 0 ||
+        !ChooseVariant(*piece.Pyramid, PieceFrame(frame, piece.Offset), gl.GetMaxPointSize(), v)
+           .empty() ||
+        !v.FirstHit || v.Clipped)
+      {
+        continue;
+      }
+      int r[4];
+      ProjectedRectangle(v.IndexToClip, v.Cells, frame.Viewport, r);
+      for (int a = 0; a < 2; ++a)
+      {
+        lo[a] = std::min(lo[a], r[a]);
+        hi[a] = std::max(hi[a], r[a] + r[2 + a]);
+      }
+      shared = true;
+    }
+    rect[0] = lo[0];
+    rect[1] = lo[1];
+    rect[2] = hi[0] - lo[0];
+    rect[3] = hi[1] - lo[1];
+  }
+  ScopedGLState saved(gl, 2);
+  GLint hostFramebuffer = 0;
+  f.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &hostFramebuffer);
+  if (shared)
+  {
+    gl.TakeErrors();
+    std::copy(rect, rect + 4, impl.HitRect);
+    shared = impl.PrepareFirstHit(rect[2], rect[3], frame.Viewport).empty();
+    if (shared)
+    {
+      f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, impl.HitFBO.Get());
+      impl.ClearHits();
+    }
+    f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(hostFramebuffer));
+  }
+  impl.SharedHit = shared;
+  bool drawn = true;
+  for (const IsosurfacePiece& piece : pieces)
+  {
+    if (piece.Pyramid->IsBuilt() && piece.Pyramid->GetTotal() == 0)
+    {
+      continue; // nothing crosses in this brick
+    }
+    IsosurfaceFrame local = PieceFrame(frame, piece.Offset);
+    local.FirstHitPass = shared;
+    IsosurfaceFrameStats pieceStats;
+    drawn = this->RenderPiece(*piece.Pyramid, local, pieceStats, error);
+    if (!drawn)
+    {
+      break;
+    }
+    stats.Primitives += pieceStats.Primitives;
+    stats.PointFootprint = stats.PointFootprint || pieceStats.PointFootprint;
+    stats.FirstHit = stats.FirstHit || pieceStats.FirstHit;
+  }
+  impl.SharedHit = false;
+  if (drawn && stats.FirstHit)
+  {
+    // The hits into the host's framebuffer, in the state of an opaque surface pass.
+    f.Enable(GL_DEPTH_TEST);
+    f.Disable(GL_CULL_FACE);
+    f.Disable(GL_SCISSOR_TEST);
+    f.Disable(GL_STENCIL_TEST);
+    f.Disable(GL_RASTERIZER_DISCARD);
+    f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    SetSurfacePassBlending(gl, false);
+    if (!impl.VertexArray)
+    {
+      impl.VertexArray = Name(gl, NameKind::VertexArray);
+    }
+    f.BindVertexArray(impl.VertexArray.Get());
+    const std::string problem = impl.CompositeHits();
+    const std::string errors = gl.TakeErrors();
+    if (!problem.empty() || !errors.empty())
+    {
+      error = problem.empty() ? "drawing the isosurfaces failed: " + errors : problem;
+      return false;
+    }
+  }
+  return drawn;
+}
+
+bool IsosurfaceRendererGL::RenderPiece(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
+  IsosurfaceFrameStats& stats, std::string& error)
+{
+  Internals& impl = *this->Impl;
+  const GLApi& gl = *impl.GL;
+  const GLApi::Functions& f = gl.F();
+  stats = IsosurfaceFrameStats();
   if (!pyramid.IsBuilt())
   {
     error = "the pyramid is not built";
@@ -670,7 +842,7 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
   gl.TakeErrors();
   GLint hostFramebuffer = 0;
   f.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &hostFramebuffer);
-  if (v.FirstHit)
+  if (v.FirstHit && !impl.SharedHit)
   {
     ProjectedRectangle(v.IndexToClip, v.Cells, frame.Viewport, impl.HitRect);
     const std::string problem =
@@ -719,7 +891,7 @@ bool IsosurfaceRendererGL::Render(const HistoPyramidGL& pyramid, const Isosurfac
 }
 
 //------------------------------------------------------------------------------
-bool IsosurfaceRendererGL::RenderReduced(const HistoPyramidGL& pyramid,
+bool IsosurfaceRendererGL::RenderReduced(const std::vector<IsosurfacePiece>& pieces,
   const IsosurfaceFrame& frame, int width, int height, IsosurfaceFrameStats& stats,
   std::string& error)
 {
@@ -736,7 +908,7 @@ bool IsosurfaceRendererGL::RenderReduced(const HistoPyramidGL& pyramid,
   reduced.SampleDistance = 1.0f;
   if (!problem.empty())
   {
-    return this->Render(pyramid, reduced, stats, error); // every pixel: the same surfaces
+    return this->Render(pieces, reduced, stats, error); // every pixel: the same surfaces
   }
 
   // Pass 1: the whole frame into the reduced target, cleared to no surface,
@@ -755,7 +927,7 @@ bool IsosurfaceRendererGL::RenderReduced(const HistoPyramidGL& pyramid,
   reduced.Viewport[2] = width;
   reduced.Viewport[3] = height;
   impl.WriteTranslucentDepth = true;
-  const bool drawn = this->Render(pyramid, reduced, stats, error);
+  const bool drawn = this->Render(pieces, reduced, stats, error);
   impl.WriteTranslucentDepth = false;
   f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(hostFramebuffer));
   if (!drawn)

@@ -61,6 +61,19 @@
  * The still frame (distance 1) does not touch the reduced target. Where
  * the target cannot be made, the frame is drawn at every pixel instead.
  *
+ * A volume kept as bricks (IsosurfaceScene over a texture limit or a GPU
+ * budget) is drawn as pieces: one pyramid per brick, each over its own
+ * sub-volume and counting only the cells the brick owns, placed by its
+ * offset in the volume's cell-index space. Each piece is drawn as above
+ * with the frame moved into the piece's index space (its matrices and
+ * clipping planes shifted by the offset), in the order given (the scene
+ * passes a visibility order: nearest first, back to front for translucent
+ * surfaces). Opaque pieces drawn with points share one first-hit pass:
+ * buffers over the union of their projected rectangles, cleared once, every
+ * piece's cells drawn into them in that order (so each pixel's first hit is
+ * still the nearest), composited once; other pieces draw in one pass, and
+ * the depth test joins both.
+ *
  * Hosts do not call the renderer: IsosurfaceScene does.
  *
  * The renderer draws into the framebuffer bound when Render() is called,
@@ -75,6 +88,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace mediso
 {
@@ -95,6 +109,13 @@ struct IsosurfaceFrameStats
   float SampleDistance = 1.0f; ///< image sample distance drawn at (1: every pixel)
 };
 
+/// One pyramid of a volume kept as bricks, and where its cell (0, 0, 0) lies in the volume.
+struct IsosurfacePiece
+{
+  const HistoPyramidGL* Pyramid = nullptr;
+  int Offset[3] = { 0, 0, 0 };
+};
+
 class IsosurfaceRendererGL
 {
 public:
@@ -112,6 +133,13 @@ public:
   bool Render(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
     IsosurfaceFrameStats& stats, std::string& error);
 
+  /**
+   * Draw the pieces of a volume kept as bricks (each built, with the same
+   * GLApi and isovalues), in the order given. Primitives is their sum.
+   */
+  bool Render(const std::vector<IsosurfacePiece>& pieces, const IsosurfaceFrame& frame,
+    IsosurfaceFrameStats& stats, std::string& error);
+
   /// Bytes of the first-hit pass's buffers and the reduced target (0 until one is drawn).
   std::uint64_t GetFrameBufferBytes() const;
 
@@ -120,8 +148,11 @@ public:
 
 private:
   // The frame drawn into the reduced target of width x height, then up to its viewport.
-  bool RenderReduced(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame, int width,
-    int height, IsosurfaceFrameStats& stats, std::string& error);
+  bool RenderReduced(const std::vector<IsosurfacePiece>& pieces, const IsosurfaceFrame& frame,
+    int width, int height, IsosurfaceFrameStats& stats, std::string& error);
+  // One piece at full resolution into the bound framebuffer.
+  bool RenderPiece(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
+    IsosurfaceFrameStats& stats, std::string& error);
 
   struct Internals;
   std::unique_ptr<Internals> Impl;

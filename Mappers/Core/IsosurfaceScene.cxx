@@ -2,13 +2,19 @@
 #include "IsosurfaceScene.h"
 
 #include "BlockLOD.h" // MakeCoarseCopy, LevelStride
+#include "BrickGrid.h"
+#include "GLApi.h"
 #include "HistoPyramidGL.h"
 #include "IsosurfaceRendererGL.h"
+#include "Matrix4.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <new>
 #include <sstream>
+#include <unordered_map>
 #include <utility>
 
 namespace mediso
@@ -31,6 +37,23 @@ bool SameVolume(const VolumeDescription& a, const VolumeDescription& b)
 
 // The full level (the volume itself) and the coarse ones below it, as Block LOD numbers them.
 constexpr int FullLevel = NumberOfLevels - 1;
+
+// Points a brick's texture holds: the points its cells and their gradients read.
+constexpr int BrickApron = 1;
+
+std::string Megabytes(std::uint64_t bytes)
+{
+  std::ostringstream text;
+  text.precision(3);
+  text << static_cast<double>(bytes) / (1024.0 * 1024.0) << " MB";
+  return text.str();
+}
+
+std::string Size(const int points[3])
+{
+  return std::to_string(points[0]) + "x" + std::to_string(points[1]) + "x" +
+    std::to_string(points[2]);
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -79,6 +102,64 @@ struct IsosurfaceScene::Internals
     }
     return values;
   }
+
+  // Limits (0: the context's, the default budget).
+  int MaxTextureSize = 0;
+  std::uint64_t Budget = 0;
+
+  // A volume kept as bricks: the grid, each brick's range over the cells it
+  // owns, the resident bricks' pyramids, and the bricks of the last build.
+  bool Bricked = false;
+  std::string BrickReason; // why the volume is not one texture
+  BrickGrid Grid;
+  std::vector<BrickRange> Ranges;
+  BrickResidency Residency;
+  std::unordered_map<std::int64_t, std::unique_ptr<HistoPyramidGL>> Bricks;
+  std::vector<std::int64_t> Active;
+
+  int TextureLimit() const
+  {
+    const int context = this->GL ? this->GL->GetMax3DTextureSize() : 0;
+    return this->MaxTextureSize > 0 ? std::min(this->MaxTextureSize, context) : context;
+  }
+  std::uint64_t GetBudget() const
+  {
+    return this->Budget > 0 ? this->Budget : IsosurfaceScene::DefaultGPUMemoryBudget;
+  }
+  // The texture of a brick: its cells' points with the apron.
+  void BrickTexture(std::int64_t brick, int extent[6], int points[3]) const
+  {
+    this->Grid.ReadPoints(brick, BrickApron, extent);
+    for (int a = 0; a < 3; ++a)
+    {
+      points[a] = extent[2 * a + 1] - extent[2 * a] + 1;
+    }
+  }
+  std::uint64_t BrickBytes(std::int64_t brick) const
+  {
+    int extent[6], points[3];
+    this->BrickTexture(brick, extent, points);
+    return HistoPyramidGL::EstimateGPUMemoryBytes(this->Volume.Type, points);
+  }
+  void ReleaseBricks()
+  {
+    for (auto& brick : this->Bricks)
+    {
+      brick.second->Release();
+    }
+    this->Bricks.clear();
+    this->Residency.Clear();
+    this->Active.clear();
+    this->Bricked = false;
+    this->Grid = BrickGrid();
+    this->Ranges.clear();
+    this->Stats.Bricks = this->Stats.ActiveBricks = this->Stats.ResidentBricks = 0;
+    this->Stats.BrickPoints = 0;
+    this->Stats.OverBudget = false;
+  }
+  bool AdoptBricks(const VolumeDescription& volume, const std::string& why, std::string& error);
+  bool UpdateBricks(const std::vector<double>& values, std::string& error);
+  std::vector<IsosurfacePiece> Pieces(const IsosurfaceFrame& frame) const;
 };
 
 IsosurfaceScene::IsosurfaceScene(GLParallelFor parallel)
@@ -95,6 +176,8 @@ void IsosurfaceScene::SetContext(std::shared_ptr<const GLApi> gl)
   impl.GL = std::move(gl);
   impl.Pyramid.reset(impl.GL ? new HistoPyramidGL(impl.GL) : nullptr);
   impl.Renderer.reset(impl.GL ? new IsosurfaceRendererGL(impl.GL) : nullptr);
+  impl.Bricks.clear(); // Release()d in their own context before, as the doc asks
+  impl.ReleaseBricks();
   impl.HasVolume = false;
   impl.BuiltValues.clear();
   for (Internals::CoarseLevel& c : impl.Coarse)
@@ -112,6 +195,7 @@ bool IsosurfaceScene::HasContext() const
 void IsosurfaceScene::Release()
 {
   Internals& impl = *this->Impl;
+  impl.ReleaseBricks();
   if (impl.Pyramid)
   {
     impl.Pyramid->Release();
@@ -145,8 +229,40 @@ bool IsosurfaceScene::SetVolume(const VolumeDescription& volume, std::string& er
   impl.HasVolume = false;
   impl.BuiltValues.clear();
   impl.ReleaseCoarse();
+  impl.ReleaseBricks();
   const auto start = Clock::now();
-  if (!impl.Pyramid->UploadVolume(volume.Type, volume.Data, volume.Dims, impl.Parallel, error))
+  // One texture where it fits the texture limit and the budget; else bricks.
+  std::string why;
+  if (!volume.Data || volume.Dims[0] < 2 || volume.Dims[1] < 2 || volume.Dims[2] < 2)
+  {
+    why = ""; // the upload says what is wrong
+  }
+  else if (std::max({ PackedVolumeWidth(volume.Dims[0]), volume.Dims[1], volume.Dims[2] }) >
+    impl.TextureLimit())
+  {
+    const auto texture = HistoPyramidGL::VolumeTextureSize(volume.Dims);
+    const bool forced =
+      impl.MaxTextureSize > 0 && impl.MaxTextureSize < impl.GL->GetMax3DTextureSize();
+    why = "the " + Size(volume.Dims) + " volume (a " + std::to_string(texture[0]) + "x" +
+      std::to_string(texture[1]) + "x" + std::to_string(texture[2]) +
+      " texture) exceeds GL_MAX_3D_TEXTURE_SIZE " + std::to_string(impl.TextureLimit()) +
+      (forced ? " (as set)" : "");
+  }
+  else if (HistoPyramidGL::EstimateGPUMemoryBytes(volume.Type, volume.Dims) > impl.GetBudget())
+  {
+    why = "the " + Size(volume.Dims) + " volume needs " +
+      Megabytes(HistoPyramidGL::EstimateGPUMemoryBytes(volume.Type, volume.Dims)) +
+      " of GPU memory in one texture, over the budget of " + Megabytes(impl.GetBudget());
+  }
+  if (!why.empty())
+  {
+    impl.Pyramid->Release(); // the one texture of a former volume
+    if (!impl.AdoptBricks(volume, why, error))
+    {
+      return false;
+    }
+  }
+  else if (!impl.Pyramid->UploadVolume(volume.Type, volume.Data, volume.Dims, impl.Parallel, error))
   {
     return false;
   }
@@ -160,6 +276,258 @@ bool IsosurfaceScene::SetVolume(const VolumeDescription& volume, std::string& er
 bool IsosurfaceScene::HasVolume() const
 {
   return this->Impl->HasVolume;
+}
+
+void IsosurfaceScene::SetMaxTextureSize(int texels)
+{
+  if (texels != this->Impl->MaxTextureSize)
+  {
+    this->Impl->MaxTextureSize = std::max(texels, 0);
+    this->Impl->HasVolume = false; // decided again at the next SetVolume()
+  }
+}
+
+int IsosurfaceScene::GetMaxTextureSize() const
+{
+  return this->Impl->MaxTextureSize;
+}
+
+void IsosurfaceScene::SetGPUMemoryBudget(std::uint64_t bytes)
+{
+  if (bytes != this->Impl->Budget)
+  {
+    this->Impl->Budget = bytes;
+    this->Impl->HasVolume = false;
+  }
+}
+
+std::uint64_t IsosurfaceScene::GetGPUMemoryBudget() const
+{
+  return this->Impl->GetBudget();
+}
+
+bool IsosurfaceScene::IsBricked() const
+{
+  return this->Impl->HasVolume && this->Impl->Bricked;
+}
+
+int IsosurfaceScene::ChooseBrickPoints(ScalarType type, int maxTextureSize, std::uint64_t budget)
+{
+  for (int k = 8; k > 4; --k)
+  {
+    const int edge = (1 << k) - 8;
+    // A brick's texture: its points, one more on the + side, the apron on both.
+    const int points[3] = { edge + 1 + 2 * BrickApron, edge + 1 + 2 * BrickApron,
+      edge + 1 + 2 * BrickApron };
+    if (points[0] <= maxTextureSize &&
+      HistoPyramidGL::EstimateGPUMemoryBytes(type, points) <= budget / 8)
+    {
+      return edge;
+    }
+  }
+  return BlockCells;
+}
+
+//------------------------------------------------------------------------------
+// The volume as bricks: their grid and value ranges (nothing is uploaded yet).
+bool IsosurfaceScene::Internals::AdoptBricks(
+  const VolumeDescription& volume, const std::string& why, std::string& error)
+{
+  const int edge = ChooseBrickPoints(volume.Type, this->TextureLimit(), this->GetBudget());
+  if (edge + 1 + 2 * BrickApron > this->TextureLimit())
+  {
+    error = why + ", and a brick of " + std::to_string(edge) + " points does not fit either";
+    return false;
+  }
+  BrickGrid grid(volume.Dims, edge);
+  // Each brick's range over its own cells' corners (no apron: the gradients'
+  // extra points decide no crossing). Double data is compared on the GPU as
+  // float: rounding keeps the order, so the float range is the rounded one.
+  std::vector<BrickRange> ranges;
+  try
+  {
+    ranges = ComputeBrickRanges(grid, volume.Type, volume.Data, 0, this->Parallel);
+  }
+  catch (const std::bad_alloc&)
+  {
+    error = "memory ran out while finding the volume's bricks";
+    return false;
+  }
+  if (volume.Type == ScalarType::Float64)
+  {
+    for (BrickRange& r : ranges)
+    {
+      if (r.Min <= r.Max)
+      {
+        r.Min = static_cast<float>(r.Min);
+        r.Max = static_cast<float>(r.Max);
+      }
+    }
+  }
+  this->Bricked = true;
+  this->Grid = grid;
+  this->Ranges = std::move(ranges);
+  this->Residency.SetBudget(this->GetBudget());
+  this->Stats.BrickPoints = edge;
+  this->Stats.Bricks = static_cast<std::uint64_t>(grid.GetNumberOfBricks());
+  this->BrickReason = why;
+  return true;
+}
+
+// The pyramids of the bricks `values` cross: resident (uploaded where not),
+// and built. False, with the reason, where they do not fit the budget.
+bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values, std::string& error)
+{
+  IsosurfaceSceneStats& stats = this->Stats;
+  this->Active.clear(); // until every active brick is built
+  const std::vector<std::int64_t> active = ActiveBricks(this->Ranges, values);
+  std::uint64_t need = 0;
+  for (const std::int64_t brick : active)
+  {
+    need += this->BrickBytes(brick);
+  }
+  stats.ActiveBricks = active.size();
+  stats.OverBudget = need > this->GetBudget();
+  if (stats.OverBudget)
+  {
+    error = this->BrickReason + ": it is kept as bricks, but the " + std::to_string(active.size()) +
+      " of its " + std::to_string(this->Grid.GetNumberOfBricks()) +
+      " bricks that the isovalues cross need " + Megabytes(need) +
+      " of GPU memory, over the budget of " + Megabytes(this->GetBudget());
+    return false;
+  }
+  // Bricks in use first become the most recent, so that only others make room.
+  for (const std::int64_t brick : active)
+  {
+    this->Residency.Touch(brick);
+  }
+  const int bytesPerValue = ScalarTypeSize(this->Volume.Type);
+  std::vector<unsigned char> values3d;
+  for (const std::int64_t brick : active)
+  {
+    if (this->Residency.IsResident(brick))
+    {
+      continue;
+    }
+    std::vector<std::int64_t> evicted;
+    if (!this->Residency.MakeResident(brick, this->BrickBytes(brick), evicted))
+    {
+      error = "a brick of " + std::to_string(this->Grid.GetBrickPoints()) +
+        " points exceeds the GPU budget of " + Megabytes(this->GetBudget());
+      return false;
+    }
+    for (const std::int64_t gone : evicted)
+    {
+      const auto found = this->Bricks.find(gone);
+      if (found != this->Bricks.end())
+      {
+        found->second->Release();
+        this->Bricks.erase(found);
+      }
+    }
+    int extent[6], points[3];
+    this->BrickTexture(brick, extent, points);
+    try
+    {
+      values3d.resize(BrickGrid::ExtentPoints(extent) * bytesPerValue);
+    }
+    catch (const std::bad_alloc&)
+    {
+      this->Residency.Evict(brick);
+      error = "memory ran out while copying a brick for the GPU upload";
+      return false;
+    }
+    CopyBrick(this->Grid, brick, extent, this->Volume.Data, bytesPerValue, values3d.data());
+    std::unique_ptr<HistoPyramidGL> pyramid(new HistoPyramidGL(this->GL));
+    pyramid->ShareProgramsWith(*this->Pyramid);
+    if (!pyramid->UploadVolume(this->Volume.Type, values3d.data(), points, this->Parallel, error))
+    {
+      this->Residency.Evict(brick);
+      return false;
+    }
+    // Only the cells whose first corner the brick owns count.
+    int owned[6];
+    this->Grid.OwnedPoints(brick, owned);
+    const int first[3] = { owned[0] - extent[0], owned[2] - extent[2], owned[4] - extent[4] };
+    const int end[3] = { owned[1] - extent[0] + 1, owned[3] - extent[2] + 1,
+      owned[5] - extent[4] + 1 };
+    pyramid->SetOwnedCells(first, end);
+    this->Bricks[brick] = std::move(pyramid);
+    ++stats.BrickUploads;
+  }
+  stats.ResidentBricks = this->Residency.GetNumberOfResidentBricks();
+  stats.BuildTilesDrawn = 0;
+  stats.BuildTiles = 0;
+  for (const std::int64_t brick : active)
+  {
+    HistoPyramidGL& pyramid = *this->Bricks.at(brick);
+    if (!pyramid.Build(values, error))
+    {
+      return false;
+    }
+    stats.BuildTilesDrawn += pyramid.GetLastTilesDrawn();
+    stats.BuildTiles += pyramid.GetNumberOfTiles();
+  }
+  this->Active = active;
+  return true;
+}
+
+// The built bricks with something to draw, in a visibility order for the
+// frame's eye: by the sum over the axes of how many bricks lie between a
+// brick and the eye's brick. Along a ray from the eye every coordinate moves
+// away from the eye's, so a brick in front of another is nearer on every
+// axis and strictly on one: nearest first, or farthest first for
+// translucent surfaces.
+std::vector<IsosurfacePiece> IsosurfaceScene::Internals::Pieces(const IsosurfaceFrame& frame) const
+{
+  int eyeBrick[3] = { 0, 0, 0 };
+  matrix4::Matrix viewToIndex;
+  if (matrix4::Invert(matrix4::FromArray(frame.IndexToView), viewToIndex))
+  {
+    const double eyeView[4] = { 0.0, 0.0, frame.Parallel ? 1.0 : 0.0, frame.Parallel ? 0.0 : 1.0 };
+    const auto eye = matrix4::Transform(viewToIndex, eyeView);
+    for (int a = 0; a < 3; ++a)
+    {
+      const int last = this->Grid.GetBricksPerAxis()[a] - 1;
+      eyeBrick[a] = frame.Parallel
+        ? (eye[a] > 0.0 ? last : 0)
+        : static_cast<int>(std::max(0.0,
+            std::min(static_cast<double>(last), std::floor(eye[a] / this->Grid.GetBrickPoints()))));
+    }
+  }
+  bool translucent = false;
+  for (const IsosurfaceLook& s : this->Surfaces)
+  {
+    translucent = translucent || s.Opacity < 1.0f;
+  }
+  std::vector<std::pair<int, std::int64_t>> order;
+  for (const std::int64_t brick : this->Active)
+  {
+    const auto found = this->Bricks.find(brick);
+    if (found == this->Bricks.end() || found->second->GetTotal() == 0)
+    {
+      continue;
+    }
+    int index[3];
+    this->Grid.BrickIndex(brick, index);
+    const int steps = std::abs(index[0] - eyeBrick[0]) + std::abs(index[1] - eyeBrick[1]) +
+      std::abs(index[2] - eyeBrick[2]);
+    order.emplace_back(translucent ? -steps : steps, brick);
+  }
+  std::sort(order.begin(), order.end());
+  std::vector<IsosurfacePiece> pieces;
+  for (const auto& entry : order)
+  {
+    IsosurfacePiece piece;
+    piece.Pyramid = this->Bricks.at(entry.second).get();
+    int extent[6], points[3];
+    this->BrickTexture(entry.second, extent, points);
+    piece.Offset[0] = extent[0];
+    piece.Offset[1] = extent[2];
+    piece.Offset[2] = extent[4];
+    pieces.push_back(piece);
+  }
+  return pieces;
 }
 
 //------------------------------------------------------------------------------
@@ -252,14 +620,24 @@ bool IsosurfaceScene::Update(std::string& error)
   }
   impl.BuiltValues.clear();
   const auto start = Clock::now();
-  if (!impl.Pyramid->Build(values, error))
+  if (impl.Bricked)
   {
-    return false;
+    if (!impl.UpdateBricks(values, error))
+    {
+      return false;
+    }
+  }
+  else
+  {
+    if (!impl.Pyramid->Build(values, error))
+    {
+      return false;
+    }
+    impl.Stats.BuildTilesDrawn = impl.Pyramid->GetLastTilesDrawn();
+    impl.Stats.BuildTiles = impl.Pyramid->GetNumberOfTiles();
   }
   // Build() ends by reading the total back: the passes are done.
   impl.Stats.BuildSeconds = Seconds(Clock::now() - start);
-  impl.Stats.BuildTilesDrawn = impl.Pyramid->GetLastTilesDrawn();
-  impl.Stats.BuildTiles = impl.Pyramid->GetNumberOfTiles();
   ++impl.Stats.PyramidBuilds;
   impl.BuiltValues = std::move(values);
   return true;
@@ -368,7 +746,11 @@ bool IsosurfaceScene::Render(const IsosurfaceFrame& frame, std::string& error)
     }
   }
   IsosurfaceFrameStats frameStats;
-  if (!impl.Renderer->Render(*pyramid, drawn, frameStats, error))
+  // A bricked volume's full level is drawn brick by brick; its coarse levels are one texture each.
+  const bool rendered = impl.Bricked && frame.Level == FullLevel
+    ? impl.Renderer->Render(impl.Pieces(frame), drawn, frameStats, error)
+    : impl.Renderer->Render(*pyramid, drawn, frameStats, error);
+  if (!rendered)
   {
     return false;
   }
@@ -389,9 +771,20 @@ const IsosurfaceSceneStats& IsosurfaceScene::GetStats() const
 std::uint64_t IsosurfaceScene::GetActivePairs() const
 {
   const Internals& impl = *this->Impl;
-  return impl.Pyramid && impl.Pyramid->IsBuilt() && !impl.BuiltValues.empty()
-    ? impl.Pyramid->GetTotal()
-    : 0;
+  if (impl.BuiltValues.empty())
+  {
+    return 0;
+  }
+  if (impl.Bricked)
+  {
+    std::uint64_t total = 0;
+    for (const std::int64_t brick : impl.Active)
+    {
+      total += impl.Bricks.at(brick)->GetTotal();
+    }
+    return total;
+  }
+  return impl.Pyramid && impl.Pyramid->IsBuilt() ? impl.Pyramid->GetTotal() : 0;
 }
 
 std::uint64_t IsosurfaceScene::GetActivePairs(int level) const
@@ -441,6 +834,10 @@ std::uint64_t IsosurfaceScene::GetGPUMemoryBytes() const
   for (const Internals::CoarseLevel& c : impl.Coarse)
   {
     bytes += c.Pyramid ? c.Pyramid->GetGPUMemoryBytes() : 0;
+  }
+  for (const auto& brick : impl.Bricks)
+  {
+    bytes += brick.second->GetGPUMemoryBytes();
   }
   return bytes;
 }

@@ -34,6 +34,22 @@
  * Inside, HistoPyramidGL builds the pyramid (and owns its walk) and
  * IsosurfaceRendererGL draws it; no host includes either.
  *
+ * A volume over one 3D texture (GL_MAX_3D_TEXTURE_SIZE on an axis, or
+ * SetMaxTextureSize()) or over the GPU-memory budget (SetGPUMemoryBudget())
+ * is kept as bricks instead (mediso::BrickGrid, BrickGrid.h): SetVolume()
+ * uploads nothing but computes every brick's value range; Update() finds
+ * the bricks the isovalues cross, uploads those not resident (each with the
+ * apron its cells and gradients read, least recently used ones evicted to
+ * stay within the budget) and builds a pyramid over each that counts only
+ * the cells the brick owns; Render() draws those pyramids as pieces, each
+ * placed at its brick, nearest brick first (farthest first for translucent
+ * surfaces). Every cell is counted by exactly one brick, so the primitives
+ * are the one-texture count exactly. Where the active bricks alone exceed
+ * the budget, Update() fails with that reason (GetStats().OverBudget), and
+ * the host falls back as for any other reason. Bricks read the host's values
+ * when they become active: Data must stay valid while it is the scene's
+ * volume (every host passes it to SetVolume() before each Update()).
+ *
  * The context of SetContext() (or one sharing its objects) must be current
  * in every call that touches GL: SetVolume(), Update(), Render(),
  * Release() and the destructor. Release() frees every GL object but keeps
@@ -95,14 +111,44 @@ public:
   /**
    * Adopt a volume: uploaded when its Type, Data, Dims or Stamp differ from
    * the current volume's (the rest of the description does not change the
-   * GPU's copy). False, with the reason in @a error, when it cannot be
-   * uploaded (over the context's texture limits, a GL failure); the scene
-   * then has no volume until one uploads. The values stay the host's: they
-   * must stay valid while the scene holds the volume, since a coarse level
-   * (UpdateLevel()) is sampled from them on its first frame.
+   * GPU's copy). A volume over the texture limit or the GPU budget is
+   * adopted as bricks (its ranges computed, nothing uploaded until
+   * Update()). False, with the reason in @a error, when it cannot be
+   * uploaded (a GL failure, memory, a texture limit below the smallest
+   * brick); the scene then has no volume until one uploads. The values stay
+   * the host's: they must stay valid while the scene holds the volume, since
+   * a coarse level (UpdateLevel()) is sampled from them on its first frame.
    */
   bool SetVolume(const VolumeDescription& volume, std::string& error);
   bool HasVolume() const;
+
+  ///@{
+  /**
+   * Where a volume is kept as bricks. SetMaxTextureSize(): the largest 3D
+   * texture side the scene uses (0, the default: the context's
+   * GL_MAX_3D_TEXTURE_SIZE; a smaller one makes tests brick a small volume).
+   * SetGPUMemoryBudget(): the bytes the volume's textures and pyramids may
+   * take on the GPU (0, the default: DefaultGPUMemoryBudget). A volume whose
+   * one texture exceeds either is kept as bricks. A change takes effect at
+   * the next SetVolume(), which then uploads again.
+   */
+  void SetMaxTextureSize(int texels);
+  int GetMaxTextureSize() const;
+  void SetGPUMemoryBudget(std::uint64_t bytes);
+  std::uint64_t GetGPUMemoryBudget() const;
+  /// The budget where none is set: 1 GiB, what a WebGL2 page can expect of most devices.
+  static constexpr std::uint64_t DefaultGPUMemoryBudget = std::uint64_t(1) << 30;
+  /// Whether the current volume is kept as bricks.
+  bool IsBricked() const;
+  ///@}
+
+  /**
+   * The brick edge (points, a multiple of 8) for a volume of `type` under a
+   * texture limit and a budget: the largest 2^k - 8 (so that a brick's
+   * cells with its apron, edge + 2, fit a pyramid of 2^k cells a side) up to
+   * 248 whose textures fit the limit and an eighth of the budget; 8 at least.
+   */
+  static int ChooseBrickPoints(ScalarType type, int maxTextureSize, std::uint64_t budget);
 
   /**
    * The surfaces `looks` say, as every host draws them: NaN values left out,

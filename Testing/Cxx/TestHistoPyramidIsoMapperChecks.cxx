@@ -50,7 +50,9 @@
 //  BadInput  - no scalars, cell scalars, 3 components, 64-bit integers, 2D
 //              data, no isovalues, more than 8 isovalues, NaN values, an
 //              isovalue outside the range: one clear message each (said once
-//              over several renders) and nothing drawn, never a crash.
+//              over several renders) and nothing drawn, never a crash; a
+//              volume over GL_MAX_3D_TEXTURE_SIZE is drawn as bricks on the
+//              GPU path with no message.
 #include "HistoPyramid.h"
 #include "IsoMapperTestScenes.h"
 #include "MedicalTestUtilities.h"
@@ -969,6 +971,10 @@ void BadInput()
     withNaN->SetValue(i, std::numeric_limits<float>::quiet_NaN());
   }
   ExpectMessage("NaN values", nanImage, { 40.0 }, false, "", vtkHistoPyramidIsoMapper::GPUPath);
+  // Over GL_MAX_3D_TEXTURE_SIZE (2048 here) along z: kept as bricks, still the GPU path (issue 31).
+  vtkNew<vtkFloatArray> tall;
+  ExpectMessage("2100 slices (bricks)", SmallImage(4, 4, 2100, tall), { 40.0 }, false, "",
+    vtkHistoPyramidIsoMapper::GPUPath);
 }
 } // namespace
 

@@ -5,7 +5,7 @@
 
 Plain python3 (no ParaView): writes its own small MetaImage files. Exit statuses of mediso-render:
 2 bad options, 3 a volume that cannot be read or used, 4 no usable OpenGL (no EGL display, too old
-a context, the volume over the context's limits). A good volume is rendered too, so that the
+a context, the bricks an isovalue crosses over the GPU budget). A good volume is rendered too, so that the
 failures are the input's and not the program's.
 """
 import os
@@ -139,10 +139,20 @@ def main():
            [good, "--write-volume", os.path.join(temp, "no-such-dir", "v.mha")], 1,
            ["cannot be written"])
 
-    # The context's limits, and no usable context.
-    expect(binary, "over GL_MAX_3D_TEXTURE_SIZE",
-           [write_mha(os.path.join(temp, "long.mha"), (2, 2, 20000), "MET_UCHAR",
-                      values=[0] * 80000, fmt="<B"), "--iso", "1"], 4, ["GL_MAX_3D_TEXTURE_SIZE"])
+    # The context's limits, and no usable context. A volume over GL_MAX_3D_TEXTURE_SIZE is kept as
+    # bricks (issue 31) and drawn; only bricks that alone exceed the GPU budget fail.
+    long_volume = write_mha(os.path.join(temp, "long.mha"), (2, 2, 20000))
+    code, text = run(binary, [long_volume, "--iso", "1", "--stats", "--size", "64x64"])
+    print("over GL_MAX_3D_TEXTURE_SIZE: exit %d: %s" % (code, text.strip().splitlines()[-1:]))
+    check(code == 0 and '"bricks": 0,' not in text and '"active_bricks"' in text,
+          "over GL_MAX_3D_TEXTURE_SIZE: drawn from bricks (exit %d):\n%s" % (code, text))
+    expect(binary, "active bricks over the GPU budget",
+           [long_volume, "--iso", "1", "--gpu-budget-mb", "0.01", "--size", "64x64"], 4,
+           ["over the budget"])
+    expect(binary, "texture limit too small", [good, "--iso", "0", "--max-texture-size", "8"], 2,
+           ["--max-texture-size"])
+    expect(binary, "no GPU budget", [good, "--iso", "0", "--gpu-budget-mb", "0"], 2,
+           ["--gpu-budget-mb"])
     expect(binary, "no EGL display", [good, "--iso", "0"], 4, ["no EGL"],
            env={"__EGL_VENDOR_LIBRARY_FILENAMES": os.path.join(temp, "no-such-vendor.json")})
     expect(binary, "an OpenGL ES 2 context only", [good, "--iso", "0"], 4, ["OpenGL"],

@@ -1,0 +1,393 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// IsosurfaceScene over a volume kept as bricks (issue 31), on an EGL context
+// of OpenGL ES 3.0 (the WebGL2 subset) or OpenGL 3.2 core, no VTK, no X:
+//   TestIsosurfaceSceneBricks es|gl
+// A noisy phantom of odd size (and one whose last bricks own no cell) drawn with a forced small
+// texture limit and a small GPU budget is kept as bricks and drawn on the GPU path with exactly the
+// primitives of the one-texture scene and of a brute-force count, and images within the footprint
+// tests' thresholds of the one-texture images (one opaque surface, two, translucent over opaque, a
+// clipping plane, a parallel view, a sample distance of 2); float data with NaN values counts the
+// same; isovalue changes evict least recently used bricks within the budget and still count
+// exactly; active bricks over the budget fail with that reason; the limits set back to the defaults
+// give one texture again. Exit 125 (skip) where no such context can be made.
+#include "GLApi.h"
+#include "GLApiFunctions.h"
+#include "HeadlessContext.h"
+#include "HistoPyramidGLChecks.h" // MakePhantom
+#include "IsosurfaceScene.h"
+#include "MedicalTestUtilities.h"
+#include "SceneView.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace
+{
+using medical_test::Check;
+using namespace mediso;
+
+constexpr int Width = 160;
+constexpr int Height = 120;
+
+// Cells crossed by each isovalue (min < iso <= max over the 8 corners, none NaN), summed.
+template<typename T>
+std::uint64_t BruteForceCount(
+  const std::vector<T>& v, const int n[3], const std::vector<double>& isos)
+{
+  std::uint64_t count = 0;
+  for (int z = 0; z + 1 < n[2]; ++z)
+    for (int y = 0; y + 1 < n[1]; ++y)
+      for (int x = 0; x + 1 < n[0]; ++x)
+      {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        bool nan = false;
+        for (int c = 0; c < 8; ++c)
+        {
+          const double value = static_cast<double>(
+            v[(static_cast<std::size_t>(z + (c >> 2)) * n[1] + y + ((c >> 1) & 1)) * n[0] + x +
+              (c & 1)]);
+          nan = nan || std::isnan(value);
+          lo = std::min(lo, value);
+          hi = std::max(hi, value);
+        }
+        for (const double iso : isos)
+        {
+          count += !nan && lo < iso && iso <= hi;
+        }
+      }
+  return count;
+}
+
+// A framebuffer of Width x Height with depth, and the frames' view of a volume.
+class Target
+{
+public:
+  explicit Target(const GLApi& gl)
+    : GL(gl)
+  {
+    const GLApi::Functions& f = gl.F();
+    f.GenFramebuffers(1, &this->FBO);
+    f.GenRenderbuffers(2, this->Buffers);
+    f.BindRenderbuffer(GL_RENDERBUFFER, this->Buffers[0]);
+    f.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, Width, Height);
+    f.BindRenderbuffer(GL_RENDERBUFFER, this->Buffers[1]);
+    f.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, Width, Height);
+    f.BindFramebuffer(GL_FRAMEBUFFER, this->FBO);
+    f.FramebufferRenderbuffer(
+      GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, this->Buffers[0]);
+    f.FramebufferRenderbuffer(
+      GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, this->Buffers[1]);
+  }
+  ~Target()
+  {
+    this->GL.F().DeleteFramebuffers(1, &this->FBO);
+    this->GL.F().DeleteRenderbuffers(2, this->Buffers);
+  }
+
+  // One frame of `scene` (cleared to black); its RGB pixels, or empty with `error`.
+  std::vector<unsigned char> Draw(
+    IsosurfaceScene& scene, const IsosurfaceFrame& frame, std::string& error)
+  {
+    const GLApi::Functions& f = this->GL.F();
+    f.BindFramebuffer(GL_FRAMEBUFFER, this->FBO);
+    f.Viewport(0, 0, Width, Height);
+    f.Enable(GL_DEPTH_TEST);
+    f.DepthFunc(GL_LEQUAL);
+    f.DepthMask(GL_TRUE);
+    const GLfloat black[4] = { 0.0f, 0.0f, 0.0f, 1.0f };
+    const GLfloat one = 1.0f;
+    f.ClearBufferfv(GL_COLOR, 0, black);
+    f.ClearBufferfv(GL_DEPTH, 0, &one);
+    if (!scene.Render(frame, error))
+    {
+      return {};
+    }
+    std::vector<unsigned char> rgba(4 * static_cast<std::size_t>(Width) * Height);
+    f.ReadBuffer(GL_COLOR_ATTACHMENT0);
+    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
+    f.ReadPixels(0, 0, Width, Height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+    std::vector<unsigned char> rgb;
+    for (std::size_t p = 0; p < rgba.size(); p += 4)
+    {
+      rgb.insert(rgb.end(), rgba.begin() + p, rgba.begin() + p + 3);
+    }
+    return rgb;
+  }
+
+private:
+  const GLApi& GL;
+  GLuint FBO = 0;
+  GLuint Buffers[2] = { 0, 0 };
+};
+
+IsosurfaceFrame View(const int dims[3], double azimuth, double elevation, bool parallel)
+{
+  VolumePlacement placement;
+  std::copy(dims, dims + 3, placement.Dimensions);
+  double bounds[6];
+  placement.Bounds(bounds);
+  Camera camera;
+  camera.Parallel = parallel;
+  camera.Reset(bounds, static_cast<double>(Width) / Height);
+  camera.Azimuth(azimuth);
+  camera.Elevation(elevation);
+  camera.OrthogonalizeViewUp();
+  camera.ResetClippingRange(bounds);
+  IsosurfaceFrame frame;
+  SetFrameView(frame, camera, placement, Width, Height);
+  return frame;
+}
+
+IsosurfaceLook Look(double value, float r, float g, float b, float opacity)
+{
+  IsosurfaceLook look;
+  look.Value = value;
+  look.Color[0] = r;
+  look.Color[1] = g;
+  look.Color[2] = b;
+  look.Opacity = opacity;
+  return look;
+}
+
+// The footprint tests' agreement between two GPU images of one scene.
+void CompareImages(
+  const std::vector<unsigned char>& a, const std::vector<unsigned char>& b, const std::string& name)
+{
+  int either = 0, disagree = 0, both = 0;
+  double diff = 0.0;
+  for (std::size_t p = 0; p + 2 < a.size() && a.size() == b.size(); p += 3)
+  {
+    const bool ca = a[p] || a[p + 1] || a[p + 2];
+    const bool cb = b[p] || b[p + 1] || b[p + 2];
+    either += ca || cb;
+    disagree += ca != cb;
+    if (ca && cb)
+    {
+      ++both;
+      for (int c = 0; c < 3; ++c)
+      {
+        diff += std::abs(static_cast<int>(a[p + c]) - static_cast<int>(b[p + c]));
+      }
+    }
+  }
+  const double agreement = either ? 1.0 - static_cast<double>(disagree) / either : 0.0;
+  const double mean = both ? diff / (3.0 * both) : 255.0;
+  std::printf("%s: %d pixels covered, agreement %.5f, mean difference %.3f\n", name.c_str(), either,
+    agreement, mean);
+  Check(
+    a.size() == b.size() && either > 1000, name + ": both images drawn, the surface covers pixels");
+  Check(agreement >= 0.998, name + ": covered pixels agree between one texture and bricks");
+  Check(mean <= 1.0, name + ": colours agree between one texture and bricks");
+}
+
+struct Case
+{
+  std::string Name;
+  std::vector<IsosurfaceLook> Looks;
+  double Azimuth, Elevation;
+  bool Parallel;
+  std::vector<std::array<double, 4>> Clip;
+  float SampleDistance;
+};
+
+template<typename T>
+void RunCases(const std::shared_ptr<const GLApi>& gl, Target& target, const std::vector<T>& values,
+  const int dims[3], const std::vector<Case>& cases, const std::string& prefix)
+{
+  VolumeDescription volume;
+  volume.Type = ScalarTypeOf<T>();
+  volume.Data = values.data();
+  std::copy(dims, dims + 3, volume.Dims);
+  volume.Stamp = 1;
+
+  IsosurfaceScene dense(nullptr), bricked(nullptr);
+  dense.SetContext(gl);
+  bricked.SetContext(gl);
+  bricked.SetMaxTextureSize(32);
+  bricked.SetGPUMemoryBudget(3u << 20);
+  std::string error;
+  Check(
+    dense.SetVolume(volume, error) && !dense.IsBricked(), prefix + ": one texture (" + error + ")");
+  Check(bricked.SetVolume(volume, error) && bricked.IsBricked(),
+    prefix + ": over a texture limit of 32, bricks (" + error + ")");
+  for (const Case& c : cases)
+  {
+    const std::string name = prefix + " " + c.Name;
+    IsosurfaceFrame frame = View(dims, c.Azimuth, c.Elevation, c.Parallel);
+    frame.ClipPlanes = c.Clip;
+    frame.SampleDistance = c.SampleDistance;
+    dense.SetSurfaces(c.Looks);
+    bricked.SetSurfaces(c.Looks);
+    std::string denseError, brickError;
+    const std::vector<unsigned char> a = target.Draw(dense, frame, denseError);
+    const std::vector<unsigned char> b = target.Draw(bricked, frame, brickError);
+    Check(!a.empty(), name + ": one texture drawn (" + denseError + ")");
+    Check(!b.empty(), name + ": bricks drawn (" + brickError + ")");
+    if (a.empty() || b.empty())
+    {
+      continue;
+    }
+    std::vector<double> isos;
+    for (const auto& look : c.Looks)
+    {
+      isos.push_back(look.Value);
+    }
+    const std::uint64_t expected = BruteForceCount(values, dims, isos);
+    const IsosurfaceSceneStats& s = bricked.GetStats();
+    std::printf("%s: %llu primitives (brute force %llu), %llu of %llu bricks of %d active, "
+                "%llu resident, %llu GPU bytes\n",
+      name.c_str(), static_cast<unsigned long long>(bricked.GetActivePairs()),
+      static_cast<unsigned long long>(expected), static_cast<unsigned long long>(s.ActiveBricks),
+      static_cast<unsigned long long>(s.Bricks), s.BrickPoints,
+      static_cast<unsigned long long>(s.ResidentBricks),
+      static_cast<unsigned long long>(bricked.GetGPUMemoryBytes()));
+    Check(dense.GetActivePairs() == expected, name + ": one texture counts the brute-force cells");
+    Check(bricked.GetActivePairs() == expected, name + ": bricks count exactly the same cells");
+    Check(c.Clip.empty() ? s.Primitives == expected : s.Primitives <= expected,
+      name + ": the frame drew them");
+    Check(s.Bricks > 8 && s.ActiveBricks > 1 && s.ActiveBricks <= s.Bricks,
+      name + ": several bricks, several active");
+    Check(
+      bricked.GetGPUMemoryBytes() <= bricked.GetGPUMemoryBudget(), name + ": within the budget");
+    Check(s.FirstHit == dense.GetStats().FirstHit,
+      name + ": the bricks take the first-hit pass where one texture does (one, shared)");
+    CompareImages(a, b, name);
+  }
+  dense.Release();
+  bricked.Release();
+}
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  if (argc != 2 || (std::strcmp(argv[1], "es") != 0 && std::strcmp(argv[1], "gl") != 0))
+  {
+    std::cerr << "usage: " << argv[0] << " es|gl\n";
+    return 2;
+  }
+  const bool es = std::strcmp(argv[1], "es") == 0;
+  std::string error;
+  auto context = headless::HeadlessContext::Create(
+    es ? headless::ContextApi::ES3 : headless::ContextApi::GL32, error);
+  if (!context)
+  {
+    std::cout << "SKIP: " << error << "\n";
+    return 125;
+  }
+  const std::shared_ptr<const GLApi> gl = context->GetGLApi();
+  Target target(*gl);
+
+  const int dims[3] = { 61, 53, 47 };
+  const std::vector<std::int16_t> phantom = pyramid_checks::MakePhantom(dims, 40.0, 7);
+  const IsosurfaceLook skin = Look(-500, 0.93f, 0.75f, 0.62f, 1.0f);
+  const IsosurfaceLook bone = Look(400, 0.95f, 0.95f, 0.9f, 1.0f);
+  const IsosurfaceLook glass = Look(-500, 0.93f, 0.75f, 0.62f, 0.4f);
+  const std::vector<Case> cases = {
+    { "bone", { bone }, 0, 0, false, {}, 1.0f },
+    { "skin and bone, turned", { skin, bone }, 40, 25, false, {}, 1.0f },
+    { "translucent skin over bone", { glass, bone }, -60, 10, false, {}, 1.0f },
+    { "bone, clipped", { bone }, 30, 0, false, { { 1.0, 0.2, 0.0, -29.0 } }, 1.0f },
+    { "skin, parallel", { skin }, 120, -20, true, {}, 1.0f },
+    { "bone, sample distance 2", { bone }, 200, 30, false, {}, 2.0f },
+  };
+  RunCases(gl, target, phantom, dims, cases, "int16");
+  // Sizes whose last brick on an axis owns one plane of points and no cell (48 = 2 x 24).
+  {
+    const int edge[3] = { 49, 25, 49 };
+    RunCases(
+      gl, target, pyramid_checks::MakePhantom(edge, 40.0, 3), edge, { cases[1] }, "int16 49x25x49");
+  }
+
+  // Float data with NaN values: cells with a NaN corner count nothing, in bricks too.
+  {
+    std::vector<float> values(phantom.begin(), phantom.end());
+    for (std::size_t i = 0; i < values.size(); i += 37)
+    {
+      values[i] = std::nanf("");
+    }
+    RunCases(gl, target, values, dims, { cases[1] }, "float with NaN");
+  }
+
+  // Isovalue changes within a budget that holds the bricks of one change but
+  // not of all: least recently used bricks go, the counts stay exact.
+  {
+    VolumeDescription volume;
+    volume.Type = ScalarType::Int16;
+    volume.Data = phantom.data();
+    std::copy(dims, dims + 3, volume.Dims);
+    // Bricks of 8 points (a limit of 16 texels); the bytes each isovalue's
+    // bricks take, each alone; the budget then holds the largest of them.
+    const std::vector<double> changes = { 1000.0, -500.0, 400.0, 1000.0, -500.0 };
+    std::uint64_t largest = 0;
+    for (const double iso : changes)
+    {
+      IsosurfaceScene alone(nullptr);
+      alone.SetContext(gl);
+      alone.SetMaxTextureSize(16);
+      alone.SetSurfaces({ Look(iso, 1, 1, 1, 1) });
+      Check(alone.SetVolume(volume, error) && alone.Update(error), "budget: alone (" + error + ")");
+      largest = std::max(largest, alone.GetGPUMemoryBytes());
+      alone.Release();
+    }
+    IsosurfaceScene scene(nullptr);
+    scene.SetContext(gl);
+    scene.SetMaxTextureSize(16);
+    scene.SetGPUMemoryBudget(largest);
+    Check(scene.SetVolume(volume, error) && scene.IsBricked(), "budget: bricks (" + error + ")");
+    std::uint64_t uploads = 0;
+    for (const double iso : changes)
+    {
+      scene.SetSurfaces({ Look(iso, 1, 1, 1, 1) });
+      const bool updated = scene.Update(error);
+      const IsosurfaceSceneStats& s = scene.GetStats();
+      std::printf(
+        "budget, iso %g: %llu active, %llu resident, %llu uploads so far, %llu GPU bytes%s\n", iso,
+        static_cast<unsigned long long>(s.ActiveBricks),
+        static_cast<unsigned long long>(s.ResidentBricks),
+        static_cast<unsigned long long>(s.BrickUploads),
+        static_cast<unsigned long long>(scene.GetGPUMemoryBytes()), updated ? "" : " (over)");
+      Check(updated, "budget, iso " + std::to_string(iso) + ": fits (" + error + ")");
+      Check(scene.GetActivePairs() == BruteForceCount(phantom, dims, { iso }),
+        "budget, iso " + std::to_string(iso) + ": exact count");
+      Check(scene.GetGPUMemoryBytes() <= scene.GetGPUMemoryBudget(),
+        "budget, iso " + std::to_string(iso) + ": GPU memory within the budget");
+      uploads = s.BrickUploads;
+    }
+    const IsosurfaceSceneStats& s = scene.GetStats();
+    Check(uploads > s.ResidentBricks, "budget: bricks were evicted and uploaded again");
+
+    // Active bricks alone over the budget: the reason, and no volume drawn.
+    scene.SetMaxTextureSize(32);
+    scene.SetGPUMemoryBudget(96u << 10);
+    Check(scene.SetVolume(volume, error), "small budget: the volume is adopted as bricks");
+    scene.SetSurfaces({ skin, bone });
+    error.clear();
+    const bool updated = scene.Update(error);
+    std::printf("small budget: %s\n", error.c_str());
+    Check(
+      !updated && scene.GetStats().OverBudget && error.find("over the budget") != std::string::npos,
+      "active bricks over the budget: the update fails with that reason");
+    IsosurfaceFrame frame = View(dims, 0, 0, false);
+    error.clear();
+    std::vector<unsigned char> none = target.Draw(scene, frame, error);
+    Check(none.empty() && error.find("budget") != std::string::npos, "and so does the frame");
+
+    // Back to the defaults: one texture, the same count.
+    scene.SetGPUMemoryBudget(0);
+    scene.SetMaxTextureSize(0);
+    Check(scene.SetVolume(volume, error) && !scene.IsBricked() && scene.Update(error) &&
+        scene.GetActivePairs() == BruteForceCount(phantom, dims, { -500.0, 400.0 }) &&
+        !scene.GetStats().OverBudget && scene.GetStats().Bricks == 0,
+      "default limits: one texture again, the same count (" + error + ")");
+    scene.Release();
+  }
+  return medical_test::Finish(
+    es ? "TestIsosurfaceSceneBricks es passed" : "TestIsosurfaceSceneBricks gl passed");
+}
