@@ -431,6 +431,14 @@ void NIfTIPlacement(
         m[r][3] += h.SRow[r][2] * static_cast<double>(slices - 1);
       }
     }
+    const double turned = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+      m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+      m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    if (turned < 0.0)
+    {
+      // qfac -1 reversed the slices, and the sform did not expect it (VTK warns too).
+      warnings.push_back("the sform is a mirror image of the qform (qfac -1); the sform is used.");
+    }
     p.Placement = "sform";
   }
   else if (qform)
