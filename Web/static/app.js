@@ -19,6 +19,7 @@
 //   slices.js       the axial, coronal and sagittal views: window, crosshair, contours
 //   histogram.js    the volume's histogram, its isovalue markers dragged
 //   presets.js      the first surfaces (Hounsfield units or Otsu), the CT presets
+//   local.js        a local file dropped or picked, read in the page by the module
 
 import { interact } from "./interaction.js";
 import { linkedView, readLink, scheduleLink } from "./link.js";
@@ -27,11 +28,12 @@ import { VIEWS, applyNamedView, drawMarker, markerLabels, sceneView, setDataset,
   from "./orientation.js";
 import { applyPath, drawnLevel, requestPath } from "./path.js";
 import { drawHistogram, histogramInfo, setupHistogram } from "./histogram.js";
+import { serverDataset, setupLocalFiles } from "./local.js";
 import { setupPresets } from "./presets.js";
 import { fps, showDataset, unsupported, updateReadout } from "./readout.js";
 import { $, params, state } from "./state.js";
-import { crosshairInfo, drawSlices, pick, setCrosshair, setSliceWindow, setupSlices, slicesInfo }
-  from "./slices.js";
+import { crosshairInfo, drawSlices, pick, resetSlices, setCrosshair, setSliceWindow, setupSlices,
+  slicesInfo } from "./slices.js";
 import { replaceSurfaces, setupSurfaceList } from "./surfaces.js";
 import { afterFrame, change, clearMesh, drawn, fitCanvas, renderNow, requestFrame, showMesh, startViewer }
   from "./viewer.js";
@@ -131,7 +133,8 @@ async function start() {
   await drawn(); // ready after the first frame (the worker's answer)
   // The "On the server" panel (Web/static/operations.js) is given what it needs here.
   setupOperations({
-    dataset: d,
+    get dataset() { return state.dataset; }, // a local file's once it is opened
+    serverDataset: () => serverDataset(state.dataset),
     token: sessionToken(),
     surfaces: () => state.surfaces,
     levels: state.facts.levels.count,
@@ -147,6 +150,25 @@ async function start() {
       change(() => { surface.hidden = !shown; });
     },
   });
+  setupLocalFiles(openLocal);
+}
+
+// A local file's volume (local.js) in place of the one shown: placed, fetched from the page's own
+// levels at the level the path affords, in the anterior view with its first surfaces.
+async function openLocal(d) {
+  state.dataset = d;
+  showDataset(d);
+  const placement = setDataset(d);
+  $("space").textContent = "Shown in " + placement.space + "." +
+    (placement.note ? " Note: " + placement.note + "." : "");
+  state.level = null; // another volume: its level is loaded whatever the last one's was
+  await applyPath();
+  applyNamedView("anterior");
+  setupSurfaceList();
+  setupPresets((surfaces) => replaceSurfaces(surfaces, false));
+  resetSlices(histogramInfo());
+  renderNow();
+  await drawn();
 }
 
 // ---------------------------------------------------------------------------- automation
@@ -235,6 +257,12 @@ window.mediso = {
     info: state.viewer ? state.viewer.info() : null,
   }),
   cpuCount: (values) => state.viewer.countOnCPU(values),
+  // The dataset shown, as /api/datasets describes it (a local file's as the module read it:
+  // local.js), without its values.
+  dataset: () => {
+    const { local, ...d } = state.dataset || {};
+    return Object.assign(JSON.parse(JSON.stringify(d)), { local: Boolean(local) });
+  },
   // The stats once the newest frame asked for is drawn at its full level (with the viewer in a
   // worker, frames come after the change that asked for them; on the main thread, at once).
   async drawn() {

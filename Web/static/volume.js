@@ -84,9 +84,16 @@ function typedValues(bytes, typeName) {
   return new Typed(copy.buffer, copy.byteOffset, copy.length / Typed.BYTES_PER_ELEMENT);
 }
 
-/** Fetches level `level` of the dataset and gives it to the viewer (the module's memory). */
+/**
+ * Fetches level `level` of the dataset and gives it to the viewer (the module's memory). A local
+ * file's dataset (local.js) has its levels in the page already: `d.local.level(k)`.
+ */
 export async function loadVolume(level) {
   const d = state.dataset;
+  if (d.local) {
+    const { dims, spacing, origin, bytes } = d.local.level(level);
+    return putVolume(state.facts.scalarTypes.get(d.type), d.type, dims, spacing, origin, bytes, level);
+  }
   const { response, body } = await request("/api/volume/" + d.id + "?level=" + level, "no-cache");
   const typeName = response.headers.get("X-Mediso-Type");
   const type = state.facts.scalarTypes.get(typeName);
@@ -97,6 +104,11 @@ export async function loadVolume(level) {
   const spacing = response.headers.get("X-Mediso-Spacing").split(",").map(Number);
   const origin = response.headers.get("X-Mediso-Origin").split(",").map(Number);
   const bytes = unshuffle(new Uint8Array(body), type.bytes);
+  return putVolume(type, typeName, dims, spacing, origin, bytes, level);
+}
+
+// The level's values (little-endian bytes) into the page's copy and the module's memory.
+async function putVolume(type, typeName, dims, spacing, origin, bytes, level) {
   state.values = typedValues(bytes, typeName);
   state.grid = { dims, spacing, origin };
   const M = state.module;
