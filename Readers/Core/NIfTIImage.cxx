@@ -548,6 +548,17 @@ bool ReadNIfTI(const unsigned char* bytes, std::size_t size, NIfTIImage& image, 
   const std::size_t out = static_cast<std::size_t>(ScalarTypeSize(image.Type));
   const std::size_t slice = static_cast<std::size_t>(dims[1]) * static_cast<std::size_t>(dims[2]);
   const std::size_t nz = static_cast<std::size_t>(dims[3]);
+  // Calibration may widen the values (uint8 to float32): within what this process addresses
+  // (a 32-bit size_t in the page's WebAssembly).
+  const long double outBytes = volumeBytes / static_cast<long double>(stored) * out;
+  if (outBytes > static_cast<long double>(std::numeric_limits<std::size_t>::max() / 2))
+  {
+    std::ostringstream msg;
+    msg << "its " << ScalarTypeName(image.Type) << " values would take " << outBytes
+        << " bytes, more than this process can address";
+    error = msg.str();
+    return false;
+  }
   try
   {
     image.Bytes.resize(slice * nz * out);

@@ -9,7 +9,8 @@
 // - the CPU path's triangles at level 3 and at the estimator's level, and the GPU path's
 //   primitives, for the same isovalues, equal the served volume's;
 // - opening it sent and received nothing (the page's byte counters unchanged);
-// - a truncated NIfTI, a NIfTI with a bad sizeof_hdr and a file of another kind are refused with
+// - a truncated NIfTI, a NIfTI with a bad sizeof_hdr, a file of another kind and a NIfTI over a
+//   memory budget of 0.1 MB are refused with
 //   one visible message (#local-note) and the volume shown stays (its facts and triangles);
 // - a server operation on the local MetaImage uploads it once (one POST /api/upload, the page saying
 //   how many bytes before and after) and gives the triangles the same operation gives on the
@@ -189,8 +190,12 @@ for (const [server, kind, locals] of [
   if (kind === "nii") {
     const kept = await measure(page, ISOVALUES[kind]);
     for (const [paths, expected] of [[[files.truncated], /holds only 1352 bytes/],
-      [[files.badHeader], /sizeof_hdr, is 123/], [[files.other], /open anything else .*through the server/]]) {
+      [[files.badHeader], /sizeof_hdr, is 123/], [[files.other], /open anything else .*through the server/],
+      [[files.nii], /over the page's memory budget of 0.1 MB/]]) {
+      // The last: a good file over a budget of 0.1 MB (the box's value, read at each file).
+      await page.fill("#budget", expected.source.includes("budget") ? "0.1" : "1024");
       const note = await openLocal(page, paths);
+      await page.fill("#budget", "1024"); // the view measured at the budget it was shown with
       const now = await measure(page, ISOVALUES[kind]);
       checks.check(/^Not opened: /.test(note) && expected.test(note) && /The volume shown stays/.test(note),
         path.basename(paths[0]) + ": refused with " + JSON.stringify(note));

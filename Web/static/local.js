@@ -90,8 +90,8 @@ export async function readLocalFiles(files, budgetBytes) {
       const bytes = await bytesOf(file);
       if (bytes.length > budgetBytes) {
         throw new Error(file.name + ": " + (bytes.length / 1e6).toFixed(1) + " MB is over the page's " +
-          "memory budget of " + (budgetBytes / 1e6).toFixed(0) + " MB (raise the budget, or open it " +
-          "through the server, which sends a coarser level)");
+          "memory budget of " + budgetBytes / 1e6 + " MB (raise the budget, or open it " +
+          "through the server, which sends a coarser level).");
       }
       const path = folder + "/" + file.name.replace(/\.gz$/i, "");
       M.FS.writeFile(path, bytes);
@@ -105,6 +105,12 @@ export async function readLocalFiles(files, budgetBytes) {
   }
   if (read.error) {
     throw new Error(main.name + ": " + read.error + ".");
+  }
+  if (read.bytes > budgetBytes) { // calibrated values may be wider than the file's
+    M._free(read.pointer);
+    throw new Error(main.name + ": its " + read.type + " values take " + (read.bytes / 1e6).toFixed(1) +
+      " MB, over the page's memory budget of " + budgetBytes / 1e6 + " MB (raise the " +
+      "budget, or open it through the server, which sends a coarser level).");
   }
   const values = M.HEAPU8.slice(read.pointer, read.pointer + read.bytes);
   M._free(read.pointer);
