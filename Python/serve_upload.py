@@ -75,10 +75,14 @@ def handler(state_key, dataset_class):
                     raise web.HTTPRequestEntityTooLarge(max_size=MAX_UPLOAD_BYTES, actual_size=received)
                 out += inflate.decompress(chunk, raw + 1 - len(out))
                 if len(out) > raw:
-                    break
-            out += inflate.flush()
+                    break  # more than promised: what is left is never inflated
+            else:
+                out += inflate.flush(raw + 1 - len(out))
         except zlib.error as e:
             raise web.HTTPBadRequest(text="the body is not a gzip stream (%s)\n" % e)
+        if len(out) > raw:
+            raise web.HTTPBadRequest(text="the body inflates past the %d bytes of values of %s %s\n"
+                                     % (raw, "x".join(map(str, dims)), type_name))
         if len(out) != raw:
             raise web.HTTPBadRequest(text="the body holds %d bytes of values, %d are needed for %s %s\n"
                                      % (len(out), raw, "x".join(map(str, dims)), type_name))
