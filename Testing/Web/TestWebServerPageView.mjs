@@ -8,7 +8,7 @@
 //   and left of it (left view: anterior is on the left). The phantom (RAS, nose at +y) opens the
 //   same way. A MetaImage with a mirroring TransformMatrix (diag(1, -1, 1), as the cached
 //   ct_head.mha's) opens in the anterior view by the matrix the server states, and the page says
-//   that its left and right are swapped in the picture.
+//   that its grid is a mirror image drawn reflected (TestWebServerPageShots checks the picture).
 // - navigation: a right-drag and a shift-drag of 120 px move the focal point by 120 px of the
 //   focal plane (within 5%) across the view, and turn it by less than 0.001 degree; a left-drag
 //   does turn it (more than 10 degrees); a wheel step 100 px off the centre dollies 1.1x nearer
@@ -129,8 +129,8 @@ const browser = await launchBrowser();
 }
 
 // --- a MetaImage whose TransformMatrix is a mirror (as the cached ct_head.mha's) -----------------
-// The server states the header's matrix; the page places the volume by it and says that left
-// and right are swapped, since its module draws the grid unmirrored.
+// The server states the header's matrix; the page places the volume by it, draws the grid
+// reflected along i so that the picture is not a mirror image, and says so.
 const mirrored = path.join(folder, "mirrored.mha");
 let mirrorServer;
 {
@@ -147,7 +147,7 @@ let mirrorServer;
   const space = (await page.evaluate(() => window.mediso.orientation())).space;
   const view = await page.evaluate(() => window.mediso.getView());
   const forward = sub(view.focalPoint, view.position).map((x) => x / len(sub(view.focalPoint, view.position)));
-  checks.check(/MetaImage \(LPS\)/.test(space) && /mirror image/.test(space),
+  checks.check(/MetaImage \(LPS\)/.test(space) && /mirror image/.test(space) && /drawn reflected/.test(space),
     "a mirrored MetaImage: " + space);
   checks.check(near(view.world.direction, [0, 1, 0], 1e-6) && near(forward, [0, -1, 0], 1e-6),
     "... opens in the anterior view, in the module's frame looking along -j " + fmt(forward) +

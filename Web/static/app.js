@@ -9,14 +9,15 @@
 //   volume.js       the counted requests and the volume, fetched once per level
 //   path.js         the GPU or the CPU path, and the level of the volume each can afford
 //   viewer.js       the WebAssembly module, its viewer, the frames; the facts the module states
-//   interaction.js  mouse, wheel and keys on the canvas (turn, pan, zoom at the cursor, reset)
+//   interaction.js  mouse, wheel, two fingers and keys on the canvas (turn, pan, zoom at the cursor, reset)
 //   orientation.js  patient space (LPS): the views, the orientation marker, getView().world
-//   link.js         the surfaces, camera and path in the URL's fragment
+//   link.js         the surfaces, camera, crosshair and path in the URL's fragment
 //   surfaces.js     the surface list
 //   readout.js      the stats, the notes, and why the page cannot run
 //   operations.js   the "On the server" panel
 //   ply.js          the server's surfaces, read
 //   slices.js       the axial, coronal and sagittal views: window, crosshair, contours
+//   crosshair3d.js  the crosshair drawn over the 3D view
 //   histogram.js    the volume's histogram, its isovalue markers dragged
 //   presets.js      the first surfaces (Hounsfield units or Otsu), the CT presets
 //   local.js        a local file dropped or picked, read in the page by the module
@@ -32,6 +33,7 @@ import { serverDataset, setupLocalFiles } from "./local.js";
 import { setupPresets } from "./presets.js";
 import { fps, showDataset, unsupported, updateReadout } from "./readout.js";
 import { $, params, state } from "./state.js";
+import { drawCrosshair3D, setupCrosshair3D } from "./crosshair3d.js";
 import { crosshairInfo, drawSlices, pick, resetSlices, setCrosshair, setSliceWindow, setupSlices,
   slicesInfo } from "./slices.js";
 import { replaceSurfaces, setupSurfaceList } from "./surfaces.js";
@@ -96,6 +98,11 @@ async function start() {
   setupPresets((surfaces) => replaceSurfaces(surfaces, false));
   setupHistogram();
   setupSlices(histogramInfo());
+  setupCrosshair3D(canvas, scheduleLink);
+  afterFrame.push(drawCrosshair3D);
+  if (link.crosshair) {
+    setCrosshair(link.crosshair);
+  }
   let drawnKey = "";
   afterFrame.push(() => {
     const key = JSON.stringify([state.surfaces, state.level]);

@@ -2,7 +2,8 @@
 // Interaction on the canvas: left-drag turns the camera about the focal point (azimuth,
 // elevation); right-drag, middle-drag and shift-drag pan (the camera and its focal point move
 // together in the picture's plane); the wheel dollies towards the point under the cursor; the
-// arrow keys turn by 5 degrees and `r` resets to the anterior view. Each asks for one frame at the
+// arrow keys turn by 5 degrees and `r` resets to the anterior view; two fingers on a touch screen
+// pan (their midpoint) and zoom (their spread) at once (twoFingers). Each asks for one frame at the
 // next animation frame. Pan and zoom are computed here from the camera's own view (setView), so
 // the module needs no camera operation of its own for them.
 
@@ -66,8 +67,9 @@ export function interact(canvas, { reset, changed }) {
   };
   canvas.addEventListener("pointerup", release);
   canvas.addEventListener("pointercancel", release);
+  const fingers = twoFingers(canvas, moved);
   canvas.addEventListener("pointermove", (e) => {
-    if (!last) {
+    if (!last || fingers.active()) {
       return;
     }
     const dx = e.clientX - last[0], dy = e.clientY - last[1];
@@ -105,4 +107,44 @@ export function interact(canvas, { reset, changed }) {
     e.preventDefault();
     moved();
   });
+}
+
+/**
+ * Two touches on the canvas: the picture follows their midpoint (pan) and their spread (zoom at
+ * the midpoint, the distance between the fingers' ratio), as on a map; while two are down the
+ * one-finger turn is left alone (`active`). Pointer events: a touch is a pointer of type "touch".
+ */
+function twoFingers(canvas, moved) {
+  const touches = new Map(); // pointerId -> [x, y] (CSS pixels of the canvas)
+  const at = (e) => {
+    const box = canvas.getBoundingClientRect();
+    return [e.clientX - box.left, e.clientY - box.top];
+  };
+  const pair = () => {
+    const [a, b] = [...touches.values()];
+    return { mid: [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2], spread: Math.hypot(a[0] - b[0], a[1] - b[1]) };
+  };
+  canvas.addEventListener("pointerdown", (e) => {
+    if (e.pointerType === "touch") {
+      touches.set(e.pointerId, at(e));
+    }
+  });
+  const lift = (e) => touches.delete(e.pointerId);
+  canvas.addEventListener("pointerup", lift);
+  canvas.addEventListener("pointercancel", lift);
+  canvas.addEventListener("pointermove", (e) => {
+    if (e.pointerType !== "touch" || !touches.has(e.pointerId) || touches.size !== 2) {
+      return;
+    }
+    const before = pair();
+    touches.set(e.pointerId, at(e));
+    const after = pair();
+    state.interacting = true;
+    pan(canvas, after.mid[0] - before.mid[0], after.mid[1] - before.mid[1]);
+    if (before.spread > 0 && after.spread > 0) {
+      zoomAt(canvas, after.mid[0], after.mid[1], after.spread / before.spread);
+    }
+    moved();
+  });
+  return { active: () => touches.size >= 2 };
 }

@@ -4,12 +4,15 @@
 // and read at the start, so that a reload or a shared link shows the same view. The fragment
 // never reaches the server. A value that cannot be used is left out with a note; the rest applies.
 //
-//   #iso=VALUE,RRGGBB,OPACITY;VALUE,RRGGBB,OPACITY&cam=PX,PY,PZ,FX,FY,FZ,UX,UY,UZ,ANGLE&path=cpu
+//   #iso=VALUE,RRGGBB,OPACITY;VALUE,RRGGBB,OPACITY&cam=PX,PY,PZ,FX,FY,FZ,UX,UY,UZ,ANGLE&xh=X,Y,Z&path=cpu
+//
+// xh: the slice views' crosshair (LPS mm), kept within the volume when applied.
 //
 // The camera is in patient space (LPS millimetres, orientation.js), so that a link means the same
 // view of the same scan whatever the module's scene frame.
 
-import { lpsFromScenePoint, lpsFromSceneVector, sceneView, vec } from "./orientation.js";
+import { lpsFromDrawnPoint, lpsFromDrawnVector, sceneView, vec } from "./orientation.js";
+import { crosshairInfo } from "./slices.js";
 import { state } from "./state.js";
 
 const PATHS = ["auto", "gpu", "cpu"];
@@ -22,7 +25,7 @@ const number = (x) => Number(x.toPrecision(7));
  */
 export function readLink(hash, range, maximum) {
   const fields = new URLSearchParams(hash.replace(/^#/, ""));
-  const out = { surfaces: null, camera: null, path: null, notes: [] };
+  const out = { surfaces: null, camera: null, crosshair: null, path: null, notes: [] };
   if (fields.has("iso")) {
     const surfaces = [];
     for (const text of fields.get("iso").split(";").filter((t) => t !== "")) {
@@ -66,6 +69,14 @@ export function readLink(hash, range, maximum) {
         "position and focal point and a view up off the view direction, and a view angle 0-180");
     }
   }
+  if (fields.has("xh")) {
+    const n = fields.get("xh").split(",").map((t) => (t.trim() === "" ? NaN : Number(t)));
+    if (n.length === 3 && n.every(Number.isFinite)) {
+      out.crosshair = n;
+    } else {
+      out.notes.push("the crosshair (" + fields.get("xh") + ") is not 3 numbers");
+    }
+  }
   if (fields.has("path")) {
     if (PATHS.includes(fields.get("path"))) {
       out.path = fields.get("path");
@@ -89,9 +100,13 @@ export function linkedView(camera) {
 export function writeLink() {
   const iso = state.surfaces.map((s) => number(s.value) + "," + hex(s.color) + "," + number(s.opacity));
   const v = state.viewer.getView();
-  const cam = [...lpsFromScenePoint(v.position), ...lpsFromScenePoint(v.focalPoint),
-    ...lpsFromSceneVector(v.viewUp), v.viewAngle].map(number);
-  return "#iso=" + iso.join(";") + "&cam=" + cam.join(",") + "&path=" + state.requestedPath;
+  const cam = [...lpsFromDrawnPoint(v.position), ...lpsFromDrawnPoint(v.focalPoint),
+    ...lpsFromDrawnVector(v.viewUp), v.viewAngle].map(number);
+  let xh = "";
+  try {
+    xh = "&xh=" + crosshairInfo().point.map(number).join(",");
+  } catch { /* no slice views yet */ }
+  return "#iso=" + iso.join(";") + "&cam=" + cam.join(",") + xh + "&path=" + state.requestedPath;
 }
 
 let timer = 0;

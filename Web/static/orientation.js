@@ -10,6 +10,12 @@
 // space as DICOM and ITK do, LPS (x to the patient's left, y posterior, z superior): a RAS world
 // is turned into LPS by negating x and y. The views, the marker, getView().world and the camera
 // in the URL are all in LPS millimetres.
+//
+// The module's camera looks at the *drawn* frame: the scene itself, or, for a volume whose axes
+// are a mirror image of patient space (determinant -1), the scene reflected along its first axis
+// about the origin (the module's setDirection). Drawn so, the grid lies in patient space by a
+// rotation, and the picture is the patient as seen, not a mirror image. The camera's conversions
+// below go through the drawn frame; the slice views' through the scene (grid) frame.
 
 import { state } from "./state.js";
 
@@ -97,15 +103,20 @@ export function setDataset(d) {
   const f = world === "RAS" ? [-1, -1, 1] : [1, 1, 1];
   const rows = [0, 1, 2].map((r) => [0, 1, 2].map((c) => f[r] * m[3 * r + c]));
   // Axes that are a mirror image of patient space (determinant -1: a series read with its rows
-  // flipped, as the cached ct_head.mha, or a NIfTI stored left to right) cannot be turned into
-  // it: the module draws the grid as it is, so the views face the right way with left and right
-  // swapped in the picture. Said, not hidden.
-  if (!note && dot(rows[0], cross(rows[1], rows[2])) < 0) {
-    note = "the volume's axes are a mirror image of patient space: the views face the right way, " +
-      "with left and right swapped in the picture";
+  // flipped, as the cached ct_head.mha, or a NIfTI stored left to right) are drawn reflected
+  // along the grid's first axis, so that the drawn frame is patient space turned, not mirrored.
+  const mirrored = !note && dot(rows[0], cross(rows[1], rows[2])) < 0;
+  frame = { origin: d.origin.map(Number), rows, flip: f, world, source, mirror: mirrored ? 0 : -1 };
+  const drawn = [1, 0, 0, 0, 1, 0, 0, 0, 1];
+  if (mirrored) {
+    drawn[0] = -1;
   }
-  frame = { origin: d.origin.map(Number), rows, flip: f, world, source };
-  return { space: "patient space (LPS) from " + source, note };
+  if (state.viewer && state.viewer.setDirection) {
+    state.viewer.setDirection(drawn);
+  }
+  const space = "patient space (LPS) from " + source +
+    (mirrored ? "; its grid's axes are a mirror image of patient space, drawn reflected along i" : "");
+  return { space, note };
 }
 
 // A vector in the scene as a vector in LPS, and back (the rotation's transpose).
@@ -125,25 +136,39 @@ export function sceneFromLPSPoint(p) {
   return add(o, sceneFromLPSVector(sub(p, [0, 1, 2].map((a) => frame.flip[a] * o[a]))));
 }
 
-/** The module's view (scene) with its world (LPS) placement added. */
+// The drawn frame (the module's camera) and the scene: the same, or reflected along the grid's
+// first axis about its origin (an involution: each direction is the same function).
+export function sceneFromDrawnVector(v) {
+  return frame.mirror < 0 ? v.slice() : v.map((x, a) => (a === frame.mirror ? -x : x));
+}
+export function sceneFromDrawnPoint(p) {
+  const o = frame.origin;
+  return frame.mirror < 0 ? p.slice() : p.map((x, a) => (a === frame.mirror ? 2 * o[a] - x : x));
+}
+export const lpsFromDrawnVector = (v) => lpsFromSceneVector(sceneFromDrawnVector(v));
+export const lpsFromDrawnPoint = (p) => lpsFromScenePoint(sceneFromDrawnPoint(p));
+export const drawnFromLPSVector = (v) => sceneFromDrawnVector(sceneFromLPSVector(v));
+export const drawnFromLPSPoint = (p) => sceneFromDrawnPoint(sceneFromLPSPoint(p));
+
+/** The module's view (drawn frame) with its world (LPS) placement added. */
 export function withWorld(view) {
-  const position = lpsFromScenePoint(view.position);
-  const focalPoint = lpsFromScenePoint(view.focalPoint);
+  const position = lpsFromDrawnPoint(view.position);
+  const focalPoint = lpsFromDrawnPoint(view.focalPoint);
   return Object.assign({}, view, {
     world: {
       space: "LPS", position, focalPoint,
-      viewUp: lpsFromSceneVector(view.viewUp),
+      viewUp: lpsFromDrawnVector(view.viewUp),
       direction: unit(sub(focalPoint, position)), // of projection: from the camera to the focal point
     },
   });
 }
 
-/** A view given in LPS ({position, focalPoint, viewUp}) as the module's scene view. */
+/** A view given in LPS ({position, focalPoint, viewUp}) as the module's (drawn frame) view. */
 export function sceneView(world) {
   return {
-    position: sceneFromLPSPoint(world.position),
-    focalPoint: sceneFromLPSPoint(world.focalPoint),
-    viewUp: sceneFromLPSVector(world.viewUp),
+    position: drawnFromLPSPoint(world.position),
+    focalPoint: drawnFromLPSPoint(world.focalPoint),
+    viewUp: drawnFromLPSVector(world.viewUp),
   };
 }
 
@@ -155,9 +180,9 @@ export function applyNamedView(name) {
   const v = viewer.getView();
   const distance = norm(sub(v.position, v.focalPoint));
   viewer.setView({
-    position: add(v.focalPoint, scale(sceneFromLPSVector(preset.toCamera), distance)),
+    position: add(v.focalPoint, scale(drawnFromLPSVector(preset.toCamera), distance)),
     focalPoint: v.focalPoint,
-    viewUp: sceneFromLPSVector(preset.up),
+    viewUp: drawnFromLPSVector(preset.up),
   });
 }
 
@@ -178,7 +203,7 @@ export function markerLabels(view) {
   const { right, up, forward } = cameraBasis(view);
   const out = {};
   for (const axis of AXES) {
-    const s = sceneFromLPSVector(axis.to);
+    const s = drawnFromLPSVector(axis.to);
     out[axis.label] = { x: dot(s, right), y: dot(s, up), toward: -dot(s, forward) };
   }
   return out;

@@ -141,6 +141,11 @@ export class RemoteViewer {
     this.call("setParallel", p);
   }
   setView(view) { this.camera.setView(view); }
+  /** The direction the grid is drawn with (PageCamera::SetDirection), here and in the worker. */
+  setDirection(d) {
+    this.call("setDirection", d);
+    return this.camera.setDirection(d);
+  }
   getView() { return this.camera.getView(); }
 
   setBackground(r, g, b) { this.call("setBackground", r, g, b); }

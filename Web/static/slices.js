@@ -14,7 +14,8 @@
 // surface's own intersection with the plane (its vertices on the plane's edges, interpolated the
 // same way), so a contour on a slice is where the 3D surface cuts it.
 
-import { AXES, lpsFromScenePoint, lpsFromSceneVector, sceneFromLPSPoint, vec } from "./orientation.js";
+import { AXES, lpsFromScenePoint, lpsFromSceneVector, sceneFromDrawnPoint, sceneFromDrawnVector, sceneFromLPSPoint, vec }
+  from "./orientation.js";
 import { CT_WINDOWS, isHounsfield } from "./presets.js";
 import { $, state } from "./state.js";
 
@@ -278,6 +279,7 @@ export function setCrosshair(p) {
   const idx = indexOf(p).map((x, a) => Math.min(state.grid.dims[a] - 1, Math.max(0, x)));
   crosshair = pointOf(idx);
   drawSlices();
+  document.dispatchEvent(new CustomEvent("mediso:crosshair")); // the 3D view's cross, the URL
 }
 
 // The first point along the ray from the camera through (x, y) (CSS pixels of the 3D canvas)
@@ -293,19 +295,22 @@ export function pick(canvas, x, y) {
   const right = vec.cross(forward, up);
   const w = canvas.clientWidth, h = canvas.clientHeight;
   const tan = Math.tan((view.viewAngle * Math.PI) / 360);
-  const ray = vec.unit(vec.add(forward, vec.add(vec.scale(right, ((2 * x) / w - 1) * tan * (w / h)),
-    vec.scale(up, (1 - (2 * y) / h) * tan))));
+  // the ray in the module's (drawn) frame, then in the grid's scene frame (a mirrored grid is
+  // drawn reflected: orientation.js)
+  const ray = sceneFromDrawnVector(vec.unit(vec.add(forward, vec.add(vec.scale(right, ((2 * x) / w - 1) * tan * (w / h)),
+    vec.scale(up, (1 - (2 * y) / h) * tan)))));
+  const eye = sceneFromDrawnPoint(view.position);
   // the ray's stretch inside the volume's box (scene frame)
   let t0 = 0, t1 = Infinity;
   for (let a = 0; a < 3; ++a) {
     const lo = origin[a], hi = origin[a] + (dims[a] - 1) * spacing[a];
     if (Math.abs(ray[a]) < 1e-12) {
-      if (view.position[a] < lo || view.position[a] > hi) {
+      if (eye[a] < lo || eye[a] > hi) {
         return null;
       }
       continue;
     }
-    let ta = (lo - view.position[a]) / ray[a], tb = (hi - view.position[a]) / ray[a];
+    let ta = (lo - eye[a]) / ray[a], tb = (hi - eye[a]) / ray[a];
     if (ta > tb) {
       [ta, tb] = [tb, ta];
     }
@@ -317,14 +322,14 @@ export function pick(canvas, x, y) {
   }
   const isovalues = state.surfaces.filter((s) => s.opacity > 0).map((s) => s.value);
   const step = 0.5 * Math.min(...spacing);
-  const sample = (t) => trilinear([0, 1, 2].map((a) => (view.position[a] + t * ray[a] - origin[a]) / spacing[a]));
+  const sample = (t) => trilinear([0, 1, 2].map((a) => (eye[a] + t * ray[a] - origin[a]) / spacing[a]));
   let previous = sample(t0);
   for (let t = t0 + step; t <= t1 + 1e-9; t += step) {
     const value = sample(Math.min(t, t1));
     for (const iso of isovalues) {
       if ((previous - iso) * (value - iso) <= 0 && previous !== value) {
         const at = t - step + ((iso - previous) / (value - previous)) * step;
-        return lpsFromScenePoint([0, 1, 2].map((a) => view.position[a] + at * ray[a]));
+        return lpsFromScenePoint([0, 1, 2].map((a) => eye[a] + at * ray[a]));
       }
     }
     previous = value;

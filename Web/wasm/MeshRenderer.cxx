@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "MeshRenderer.h"
 
+#include "GLApiFunctions.h"
 #include "GLObjects.h"
 #include "Lighting.h"
 #include "WebShaders.h"
@@ -158,6 +159,14 @@ bool MeshRenderer::Render(const IsosurfaceFrame& frame, const matrix4::Matrix& w
   SetLightingUniforms(*program, frame);
   f.Enable(GL_DEPTH_TEST);
   f.Disable(GL_CULL_FACE);
+  // A mirrored placement (a reflection in worldToView) turns the triangles'
+  // winding in the picture: counter-clockwise faces would then be the back
+  // ones, and the two-sided shading would turn every normal away from the
+  // viewer. The front faces are then the clockwise ones.
+  const matrix4::Matrix& m = worldToView;
+  const double det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
+    m[2] * (m[4] * m[9] - m[5] * m[8]);
+  glFrontFace(det < 0.0 ? GL_CW : GL_CCW);
   for (int translucent = 0; translucent < 2; ++translucent)
   {
     SetSurfacePassBlending(gl, translucent != 0);
@@ -172,6 +181,7 @@ bool MeshRenderer::Render(const IsosurfaceFrame& frame, const matrix4::Matrix& w
       f.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * mesh->Triangles), GL_UNSIGNED_INT, nullptr);
     }
   }
+  glFrontFace(GL_CCW); // WebGL's default, which the rest of the page's drawing takes
   const std::string errors = gl.TakeErrors();
   if (!errors.empty())
   {

@@ -4,6 +4,7 @@
 #include "HistoPyramid.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -42,6 +43,38 @@ void PageCamera::SetPlacement(const val& dims, const val& spacing, const val& or
     this->Placement.Spacing[a] = spacing[a].as<double>();
     this->Placement.Origin[a] = origin[a].as<double>();
   }
+}
+
+bool PageCamera::SetDirection(const val& direction)
+{
+  if (direction["length"].as<int>() != 9)
+  {
+    return false;
+  }
+  double d[9];
+  for (int k = 0; k < 9; ++k)
+  {
+    d[k] = direction[k].as<double>();
+    if (!std::isfinite(d[k]))
+    {
+      return false;
+    }
+  }
+  // Columns of unit length and orthogonal: a rotation or a reflection, which
+  // keeps the spacing's lengths and the normals' angles.
+  for (int a = 0; a < 3; ++a)
+  {
+    for (int b = 0; b < 3; ++b)
+    {
+      const double dot = d[a] * d[b] + d[3 + a] * d[3 + b] + d[6 + a] * d[6 + b];
+      if (std::abs(dot - (a == b ? 1.0 : 0.0)) > 1e-6)
+      {
+        return false;
+      }
+    }
+  }
+  std::copy(d, d + 9, this->Placement.Direction);
+  return true;
 }
 
 void PageCamera::Resize(int width, int height)

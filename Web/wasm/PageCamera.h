@@ -13,7 +13,11 @@
  *
  * A PageCamera is:
  * 1. the volume's placement (dimensions, spacing, origin; the camera resets
- *    to its bounds),
+ *    to its bounds), and the direction its grid is drawn with about its
+ *    origin: the identity, or a reflection of one index axis for a volume
+ *    whose axes are a mirror image of patient space (the page then turns the
+ *    drawn frame into patient space by a rotation, so that the picture is not
+ *    mirrored: docs/web.md, Orientation),
  * 2. the canvas's size in pixels (its aspect ratio; never below one pixel),
  * 3. a mediso::Camera (Mappers/Core, the one the ParaView mapper and
  *    mediso-render use) and whether it projects in parallel, which a reset
@@ -29,7 +33,7 @@
  * BindPageCamera gives a bound class that holds one (WebViewer, ViewCamera)
  * the camera's JavaScript names, so that they are written once too:
  * `resetCamera`, `azimuth`, `elevation`, `zoom`, `dolly`, `setParallel`,
- * `setView`, `getView` (each class binds `resize` and `setVolume` itself,
+ * `setView`, `getView`, `setDirection` (each class binds `resize` and `setVolume` itself,
  * since the viewer also sizes its canvas and uploads the volume).
  *
  * CountActivePairs is the CPU model's count of active (cell, isovalue) pairs
@@ -61,6 +65,14 @@ public:
   void SetPlacement(
     const emscripten::val& dims, const emscripten::val& spacing, const emscripten::val& origin);
   const VolumePlacement& GetPlacement() const { return this->Placement; }
+  /**
+   * The direction the grid is drawn with about its origin, a JavaScript
+   * array of 9 numbers (row-major, column a the direction of index axis a),
+   * kept by later SetPlacement calls (another level of the same volume).
+   * Anything but an orthonormal matrix is refused (false; the direction is
+   * left as it was). The camera is not reset.
+   */
+  bool SetDirection(const emscripten::val& direction);
 
   /// The canvas's size in pixels (default 640 x 480); each side at least 1.
   void Resize(int width, int height);
@@ -112,7 +124,9 @@ void BindPageCamera(const emscripten::class_<Holder>& bound)
       "setParallel", optional_override([](Holder& h, bool p) { h.GetPageCamera().SetParallel(p); }))
     .function(
       "setView", optional_override([](Holder& h, const val& v) { h.GetPageCamera().SetView(v); }))
-    .function("getView", optional_override([](Holder& h) { return h.GetPageCamera().GetView(); }));
+    .function("getView", optional_override([](Holder& h) { return h.GetPageCamera().GetView(); }))
+    .function("setDirection",
+      optional_override([](Holder& h, const val& d) { return h.GetPageCamera().SetDirection(d); }));
 }
 
 /**
