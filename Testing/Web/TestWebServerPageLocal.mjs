@@ -149,9 +149,16 @@ async function runOperation(page) {
   for (const step of ["#op-smooth", "#op-fill", "#op-clip", "#op-decimate"]) {
     await page.setChecked(step, false);
   }
+  await page.evaluate(() => { window.shownResults = performance.getEntriesByType("resource").filter((e) =>
+    e.name.includes("/api/result/") && e.name.includes("format=ply")).length; });
   await page.click("#op-run");
   await page.waitForFunction(() => ["done", "error"].includes(
     document.getElementById("op-run").closest("section").dataset.state), null, { timeout: 180000 });
+  // The result's PLY, which the panel fetches to show it, has arrived (its bytes are counted).
+  await page.waitForFunction(() => performance.getEntriesByType("resource").filter((e) =>
+    e.name.includes("/api/result/") && e.name.includes("format=ply")).length >= window.shownResults + 1,
+  null, { timeout: 60000 }).catch(() => {});
+  await page.waitForTimeout(300);
   const summary = await page.textContent("#op-result");
   const triangles = /([\d,]+) triangles/.exec(summary);
   return { summary, triangles: triangles ? Number(triangles[1].replace(/,/g, "")) : -1 };
