@@ -46,6 +46,7 @@ import serve_operations  # noqa: E402  (the volumes' default, and the worker's p
 from serve_jobs import (FORMATS, RESULT_GRACE_S, RESULTS_PER_SESSION, Operations,  # noqa: E402
                         Session, StartFailed, log)
 from serve_messages import LEVEL_STRIDES, BadRequest, parse_message  # noqa: E402
+import serve_upload  # noqa: E402  (a local volume uploaded once: POST /api/upload)
 
 MAX_FRAME = 1024 * 1024        # above this aiohttp closes the socket (1009, message too big)
 MAX_SESSIONS = 64              # WebSockets open at once
@@ -404,6 +405,8 @@ def make_app(args, datasets, operations):
     app.router.add_get("/api/result/{rid}", result)
     app.router.add_get("/api/status", status)
     app.router.add_get("/api/ws", websocket)
+    # A local volume the page read itself, uploaded once for the operations (serve_upload.py).
+    app.router.add_post("/api/upload", serve_upload.handler(STATE, Dataset))
     app.on_startup.append(start_jobs)
     app.on_cleanup.append(stop_jobs)
     return app

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMedicalNIfTIReader.h"
 
+#include "NIfTIImage.h"
 #include "ProcessMemory.h"
 
 #include "vtkCallbackCommand.h"
@@ -37,67 +38,49 @@ vtkStandardNewMacro(vtkMedicalNIfTIReader);
 
 namespace
 {
-constexpr int NIfTI1HeaderBytes = 348;
-constexpr int NIfTI2HeaderBytes = 540;
-
-// NIfTI's datatype codes (nifti1.h), with the VTK type the superclass reads
-// them into; 0 where this reader refuses the type.
-struct DataTypeInfo
+// The VTK type the superclass reads a stored datatype into (the core's table
+// gives the rest).
+int StoredVTKType(const mediso::NIfTIDataType& type)
 {
-  int Code;
-  const char* Name;
-  int Bits;
-  int VTKType;
-};
-const DataTypeInfo DataTypes[] = { { 1, "BINARY", 1, 0 }, { 2, "UINT8", 8, VTK_TYPE_UINT8 },
-  { 4, "INT16", 16, VTK_TYPE_INT16 }, { 8, "INT32", 32, VTK_TYPE_INT32 },
-  { 16, "FLOAT32", 32, VTK_TYPE_FLOAT32 }, { 32, "COMPLEX64", 64, 0 },
-  { 64, "FLOAT64", 64, VTK_TYPE_FLOAT64 }, { 128, "RGB24", 24, 0 },
-  { 256, "INT8", 8, VTK_TYPE_INT8 }, { 512, "UINT16", 16, VTK_TYPE_UINT16 },
-  { 768, "UINT32", 32, VTK_TYPE_UINT32 }, { 1024, "INT64", 64, VTK_TYPE_INT64 },
-  { 1280, "UINT64", 64, VTK_TYPE_UINT64 }, { 1536, "FLOAT128", 128, 0 },
-  { 1792, "COMPLEX128", 128, 0 }, { 2048, "COMPLEX256", 256, 0 }, { 2304, "RGBA32", 32, 0 } };
-
-const DataTypeInfo* FindDataType(int code)
-{
-  for (const DataTypeInfo& t : DataTypes)
+  if (!type.Stored)
   {
-    if (t.Code == code)
-    {
-      return &t;
-    }
+    return type.Code == 1024 ? VTK_TYPE_INT64 : VTK_TYPE_UINT64;
   }
-  return nullptr;
+  switch (type.Type)
+  {
+    case mediso::ScalarType::Int8:
+      return VTK_TYPE_INT8;
+    case mediso::ScalarType::UInt8:
+      return VTK_TYPE_UINT8;
+    case mediso::ScalarType::Int16:
+      return VTK_TYPE_INT16;
+    case mediso::ScalarType::UInt16:
+      return VTK_TYPE_UINT16;
+    case mediso::ScalarType::Int32:
+      return VTK_TYPE_INT32;
+    case mediso::ScalarType::UInt32:
+      return VTK_TYPE_UINT32;
+    case mediso::ScalarType::Float32:
+      return VTK_TYPE_FLOAT32;
+    default:
+      return VTK_TYPE_FLOAT64;
+  }
 }
 
-// The fields of a NIfTI-1, NIfTI-2 or Analyze 7.5 header this reader checks,
-// in native byte order and NIfTI-2's widths.
-struct Header
+// The VTK type of a calibrated scalar type (int16, int32, float32 or float64).
+int CalibratedVTKType(mediso::ScalarType type)
 {
-  int Version = 0;         // 0: Analyze 7.5
-  bool SingleFile = false; // magic "n+1"/"n+2": the voxels follow the header in the same file
-  std::int64_t Dim[8] = {};
-  double PixDim[8] = {};
-  int DataType = 0;
-  int BitPix = 0;
-  double VoxOffset = 0.0;
-  double Slope = 0.0;
-  double Intercept = 0.0;
-  double TOffset = 0.0;
-};
-
-template<typename T>
-T Field(const unsigned char* bytes, std::size_t offset, bool swap)
-{
-  unsigned char raw[sizeof(T)];
-  std::memcpy(raw, bytes + offset, sizeof(T));
-  if (swap)
+  switch (type)
   {
-    std::reverse(raw, raw + sizeof(T));
+    case mediso::ScalarType::Int16:
+      return VTK_SHORT;
+    case mediso::ScalarType::Int32:
+      return VTK_INT;
+    case mediso::ScalarType::Float32:
+      return VTK_FLOAT;
+    default:
+      return VTK_DOUBLE;
   }
-  T value;
-  std::memcpy(&value, raw, sizeof(T));
-  return value;
 }
 
 struct GzCloser
@@ -106,91 +89,27 @@ struct GzCloser
 };
 using GzFile = std::unique_ptr<gzFile_s, GzCloser>;
 
-// Reads the header of `path` (gzipped or not); empty string or the reason.
-std::string ReadHeader(const std::string& path, Header& h)
+// Reads the header of `path` (gzipped or not) and parses it with the core;
+// empty string or the reason.
+std::string ReadHeader(const std::string& path, mediso::NIfTIHeader& h)
 {
   GzFile file(gzopen(path.c_str(), "rb"));
   if (!file)
   {
     return "the file cannot be opened";
   }
-  unsigned char bytes[NIfTI2HeaderBytes] = {};
-  int got = gzread(file.get(), bytes, NIfTI1HeaderBytes);
-  if (got < 4)
+  unsigned char bytes[mediso::NIfTI2HeaderBytes] = {};
+  int got = gzread(file.get(), bytes, mediso::NIfTI1HeaderBytes);
+  if (got == mediso::NIfTI1HeaderBytes)
   {
-    return "the file is too short for a NIfTI header (" + std::to_string(std::max(got, 0)) +
-      " bytes)";
-  }
-  const std::int32_t size = Field<std::int32_t>(bytes, 0, false);
-  const std::int32_t swappedSize = Field<std::int32_t>(bytes, 0, true);
-  bool swap = false;
-  if (size == NIfTI1HeaderBytes || size == NIfTI2HeaderBytes)
-  {
-    swap = false;
-  }
-  else if (swappedSize == NIfTI1HeaderBytes || swappedSize == NIfTI2HeaderBytes)
-  {
-    swap = true;
-  }
-  else
-  {
-    return "this is not a NIfTI-1, NIfTI-2 or Analyze 7.5 header (its first field, sizeof_hdr, "
-           "is " +
-      std::to_string(size) + "; 348 or 540 expected)";
-  }
-  const int headerBytes = swap ? swappedSize : size;
-  if (headerBytes == NIfTI2HeaderBytes && got == NIfTI1HeaderBytes)
-  {
-    const int more =
-      gzread(file.get(), bytes + NIfTI1HeaderBytes, NIfTI2HeaderBytes - NIfTI1HeaderBytes);
+    const int more = gzread(file.get(), bytes + mediso::NIfTI1HeaderBytes,
+      mediso::NIfTI2HeaderBytes - mediso::NIfTI1HeaderBytes);
     if (more > 0)
     {
       got += more;
     }
   }
-  if (got < headerBytes)
-  {
-    return "the file ends inside its " + std::to_string(headerBytes) + "-byte header (" +
-      std::to_string(got) + " bytes)";
-  }
-  if (headerBytes == NIfTI2HeaderBytes)
-  {
-    if (std::memcmp(bytes + 4, "n+2", 4) != 0 && std::memcmp(bytes + 4, "ni2", 4) != 0)
-    {
-      return "the 540-byte header lacks NIfTI-2's magic (\"n+2\" or \"ni2\")";
-    }
-    h.Version = 2;
-    h.SingleFile = bytes[5] == '+';
-    h.DataType = Field<std::int16_t>(bytes, 12, swap);
-    h.BitPix = Field<std::int16_t>(bytes, 14, swap);
-    for (int i = 0; i < 8; ++i)
-    {
-      h.Dim[i] = Field<std::int64_t>(bytes, 16 + 8 * i, swap);
-      h.PixDim[i] = Field<double>(bytes, 104 + 8 * i, swap);
-    }
-    h.VoxOffset = static_cast<double>(Field<std::int64_t>(bytes, 168, swap));
-    h.Slope = Field<double>(bytes, 176, swap);
-    h.Intercept = Field<double>(bytes, 184, swap);
-    h.TOffset = Field<double>(bytes, 216, swap);
-    return std::string();
-  }
-  const bool nifti1 =
-    std::memcmp(bytes + 344, "n+1", 4) == 0 || std::memcmp(bytes + 344, "ni1", 4) == 0;
-  h.Version = nifti1 ? 1 : 0;
-  h.SingleFile = nifti1 && bytes[345] == '+';
-  h.DataType = Field<std::int16_t>(bytes, 70, swap);
-  h.BitPix = Field<std::int16_t>(bytes, 72, swap);
-  for (int i = 0; i < 8; ++i)
-  {
-    h.Dim[i] = Field<std::int16_t>(bytes, 40 + 2 * i, swap);
-    h.PixDim[i] = Field<float>(bytes, 76 + 4 * i, swap);
-  }
-  h.VoxOffset = Field<float>(bytes, 108, swap);
-  // Analyze 7.5 has no scale (the superclass ignores those bytes too).
-  h.Slope = nifti1 ? Field<float>(bytes, 112, swap) : 0.0;
-  h.Intercept = nifti1 ? Field<float>(bytes, 116, swap) : 0.0;
-  h.TOffset = nifti1 ? Field<float>(bytes, 136, swap) : 0.0;
-  return std::string();
+  return mediso::ParseNIfTIHeader(bytes, static_cast<std::size_t>(std::max(got, 0)), h);
 }
 
 // Whether `path` holds at least `needed` bytes, uncompressed; `held` is what it
@@ -247,44 +166,6 @@ const char* AxisName(int axis)
 {
   static const char* const names[] = { "x", "y", "z" };
   return names[axis];
-}
-
-// The calibrated type of the class comment's rule.
-int CalibratedType(int stored, double slope, double intercept)
-{
-  double lo = 0.0, hi = 0.0;
-  bool small = true;
-  switch (stored)
-  {
-    case VTK_TYPE_INT8:
-      lo = -128.0;
-      hi = 127.0;
-      break;
-    case VTK_TYPE_UINT8:
-      hi = 255.0;
-      break;
-    case VTK_TYPE_INT16:
-      lo = -32768.0;
-      hi = 32767.0;
-      break;
-    case VTK_TYPE_UINT16:
-      hi = 65535.0;
-      break;
-    default:
-      small = false;
-  }
-  if (small && slope == 1.0 && intercept == std::floor(intercept))
-  {
-    if (lo + intercept >= -32768.0 && hi + intercept <= 32767.0)
-    {
-      return VTK_SHORT;
-    }
-    if (lo + intercept >= -2147483648.0 && hi + intercept <= 2147483647.0)
-    {
-      return VTK_INT;
-    }
-  }
-  return (small || stored == VTK_TYPE_FLOAT32) ? VTK_FLOAT : VTK_DOUBLE;
 }
 
 template<typename In, typename Out>
@@ -398,93 +279,22 @@ std::string vtkMedicalNIfTIReader::CheckFile()
     }
   }
 
-  Header h;
+  mediso::NIfTIHeader h;
   std::string reason = ReadHeader(headerPath, h);
+  std::int64_t dims[8] = {};
+  if (reason.empty())
+  {
+    reason = mediso::CheckNIfTIHeader(h, dims);
+  }
   if (!reason.empty())
   {
     return reason;
   }
   std::ostringstream msg;
-  const std::int64_t ndim = h.Dim[0];
-  if (ndim < 1 || ndim > 7)
-  {
-    msg << "dim[0] (the number of dimensions) is " << ndim << "; NIfTI allows 1 to 7";
-    return msg.str();
-  }
-  std::int64_t dims[8] = { ndim, 1, 1, 1, 1, 1, 1, 1 };
-  for (int i = 1; i <= ndim; ++i)
-  {
-    if (h.Dim[i] < 1)
-    {
-      msg << "dim[" << i << "] is " << h.Dim[i] << "; every dimension must be at least 1";
-      return msg.str();
-    }
-    if (h.Dim[i] > std::numeric_limits<int>::max())
-    {
-      msg << "dim[" << i << "] is " << h.Dim[i] << ", more than a VTK extent holds ("
-          << std::numeric_limits<int>::max() << ")";
-      return msg.str();
-    }
-    dims[i] = h.Dim[i];
-  }
-  for (int i = 5; i <= 7; ++i)
-  {
-    if (dims[i] > 1)
-    {
-      msg << "dim[" << i << "] is " << dims[i]
-          << ": vectors and dimensions beyond time (dim[5..7] above 1) are not read";
-      return msg.str();
-    }
-  }
-  const DataTypeInfo* type = FindDataType(h.DataType);
-  if (!type)
-  {
-    msg << "datatype code " << h.DataType << " is not a NIfTI datatype";
-    return msg.str();
-  }
-  if (!type->VTKType)
-  {
-    msg << "datatype " << type->Name << " (" << type->Code
-        << ") is not read: one real number per voxel is needed";
-    return msg.str();
-  }
-  if (h.BitPix != type->Bits)
-  {
-    msg << "bitpix is " << h.BitPix << " but datatype " << type->Name << " has " << type->Bits
-        << " bits per voxel";
-    return msg.str();
-  }
-  for (int a = 0; a < 3; ++a)
-  {
-    if (!std::isfinite(h.PixDim[a + 1]))
-    {
-      msg << "pixdim[" << a + 1 << "] (the spacing along " << AxisName(a) << ") is "
-          << h.PixDim[a + 1];
-      return msg.str();
-    }
-  }
-  const double minOffset =
-    h.SingleFile ? (h.Version == 2 ? NIfTI2HeaderBytes : NIfTI1HeaderBytes) : 0;
-  if (!std::isfinite(h.VoxOffset) || h.VoxOffset < minOffset ||
-    h.VoxOffset != std::floor(h.VoxOffset) || h.VoxOffset > 9.0e18)
-  {
-    msg << "vox_offset is " << h.VoxOffset;
-    if (h.SingleFile)
-    {
-      msg << "; the voxels of a single-file NIfTI-" << h.Version << " image start after its "
-          << minOffset << "-byte header";
-    }
-    else
-    {
-      msg << ": not a byte offset";
-    }
-    return msg.str();
-  }
+  const mediso::NIfTIDataType* type = mediso::FindNIfTIDataType(h.DataType);
 
   // The voxels of one volume and of all of them, in bytes, without overflow.
-  const std::uint64_t bytesPerVoxel = static_cast<std::uint64_t>(type->Bits / 8);
-  const long double volumeBytes =
-    static_cast<long double>(dims[1]) * dims[2] * dims[3] * bytesPerVoxel;
+  const long double volumeBytes = mediso::NIfTIVolumeBytes(h, dims);
   const long double allBytes = volumeBytes * dims[4] + h.VoxOffset;
   std::uint64_t held = 0;
   bool gzipped = false;
@@ -520,31 +330,17 @@ std::string vtkMedicalNIfTIReader::CheckFile()
   }
 
   // The checks passed: what RequestInformation and RequestData need.
-  this->StoredScalarType = type->VTKType;
+  this->StoredScalarType = StoredVTKType(*type);
   this->DataOffset = static_cast<unsigned long>(h.VoxOffset);
   this->VolumeBytes = static_cast<unsigned long>(volumeBytes);
-  this->Slope = 1.0;
-  this->Intercept = 0.0;
-  double slope = h.Slope, intercept = h.Intercept;
-  if (!std::isfinite(slope))
+  std::vector<std::string> warnings;
+  this->Calibrate = mediso::NIfTICalibration(h, this->Slope, this->Intercept, warnings);
+  for (const std::string& warning : warnings)
   {
-    vtkWarningMacro(<< this->FileLabel << ": scl_slope is " << slope
-                    << "; the voxels are read unscaled.");
-    slope = 0.0;
-  }
-  if (slope != 0.0 && !std::isfinite(intercept))
-  {
-    vtkWarningMacro(<< this->FileLabel << ": scl_inter is " << intercept << "; 0 is used.");
-    intercept = 0.0;
-  }
-  this->Calibrate = slope != 0.0 && (slope != 1.0 || intercept != 0.0);
-  if (this->Calibrate)
-  {
-    this->Slope = slope;
-    this->Intercept = intercept;
+    vtkWarningMacro(<< this->FileLabel << ": " << warning);
   }
   this->OutputScalarType = this->Calibrate
-    ? CalibratedType(this->StoredScalarType, this->Slope, this->Intercept)
+    ? CalibratedVTKType(mediso::NIfTICalibratedType(h.DataType, this->Slope, this->Intercept))
     : this->StoredScalarType;
 
   this->TimeSteps.clear();
@@ -704,7 +500,8 @@ bool vtkMedicalNIfTIReader::ReadVolume(vtkInformation* request, vtkInformationVe
   {
     if (this->GetErrorCode() == vtkErrorCode::PrematureEndOfFileError)
     {
-      reason = "the file ends before the voxels the header describes do (it is truncated)";
+      reason = "the file ends before the voxels the header describes do (it is "
+               "truncated)";
     }
     else
     {

@@ -21,6 +21,7 @@
 //   histogram.js    the volume's histogram, its isovalue markers dragged
 //   presets.js      the first surfaces (Hounsfield units or Otsu), the CT presets
 //   stream.js       level 0 first, then the full level's bricks (CPU path, in the worker)
+//   local.js        a local file dropped or picked, read in the page by the module
 
 import { interact } from "./interaction.js";
 import { linkedView, readLink, scheduleLink } from "./link.js";
@@ -29,17 +30,18 @@ import { VIEWS, applyNamedView, drawMarker, markerLabels, sceneView, setDataset,
   from "./orientation.js";
 import { applyPath, drawnLevel, requestPath } from "./path.js";
 import { drawHistogram, histogramInfo, setupHistogram } from "./histogram.js";
+import { serverDataset, setupLocalFiles } from "./local.js";
 import { setupPresets } from "./presets.js";
 import { fps, showDataset, unsupported, updateReadout } from "./readout.js";
 import { $, params, state } from "./state.js";
 import { drawCrosshair3D, setupCrosshair3D } from "./crosshair3d.js";
-import { crosshairInfo, drawSlices, pick, setCrosshair, setSliceWindow, setupSlices, slicesInfo }
-  from "./slices.js";
+import { crosshairInfo, drawSlices, pick, resetSlices, setCrosshair, setSliceWindow, setupSlices,
+  slicesInfo } from "./slices.js";
 import { replaceSurfaces, setupSurfaceList } from "./surfaces.js";
 import { afterFrame, change, clearMesh, drawn, fitCanvas, renderNow, requestFrame, showMesh, startViewer }
   from "./viewer.js";
 import { countBytes, request, requestJSON, sessionToken } from "./volume.js";
-import { brickRanges, setupStream, streamInfo, whenFull } from "./stream.js";
+import { brickRanges, setupStream, stopStream, streamInfo, whenFull } from "./stream.js";
 
 async function start() {
   const probe = document.createElement("canvas").getContext("webgl2");
@@ -141,7 +143,8 @@ async function start() {
   await drawn(); // ready after the first frame (the worker's answer)
   // The "On the server" panel (Web/static/operations.js) is given what it needs here.
   setupOperations({
-    dataset: d,
+    get dataset() { return state.dataset; }, // a local file's once it is opened
+    serverDataset: () => serverDataset(state.dataset),
     token: sessionToken(),
     surfaces: () => state.surfaces,
     levels: state.facts.levels.count,
@@ -157,6 +160,26 @@ async function start() {
       change(() => { surface.hidden = !shown; });
     },
   });
+  setupLocalFiles(openLocal);
+}
+
+// A local file's volume (local.js) in place of the one shown: placed, fetched from the page's own
+// levels at the level the path affords, in the anterior view with its first surfaces.
+async function openLocal(d) {
+  state.dataset = d;
+  showDataset(d);
+  const placement = setDataset(d);
+  $("space").textContent = "Shown in " + placement.space + "." +
+    (placement.note ? " Note: " + placement.note + "." : "");
+  state.level = null; // another volume: its level is loaded whatever the last one's was
+  stopStream(); // a served volume's bricks still on their way are not this volume's
+  await applyPath();
+  applyNamedView("anterior");
+  setupSurfaceList();
+  setupPresets((surfaces) => replaceSurfaces(surfaces, false));
+  resetSlices(histogramInfo());
+  renderNow();
+  await drawn();
 }
 
 // ---------------------------------------------------------------------------- automation
@@ -261,6 +284,12 @@ window.mediso = {
   // the CPU model's count on the volume, or on its samples of volume level `level` (the GPU
   // path's coarse levels: stats().gpuLevel)
   cpuCount: (values, level = state.facts.levels.count - 1) => state.viewer.countOnCPU(values, level),
+  // The dataset shown, as /api/datasets describes it (a local file's as the module read it:
+  // local.js), without its values.
+  dataset: () => {
+    const { local, ...d } = state.dataset || {};
+    return Object.assign(JSON.parse(JSON.stringify(d)), { local: Boolean(local) });
+  },
   // The stats once the newest frame asked for is drawn at its full level (with the viewer in a
   // worker, frames come after the change that asked for them; on the main thread, at once).
   async drawn() {

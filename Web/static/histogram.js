@@ -29,12 +29,14 @@ export function countHistogram() {
   }
   const list = Array.from(counts);
   histogram = { low: bins.low, width: bins.width, count: bins.count, counts: list,
-    otsu: state.facts.otsuThreshold(list, bins), level: state.level };
+    otsu: state.facts.otsuThreshold(list, bins), level: state.level, values };
   return histogram;
 }
 
 function current() {
-  return histogram && histogram.level === state.level ? histogram : countHistogram();
+  // Counted again for another level, or another volume (a local file: local.js).
+  return histogram && histogram.level === state.level && histogram.values === state.values
+    ? histogram : countHistogram();
 }
 
 // CSS pixels of the canvas per value, and back.

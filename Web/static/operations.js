@@ -47,6 +47,7 @@ function megabytes(n) {
 /**
  * Drives the panel. `page` gives what it needs of the rest of the page (app.js hands it over):
  *   dataset                  the dataset the page shows (docs/web.md's D)
+ *   serverDataset()          a promise of its id on the server (a local file's: uploaded once)
  *   token                    the session's token
  *   surfaces()               the page's surfaces [{value, ...}]
  *   levels                   the number of levels of detail (the module's; the last is the full volume)
@@ -160,7 +161,9 @@ export function setupOperations(page) {
     setState("running", "Sending the parameters...");
     try {
       await connect();
-      send({ op: "surface", id: current.id, dataset: page.dataset.id, isovalue: surface.value,
+      // A local file's volume is uploaded first, once (local.js).
+      const dataset = await page.serverDataset();
+      send({ op: "surface", id: current.id, dataset, isovalue: surface.value,
              level, steps: steps(), export: exportOptions() });
     } catch (error) {
       current = null;

@@ -407,7 +407,7 @@ export function setupSlices(histogram) {
     box.append(panel);
     const view = { def, canvas, select, choices, picture: document.createElement("canvas"),
       index: 0, window: Object.assign({}, choices[0]), axes: null, place: null, contours: [] };
-    select.onchange = () => setWindow(view, choices[Number(select.value)]);
+    select.onchange = () => setWindow(view, view.choices[Number(select.value)]);
     attach(view);
     return view;
   });
@@ -437,6 +437,27 @@ export function setupSlices(histogram) {
     }
     down = null;
   });
+  drawSlices();
+}
+
+/**
+ * Another volume in the views (a local file: local.js): its windows (`histogram`: its counts),
+ * the crosshair at its centre, its axes.
+ */
+export function resetSlices(histogram) {
+  const choices = windowChoices(histogram);
+  for (const view of views) {
+    view.choices = choices;
+    view.window = Object.assign({}, choices[0]);
+    view.select.replaceChildren(...choices.map((c, i) => Object.assign(document.createElement("option"),
+      { value: String(i), textContent: c.name, title: "W " + round(c.width) + " L " + round(c.level) })),
+    Object.assign(document.createElement("option"), { value: "custom", textContent: "dragged", disabled: true }));
+    view.select.value = "0";
+  }
+  geometry = null;
+  chooseAxes();
+  crosshair = pointOf(state.grid.dims.map((n) => Math.floor((n - 1) / 2)));
+  $("slices").title = note;
   drawSlices();
 }
 

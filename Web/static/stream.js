@@ -25,7 +25,8 @@ const IN_FLIGHT = 6;
 
 /** Whether the page streams level `level` on `path` (?stream=0: the whole level at once). */
 export function canStream(path, level) {
-  return path === "cpu" && state.remote && level > 0 && params.get("stream") !== "0";
+  return path === "cpu" && state.remote && level > 0 && params.get("stream") !== "0" &&
+    !(state.dataset && state.dataset.local); // a local file is in the page already
 }
 
 /** Stops a stream under way (a new level or path replaces the volume). */

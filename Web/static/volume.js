@@ -106,10 +106,23 @@ export async function fetchLevel(level) {
 /** Byte-shuffled values of `size` bytes back in order, and their typed view (stream.js). */
 export { unshuffle, typedValues };
 
-/** Fetches level `level` of the dataset and gives it to the viewer (the module's memory). */
+/**
+ * Fetches level `level` of the dataset and gives it to the viewer (the module's memory). A local
+ * file's dataset (local.js) has its levels in the page already: `d.local.level(k)`.
+ */
 export async function loadVolume(level) {
-  const { type, dims, spacing, origin, bytes, values } = await fetchLevel(level);
-  state.values = values;
+  const d = state.dataset;
+  if (d.local) {
+    const { dims, spacing, origin, bytes } = d.local.level(level);
+    return putVolume(state.facts.scalarTypes.get(d.type), d.type, dims, spacing, origin, bytes, level);
+  }
+  const { type, dims, spacing, origin, bytes } = await fetchLevel(level);
+  return putVolume(type, type.name, dims, spacing, origin, bytes, level);
+}
+
+// The level's values (little-endian bytes) into the page's copy and the module's memory.
+async function putVolume(type, typeName, dims, spacing, origin, bytes, level) {
+  state.values = typedValues(bytes, typeName);
   state.grid = { dims, spacing, origin };
   const M = state.module;
   const pointerBefore = state.volumePointer;
