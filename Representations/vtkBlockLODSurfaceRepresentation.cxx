@@ -54,13 +54,44 @@ struct ProcessFrames
   // Per renderer: the frame being drawn, and each display's last triangles.
   std::map<const void*, Frame> Pending;
   std::map<const void*, std::map<const void*, double>> Drawn;
+  // Per renderer, each display's triangles at each level for its current
+  // data (-1: unknown), known from its first frame of the data.
+  std::map<const void*, std::map<const void*, std::array<double, Levels>>> AtLevel;
+  // Per renderer, whether each display drew translucent last: a frame with
+  // one translucent display is a translucent frame for all of them.
+  std::map<const void*, std::map<const void*, bool>> Translucent;
 
-  double OthersDrawn(const void* renderer, const void* display)
+  bool OthersTranslucent(const void* renderer, const void* display)
   {
-    double sum = 0.0;
+    const auto& translucent = this->Translucent[renderer];
     for (const auto& entry : this->Drawn[renderer])
     {
-      sum += entry.first == display ? 0.0 : entry.second;
+      const auto known = translucent.find(entry.first);
+      if (entry.first != display && known != translucent.end() && known->second)
+      {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // The triangles the other displays of a renderer draw in a frame in which
+  // `display` draws `level`: the same level for those that have one (their
+  // candidates are the same sums, so they choose it too, and the prediction
+  // is the frame's), else what they drew last.
+  double OthersAt(const void* renderer, const void* display, int level)
+  {
+    double sum = 0.0;
+    const auto& levels = this->AtLevel[renderer];
+    for (const auto& entry : this->Drawn[renderer])
+    {
+      if (entry.first == display)
+      {
+        continue;
+      }
+      const auto known = levels.find(entry.first);
+      const double at = known == levels.end() ? -1.0 : known->second[level];
+      sum += at >= 0.0 ? at : entry.second;
     }
     return sum;
   }
@@ -204,6 +235,29 @@ vtkBlockLODContour* vtkBlockLODSurfaceRepresentation::FindContour()
 }
 
 //------------------------------------------------------------------------------
+std::array<double, 4> vtkBlockLODSurfaceRepresentation::LevelTriangles(vtkBlockLODContour* contour)
+{
+  // The shown surface's triangles at its level and above it (a display never
+  // draws finer than its output), the estimator's below.
+  std::array<double, Levels> triangles;
+  triangles.fill(-1.0);
+  const int still = contour ? contour->GetChosenLevel() : -1;
+  auto* shown = vtkPolyData::SafeDownCast(this->GetInputDataObject(0, 0));
+  if (still >= 0 && still < Levels && shown)
+  {
+    for (int level = still; level < Levels; ++level)
+    {
+      triangles[level] = static_cast<double>(shown->GetNumberOfPolys());
+    }
+    for (int level = still - 1; level >= 0; --level)
+    {
+      triangles[level] = contour->EstimateLevelTriangles(level);
+    }
+  }
+  return triangles;
+}
+
+//------------------------------------------------------------------------------
 bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
 {
   this->ChosenInteractiveLevel = -1;
@@ -215,17 +269,7 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
   // Triangles per level, this process's (unknown: -1), then summed over the
   // processes so that every piece picks the same level. Every data process
   // runs this pass, with or without a piece.
-  std::array<double, Levels> triangles;
-  triangles.fill(-1.0);
-  if (still >= 0 && still < Levels)
-  {
-    auto* shown = vtkPolyData::SafeDownCast(this->GetInputDataObject(0, 0));
-    triangles[still] = static_cast<double>(shown->GetNumberOfPolys());
-    for (int level = still - 1; level >= 0; --level)
-    {
-      triangles[level] = contour->EstimateLevelTriangles(level);
-    }
-  }
+  std::array<double, Levels> triangles = this->LevelTriangles(contour);
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
   const bool parallel = controller && controller->GetNumberOfProcesses() > 1;
   if (parallel)
@@ -258,11 +302,17 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
       work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
         static_cast<std::uint64_t>(std::max(0, size[1]));
     }
-    double others = 0.0;
+    std::array<double, Levels> others;
+    others.fill(0.0);
     if (this->ObservedRenderer)
     {
       std::lock_guard<std::mutex> lock(Frames().Mutex);
-      others = Frames().OthersDrawn(this->ObservedRenderer.GetPointer(), this);
+      for (int level = 0; level < Levels; ++level)
+      {
+        others[level] = Frames().OthersAt(this->ObservedRenderer.GetPointer(), this, level);
+      }
+      work.Translucent =
+        work.Translucent || Frames().OthersTranslucent(this->ObservedRenderer.GetPointer(), this);
     }
     for (int level = still; level >= 0; --level)
     {
@@ -273,7 +323,7 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
         mediso::FrameTimeModel::Candidate candidate;
         candidate.Level = level;
         candidate.Work = work;
-        candidate.Work.Primitives = static_cast<std::uint64_t>(triangles[level] + others);
+        candidate.Work.Primitives = static_cast<std::uint64_t>(triangles[level] + others[level]);
         candidates.push_back(candidate);
       }
     }
@@ -414,12 +464,27 @@ int vtkBlockLODSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKe
       int level = -1;
       double triangles = 0.0;
       DescribeLOD(drawn, level, triangles);
+      // A display's levels, for the others' choices, once per new data it
+      // shows (their triangles in a frame at a level they choose too).
+      const bool newData = drawn->GetMTime() != this->DrawnDataTime;
+      std::array<double, Levels> levels;
+      levels.fill(-1.0);
+      if (newData && !this->LastRenderUsedLOD && this->InteractiveLevels)
+      {
+        levels = this->LevelTriangles(this->FindContour());
+      }
       std::lock_guard<std::mutex> lock(Frames().Mutex);
       ProcessFrames::Frame& frame = Frames().Pending[this->ObservedRenderer.GetPointer()];
       frame.Triangles += triangles;
-      frame.Learn = frame.Learn && drawn->GetMTime() == this->DrawnDataTime;
+      frame.Learn = frame.Learn && !newData;
       frame.Translucent = frame.Translucent || this->Property->GetOpacity() < 1.0;
       Frames().Drawn[this->ObservedRenderer.GetPointer()][this] = triangles;
+      Frames().Translucent[this->ObservedRenderer.GetPointer()][this] =
+        this->Property->GetOpacity() < 1.0;
+      if (newData && !this->LastRenderUsedLOD)
+      {
+        Frames().AtLevel[this->ObservedRenderer.GetPointer()][this] = levels;
+      }
       this->DrawnDataTime = drawn->GetMTime();
     }
   }
@@ -452,9 +517,13 @@ bool vtkBlockLODSurfaceRepresentation::RemoveFromView(vtkView* view)
     {
       std::lock_guard<std::mutex> lock(Frames().Mutex);
       Frames().Drawn[this->ObservedRenderer.GetPointer()].erase(this);
+      Frames().AtLevel[this->ObservedRenderer.GetPointer()].erase(this);
+      Frames().Translucent[this->ObservedRenderer.GetPointer()].erase(this);
       if (Frames().Drawn[this->ObservedRenderer.GetPointer()].empty())
       {
         Frames().Drawn.erase(this->ObservedRenderer.GetPointer());
+        Frames().AtLevel.erase(this->ObservedRenderer.GetPointer());
+        Frames().Translucent.erase(this->ObservedRenderer.GetPointer());
         Frames().Pending.erase(this->ObservedRenderer.GetPointer());
       }
     }

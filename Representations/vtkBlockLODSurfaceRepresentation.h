@@ -72,6 +72,8 @@
 #include "vtkSmartPointer.h" // For vtkSmartPointer
 #include "vtkWeakPointer.h"  // For vtkWeakPointer
 
+#include <array> // For std::array
+
 class vtkBlockLODContour;
 class vtkCompositeDataSet;
 class vtkRenderer;
@@ -163,6 +165,9 @@ protected:
   // The LOD geometry of REQUEST_UPDATE_LOD: the chosen level, or false (the
   // decimated copy is used).
   bool MakeLevelLOD();
+  // This process's triangles of each of the four levels for the shown data
+  // (-1 where unknown, all -1 without the filter).
+  std::array<double, 4> LevelTriangles(vtkBlockLODContour* contour);
   // The LOD geometry in the shape of the view's piece.
   vtkDataObject* WrapLikePiece(vtkDataObject* piece);
 
