@@ -19,6 +19,7 @@
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkProperty.h"
+#include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkSmartPointer.h"
 
@@ -500,11 +501,18 @@ bool vtkBlockLODSurfaceRepresentation::AddToView(vtkView* view)
   }
   if (auto* renderView = vtkPVRenderView::SafeDownCast(view))
   {
+    // Frames are timed by the render window, not the renderer: the window's
+    // render is what a user waits for (the other renderers, the final blit
+    // and swap), and on llvmpipe it is most of a coarse level's frame.
     this->ObservedRenderer = renderView->GetRenderer();
-    this->StartObserver = this->ObservedRenderer->AddObserver(
-      vtkCommand::StartEvent, this, &vtkBlockLODSurfaceRepresentation::OnRenderStart);
-    this->EndObserver = this->ObservedRenderer->AddObserver(
-      vtkCommand::EndEvent, this, &vtkBlockLODSurfaceRepresentation::OnRenderEnd);
+    this->ObservedWindow = renderView->GetRenderWindow();
+    if (this->ObservedWindow)
+    {
+      this->StartObserver = this->ObservedWindow->AddObserver(
+        vtkCommand::StartEvent, this, &vtkBlockLODSurfaceRepresentation::OnRenderStart);
+      this->EndObserver = this->ObservedWindow->AddObserver(
+        vtkCommand::EndEvent, this, &vtkBlockLODSurfaceRepresentation::OnRenderEnd);
+    }
   }
   return true;
 }
@@ -527,8 +535,12 @@ bool vtkBlockLODSurfaceRepresentation::RemoveFromView(vtkView* view)
         Frames().Pending.erase(this->ObservedRenderer.GetPointer());
       }
     }
-    this->ObservedRenderer->RemoveObserver(this->StartObserver);
-    this->ObservedRenderer->RemoveObserver(this->EndObserver);
+    if (this->ObservedWindow)
+    {
+      this->ObservedWindow->RemoveObserver(this->StartObserver);
+      this->ObservedWindow->RemoveObserver(this->EndObserver);
+    }
+    this->ObservedWindow = nullptr;
     this->ObservedRenderer = nullptr;
   }
   return this->Superclass::RemoveFromView(view);
@@ -537,9 +549,13 @@ bool vtkBlockLODSurfaceRepresentation::RemoveFromView(vtkView* view)
 //------------------------------------------------------------------------------
 void vtkBlockLODSurfaceRepresentation::OnRenderStart()
 {
-  // Every Block LOD display observes the renderer; the first one to hear of
-  // a prepared frame starts its clock.
+  // Every Block LOD display observes the render window; the first one to
+  // hear of a prepared frame starts its clock.
   std::lock_guard<std::mutex> lock(Frames().Mutex);
+  if (!this->ObservedRenderer)
+  {
+    return;
+  }
   auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
   if (frame != Frames().Pending.end() && frame->second.Start == 0.0)
   {
@@ -553,6 +569,10 @@ void vtkBlockLODSurfaceRepresentation::OnRenderEnd()
   // The first display to hear of the frame's end records it, once.
   const double end = Now();
   std::lock_guard<std::mutex> lock(Frames().Mutex);
+  if (!this->ObservedRenderer)
+  {
+    return;
+  }
   auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
   if (frame == Frames().Pending.end())
   {

@@ -76,6 +76,7 @@
 
 class vtkBlockLODContour;
 class vtkCompositeDataSet;
+class vtkRenderWindow;
 class vtkRenderer;
 class vtkPolyData;
 
@@ -171,8 +172,8 @@ protected:
   // The LOD geometry in the shape of the view's piece.
   vtkDataObject* WrapLikePiece(vtkDataObject* piece);
 
-  // Frames drawn here, for the frame-time model: a renderer's StartEvent and
-  // EndEvent around the render that REQUEST_RENDER prepared.
+  // Frames drawn here, for the frame-time model: the render window's
+  // StartEvent and EndEvent around the render that REQUEST_RENDER prepared.
   void OnRenderStart();
   void OnRenderEnd();
   bool AddToView(vtkView* view) override;
@@ -185,6 +186,7 @@ protected:
   unsigned long StartObserver = 0;
   unsigned long EndObserver = 0;
   vtkWeakPointer<vtkRenderer> ObservedRenderer;
+  vtkWeakPointer<vtkRenderWindow> ObservedWindow;
   // The data drawn by the last frame, so that its first frame (uploads) is
   // not learnt from.
   vtkMTimeType DrawnDataTime = 0;
