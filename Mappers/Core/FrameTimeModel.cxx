@@ -187,63 +187,55 @@ void FrameTimeModel::Observe(const FrameWork& work, double seconds)
     pair.Samples.pop_front();
   }
   this->Refit(work.Method, work.Translucent);
-  // The other translucency of the method is anchored to this fit's shape.
-  if (this->HasObservations(work.Method, !work.Translucent))
-  {
-    this->Refit(work.Method, !work.Translucent);
-  }
 }
 
 void FrameTimeModel::Refit(FrameMethod method, bool translucent)
 {
   Pair& pair = this->Pairs[Key(method, translucent)];
   double scale = 1.0;
-  pair.Fitted =
-    Solve(pair.Samples, Prior(method, translucent), this->Anchor(method, translucent), scale);
+  // Anchored to the prior's shape; the scale found is the frames' ratio to
+  // the prior, what a pair without frames borrows (Anchor()).
+  const Coefficients prior = Prior(method, translucent);
+  pair.Fitted = Solve(pair.Samples, prior, prior, scale);
   pair.PriorScale = scale;
 }
 
 FrameTimeModel::Coefficients FrameTimeModel::Anchor(FrameMethod method, bool translucent) const
 {
+  // The prior, scaled as the frames of another pair scale theirs: how much
+  // faster or slower than the priors this machine is. Only the scale
+  // transfers, not a fitted split: a translucent frame's split differs in
+  // kind from an opaque one's (depth peeling's full-viewport passes), and a
+  // method's from the other's. The same method drawn the other way says it
+  // first; else the other method's pair with more frames.
   const Coefficients prior = Prior(method, translucent);
-  // The same method drawn the other way: its fitted split between fixed,
-  // per-primitive and per-pixel work, in this pair's proportions. What a
-  // machine's opaque frames taught about the split holds for its translucent
-  // ones more closely than any prior does.
+  const Pair* source = nullptr;
   const Pair& sibling = this->Pairs[Key(method, !translucent)];
   if (!sibling.Samples.empty())
   {
-    const Coefficients other = Prior(method, !translucent);
-    Coefficients anchor;
-    anchor.Seconds = sibling.Fitted.Seconds * prior.Seconds / other.Seconds;
-    anchor.PerPrimitive = sibling.Fitted.PerPrimitive * prior.PerPrimitive / other.PerPrimitive;
-    anchor.PerPixel = sibling.Fitted.PerPixel * prior.PerPixel / other.PerPixel;
-    if (anchor.Seconds + anchor.PerPrimitive + anchor.PerPixel > 0.0)
-    {
-      return anchor;
-    }
+    source = &sibling;
   }
-  // The other method's frames: only how much faster or slower than its prior
-  // this machine is (their shapes differ in kind). The pair with more frames
-  // says it.
-  const FrameMethod otherMethod = method == FrameMethod::CellRasterisation
-    ? FrameMethod::Triangles
-    : FrameMethod::CellRasterisation;
-  const Pair* most = nullptr;
-  for (bool t : { false, true })
+  else
   {
-    const Pair& candidate = this->Pairs[Key(otherMethod, t)];
-    if (!candidate.Samples.empty() && (!most || candidate.Samples.size() > most->Samples.size()))
+    const FrameMethod otherMethod = method == FrameMethod::CellRasterisation
+      ? FrameMethod::Triangles
+      : FrameMethod::CellRasterisation;
+    for (bool t : { false, true })
     {
-      most = &candidate;
+      const Pair& candidate = this->Pairs[Key(otherMethod, t)];
+      if (!candidate.Samples.empty() &&
+        (!source || candidate.Samples.size() > source->Samples.size()))
+      {
+        source = &candidate;
+      }
     }
   }
-  if (most && most->PriorScale > 0.0)
+  if (source && source->PriorScale > 0.0)
   {
     Coefficients anchor = prior;
-    anchor.Seconds *= most->PriorScale;
-    anchor.PerPrimitive *= most->PriorScale;
-    anchor.PerPixel *= most->PriorScale;
+    anchor.Seconds *= source->PriorScale;
+    anchor.PerPrimitive *= source->PriorScale;
+    anchor.PerPixel *= source->PriorScale;
     return anchor;
   }
   return prior;

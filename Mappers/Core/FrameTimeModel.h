@@ -32,11 +32,11 @@
  * machine is followed within a few frames), with a, b, c >= 0 (solved exactly
  * over the 8 supports of the three coefficients). A frame sequence rarely
  * varies all three counts (a rotation keeps both), so the fit is anchored to
- * a shape, scaled to the frames: a small ridge term pulls (a, b, c) towards s
- * * (a0, b0, c0), s the least-squares scale of the anchor to the frames.
- * Directions the frames do not determine keep the anchor's shape; directions
+ * the prior, scaled to the frames: a small ridge term pulls (a, b, c) towards
+ * s * (a0, b0, c0), s the least-squares scale of the prior to the frames.
+ * Directions the frames do not determine keep the prior's shape; directions
  * they determine follow the frames. With one frame (or many with the same work)
- * the prediction is exactly that frame's time scaled by the anchor's ratio of
+ * the prediction is exactly that frame's time scaled by the prior's ratio of
  * the two works; with frames at several levels or distances the split between
  * a, b and c is learnt.
  *
@@ -49,15 +49,15 @@
  * (a handful of frames), is followed. A frame at a work not seen before is
  * not an outlier: the split between the coefficients fits it.
  *
- * The anchor of a pair (and its prediction before any of its frames) is, in
- * order: the fit of the same method drawn the other way (opaque for
- * translucent and back) in this pair's prior proportions, so that the split
- * learnt from opaque frames at two levels predicts a translucent level not
- * yet drawn; else the prior scaled as the other method's frames scale theirs
- * (how fast this machine is); else the prior (Prior()), whose shape is a
- * software renderer's (llvmpipe, SwiftShader) as measured, and whose size is
- * conservative, so a host's first interactive frame errs on the coarse side.
- * A GPU's first observed frame scales it down at once.
+ * The anchor is the prior (Prior()), whose shape is a software renderer's
+ * (llvmpipe, SwiftShader) as measured and whose size is conservative. A pair
+ * without frames predicts its prior scaled as the frames of the same method
+ * drawn the other way (opaque for translucent and back) scale theirs, else as
+ * the other method's do: how fast this machine is transfers, a fitted split
+ * does not (a translucent frame's split differs in kind from an opaque one's:
+ * depth peeling's full-viewport passes). Before any frame at all the prior
+ * predicts, so a host's first interactive frame errs on the coarse side; a
+ * GPU's first observed frame scales it down at once.
  *
  * Limits: a frame's time also depends on what the counts do not say (overdraw,
  * the depth complexity of translucent layers, caches, other load on the
@@ -130,12 +130,13 @@ public:
   /// method and translucency.
   void Observe(const FrameWork& work, double seconds);
   /// Predicted seconds for a frame (before any frame of its method and
-  /// translucency: the anchor, from the other pairs' frames or the prior).
+  /// translucency: its prior, scaled as another pair's frames scale theirs).
   double Predict(const FrameWork& work) const;
   bool HasObservations(FrameMethod method, bool translucent) const;
   /// Frames currently kept for a pair (at most HistoryLength).
   std::size_t ObservationCount(FrameMethod method, bool translucent) const;
-  /// The fitted coefficients of a pair (its anchor before any frame).
+  /// The fitted coefficients of a pair (before any frame: its prior, scaled
+  /// as another pair's frames scale theirs).
   Coefficients Fit(FrameMethod method, bool translucent) const;
   /// Forgets every frame (another renderer, another window).
   void Reset();
@@ -161,12 +162,12 @@ private:
   {
     std::deque<Sample> Samples; // oldest first
     Coefficients Fitted;
-    double PriorScale = 1.0; // the frames' least-squares ratio to the anchor
+    double PriorScale = 1.0; // the frames' least-squares ratio to the prior
   };
   static std::size_t Key(FrameMethod method, bool translucent);
-  // The shape a pair's fit is anchored to, and its prediction before any of
-  // its frames: the sibling pair's fit in this pair's proportions, else the
-  // prior scaled as the other method's frames scale theirs, else the prior.
+  // A pair's prediction before any of its frames: its prior, scaled as the
+  // same method drawn the other way scales its frames, else as the other
+  // method's do, else the prior.
   Coefficients Anchor(FrameMethod method, bool translucent) const;
   void Refit(FrameMethod method, bool translucent);
   static Coefficients Solve(const std::deque<Sample>& samples, const Coefficients& prior,

@@ -293,40 +293,27 @@ int main()
 
   // A pair not yet drawn predicted from the frames of the others.
   {
-    // Translucent frames seen only at the full level after opaque frames at
-    // two levels: the opaque split, in the translucent prior's proportions.
-    // The underlying translucent cost has exactly those proportions.
+    // Opaque frames at 2.5 times the opaque prior: a translucent frame not
+    // yet drawn is predicted at 2.5 times the translucent prior (the
+    // machine's speed transfers, the opaque split does not), and its own
+    // frames take over from the first one.
     FrameTimeModel model;
+    const FrameTimeModel::Coefficients po = FrameTimeModel::Prior(FrameMethod::Triangles, false);
+    const FrameTimeModel::Coefficients pt = FrameTimeModel::Prior(FrameMethod::Triangles, true);
     const auto still = Work(FrameMethod::Triangles, stillTriangles, viewport);
     const auto coarse = Work(FrameMethod::Triangles, levelZero, viewport);
     for (int i = 0; i < 4; ++i)
     {
-      model.Observe(still, opaqueCost(still));
-      model.Observe(coarse, opaqueCost(coarse));
+      model.Observe(still, 2.5 * po.Evaluate(still));
+      model.Observe(coarse, 2.5 * po.Evaluate(coarse));
     }
-    const FrameTimeModel::Coefficients opaque = model.Fit(FrameMethod::Triangles, false);
-    const FrameTimeModel::Coefficients po = FrameTimeModel::Prior(FrameMethod::Triangles, false);
-    const FrameTimeModel::Coefficients pt = FrameTimeModel::Prior(FrameMethod::Triangles, true);
-    const auto translucentCost = [&](const mediso::FrameWork& work)
-    {
-      return 1.5 *
-        (opaque.Seconds * pt.Seconds / po.Seconds +
-          opaque.PerPrimitive * pt.PerPrimitive / po.PerPrimitive *
-            static_cast<double>(work.Primitives) +
-          opaque.PerPixel * pt.PerPixel / po.PerPixel * static_cast<double>(work.Pixels));
-    };
-    const auto stillT = Work(FrameMethod::Triangles, stillTriangles, viewport, true);
     const auto coarseT = Work(FrameMethod::Triangles, levelZero, viewport, true);
-    Check(Near(model.Predict(coarseT), translucentCost(coarseT) / 1.5, 1e-6),
-      "no translucent frame yet: the opaque fit in the translucent prior's proportions (" +
-        Number(model.Predict(coarseT)) + " vs " + Number(translucentCost(coarseT) / 1.5) + ")");
-    for (int i = 0; i < 5; ++i)
-    {
-      model.Observe(stillT, translucentCost(stillT));
-    }
-    Check(Near(model.Predict(coarseT), translucentCost(coarseT), 0.02),
-      "translucent still frames only: level 0 within 2% (" + Number(model.Predict(coarseT)) +
-        " vs " + Number(translucentCost(coarseT)) + ")");
+    Check(Near(model.Predict(coarseT), 2.5 * pt.Evaluate(coarseT), 1e-6),
+      "no translucent frame yet: the translucent prior at the opaque frames' scale (" +
+        Number(model.Predict(coarseT)) + " vs " + Number(2.5 * pt.Evaluate(coarseT)) + ")");
+    model.Observe(coarseT, 0.2);
+    Check(Near(model.Predict(coarseT), 0.2, 1e-9),
+      "one translucent frame: predicted as measured (" + Number(model.Predict(coarseT)) + ")");
 
     // Triangles never drawn, the cell rasteriser's frames three times its
     // prior: triangles predicted at three times theirs.
