@@ -48,10 +48,18 @@ struct ProcessFrames
     double Triangles = 0.0;
     bool Learn = true; // false when a display drew new data (its upload)
     bool Translucent = false;
-    double Start = 0.0;
+    double Start = 0.0;         // the render window's StartEvent
+    double RendererStart = 0.0; // the view's renderer's StartEvent
+    double RendererSeconds = -1.0;
   };
   std::mutex Mutex;
+  // Fitted to the view's renderer's time of each frame: the triangles' cost.
   mediso::FrameTimeModel Model;
+  // Per renderer, the rest of its window's render (the other renderers, the
+  // blit and the swap), a fixed cost per frame whatever the level: added to
+  // the model's prediction, so that the prediction is the frame a user waits
+  // for without that cost blurring the model's split of the triangles' cost.
+  std::map<const void*, double> Overhead;
   // Per renderer: the frame being drawn, and each display's last triangles.
   std::map<const void*, Frame> Pending;
   std::map<const void*, std::map<const void*, double>> Drawn;
@@ -334,7 +342,8 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
       if (this->InteractiveFrameBudget > 0)
       {
         std::lock_guard<std::mutex> lock(Frames().Mutex);
-        pick = Frames().Model.Choose(candidates, this->InteractiveFrameBudget);
+        pick = Frames().Model.Choose(
+          candidates, this->InteractiveFrameBudget - this->FrameOverhead());
       }
       chosen = candidates[pick].Level;
     }
@@ -357,7 +366,7 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
     if (candidate.Level == chosen)
     {
       std::lock_guard<std::mutex> lock(Frames().Mutex);
-      predicted = Frames().Model.Predict(candidate.Work);
+      predicted = Frames().Model.Predict(candidate.Work) + this->FrameOverhead();
     }
   }
   if (chosen == still)
@@ -501,11 +510,17 @@ bool vtkBlockLODSurfaceRepresentation::AddToView(vtkView* view)
   }
   if (auto* renderView = vtkPVRenderView::SafeDownCast(view))
   {
-    // Frames are timed by the render window, not the renderer: the window's
-    // render is what a user waits for (the other renderers, the final blit
-    // and swap), and on llvmpipe it is most of a coarse level's frame.
+    // Frames are timed by the render window, what a user waits for, and by
+    // the view's renderer within it: the model learns the renderer's time
+    // (the triangles' cost), and the rest of the window's (the other
+    // renderers, the blit and the swap; under load most of a coarse level's
+    // frame on llvmpipe) is a fixed cost added to its predictions.
     this->ObservedRenderer = renderView->GetRenderer();
     this->ObservedWindow = renderView->GetRenderWindow();
+    this->RendererStartObserver = this->ObservedRenderer->AddObserver(
+      vtkCommand::StartEvent, this, &vtkBlockLODSurfaceRepresentation::OnRendererStart);
+    this->RendererEndObserver = this->ObservedRenderer->AddObserver(
+      vtkCommand::EndEvent, this, &vtkBlockLODSurfaceRepresentation::OnRendererEnd);
     if (this->ObservedWindow)
     {
       this->StartObserver = this->ObservedWindow->AddObserver(
@@ -532,6 +547,7 @@ bool vtkBlockLODSurfaceRepresentation::RemoveFromView(vtkView* view)
         Frames().Drawn.erase(this->ObservedRenderer.GetPointer());
         Frames().AtLevel.erase(this->ObservedRenderer.GetPointer());
         Frames().Translucent.erase(this->ObservedRenderer.GetPointer());
+        Frames().Overhead.erase(this->ObservedRenderer.GetPointer());
         Frames().Pending.erase(this->ObservedRenderer.GetPointer());
       }
     }
@@ -540,6 +556,8 @@ bool vtkBlockLODSurfaceRepresentation::RemoveFromView(vtkView* view)
       this->ObservedWindow->RemoveObserver(this->StartObserver);
       this->ObservedWindow->RemoveObserver(this->EndObserver);
     }
+    this->ObservedRenderer->RemoveObserver(this->RendererStartObserver);
+    this->ObservedRenderer->RemoveObserver(this->RendererEndObserver);
     this->ObservedWindow = nullptr;
     this->ObservedRenderer = nullptr;
   }
@@ -580,7 +598,23 @@ void vtkBlockLODSurfaceRepresentation::OnRenderEnd()
   }
   const ProcessFrames::Frame drawn = frame->second;
   Frames().Pending.erase(frame);
-  if (!drawn.Learn || drawn.Triangles <= 0 || drawn.Start == 0.0)
+  if (drawn.Start == 0.0 || drawn.RendererSeconds < 0.0)
+  {
+    return;
+  }
+  // The window's fixed cost, from every frame (an upload is the renderer's
+  // work): half the last frame's, half the frames' before.
+  const double overhead = std::max(0.0, end - drawn.Start - drawn.RendererSeconds);
+  auto known = Frames().Overhead.find(this->ObservedRenderer.GetPointer());
+  if (known == Frames().Overhead.end())
+  {
+    Frames().Overhead[this->ObservedRenderer.GetPointer()] = overhead;
+  }
+  else
+  {
+    known->second = 0.5 * (known->second + overhead);
+  }
+  if (!drawn.Learn || drawn.Triangles <= 0)
   {
     return;
   }
@@ -591,7 +625,51 @@ void vtkBlockLODSurfaceRepresentation::OnRenderEnd()
   work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
     static_cast<std::uint64_t>(std::max(0, size[1]));
   work.Translucent = drawn.Translucent;
-  Frames().Model.Observe(work, end - drawn.Start);
+  Frames().Model.Observe(work, drawn.RendererSeconds);
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::OnRendererStart()
+{
+  std::lock_guard<std::mutex> lock(Frames().Mutex);
+  if (!this->ObservedRenderer)
+  {
+    return;
+  }
+  auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
+  if (frame != Frames().Pending.end() && frame->second.RendererStart == 0.0)
+  {
+    frame->second.RendererStart = Now();
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::OnRendererEnd()
+{
+  const double end = Now();
+  std::lock_guard<std::mutex> lock(Frames().Mutex);
+  if (!this->ObservedRenderer)
+  {
+    return;
+  }
+  auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
+  if (frame != Frames().Pending.end() && frame->second.RendererStart != 0.0 &&
+    frame->second.RendererSeconds < 0.0)
+  {
+    frame->second.RendererSeconds = end - frame->second.RendererStart;
+  }
+}
+
+//------------------------------------------------------------------------------
+double vtkBlockLODSurfaceRepresentation::FrameOverhead()
+{
+  // Called with Frames().Mutex held.
+  if (!this->ObservedRenderer)
+  {
+    return 0.0;
+  }
+  const auto known = Frames().Overhead.find(this->ObservedRenderer.GetPointer());
+  return known == Frames().Overhead.end() ? 0.0 : known->second;
 }
 
 //------------------------------------------------------------------------------

@@ -173,9 +173,16 @@ protected:
   vtkDataObject* WrapLikePiece(vtkDataObject* piece);
 
   // Frames drawn here, for the frame-time model: the render window's
-  // StartEvent and EndEvent around the render that REQUEST_RENDER prepared.
+  // StartEvent and EndEvent around the render that REQUEST_RENDER prepared
+  // (the frame a user waits for), and the view's renderer's within it (the
+  // triangles' cost, what the model is fitted to; the rest is a fixed cost
+  // per frame, added to its predictions).
   void OnRenderStart();
   void OnRenderEnd();
+  void OnRendererStart();
+  void OnRendererEnd();
+  // The window's fixed cost per frame on this renderer (0 before a frame).
+  double FrameOverhead();
   bool AddToView(vtkView* view) override;
   bool RemoveFromView(vtkView* view) override;
 
@@ -185,6 +192,8 @@ protected:
   double PredictedInteractiveSeconds = 0.0;
   unsigned long StartObserver = 0;
   unsigned long EndObserver = 0;
+  unsigned long RendererStartObserver = 0;
+  unsigned long RendererEndObserver = 0;
   vtkWeakPointer<vtkRenderer> ObservedRenderer;
   vtkWeakPointer<vtkRenderWindow> ObservedWindow;
   // The data drawn by the last frame, so that its first frame (uploads) is
