@@ -1304,6 +1304,7 @@ def run_interaction(args):
              "Command: `%s`" % " ".join(shlex.quote(a) for a in sys.argv),
              "Machine: %s, %.0f GB; load average before: %s" % (cpu_model(), mem_total_gb(),
                                                                  load_average()), ""]
+    frame_log = []
     for name in (args.inputs.split(",") if args.inputs else ["ct"]):
         source, image, label, keep = make_input(name, pvs, pvs.MedicalPhantom)
         array_name = image.GetPointData().GetScalars().GetName()
@@ -1324,6 +1325,32 @@ def run_interaction(args):
         camera = view.GetActiveCamera()
         still_triangles = [int(f.GetDataInformation().GetNumberOfCells()) for f in filters]
         rows = []
+        # The main renderer's own time of each frame (its StartEvent to its EndEvent) and the
+        # render window's (every renderer, the blit and the swap): the displays' frame-time model
+        # observes and predicts the window's (a frame's wall time adds little around it).
+        renderer = view.GetRenderer()
+        clock = {"start": 0.0, "last": 0.0}
+
+        def on_start(*_):
+            clock["start"] = time.perf_counter()
+
+        def on_end(*_):
+            clock["last"] = time.perf_counter() - clock["start"]
+
+        renderer.AddObserver("StartEvent", on_start)
+        renderer.AddObserver("EndEvent", on_end)
+        # And the render window's (every renderer of the view, and the buffer swap).
+        window = view.GetRenderWindow()
+        window_clock = {"start": 0.0, "last": 0.0}
+
+        def on_window_start(*_):
+            window_clock["start"] = time.perf_counter()
+
+        def on_window_end(*_):
+            window_clock["last"] = time.perf_counter() - window_clock["start"]
+
+        window.AddObserver("StartEvent", on_window_start)
+        window.AddObserver("EndEvent", on_window_end)
 
         def drawn(d):
             sub = d.SMProxy.GetProperty("BlockLODInteractiveLevel").GetParent()
@@ -1339,12 +1366,13 @@ def run_interaction(args):
                     d.BlockLODInteractiveLevels = levels
                 pvs.Render(view)
                 pvs.Render(view)
-                still, moving = [], []
+                still, moving, rendered, still_rendered, windowed = [], [], [], [], []
                 for _ in range(args.rotation_frames):
                     camera.Azimuth(1.0)
                     t0 = time.perf_counter()
                     pvs.Render(view)
                     still.append(time.perf_counter() - t0)
+                    still_rendered.append(clock["last"])
                 camera.Azimuth(1.0)
                 t0 = time.perf_counter()
                 view.SMProxy.InteractiveRender()  # makes and delivers the LOD geometry
@@ -1354,7 +1382,18 @@ def run_interaction(args):
                     t0 = time.perf_counter()
                     view.SMProxy.InteractiveRender()
                     moving.append(time.perf_counter() - t0)
+                    rendered.append(clock["last"])
+                    windowed.append(window_clock["last"])
                 what = [drawn(d) for d in displays]
+                # The prediction of the frame drawn: each display predicts its level with the
+                # others' triangles added, so the last display to choose predicts the frame.
+                predicted = what[-1][2] if levels and what[-1][0] >= 0 else 0.0
+                within = [abs(predicted / m - 1.0) <= 0.25 for m in windowed if m > 0] \
+                    if predicted > 0 else []
+                frame_log.append({"scene": "%s, %s" % (opacity, mode), "still_wall": still,
+                                  "interactive_wall": moving, "interactive_renderer": rendered,
+                                  "still_renderer": still_rendered, "interactive_window": windowed,
+                                  "drawn": what})
                 rows.append(["%s (%s)" % ("translucent skin %.1f" % opacity if opacity < 1 else "opaque",
                                           mode),
                              fmt_s(statistics.median(still)), fmt_s(statistics.median(moving)),
@@ -1362,14 +1401,18 @@ def run_interaction(args):
                              fmt_s(first),
                              " / ".join("L%d %d" % w[:2] if w[0] >= 0 else "decimated %d" % w[1]
                                         for w in what),
-                             " / ".join(fmt_s(w[2]) if w[0] >= 0 else "-" for w in what)])
+                             " / ".join(fmt_s(w[2]) if w[0] >= 0 else "-" for w in what),
+                             "%s / %s" % (fmt_s(statistics.median(rendered)),
+                                          fmt_s(statistics.median(windowed))),
+                             ("%d%%" % round(100.0 * sum(within) / len(within))) if within else "-"])
                 progress("[%s] %s" % (name, rows[-1]))
         lines += ["## %s, %dx%d, LODThreshold %g MB, skin %g + bone %g (level 3: %s triangles)"
                   % (label, width, height, view.LODThreshold, skin, bone,
                      " + ".join(str(t) for t in still_triangles)), ""]
         lines += markdown_table(["scene (interactive LOD)", "still median", "interactive median",
                                  "ratio", "first interactive", "drawn while moving (skin / bone)",
-                                 "predicted (skin / bone)"],
+                                 "predicted (skin / bone)", "interactive median: renderer / window",
+                                 "frames within 25% of the prediction"],
                                 rows)
         lines += [""]
         for d in displays:
@@ -1384,6 +1427,9 @@ def run_interaction(args):
     if args.out:
         with open(args.out, "w") as f:
             f.write(text)
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(frame_log, f, indent=1)
     return 0
 
 

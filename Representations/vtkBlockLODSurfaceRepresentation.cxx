@@ -19,6 +19,7 @@
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkProperty.h"
+#include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkSmartPointer.h"
 
@@ -47,20 +48,59 @@ struct ProcessFrames
     double Triangles = 0.0;
     bool Learn = true; // false when a display drew new data (its upload)
     bool Translucent = false;
-    double Start = 0.0;
+    double Start = 0.0;         // the render window's StartEvent
+    double RendererStart = 0.0; // the view's renderer's StartEvent
+    double RendererSeconds = -1.0;
   };
   std::mutex Mutex;
+  // Fitted to the view's renderer's time of each frame: the triangles' cost.
   mediso::FrameTimeModel Model;
+  // Per renderer, the rest of its window's render (the other renderers, the
+  // blit and the swap), a fixed cost per frame whatever the level: added to
+  // the model's prediction, so that the prediction is the frame a user waits
+  // for without that cost blurring the model's split of the triangles' cost.
+  std::map<const void*, double> Overhead;
   // Per renderer: the frame being drawn, and each display's last triangles.
   std::map<const void*, Frame> Pending;
   std::map<const void*, std::map<const void*, double>> Drawn;
+  // Per renderer, each display's triangles at each level for its current
+  // data (-1: unknown), known from its first frame of the data.
+  std::map<const void*, std::map<const void*, std::array<double, Levels>>> AtLevel;
+  // Per renderer, whether each display drew translucent last: a frame with
+  // one translucent display is a translucent frame for all of them.
+  std::map<const void*, std::map<const void*, bool>> Translucent;
 
-  double OthersDrawn(const void* renderer, const void* display)
+  bool OthersTranslucent(const void* renderer, const void* display)
   {
-    double sum = 0.0;
+    const auto& translucent = this->Translucent[renderer];
     for (const auto& entry : this->Drawn[renderer])
     {
-      sum += entry.first == display ? 0.0 : entry.second;
+      const auto known = translucent.find(entry.first);
+      if (entry.first != display && known != translucent.end() && known->second)
+      {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // The triangles the other displays of a renderer draw in a frame in which
+  // `display` draws `level`: the same level for those that have one (their
+  // candidates are the same sums, so they choose it too, and the prediction
+  // is the frame's), else what they drew last.
+  double OthersAt(const void* renderer, const void* display, int level)
+  {
+    double sum = 0.0;
+    const auto& levels = this->AtLevel[renderer];
+    for (const auto& entry : this->Drawn[renderer])
+    {
+      if (entry.first == display)
+      {
+        continue;
+      }
+      const auto known = levels.find(entry.first);
+      const double at = known == levels.end() ? -1.0 : known->second[level];
+      sum += at >= 0.0 ? at : entry.second;
     }
     return sum;
   }
@@ -204,6 +244,29 @@ vtkBlockLODContour* vtkBlockLODSurfaceRepresentation::FindContour()
 }
 
 //------------------------------------------------------------------------------
+std::array<double, 4> vtkBlockLODSurfaceRepresentation::LevelTriangles(vtkBlockLODContour* contour)
+{
+  // The shown surface's triangles at its level and above it (a display never
+  // draws finer than its output), the estimator's below.
+  std::array<double, Levels> triangles;
+  triangles.fill(-1.0);
+  const int still = contour ? contour->GetChosenLevel() : -1;
+  auto* shown = vtkPolyData::SafeDownCast(this->GetInputDataObject(0, 0));
+  if (still >= 0 && still < Levels && shown)
+  {
+    for (int level = still; level < Levels; ++level)
+    {
+      triangles[level] = static_cast<double>(shown->GetNumberOfPolys());
+    }
+    for (int level = still - 1; level >= 0; --level)
+    {
+      triangles[level] = contour->EstimateLevelTriangles(level);
+    }
+  }
+  return triangles;
+}
+
+//------------------------------------------------------------------------------
 bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
 {
   this->ChosenInteractiveLevel = -1;
@@ -215,17 +278,7 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
   // Triangles per level, this process's (unknown: -1), then summed over the
   // processes so that every piece picks the same level. Every data process
   // runs this pass, with or without a piece.
-  std::array<double, Levels> triangles;
-  triangles.fill(-1.0);
-  if (still >= 0 && still < Levels)
-  {
-    auto* shown = vtkPolyData::SafeDownCast(this->GetInputDataObject(0, 0));
-    triangles[still] = static_cast<double>(shown->GetNumberOfPolys());
-    for (int level = still - 1; level >= 0; --level)
-    {
-      triangles[level] = contour->EstimateLevelTriangles(level);
-    }
-  }
+  std::array<double, Levels> triangles = this->LevelTriangles(contour);
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
   const bool parallel = controller && controller->GetNumberOfProcesses() > 1;
   if (parallel)
@@ -258,11 +311,17 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
       work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
         static_cast<std::uint64_t>(std::max(0, size[1]));
     }
-    double others = 0.0;
+    std::array<double, Levels> others;
+    others.fill(0.0);
     if (this->ObservedRenderer)
     {
       std::lock_guard<std::mutex> lock(Frames().Mutex);
-      others = Frames().OthersDrawn(this->ObservedRenderer.GetPointer(), this);
+      for (int level = 0; level < Levels; ++level)
+      {
+        others[level] = Frames().OthersAt(this->ObservedRenderer.GetPointer(), this, level);
+      }
+      work.Translucent =
+        work.Translucent || Frames().OthersTranslucent(this->ObservedRenderer.GetPointer(), this);
     }
     for (int level = still; level >= 0; --level)
     {
@@ -273,7 +332,7 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
         mediso::FrameTimeModel::Candidate candidate;
         candidate.Level = level;
         candidate.Work = work;
-        candidate.Work.Primitives = static_cast<std::uint64_t>(triangles[level] + others);
+        candidate.Work.Primitives = static_cast<std::uint64_t>(triangles[level] + others[level]);
         candidates.push_back(candidate);
       }
     }
@@ -283,7 +342,8 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
       if (this->InteractiveFrameBudget > 0)
       {
         std::lock_guard<std::mutex> lock(Frames().Mutex);
-        pick = Frames().Model.Choose(candidates, this->InteractiveFrameBudget);
+        pick = Frames().Model.Choose(
+          candidates, this->InteractiveFrameBudget - this->FrameOverhead());
       }
       chosen = candidates[pick].Level;
     }
@@ -306,7 +366,7 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
     if (candidate.Level == chosen)
     {
       std::lock_guard<std::mutex> lock(Frames().Mutex);
-      predicted = Frames().Model.Predict(candidate.Work);
+      predicted = Frames().Model.Predict(candidate.Work) + this->FrameOverhead();
     }
   }
   if (chosen == still)
@@ -414,12 +474,27 @@ int vtkBlockLODSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKe
       int level = -1;
       double triangles = 0.0;
       DescribeLOD(drawn, level, triangles);
+      // A display's levels, for the others' choices, once per new data it
+      // shows (their triangles in a frame at a level they choose too).
+      const bool newData = drawn->GetMTime() != this->DrawnDataTime;
+      std::array<double, Levels> levels;
+      levels.fill(-1.0);
+      if (newData && !this->LastRenderUsedLOD && this->InteractiveLevels)
+      {
+        levels = this->LevelTriangles(this->FindContour());
+      }
       std::lock_guard<std::mutex> lock(Frames().Mutex);
       ProcessFrames::Frame& frame = Frames().Pending[this->ObservedRenderer.GetPointer()];
       frame.Triangles += triangles;
-      frame.Learn = frame.Learn && drawn->GetMTime() == this->DrawnDataTime;
+      frame.Learn = frame.Learn && !newData;
       frame.Translucent = frame.Translucent || this->Property->GetOpacity() < 1.0;
       Frames().Drawn[this->ObservedRenderer.GetPointer()][this] = triangles;
+      Frames().Translucent[this->ObservedRenderer.GetPointer()][this] =
+        this->Property->GetOpacity() < 1.0;
+      if (newData && !this->LastRenderUsedLOD)
+      {
+        Frames().AtLevel[this->ObservedRenderer.GetPointer()][this] = levels;
+      }
       this->DrawnDataTime = drawn->GetMTime();
     }
   }
@@ -435,11 +510,24 @@ bool vtkBlockLODSurfaceRepresentation::AddToView(vtkView* view)
   }
   if (auto* renderView = vtkPVRenderView::SafeDownCast(view))
   {
+    // Frames are timed by the render window, what a user waits for, and by
+    // the view's renderer within it: the model learns the renderer's time
+    // (the triangles' cost), and the rest of the window's (the other
+    // renderers, the blit and the swap; under load most of a coarse level's
+    // frame on llvmpipe) is a fixed cost added to its predictions.
     this->ObservedRenderer = renderView->GetRenderer();
-    this->StartObserver = this->ObservedRenderer->AddObserver(
-      vtkCommand::StartEvent, this, &vtkBlockLODSurfaceRepresentation::OnRenderStart);
-    this->EndObserver = this->ObservedRenderer->AddObserver(
-      vtkCommand::EndEvent, this, &vtkBlockLODSurfaceRepresentation::OnRenderEnd);
+    this->ObservedWindow = renderView->GetRenderWindow();
+    this->RendererStartObserver = this->ObservedRenderer->AddObserver(
+      vtkCommand::StartEvent, this, &vtkBlockLODSurfaceRepresentation::OnRendererStart);
+    this->RendererEndObserver = this->ObservedRenderer->AddObserver(
+      vtkCommand::EndEvent, this, &vtkBlockLODSurfaceRepresentation::OnRendererEnd);
+    if (this->ObservedWindow)
+    {
+      this->StartObserver = this->ObservedWindow->AddObserver(
+        vtkCommand::StartEvent, this, &vtkBlockLODSurfaceRepresentation::OnRenderStart);
+      this->EndObserver = this->ObservedWindow->AddObserver(
+        vtkCommand::EndEvent, this, &vtkBlockLODSurfaceRepresentation::OnRenderEnd);
+    }
   }
   return true;
 }
@@ -452,14 +540,25 @@ bool vtkBlockLODSurfaceRepresentation::RemoveFromView(vtkView* view)
     {
       std::lock_guard<std::mutex> lock(Frames().Mutex);
       Frames().Drawn[this->ObservedRenderer.GetPointer()].erase(this);
+      Frames().AtLevel[this->ObservedRenderer.GetPointer()].erase(this);
+      Frames().Translucent[this->ObservedRenderer.GetPointer()].erase(this);
       if (Frames().Drawn[this->ObservedRenderer.GetPointer()].empty())
       {
         Frames().Drawn.erase(this->ObservedRenderer.GetPointer());
+        Frames().AtLevel.erase(this->ObservedRenderer.GetPointer());
+        Frames().Translucent.erase(this->ObservedRenderer.GetPointer());
+        Frames().Overhead.erase(this->ObservedRenderer.GetPointer());
         Frames().Pending.erase(this->ObservedRenderer.GetPointer());
       }
     }
-    this->ObservedRenderer->RemoveObserver(this->StartObserver);
-    this->ObservedRenderer->RemoveObserver(this->EndObserver);
+    if (this->ObservedWindow)
+    {
+      this->ObservedWindow->RemoveObserver(this->StartObserver);
+      this->ObservedWindow->RemoveObserver(this->EndObserver);
+    }
+    this->ObservedRenderer->RemoveObserver(this->RendererStartObserver);
+    this->ObservedRenderer->RemoveObserver(this->RendererEndObserver);
+    this->ObservedWindow = nullptr;
     this->ObservedRenderer = nullptr;
   }
   return this->Superclass::RemoveFromView(view);
@@ -468,9 +567,13 @@ bool vtkBlockLODSurfaceRepresentation::RemoveFromView(vtkView* view)
 //------------------------------------------------------------------------------
 void vtkBlockLODSurfaceRepresentation::OnRenderStart()
 {
-  // Every Block LOD display observes the renderer; the first one to hear of
-  // a prepared frame starts its clock.
+  // Every Block LOD display observes the render window; the first one to
+  // hear of a prepared frame starts its clock.
   std::lock_guard<std::mutex> lock(Frames().Mutex);
+  if (!this->ObservedRenderer)
+  {
+    return;
+  }
   auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
   if (frame != Frames().Pending.end() && frame->second.Start == 0.0)
   {
@@ -484,6 +587,10 @@ void vtkBlockLODSurfaceRepresentation::OnRenderEnd()
   // The first display to hear of the frame's end records it, once.
   const double end = Now();
   std::lock_guard<std::mutex> lock(Frames().Mutex);
+  if (!this->ObservedRenderer)
+  {
+    return;
+  }
   auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
   if (frame == Frames().Pending.end())
   {
@@ -491,7 +598,23 @@ void vtkBlockLODSurfaceRepresentation::OnRenderEnd()
   }
   const ProcessFrames::Frame drawn = frame->second;
   Frames().Pending.erase(frame);
-  if (!drawn.Learn || drawn.Triangles <= 0 || drawn.Start == 0.0)
+  if (drawn.Start == 0.0 || drawn.RendererSeconds < 0.0)
+  {
+    return;
+  }
+  // The window's fixed cost, from every frame (an upload is the renderer's
+  // work): half the last frame's, half the frames' before.
+  const double overhead = std::max(0.0, end - drawn.Start - drawn.RendererSeconds);
+  auto known = Frames().Overhead.find(this->ObservedRenderer.GetPointer());
+  if (known == Frames().Overhead.end())
+  {
+    Frames().Overhead[this->ObservedRenderer.GetPointer()] = overhead;
+  }
+  else
+  {
+    known->second = 0.5 * (known->second + overhead);
+  }
+  if (!drawn.Learn || drawn.Triangles <= 0)
   {
     return;
   }
@@ -502,7 +625,51 @@ void vtkBlockLODSurfaceRepresentation::OnRenderEnd()
   work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
     static_cast<std::uint64_t>(std::max(0, size[1]));
   work.Translucent = drawn.Translucent;
-  Frames().Model.Observe(work, end - drawn.Start);
+  Frames().Model.Observe(work, drawn.RendererSeconds);
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::OnRendererStart()
+{
+  std::lock_guard<std::mutex> lock(Frames().Mutex);
+  if (!this->ObservedRenderer)
+  {
+    return;
+  }
+  auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
+  if (frame != Frames().Pending.end() && frame->second.RendererStart == 0.0)
+  {
+    frame->second.RendererStart = Now();
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::OnRendererEnd()
+{
+  const double end = Now();
+  std::lock_guard<std::mutex> lock(Frames().Mutex);
+  if (!this->ObservedRenderer)
+  {
+    return;
+  }
+  auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
+  if (frame != Frames().Pending.end() && frame->second.RendererStart != 0.0 &&
+    frame->second.RendererSeconds < 0.0)
+  {
+    frame->second.RendererSeconds = end - frame->second.RendererStart;
+  }
+}
+
+//------------------------------------------------------------------------------
+double vtkBlockLODSurfaceRepresentation::FrameOverhead()
+{
+  // Called with Frames().Mutex held.
+  if (!this->ObservedRenderer)
+  {
+    return 0.0;
+  }
+  const auto known = Frames().Overhead.find(this->ObservedRenderer.GetPointer());
+  return known == Frames().Overhead.end() ? 0.0 : known->second;
 }
 
 //------------------------------------------------------------------------------

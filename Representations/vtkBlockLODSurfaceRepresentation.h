@@ -72,8 +72,11 @@
 #include "vtkSmartPointer.h" // For vtkSmartPointer
 #include "vtkWeakPointer.h"  // For vtkWeakPointer
 
+#include <array> // For std::array
+
 class vtkBlockLODContour;
 class vtkCompositeDataSet;
+class vtkRenderWindow;
 class vtkRenderer;
 class vtkPolyData;
 
@@ -163,13 +166,23 @@ protected:
   // The LOD geometry of REQUEST_UPDATE_LOD: the chosen level, or false (the
   // decimated copy is used).
   bool MakeLevelLOD();
+  // This process's triangles of each of the four levels for the shown data
+  // (-1 where unknown, all -1 without the filter).
+  std::array<double, 4> LevelTriangles(vtkBlockLODContour* contour);
   // The LOD geometry in the shape of the view's piece.
   vtkDataObject* WrapLikePiece(vtkDataObject* piece);
 
-  // Frames drawn here, for the frame-time model: a renderer's StartEvent and
-  // EndEvent around the render that REQUEST_RENDER prepared.
+  // Frames drawn here, for the frame-time model: the render window's
+  // StartEvent and EndEvent around the render that REQUEST_RENDER prepared
+  // (the frame a user waits for), and the view's renderer's within it (the
+  // triangles' cost, what the model is fitted to; the rest is a fixed cost
+  // per frame, added to its predictions).
   void OnRenderStart();
   void OnRenderEnd();
+  void OnRendererStart();
+  void OnRendererEnd();
+  // The window's fixed cost per frame on this renderer (0 before a frame).
+  double FrameOverhead();
   bool AddToView(vtkView* view) override;
   bool RemoveFromView(vtkView* view) override;
 
@@ -179,7 +192,10 @@ protected:
   double PredictedInteractiveSeconds = 0.0;
   unsigned long StartObserver = 0;
   unsigned long EndObserver = 0;
+  unsigned long RendererStartObserver = 0;
+  unsigned long RendererEndObserver = 0;
   vtkWeakPointer<vtkRenderer> ObservedRenderer;
+  vtkWeakPointer<vtkRenderWindow> ObservedWindow;
   // The data drawn by the last frame, so that its first frame (uploads) is
   // not learnt from.
   vtkMTimeType DrawnDataTime = 0;

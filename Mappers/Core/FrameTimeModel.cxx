@@ -16,6 +16,21 @@ constexpr double MinimumSeconds = 1e-6;
 // weight: small enough that frames spanning all three counts decide, large
 // enough to fix the directions they leave open.
 constexpr double PriorWeight = 1e-6;
+// The robust fit's scale, a frame's relative error (measured / fitted - 1):
+// a frame that far off the fit keeps half its weight, one three times as far
+// a tenth. Frame-to-frame noise stays well inside it; a stall (another process
+// holding the core, a swap that waited) falls outside it and stops pulling
+// the fit once the other frames agree among themselves.
+constexpr double RobustScale = 0.3;
+// Reweighting rounds of the robust fit (each one a solve of a 3x3 system):
+// first towards the least absolute deviations, whose minimum is unique (a
+// weighted median: the frames holding most of the weight decide, whatever
+// the others say), then Cauchy's weights from there.
+constexpr int MedianRounds = 8;
+constexpr int CauchyRounds = 4;
+// Below this relative error a frame's residual counts as this in the median
+// rounds (a frame fitted exactly would otherwise take all the weight).
+constexpr double MedianFloor = 0.02;
 
 using Vector3 = std::array<double, 3>;
 using Matrix3 = std::array<Vector3, 3>;
@@ -113,25 +128,40 @@ FrameTimeModel::Coefficients FrameTimeModel::Prior(FrameMethod method, bool tran
   // Software rasterisers, pessimistically: a host's first frames without
   // observations should come out coarse rather than late. Translucent frames
   // blend every layer (and the cell rasteriser sorts), hence the factors.
+  //
+  // The shape matters more than the size: the first frames a host draws are
+  // often all of one work (still frames of the full surface), and what it
+  // then predicts for a coarser level is that frame scaled by the prior's
+  // ratio of the two works. For triangles the shape is llvmpipe's as measured
+  // in ParaView (docs/blocklod.md, issue 30): a frame of a thousandth of the
+  // triangles costs about a tenth of the full frame when opaque (the fixed
+  // work and the pixels are a small share) and about an eighth when
+  // translucent (depth peeling repeats full-viewport passes per layer, so
+  // the fixed and per-pixel work grow more than the per-triangle work).
   Coefficients prior;
   if (method == FrameMethod::CellRasterisation)
   {
     prior.Seconds = 0.005;
     prior.PerPrimitive = 6e-7;
     prior.PerPixel = 4e-7;
+    if (translucent)
+    {
+      prior.Seconds *= 3.0;
+      prior.PerPrimitive *= 3.0;
+      prior.PerPixel *= 3.0;
+    }
   }
   else
   {
-    prior.Seconds = 0.005;
+    prior.Seconds = 0.01;
     prior.PerPrimitive = 3e-7;
-    prior.PerPixel = 1e-7;
-  }
-  if (translucent)
-  {
-    const double factor = method == FrameMethod::CellRasterisation ? 3.0 : 4.0;
-    prior.Seconds *= factor;
-    prior.PerPrimitive *= factor;
-    prior.PerPixel *= factor;
+    prior.PerPixel = 2.5e-8;
+    if (translucent)
+    {
+      prior.Seconds *= 4.0;
+      prior.PerPrimitive *= 4.0;
+      prior.PerPixel *= 8.0;
+    }
   }
   return prior;
 }
@@ -156,11 +186,63 @@ void FrameTimeModel::Observe(const FrameWork& work, double seconds)
   {
     pair.Samples.pop_front();
   }
-  pair.Fitted = Solve(pair.Samples, Prior(work.Method, work.Translucent));
+  this->Refit(work.Method, work.Translucent);
 }
 
-FrameTimeModel::Coefficients FrameTimeModel::Solve(
-  const std::deque<Sample>& samples, const Coefficients& prior)
+void FrameTimeModel::Refit(FrameMethod method, bool translucent)
+{
+  Pair& pair = this->Pairs[Key(method, translucent)];
+  double scale = 1.0;
+  // Anchored to the prior's shape; the scale found is the frames' ratio to
+  // the prior, what a pair without frames borrows (Anchor()).
+  const Coefficients prior = Prior(method, translucent);
+  pair.Fitted = Solve(pair.Samples, prior, prior, scale);
+  pair.PriorScale = scale;
+}
+
+FrameTimeModel::Coefficients FrameTimeModel::Anchor(FrameMethod method, bool translucent) const
+{
+  // The prior, scaled as the frames of another pair scale theirs: how much
+  // faster or slower than the priors this machine is. Only the scale
+  // transfers, not a fitted split: a translucent frame's split differs in
+  // kind from an opaque one's (depth peeling's full-viewport passes), and a
+  // method's from the other's. The same method drawn the other way says it
+  // first; else the other method's pair with more frames.
+  const Coefficients prior = Prior(method, translucent);
+  const Pair* source = nullptr;
+  const Pair& sibling = this->Pairs[Key(method, !translucent)];
+  if (!sibling.Samples.empty())
+  {
+    source = &sibling;
+  }
+  else
+  {
+    const FrameMethod otherMethod = method == FrameMethod::CellRasterisation
+      ? FrameMethod::Triangles
+      : FrameMethod::CellRasterisation;
+    for (bool t : { false, true })
+    {
+      const Pair& candidate = this->Pairs[Key(otherMethod, t)];
+      if (!candidate.Samples.empty() &&
+        (!source || candidate.Samples.size() > source->Samples.size()))
+      {
+        source = &candidate;
+      }
+    }
+  }
+  if (source && source->PriorScale > 0.0)
+  {
+    Coefficients anchor = prior;
+    anchor.Seconds *= source->PriorScale;
+    anchor.PerPrimitive *= source->PriorScale;
+    anchor.PerPixel *= source->PriorScale;
+    return anchor;
+  }
+  return prior;
+}
+
+FrameTimeModel::Coefficients FrameTimeModel::Solve(const std::deque<Sample>& samples,
+  const Coefficients& prior, const Coefficients& anchor, double& priorScale)
 {
   // Rows in relative terms: frame i asks (a, b, c) . (1, P, X) / p_i = t_i /
   // p_i, p_i the prior's seconds for its work, weighted by recency. Dividing by
@@ -169,10 +251,10 @@ FrameTimeModel::Coefficients FrameTimeModel::Solve(
   // measured divisor penalises an overestimate of a frame more than the same
   // factor of underestimate, so a slower machine would be followed late).
   const std::size_t n = samples.size();
-  std::vector<double> weight(n);
+  std::vector<double> recency(n);
   std::vector<Vector3> row(n);
   std::vector<double> target(n);
-  double totalWeight = 0.0;
+  std::vector<double> anchored(n);
   double w = 1.0;
   for (std::size_t k = n; k-- > 0;)
   {
@@ -180,11 +262,66 @@ FrameTimeModel::Coefficients FrameTimeModel::Solve(
     const double p =
       std::max(prior.Seconds + prior.PerPrimitive * s.Primitives + prior.PerPixel * s.Pixels,
         MinimumSeconds);
-    weight[k] = w;
+    recency[k] = w;
     row[k] = { 1.0 / p, s.Primitives / p, s.Pixels / p };
     target[k] = s.Seconds / p;
-    totalWeight += w;
+    anchored[k] =
+      (anchor.Seconds + anchor.PerPrimitive * s.Primitives + anchor.PerPixel * s.Pixels) / p;
     w *= RecencyDecay;
+  }
+
+  // Robust reweighting (iteratively reweighted least squares on the log of
+  // each frame's measured / fitted ratio): a frame the others contradict, a
+  // stall or a first use that a host could not tell apart, loses its pull,
+  // even when it is the newest; a frame that only adds a work not seen before
+  // is fitted by the split between the coefficients and keeps its weight.
+  // The plain fit starts, the median rounds find the frames that agree (a
+  // plain fit can sit nearer the outliers when they are recent), Cauchy's
+  // rounds weigh those by how well they agree. With fewer than three frames
+  // no frame can be outvoted: the plain fit.
+  std::vector<double> weight = recency;
+  Coefficients fitted = anchor;
+  priorScale = 1.0;
+  const int rounds = n >= 3 ? 1 + MedianRounds + CauchyRounds : 1;
+  for (int round = 0; round < rounds; ++round)
+  {
+    fitted = SolveWeighted(row, target, anchored, weight, anchor, priorScale);
+    if (round + 1 == rounds)
+    {
+      break;
+    }
+    for (std::size_t k = 0; k < n; ++k)
+    {
+      const Sample& s = samples[k];
+      const double predicted = std::max(
+        fitted.Seconds + fitted.PerPrimitive * s.Primitives + fitted.PerPixel * s.Pixels,
+        MinimumSeconds);
+      // The residual in the rows' units (seconds / p_k) over the frame's
+      // fitted time in those units: the frame's relative error.
+      const double r = (s.Seconds - predicted) / predicted;
+      if (round < MedianRounds)
+      {
+        weight[k] = recency[k] / (row[k][0] * predicted * std::max(std::fabs(r), MedianFloor));
+      }
+      else
+      {
+        const double u = r / RobustScale;
+        weight[k] = recency[k] / (1.0 + u * u);
+      }
+    }
+  }
+  return fitted;
+}
+
+FrameTimeModel::Coefficients FrameTimeModel::SolveWeighted(const std::vector<Vector3>& row,
+  const std::vector<double>& target, const std::vector<double>& anchored,
+  const std::vector<double>& weight, const Coefficients& anchor, double& priorScale)
+{
+  const std::size_t n = row.size();
+  double totalWeight = 0.0;
+  for (std::size_t k = 0; k < n; ++k)
+  {
+    totalWeight += weight[k];
   }
   Vector3 scale = { 0.0, 0.0, 0.0 };
   for (std::size_t k = 0; k < n; ++k)
@@ -203,16 +340,19 @@ FrameTimeModel::Coefficients FrameTimeModel::Solve(
     }
   }
 
-  // The prior's least-squares scale to these frames: each row of the prior
-  // is 1, so it is the frames' weighted mean ratio to the prior.
-  double ratio = 0.0;
+  // The anchor's least-squares scale to these frames (with the plain prior as
+  // anchor each anchored row is 1, and it is the frames' weighted mean ratio
+  // to the prior).
+  double num = 0.0, den = 0.0;
   for (std::size_t k = 0; k < n; ++k)
   {
-    ratio += weight[k] * target[k];
+    num += weight[k] * anchored[k] * target[k];
+    den += weight[k] * anchored[k] * anchored[k];
   }
-  const double priorScale = Finite(ratio / totalWeight, 1.0);
-  const Vector3 priorPhi = { priorScale * prior.Seconds * scale[0],
-    priorScale * prior.PerPrimitive * scale[1], priorScale * prior.PerPixel * scale[2] };
+  const double anchorScale = den > 0.0 ? Finite(num / den, 1.0) : 1.0;
+  priorScale = anchorScale;
+  const Vector3 priorPhi = { anchorScale * anchor.Seconds * scale[0],
+    anchorScale * anchor.PerPrimitive * scale[1], anchorScale * anchor.PerPixel * scale[2] };
 
   // Normal equations of the scaled problem with the ridge towards the prior.
   const double ridge = PriorWeight * totalWeight;
@@ -281,9 +421,9 @@ FrameTimeModel::Coefficients FrameTimeModel::Solve(
   }
 
   Coefficients fitted;
-  fitted.Seconds = Finite(best[0] / scale[0], prior.Seconds);
-  fitted.PerPrimitive = Finite(best[1] / scale[1], prior.PerPrimitive);
-  fitted.PerPixel = Finite(best[2] / scale[2], prior.PerPixel);
+  fitted.Seconds = Finite(best[0] / scale[0], anchor.Seconds);
+  fitted.PerPrimitive = Finite(best[1] / scale[1], anchor.PerPrimitive);
+  fitted.PerPixel = Finite(best[2] / scale[2], anchor.PerPixel);
   return fitted;
 }
 
@@ -309,7 +449,7 @@ std::size_t FrameTimeModel::ObservationCount(FrameMethod method, bool translucen
 FrameTimeModel::Coefficients FrameTimeModel::Fit(FrameMethod method, bool translucent) const
 {
   const Pair& pair = this->Pairs[Key(method, translucent)];
-  return pair.Samples.empty() ? Prior(method, translucent) : pair.Fitted;
+  return pair.Samples.empty() ? this->Anchor(method, translucent) : pair.Fitted;
 }
 
 void FrameTimeModel::Reset()
@@ -318,6 +458,7 @@ void FrameTimeModel::Reset()
   {
     pair.Samples.clear();
     pair.Fitted = Coefficients();
+    pair.PriorScale = 1.0;
   }
 }
 

@@ -32,18 +32,32 @@
  * machine is followed within a few frames), with a, b, c >= 0 (solved exactly
  * over the 8 supports of the three coefficients). A frame sequence rarely
  * varies all three counts (a rotation keeps both), so the fit is anchored to
- * the prior, scaled to the frames: a small ridge term pulls (a, b, c) towards s
- * * (a0, b0, c0), s the least-squares scale of the prior to the frames.
+ * the prior, scaled to the frames: a small ridge term pulls (a, b, c) towards
+ * s * (a0, b0, c0), s the least-squares scale of the prior to the frames.
  * Directions the frames do not determine keep the prior's shape; directions
  * they determine follow the frames. With one frame (or many with the same work)
  * the prediction is exactly that frame's time scaled by the prior's ratio of
  * the two works; with frames at several levels or distances the split between
  * a, b and c is learnt.
  *
- * The prior (Prior()) is conservative for a software renderer (llvmpipe,
- * SwiftShader): before any frame of a pair is observed, predictions are large,
- * so a host's first interactive frame errs on the coarse side. A GPU's first
- * observed frame scales them down at once.
+ * The fit is robust: from three frames on it is reweighted, first towards
+ * the least absolute deviations (a weighted median: the frames that hold most
+ * of the recency weight and agree decide), then with Cauchy's weights on each
+ * frame's relative error. A load stall, or a frame with one-off work a host
+ * could not tell apart, stops pulling the fit even when it is the newest
+ * frame; a lasting change of load, once its frames hold most of the weight
+ * (a handful of frames), is followed. A frame at a work not seen before is
+ * not an outlier: the split between the coefficients fits it.
+ *
+ * The anchor is the prior (Prior()), whose shape is a software renderer's
+ * (llvmpipe, SwiftShader) as measured and whose size is conservative. A pair
+ * without frames predicts its prior scaled as the frames of the same method
+ * drawn the other way (opaque for translucent and back) scale theirs, else as
+ * the other method's do: how fast this machine is transfers, a fitted split
+ * does not (a translucent frame's split differs in kind from an opaque one's:
+ * depth peeling's full-viewport passes). Before any frame at all the prior
+ * predicts, so a host's first interactive frame errs on the coarse side; a
+ * GPU's first observed frame scales it down at once.
  *
  * Limits: a frame's time also depends on what the counts do not say (overdraw,
  * the depth complexity of translucent layers, caches, other load on the
@@ -115,13 +129,14 @@ public:
   /// A measured frame (seconds of rendering it), folded into the fit for its
   /// method and translucency.
   void Observe(const FrameWork& work, double seconds);
-  /// Predicted seconds for a frame (a conservative prior before any observation
-  /// of that method).
+  /// Predicted seconds for a frame (before any frame of its method and
+  /// translucency: its prior, scaled as another pair's frames scale theirs).
   double Predict(const FrameWork& work) const;
   bool HasObservations(FrameMethod method, bool translucent) const;
   /// Frames currently kept for a pair (at most HistoryLength).
   std::size_t ObservationCount(FrameMethod method, bool translucent) const;
-  /// The fitted coefficients of a pair (the prior before any frame).
+  /// The fitted coefficients of a pair (before any frame: its prior, scaled
+  /// as another pair's frames scale theirs).
   Coefficients Fit(FrameMethod method, bool translucent) const;
   /// Forgets every frame (another renderer, another window).
   void Reset();
@@ -147,9 +162,19 @@ private:
   {
     std::deque<Sample> Samples; // oldest first
     Coefficients Fitted;
+    double PriorScale = 1.0; // the frames' least-squares ratio to the prior
   };
   static std::size_t Key(FrameMethod method, bool translucent);
-  static Coefficients Solve(const std::deque<Sample>& samples, const Coefficients& prior);
+  // A pair's prediction before any of its frames: its prior, scaled as the
+  // same method drawn the other way scales its frames, else as the other
+  // method's do, else the prior.
+  Coefficients Anchor(FrameMethod method, bool translucent) const;
+  void Refit(FrameMethod method, bool translucent);
+  static Coefficients Solve(const std::deque<Sample>& samples, const Coefficients& prior,
+    const Coefficients& anchor, double& priorScale);
+  static Coefficients SolveWeighted(const std::vector<std::array<double, 3>>& row,
+    const std::vector<double>& target, const std::vector<double>& anchored,
+    const std::vector<double>& weight, const Coefficients& anchor, double& priorScale);
 
   std::array<Pair, 4> Pairs;
 };

@@ -226,6 +226,111 @@ int main()
     Check(model.Choose({}, 0.1) == 0, "no candidates: 0, never past the end");
   }
 
+  // The failure patterns measured in ParaView (issue 30, docs/blocklod.md):
+  // frames whose underlying cost is linear, a (fixed + pixels) share of an
+  // opaque llvmpipe frame of 1.1 M triangles of about a tenth.
+  const double fixedOpaque = 0.05, perTriangle = 5.5e-7;
+  const std::uint64_t stillTriangles = 1108154, levelZero = 10790;
+  const auto opaqueCost = [&](const mediso::FrameWork& work)
+  { return fixedOpaque + perTriangle * static_cast<double>(work.Primitives); };
+
+  // A host sees still frames of the full surface only, then predicts level 0
+  // (a hundredth of the triangles) before drawing it: from the prior's shape.
+  {
+    FrameTimeModel model;
+    const auto still = Work(FrameMethod::Triangles, stillTriangles, viewport);
+    for (int i = 0; i < 9; ++i)
+    {
+      model.Observe(still, opaqueCost(still));
+    }
+    const auto coarse = Work(FrameMethod::Triangles, levelZero, viewport);
+    Check(Near(model.Predict(coarse), opaqueCost(coarse), 0.25),
+      "still frames only: level 0 within 25% (" + Number(model.Predict(coarse)) + " vs " +
+        Number(opaqueCost(coarse)) + ")");
+  }
+
+  // A first use (an upload or extraction a host could not tell apart) and
+  // two load stalls among frames at two levels: the next frames are
+  // predicted within 25% of the underlying cost, and within 10% once the
+  // frames after the last stall agree.
+  {
+    FrameTimeModel model;
+    const auto still = Work(FrameMethod::Triangles, stillTriangles, viewport);
+    const auto coarse = Work(FrameMethod::Triangles, levelZero, viewport);
+    const auto middle = Work(FrameMethod::Triangles, 170000, viewport);
+    for (int i = 0; i < 6; ++i)
+    {
+      model.Observe(still, opaqueCost(still));
+    }
+    model.Observe(coarse, 6.0 * opaqueCost(coarse)); // the level's first frame
+    for (int i = 0; i < 5; ++i)
+    {
+      model.Observe(coarse, opaqueCost(coarse));
+    }
+    model.Observe(coarse, 3.0 * opaqueCost(coarse)); // a stall
+    model.Observe(coarse, opaqueCost(coarse));
+    model.Observe(coarse, 2.5 * opaqueCost(coarse)); // another, the newest frame
+    for (const auto& work : { coarse, middle, still })
+    {
+      Check(Near(model.Predict(work), opaqueCost(work), 0.25),
+        "after a first use and stalls: " + std::to_string(work.Primitives) +
+          " triangles within 25% (" + Number(model.Predict(work)) + " vs " +
+          Number(opaqueCost(work)) + ")");
+    }
+    model.Observe(coarse, opaqueCost(coarse));
+    model.Observe(coarse, opaqueCost(coarse));
+    Check(Near(model.Predict(coarse), opaqueCost(coarse), 0.1),
+      "two agreeing frames after the stalls: within 10% (" + Number(model.Predict(coarse)) + ")");
+    // A lasting change of load is not a stall: followed within 6 frames.
+    for (int i = 0; i < 6; ++i)
+    {
+      model.Observe(coarse, 2.0 * opaqueCost(coarse));
+    }
+    Check(Near(model.Predict(coarse), 2.0 * opaqueCost(coarse), 0.15),
+      "a lasting slowdown, 6 frames on: followed within 15% (" + Number(model.Predict(coarse)) +
+        " vs " + Number(2.0 * opaqueCost(coarse)) + ")");
+  }
+
+  // A pair not yet drawn predicted from the frames of the others.
+  {
+    // Opaque frames at 2.5 times the opaque prior: a translucent frame not
+    // yet drawn is predicted at 2.5 times the translucent prior (the
+    // machine's speed transfers, the opaque split does not), and its own
+    // frames take over from the first one.
+    FrameTimeModel model;
+    const FrameTimeModel::Coefficients po = FrameTimeModel::Prior(FrameMethod::Triangles, false);
+    const FrameTimeModel::Coefficients pt = FrameTimeModel::Prior(FrameMethod::Triangles, true);
+    const auto still = Work(FrameMethod::Triangles, stillTriangles, viewport);
+    const auto coarse = Work(FrameMethod::Triangles, levelZero, viewport);
+    for (int i = 0; i < 4; ++i)
+    {
+      model.Observe(still, 2.5 * po.Evaluate(still));
+      model.Observe(coarse, 2.5 * po.Evaluate(coarse));
+    }
+    const auto coarseT = Work(FrameMethod::Triangles, levelZero, viewport, true);
+    Check(Near(model.Predict(coarseT), 2.5 * pt.Evaluate(coarseT), 1e-6),
+      "no translucent frame yet: the translucent prior at the opaque frames' scale (" +
+        Number(model.Predict(coarseT)) + " vs " + Number(2.5 * pt.Evaluate(coarseT)) + ")");
+    model.Observe(coarseT, 0.2);
+    Check(Near(model.Predict(coarseT), 0.2, 1e-9),
+      "one translucent frame: predicted as measured (" + Number(model.Predict(coarseT)) + ")");
+
+    // Triangles never drawn, the cell rasteriser's frames three times its
+    // prior: triangles predicted at three times theirs.
+    FrameTimeModel gpu;
+    const auto cells = Work(FrameMethod::CellRasterisation, 900000, viewport);
+    for (int i = 0; i < 3; ++i)
+    {
+      gpu.Observe(cells,
+        3.0 * FrameTimeModel::Prior(FrameMethod::CellRasterisation, false).Evaluate(cells));
+    }
+    Check(Near(gpu.Predict(coarse),
+            3.0 * FrameTimeModel::Prior(FrameMethod::Triangles, false).Evaluate(coarse), 1e-6),
+      "triangles not drawn: the prior, scaled as the cell rasteriser's frames scale theirs (" +
+        Number(gpu.Predict(coarse)) + ")");
+    Check(!gpu.HasObservations(FrameMethod::Triangles, false), "and still no triangle frame");
+  }
+
   // Bad input: not observed, never NaN.
   {
     FrameTimeModel model;

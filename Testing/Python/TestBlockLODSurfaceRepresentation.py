@@ -203,6 +203,36 @@ check(info["lod"] == 1 and info["level"] == -1 and 0 < info["triangles"] and inf
       "interactive levels off: ParaView's decimated copy (%s)" % info)
 display.BlockLODInteractiveLevels = 1
 
+# Two displays in one view, skin (translucent) and bone each from a filter of its own as a user
+# shows them: at the default frame budget they choose one level together and predict the same
+# frame, a translucent one (issue 30: the first display to choose used to add the other's still
+# triangles, and the opaque one predicted an opaque frame). Predictions are made on the data
+# server: builtin only.
+if not remote:
+    Hide(contour, view)
+    pair = []
+    for iso in (-500.0, 400.0):
+        surface = BlockLODContour(Input=phantom)
+        surface.Isosurfaces = [iso]
+        surface.LOD = 3
+        pair.append((surface, Show(surface, view)))
+    pair[0][1].Opacity = 0.3
+    Render(view)
+    Render(view)  # a display counts its levels at its first frame of new data; this one is learnt
+    interact()
+    chosen, predicted = [], []
+    for _, shown in pair:
+        shown.SMProxy.GetProperty("BlockLODInteractiveLevel").GetParent().UpdatePropertyInformation()
+        chosen.append(int(shown.GetProperty("BlockLODInteractiveLevel")[0]))
+        predicted.append(float(shown.GetProperty("BlockLODPredictedInteractiveSeconds")[0]))
+    check(chosen[0] == chosen[1] and 0 <= chosen[0] <= 3,
+          "two displays choose one level together (skin, bone: %s)" % chosen)
+    check(predicted[0] > 0 and abs(predicted[0] - predicted[1]) <= 1e-12 * predicted[0],
+          "two displays predict the same frame (skin, bone: %s s)" % predicted)
+    for surface, shown in pair:
+        Delete(shown)
+        Delete(surface)
+
 check.finish("TestBlockLODSurfaceRepresentation%s: interactive levels %s, still image unchanged"
              % (" (client/server)" if remote else "", exact))
 if remote:
