@@ -294,7 +294,7 @@ const phantomServer = await startServer(["phantom:48"]);
 // of its last frame were drawn over the GPU path's frames (the skin showed over the bone).
 {
   const SKIN = { value: -500, color: [0.93, 0.75, 0.62], opacity: 0.35 };
-  const BONE = { value: 400, color: [1, 1, 0.9], opacity: 1 };
+  const BONE = { value: 400, color: [0.3, 0.5, 1], opacity: 1 }; // unlike the skin: seen through it
   const context = await browser.newContext({ viewport: { width: 900, height: 600 } });
   // The view's pixels once the newest frame is drawn and shown (a PNG data URL).
   const picture = (page) => page.evaluate(async () => {
