@@ -382,6 +382,8 @@ for (const [width, height, ratio] of [[1920, 1080, 1], [800, 600, 2]]) {
   checks.check(fits(hidden) && Math.abs(hidden.css[0] + hidden.beside - Math.round(width * 0.75)) <= 1 &&
     hidden.css[0] * hidden.css[1] > 1.1 * r.css[0] * r.css[1],
     "panel hidden: the view is the window's width and larger (" + hidden.css.join("x") + ")");
+  // The frame asked for by the last resize drawn (the size follows with it, see above).
+  await page.evaluate(() => window.mediso.drawn());
   const drawn = await drawnCentroid(page);
   checks.check(drawn.n > 1000, "the view is drawn after resizing (" + drawn.n + " pixels)");
   await context.close();

@@ -34,6 +34,18 @@ let path = "gpu";
 let shownKey = ""; // the isovalues of the last frame drawn
 let skipped = 0;
 let volumeBytes = 0; // the pointer of the volume in this module's memory
+// The canvas's new size, applied with the next frame drawn: resizing clears the canvas, and a
+// worker's OffscreenCanvas is shown at the end of each of its tasks, so a resize in one task and
+// its frame in a later one showed a blank canvas of the new size in between (a test that read
+// the view once its size had followed found nothing drawn).
+let pendingSize = null;
+
+function applySize() {
+  if (pendingSize) {
+    viewer.resize(...pendingSize);
+    pendingSize = null;
+  }
+}
 
 // The frame budget of interactive frames and of a change's first frame (the page's
 // ?frameBudget=MS, else 100 ms), and how long a coarse frame waits before its refinement starts,
@@ -73,6 +85,7 @@ function schedule() {
 // model (mediso::FrameTimeModel, fitted from this viewer's frames) and the estimator's seconds of
 // an extraction: {level, sampleDistance, predictedMs, fullMs, memoryLevel}.
 function choose(frame) {
+  applySize();
   viewer.setSurfaces(frame.surfaces);
   viewer.setCPULevel(requestedLevel);
   return viewer.chooseFrame(budgetSeconds);
@@ -85,6 +98,7 @@ function keyOf(surfaces) {
 // Draws `frame` at CPU level `level` (-1: the estimator's within the memory budget) and sample
 // distance `distance`; the viewer's stats with the frame's time and what it was.
 function draw(frame, level, distance) {
+  applySize();
   viewer.setSurfaces(frame.surfaces);
   viewer.setView(frame.view);
   if (path === "cpu") {
@@ -184,6 +198,9 @@ self.onmessage = async (event) => {
         path = m.args[0];
       } else if (m.method === "setCPULevel") {
         requestedLevel = m.args[0];
+      } else if (m.method === "resize" && volumeBytes) {
+        pendingSize = m.args; // the page asks for the frame next (fitCanvas)
+        return;
       }
       const value = viewer[m.method](...m.args);
       if (m.id !== undefined) {
