@@ -248,9 +248,7 @@ const SURFACES = [{ value: 500, color: [0.93, 0.75, 0.62], opacity: 0.35 }, { va
     pictures[name] = {};
     await page.addStyleTag({ content: HIDE });
     for (const pathName of ["cpu", "gpu"]) {
-      // The cube alone (where the patient's left is in the picture), set before the path: on
-      // SwiftShader the GPU path's first opaque frame after a translucent one kept the
-      // translucent layer of the one before (seen in this test; not this test's subject).
+      // The cube alone (where the patient's left is in the picture), set before the path.
       await page.evaluate(() => window.mediso.setSurfaces([{ value: 1500, color: [1, 1, 1], opacity: 1 }]));
       await page.evaluate((p) => window.mediso.setPath(p), pathName);
       await settle(page);

@@ -25,6 +25,8 @@
 //   values applied and the bad ones left out.
 // - a bad isovalue (outside the range, or empty) is refused with a message beside its box and
 //   the surface keeps its value; a good one clears the message and is drawn.
+// - the GPU path after the CPU path: the skin (translucent) over the bone on the CPU path, then
+//   the GPU path and the bone alone, equals the bone on a page that never left the GPU path.
 import { mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
@@ -285,6 +287,63 @@ const phantomServer = await startServer(["phantom:48"]);
   await context.close();
 }
 
+// --- the GPU path after the CPU path's translucent frame -------------------------------------------
+// The phantom's translucent skin over its bone on the CPU path, then the GPU path, then the bone
+// alone: the picture must equal the bone alone on a page that never left the GPU path (at most
+// 0.5% of the pixels off by more than 40, TestWebServerPageShots' bound). The CPU path's meshes
+// of its last frame were drawn over the GPU path's frames (the skin showed over the bone).
+{
+  const SKIN = { value: -500, color: [0.93, 0.75, 0.62], opacity: 0.35 };
+  const BONE = { value: 400, color: [0.3, 0.5, 1], opacity: 1 }; // unlike the skin: seen through it
+  const context = await browser.newContext({ viewport: { width: 900, height: 600 } });
+  // The view's pixels once the newest frame is drawn and shown (a PNG data URL).
+  const picture = (page) => page.evaluate(async () => {
+    await window.mediso.drawn();
+    await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+    const view = document.getElementById("view");
+    const copy = Object.assign(document.createElement("canvas"), { width: view.width, height: view.height });
+    copy.getContext("2d").drawImage(view, 0, 0);
+    return copy.toDataURL("image/png");
+  });
+  const page = await openPhantom(context);
+  await page.evaluate(() => window.mediso.setPath("cpu"));
+  await page.evaluate((s) => window.mediso.setSurfaces(s), [SKIN, BONE]);
+  const cpu = await page.evaluate(() => window.mediso.stats());
+  await page.evaluate(() => window.mediso.setPath("gpu"));
+  await page.evaluate((s) => window.mediso.setSurfaces(s), [BONE]);
+  const after = await picture(page);
+  const gpu = await page.evaluate(() => window.mediso.stats());
+  const fresh = await openPhantom(context, "#path=gpu&iso=400");
+  await fresh.evaluate((s) => window.mediso.setSurfaces(s), [BONE]);
+  const r = await fresh.evaluate(async ([url, expected]) => {
+    const load = async (source) => {
+      const image = await createImageBitmap(await (await fetch(source)).blob());
+      const c = Object.assign(document.createElement("canvas"), { width: image.width, height: image.height });
+      const g = c.getContext("2d");
+      g.drawImage(image, 0, 0);
+      return g.getImageData(0, 0, image.width, image.height);
+    };
+    const a = await load(url);
+    const b = await load(expected);
+    if (a.width !== b.width || a.height !== b.height) {
+      return { sameSize: false, differing: -1, ratio: 1, drawn: 0 };
+    }
+    let differing = 0, drawn = 0;
+    for (let p = 0; p < a.data.length; p += 4) {
+      const off = (x, y) => Math.max(Math.abs(x[p] - y[0]), Math.abs(x[p + 1] - y[1]), Math.abs(x[p + 2] - y[2]));
+      differing += off(a.data, [b.data[p], b.data[p + 1], b.data[p + 2]]) > 40;
+      drawn += off(b.data, [b.data[0], b.data[1], b.data[2]]) > 30;
+    }
+    return { sameSize: true, differing, ratio: differing / (a.width * a.height), drawn };
+  }, [after, await picture(fresh)]);
+  checks.check(cpu.path === "cpu" && cpu.triangles > 0 && gpu.path === "gpu" && gpu.primitives > 0 && r.drawn > 1000,
+    "the skin and bone drawn on the CPU path (" + cpu.triangles + " triangles), then the bone on the GPU path (" +
+    gpu.primitives + " primitives; " + r.drawn + " pixels of bone on a fresh GPU page)");
+  checks.check(r.sameSize && r.ratio <= 0.005, "the GPU path's opaque frame after the CPU path's translucent one equals " +
+    "a fresh GPU page's: " + r.differing + " pixels off by more than 40 (" + (100 * r.ratio).toFixed(3) + "%, at most 0.5%)");
+  await context.close();
+}
+
 // --- the window ------------------------------------------------------------------------------------
 for (const [width, height, ratio] of [[1920, 1080, 1], [800, 600, 2]]) {
   const context = await browser.newContext({ viewport: { width, height }, deviceScaleFactor: ratio });
@@ -323,6 +382,8 @@ for (const [width, height, ratio] of [[1920, 1080, 1], [800, 600, 2]]) {
   checks.check(fits(hidden) && Math.abs(hidden.css[0] + hidden.beside - Math.round(width * 0.75)) <= 1 &&
     hidden.css[0] * hidden.css[1] > 1.1 * r.css[0] * r.css[1],
     "panel hidden: the view is the window's width and larger (" + hidden.css.join("x") + ")");
+  // The frame asked for by the last resize drawn (the size follows with it, see above).
+  await page.evaluate(() => window.mediso.drawn());
   const drawn = await drawnCentroid(page);
   checks.check(drawn.n > 1000, "the view is drawn after resizing (" + drawn.n + " pixels)");
   await context.close();

@@ -50,6 +50,19 @@ let generationWord = null;
 let aborted = 0;
 let abortNote = ""; // what stats() says about it
 
+// The canvas's new size, applied with the next frame drawn: resizing clears the canvas, and a
+// worker's OffscreenCanvas is shown at the end of each of its tasks, so a resize in one task and
+// its frame in a later one showed a blank canvas of the new size in between (a test that read
+// the view once its size had followed found nothing drawn).
+let pendingSize = null;
+
+function applySize() {
+  if (pendingSize) {
+    viewer.resize(...pendingSize);
+    pendingSize = null;
+  }
+}
+
 // The frame budget of interactive frames and of a change's first frame (the page's
 // ?frameBudget=MS, else 100 ms), and how long a coarse frame waits before its refinement starts,
 // so that the next change of a burst (typing, a slider) finds it not yet begun.
@@ -115,6 +128,7 @@ function schedule() {
 // model (mediso::FrameTimeModel, fitted from this viewer's frames) and the estimator's seconds of
 // an extraction: {level, sampleDistance, predictedMs, fullMs, memoryLevel}.
 function choose(frame) {
+  applySize();
   viewer.setSurfaces(frame.surfaces);
   viewer.setCPULevel(requestedLevel);
   return viewer.chooseFrame(budgetSeconds);
@@ -128,6 +142,7 @@ function keyOf(surfaces) {
 // distance `distance` and GPU volume level `gpuLevel` (the full volume when not given); the
 // viewer's stats with the frame's time and what it was.
 function draw(frame, level, distance, gpuLevel = M.NumberOfLevels - 1) {
+  applySize();
   viewer.setSurfaces(frame.surfaces);
   viewer.setView(frame.view);
   if (path === "cpu") {
@@ -291,6 +306,9 @@ self.onmessage = async (event) => {
         path = m.args[0];
       } else if (m.method === "setCPULevel") {
         requestedLevel = m.args[0];
+      } else if (m.method === "resize" && volumeBytes) {
+        pendingSize = m.args; // the page asks for the frame next (fitCanvas)
+        return;
       }
       const value = viewer[m.method](...m.args);
       if (m.id !== undefined) {

@@ -253,7 +253,24 @@ public:
   }
 
   /// "gpu" or "cpu": which path draws.
-  void SetPath(const std::string& path) { this->CPUPath = path == "cpu"; }
+  void SetPath(const std::string& path)
+  {
+    this->CPUPath = path == "cpu";
+    // The CPU path's meshes are drawn after the GPU path's surfaces (the server's result is
+    // drawn on both paths), so those of its last frame must go with it: kept, they were drawn
+    // over the GPU path's frames (a translucent skin over the next opaque surfaces). The
+    // surfaces unit keeps its cache; going back to the CPU path uploads them again.
+    if (!this->CPUPath && this->Meshes)
+    {
+      emscripten_webgl_make_context_current(this->Context);
+      for (int slot = 0; slot < MaximumIsovalues; ++slot)
+      {
+        this->Meshes->Clear(slot);
+      }
+      this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
+      this->ShownTriangles = 0.0;
+    }
+  }
 
   /// The CPU path's level of detail: 0-3, or -1 to let the estimator choose
   /// within the budget.
