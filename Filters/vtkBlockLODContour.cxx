@@ -27,6 +27,7 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkSMPThreadLocal.h"
 #include "vtkSMPTools.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
@@ -555,6 +556,120 @@ double Now()
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
+
+// Where the surfaces go in the world. The core makes them on the grid without
+// its direction (origin + index x spacing); VTK's image contour filters
+// (vtkFlyingEdges3D, vtkContourFilter) contour that way too and then place
+// their output by the image's index-to-physical matrix (vtkImageTransform):
+// a point x goes to origin + D (x - origin) for the direction D, a normal n
+// to det(D) D n. The triangles keep their order, so for a mirror image
+// (det -1) the normals turn with the faces' winding, as VTK's do. Surfaces
+// are placed once, when made, so that a cached one is ready as it is.
+struct Placement
+{
+  bool Identity = true;
+  double Matrix[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 }; // row-major
+  double Offset[3] = { 0, 0, 0 };
+  double Sign = 1; // det(D): +1 or -1 for an orthonormal direction
+
+  static Placement Of(vtkImageData* image)
+  {
+    Placement p;
+    vtkMatrix3x3* direction = image->GetDirectionMatrix();
+    if (!direction || direction->IsIdentity())
+    {
+      return p;
+    }
+    p.Identity = false;
+    std::copy(direction->GetData(), direction->GetData() + 9, p.Matrix);
+    p.Sign = direction->Determinant() < 0 ? -1.0 : 1.0;
+    const double* o = image->GetOrigin();
+    for (int r = 0; r < 3; ++r)
+    {
+      const double* m = p.Matrix + 3 * r;
+      p.Offset[r] = o[r] - (m[0] * o[0] + m[1] * o[1] + m[2] * o[2]);
+    }
+    return p;
+  }
+
+  bool operator==(const Placement& o) const
+  {
+    return this->Identity == o.Identity && std::equal(this->Matrix, this->Matrix + 9, o.Matrix) &&
+      std::equal(this->Offset, this->Offset + 3, o.Offset);
+  }
+  bool operator!=(const Placement& o) const { return !(*this == o); }
+
+  // Places a surface made by the core in place, and stores the ranges of its
+  // points and normals as placed.
+  void Apply(vtkPolyData* surface) const
+  {
+    vtkFloatArray* points = vtkFloatArray::FastDownCast(surface->GetPoints()->GetData());
+    vtkFloatArray* normals = vtkFloatArray::FastDownCast(surface->GetPointData()->GetNormals());
+    float* x = points ? points->GetPointer(0) : nullptr;
+    float* n = normals ? normals->GetPointer(0) : nullptr;
+    const vtkIdType count = surface->GetNumberOfPoints();
+    vtkSMPThreadLocal<mediso::SurfaceRanges> local;
+    vtkSMPTools::For(0, count,
+      [&](vtkIdType begin, vtkIdType end)
+      {
+        mediso::SurfaceRanges& ranges = local.Local();
+        const double* m = this->Matrix;
+        for (vtkIdType i = begin; i < end; ++i)
+        {
+          if (x)
+          {
+            float* p = x + 3 * i;
+            const double a = p[0], b = p[1], c = p[2];
+            for (int r = 0; r < 3; ++r)
+            {
+              p[r] = static_cast<float>(
+                m[3 * r] * a + m[3 * r + 1] * b + m[3 * r + 2] * c + this->Offset[r]);
+            }
+            ranges.Points.Add(p);
+          }
+          if (n)
+          {
+            float* q = n + 3 * i;
+            double t[3];
+            for (int r = 0; r < 3; ++r)
+            {
+              t[r] = this->Sign * (m[3 * r] * q[0] + m[3 * r + 1] * q[1] + m[3 * r + 2] * q[2]);
+            }
+            // D is orthonormal within CheckInput's tolerance: the length is
+            // kept but for that error, which this takes out.
+            const double length = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+            const double scale = length > 0 ? 1.0 / length : 0.0;
+            for (int r = 0; r < 3; ++r)
+            {
+              q[r] = static_cast<float>(t[r] * scale);
+            }
+            ranges.Normals.Add(q);
+          }
+        }
+      });
+    mediso::SurfaceRanges all;
+    for (const mediso::SurfaceRanges& r : local)
+    {
+      all.Points.Merge(r.Points);
+      all.Normals.Merge(r.Normals);
+    }
+    if (points)
+    {
+      points->Modified();
+      CacheRanges(points, all.Points);
+    }
+    if (normals)
+    {
+      normals->Modified();
+      CacheRanges(normals, all.Normals);
+    }
+  }
+};
+
+// How far a direction may be from orthonormal (each entry of D^T D against
+// the identity's): the rounding of a header's cosines, well below what would
+// tilt a normal visibly.
+constexpr double OrthonormalTolerance = 1e-3;
 } // namespace
 
 struct vtkBlockLODContour::vtkInternals
@@ -563,6 +678,8 @@ struct vtkBlockLODContour::vtkInternals
   mediso::BlockLODSurfaces<vtkSmartPointer<vtkPolyData>> Surfaces{ VTKCaseTable(), SMPFor,
     ProcessCostModel() };
   bool WarnedMissing = false; // NaN or infinite values, once per input
+  // Where the cached surfaces were placed (the input's direction and origin).
+  Placement Placed;
 
   // What the last successful update made, for GenerateLevel: its isovalues,
   // the array they were read from (and its time then), and when.
@@ -697,9 +814,9 @@ struct vtkBlockLODContour::vtkInternals
 
   // How the filter's output arrays are made from the core's plans.
   // `spares`: where the surfaces the cache drops leave their memory (lives
-  // for the update).
+  // for the update); `placement`: where each new surface is put.
   static mediso::SurfaceMaker<vtkSmartPointer<vtkPolyData>> Maker(
-    const mediso::SurfaceLayout& layout, SpareBuffers* spares)
+    const mediso::SurfaceLayout& layout, SpareBuffers* spares, const Placement& placement)
   {
     mediso::SurfaceMaker<vtkSmartPointer<vtkPolyData>> maker;
     maker.Recycle = [spares](vtkSmartPointer<vtkPolyData>& evicted) { spares->Take(evicted); };
@@ -722,11 +839,18 @@ struct vtkBlockLODContour::vtkInternals
       target.Narrow.BlockIds = target.Wide.BlockIds = arrays.BlockIds;
       return true;
     };
-    maker.Finish = [](const mediso::SurfaceKey& key, vtkSmartPointer<vtkPolyData>& surface,
+    maker.Finish = [placement](const mediso::SurfaceKey& key, vtkSmartPointer<vtkPolyData>& surface,
                      const mediso::SurfaceRanges& written)
     {
-      CacheRanges(surface->GetPoints()->GetData(), written.Points);
-      CacheRanges(surface->GetPointData()->GetNormals(), written.Normals);
+      if (placement.Identity)
+      {
+        CacheRanges(surface->GetPoints()->GetData(), written.Points);
+        CacheRanges(surface->GetPointData()->GetNormals(), written.Normals);
+      }
+      else
+      {
+        placement.Apply(surface);
+      }
       const double iso = static_cast<float>(key.Isovalue); // the scalars' value, as stored
       CacheRanges(surface->GetPointData()->GetScalars(), iso, iso);
     };
@@ -916,6 +1040,14 @@ void vtkBlockLODContour::Execute(
   {
     ++this->NumberOfBlockRangeComputations;
   }
+  // The same values under another direction: the counts hold, the cached
+  // surfaces lie elsewhere.
+  const Placement placement = Placement::Of(input);
+  if (placement != in.Placed)
+  {
+    in.Surfaces.ClearCache();
+    in.Placed = placement;
+  }
   this->UpdateProgress(0.1);
   const std::vector<double> values = this->IsovaluesWithSurface();
   if (values.empty())
@@ -949,7 +1081,7 @@ void vtkBlockLODContour::Execute(
   };
   SpareBuffers spares;
   const mediso::SurfacesUpdate update =
-    in.Surfaces.Update(values, choice, vtkInternals::Maker(layout, &spares), hooks);
+    in.Surfaces.Update(values, choice, vtkInternals::Maker(layout, &spares, in.Placed), hooks);
   this->NumberOfExtractions += update.Extractions;
   this->NumberOfCacheHits += update.CacheHits;
   this->ReportUpdate(update);
@@ -1114,11 +1246,32 @@ vtkDataArray* vtkBlockLODContour::CheckInput(vtkImageData* input, vtkInformation
       return nullptr;
     }
   }
-  if (input->GetDirectionMatrix() && !input->GetDirectionMatrix()->IsIdentity())
+  // A direction places the surface (Placement); it must be a rotation or a
+  // mirror image of one, for the normals and the faces' winding to follow it.
+  if (vtkMatrix3x3* direction = input->GetDirectionMatrix())
   {
-    vtkErrorMacro("The input has a non-identity direction matrix, which this filter does not "
-                  "support; resample it to an axis-aligned grid first. The output is empty.");
-    return nullptr;
+    const double* d = direction->GetData();
+    double worst = std::isfinite(direction->Determinant()) ? 0.0 : HUGE_VAL;
+    for (int a = 0; a < 3; ++a)
+    {
+      for (int b = 0; b < 3; ++b)
+      {
+        const double dot = d[a] * d[b] + d[3 + a] * d[3 + b] + d[6 + a] * d[6 + b];
+        const double error = std::fabs(dot - (a == b ? 1.0 : 0.0));
+        worst = std::isfinite(error) ? std::max(worst, error) : HUGE_VAL;
+      }
+    }
+    if (worst > OrthonormalTolerance)
+    {
+      vtkErrorMacro("The input's direction matrix ("
+        << d[0] << ", " << d[1] << ", " << d[2] << "; " << d[3] << ", " << d[4] << ", " << d[5]
+        << "; " << d[6] << ", " << d[7] << ", " << d[8] << ") is not orthonormal (determinant "
+        << direction->Determinant()
+        << "): its columns must be unit vectors at right angles, a rotation or its mirror "
+           "image, for the surface's normals and orientation to follow it. Resample the image "
+           "to an orthonormal grid first. The output is empty.");
+      return nullptr;
+    }
   }
   mediso::ScalarType type;
   if (!vtkMedicalCoreScalarType(array->GetDataType(), type) || !array->HasStandardMemoryLayout() ||
@@ -1439,8 +1592,8 @@ bool vtkBlockLODContour::GenerateLevel(int level, vtkPolyData* output)
   SpareBuffers spares;
   try
   {
-    const mediso::SurfacesUpdate update =
-      in.Surfaces.Update(in.LastValues, choice, vtkInternals::Maker(layout, &spares), hooks);
+    const mediso::SurfacesUpdate update = in.Surfaces.Update(
+      in.LastValues, choice, vtkInternals::Maker(layout, &spares, in.Placed), hooks);
     this->NumberOfExtractions += update.Extractions;
     this->NumberOfCacheHits += update.CacheHits;
     if (update.Status != mediso::SurfacesUpdate::Outcome::Done)

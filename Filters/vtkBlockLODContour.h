@@ -107,11 +107,18 @@
  * double: the one named by SetInputArrayToProcess (ParaView's ContourBy), or,
  * when none is named, the active point scalars if they have one component,
  * else the only one-component point array. Spacing, origin and extent are
- * honoured; a non-identity direction matrix is rejected. NaN and infinite
+ * honoured, and so is a direction matrix, as vtkFlyingEdges3D honours it
+ * (vtkImageTransform): the surface is made on the grid without the direction,
+ * then its points go to origin + D (x - origin) and its normals to
+ * det(D) D n, the triangles unchanged, so a mirror image (det -1) keeps the
+ * orientation VTK's filters give. Cached surfaces are stored placed; a change
+ * of the direction alone drops them. A direction that is not orthonormal
+ * (sheared, singular, non-finite; tolerance 1e-3) is an error. NaN and infinite
  * values are missing data: cubes touching them make no triangle (one warning
  * per input), so the output holds only finite points. Bad input (no point
  * array, a named array the input lacks or a cell array, several components,
- * 2D data, zero or non-finite spacing, an unsupported type, a constant or
+ * 2D data, zero or non-finite spacing, a direction that is not orthonormal,
+ * an unsupported type, a constant or
  * all-NaN volume, an isovalue outside the data range, a budget too small)
  * gives one error or warning saying what is wrong, and an empty or partial
  * output, never a crash. Passes run with vtkSMPTools; progress is reported and

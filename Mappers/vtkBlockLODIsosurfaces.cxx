@@ -173,8 +173,8 @@ void vtkBlockLODIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVolume* vol,
   Internals& impl = *this->Impl;
 
   // Contour an index-space copy of the image (origin 0, spacing 1, no
-  // direction: vtkBlockLODContour needs an axis-aligned grid) and place it
-  // with the actor's matrix, which also carries the volume's matrix.
+  // direction: the surface does not depend on where the image lies) and place
+  // it with the actor's matrix, which also carries the volume's matrix.
   const int* extent = image->GetExtent();
   impl.IndexImage->SetExtent(0, extent[1] - extent[0], 0, extent[3] - extent[2], 0,
     extent[5] - extent[4]);

@@ -6,9 +6,9 @@
  * Draws the isosurfaces vtkHistoPyramidIsoMapper asks for where its GPU path
  * (vtkOpenGLHistoPyramidIsosurfaces) cannot run, or when the fallback is
  * forced: the surfaces are extracted by vtkBlockLODContour at full
- * resolution (level 3) from an index-space copy of the image (vtkBlockLODContour
- * needs an axis-aligned grid) placed by an actor matrix that also carries the
- * image's direction and the volume's matrix; every point is coloured by its
+ * resolution (level 3) from an index-space copy of the image (the surface then
+ * does not depend on where the image lies) placed by an actor matrix that also
+ * carries the image's direction and the volume's matrix; every point is coloured by its
  * isovalue (RGBA), recoloured only when the surface or the looks change.
  * Translucent surfaces are drawn sorted back to front (vtkDepthSortPolyData)
  * with blending: the renderer's depth peeling does not reach geometry a

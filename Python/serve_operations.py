@@ -331,6 +331,21 @@ def padded(image, array, pad, value):
     return out
 
 
+def scene_frame(image):
+    """The image in the page's scene frame (origin + index x spacing, its direction left out:
+    docs/web.md, "Orientation"), or None when it has no direction. BlockLODContour places a
+    surface by the image's direction, as VTK's contour filters do; the page draws the server's
+    results in its scene frame, so the operations contour the image without it."""
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkCommonMath import vtkMatrix3x3
+    if image.GetDirectionMatrix().IsIdentity():
+        return None
+    out = vtkImageData()
+    out.ShallowCopy(image)
+    out.SetDirectionMatrix(vtkMatrix3x3())  # a new matrix: the source's own stays as it is
+    return out
+
+
 def _float_points(mesh):
     """The mesh with float32 points, as the STL holds them (positions equal in float32 are one
     corner there, even where they differ in double)."""
@@ -503,9 +518,12 @@ class Worker:
         the data's minimum around it (padded())."""
         if (index, pad) not in self.contours:
             source, name, image, array = self.sources[index]
+            flat = scene_frame(image)
             if pad:
-                source = _producer(padded(image, array, pad, array.GetRange()[0]),
+                source = _producer(padded(flat or image, array, pad, array.GetRange()[0]),
                                    "%s-padded-%d" % (name, pad))
+            elif flat is not None:
+                source = _producer(flat, "%s-scene" % name)
             contour = self.ns["BlockLODContour"](Input=source,
                                                 ContourBy=["POINTS", array.GetName()],
                                                 ComputeNormals=0, AutoLOD=0)
