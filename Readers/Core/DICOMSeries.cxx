@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -83,6 +84,11 @@ bool NumberAt(const std::string& text, int index, double& value)
     return false;
   }
   item = item.substr(first, last - first + 1);
+  // Decimal notation only (DS, IS): strtod's "inf", "nan" and hexadecimal forms are not DICOM's.
+  if (item.find_first_not_of("0123456789+-.eE") != std::string::npos)
+  {
+    return false;
+  }
   char* stop = nullptr;
   value = std::strtod(item.c_str(), &stop);
   return stop && *stop == '\0' && std::isfinite(value);
@@ -151,32 +157,28 @@ constexpr std::uint32_t ItemEndTag = Tag(0xFFFE, 0xE00D);
 constexpr std::uint32_t SequenceEndTag = Tag(0xFFFE, 0xE0DD);
 constexpr std::uint32_t Undefined = 0xFFFFFFFFu;
 
-bool IsTextTag(std::uint32_t tag)
+// The dictionary VR of an attribute the rules use, or nullptr for the others.
+const char* RuleVR(std::uint32_t tag)
 {
   switch (tag)
   {
     case TransferSyntaxTag:
-    case SeriesDescriptionTag:
-    case SliceThicknessTag:
     case SeriesUIDTag:
-    case InstanceNumberTag:
+      return "UI";
+    case SeriesDescriptionTag:
+      return "LO";
+    case SliceThicknessTag:
     case PositionTag:
     case OrientationTag:
-    case PhotometricTag:
-    case FramesTag:
     case PixelSpacingTag:
     case InterceptTag:
     case SlopeTag:
-      return true;
-    default:
-      return false;
-  }
-}
-
-bool IsShortTag(std::uint32_t tag)
-{
-  switch (tag)
-  {
+      return "DS";
+    case InstanceNumberTag:
+    case FramesTag:
+      return "IS";
+    case PhotometricTag:
+      return "CS";
     case SamplesTag:
     case RowsTag:
     case ColumnsTag:
@@ -184,9 +186,9 @@ bool IsShortTag(std::uint32_t tag)
     case BitsStoredTag:
     case HighBitTag:
     case RepresentationTag:
-      return true;
+      return "US";
     default:
-      return false;
+      return nullptr;
   }
 }
 
@@ -363,13 +365,26 @@ public:
       {
         return this->Fail("the file ends inside an element");
       }
-      if (header && IsTextTag(tag))
+      const char* ruleVR = header ? RuleVR(tag) : nullptr;
+      if (ruleVR && explicitVR && (vr[0] != ruleVR[0] || vr[1] != ruleVR[1]))
+      {
+        // What DCMTK makes of an attribute under another VR is its own: not guessed here.
+        char name[16];
+        std::snprintf(name, sizeof(name), "(%04X,%04X)", tag >> 16, tag & 0xFFFFu);
+        return this->Fail(std::string("attribute ") + name + " has VR \"" + std::string(vr, 2) +
+          "\", not " + ruleVR);
+      }
+      if (ruleVR && ruleVR[0] == 'U' && ruleVR[1] == 'S')
+      {
+        if (length != 2)
+        {
+          return this->Fail("an unsigned short attribute of " + std::to_string(length) + " bytes");
+        }
+        header->Short[tag] = this->U16(this->At);
+      }
+      else if (ruleVR)
       {
         header->Text[tag] = TrimmedText(this->Bytes + this->At, length);
-      }
-      else if (header && IsShortTag(tag) && length >= 2)
-      {
-        header->Short[tag] = this->U16(this->At);
       }
       this->At += length;
     }
@@ -1017,7 +1032,6 @@ std::string ReadSeries(
     [](const DICOMFileBytes& a, const DICOMFileBytes& b) { return a.Name < b.Name; });
   // 1. Scan.
   std::vector<Instance> images;
-  std::vector<std::string> unreadable;
   for (const DICOMFileBytes& file : files)
   {
     Header header;
@@ -1027,10 +1041,12 @@ std::string ReadSeries(
     {
       continue;
     }
+    // The reader skips a file DCMTK cannot parse; whether DCMTK parses one this parser cannot is
+    // not known here, so the page refuses the folder rather than read it without that file.
     if (status == HeaderStatus::Unreadable)
     {
-      unreadable.push_back(file.Name + " (" + why + ")");
-      continue;
+      return file.Name + ": a DICOM file that is not read in the page (" + why +
+        "); open the folder through the server";
     }
     const std::string& syntax = header.TransferSyntaxUID;
     if (syntax != ImplicitLittle && syntax != ExplicitLittle)
@@ -1054,11 +1070,6 @@ std::string ReadSeries(
     instance.Bytes = file.Bytes;
     Describe(header, instance);
     images.push_back(std::move(instance));
-  }
-  if (!unreadable.empty())
-  {
-    volume.Warnings.push_back(folder + ": skipped " + std::to_string(unreadable.size()) +
-      " DICOM file(s) that cannot be read: " + JoinList(unreadable, "; "));
   }
   if (images.empty())
   {

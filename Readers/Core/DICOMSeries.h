@@ -23,8 +23,10 @@
  * The tag parser walks the data set element by element, top level only,
  * skipping sequences of defined or undefined length (items, item and
  * sequence delimiters; explicit VR's UN of undefined length as implicit VR),
- * and stops at Pixel Data. A file that ends inside an element is "unreadable"
- * and skipped with a warning, as the reader skips a file DCMTK cannot parse.
+ * and stops at Pixel Data. An attribute the rules use under another VR than
+ * its dictionary's (explicit VR), and a file that ends inside an element, are
+ * refused: the reader skips a file DCMTK cannot parse, but whether DCMTK
+ * parses what this parser does not is not known here.
  *
  * The series rules are the reader's, step by step (see
  * vtkMedicalDICOMSeriesReader.h): files sorted by name; files without the
