@@ -292,7 +292,8 @@ bool RenameTag(const fs::path& file, const unsigned char tag[4], const unsigned 
 bool Damage(const std::string& corpus)
 {
   const fs::path plain = fs::path(corpus) / "plain";
-  for (const char* name : { "missing_rows", "missing_position", "header_cut", "high_bits" })
+  for (const char* name :
+    { "missing_rows", "missing_position", "header_cut", "high_bits", "pixel_ob" })
   {
     fs::remove_all(fs::path(corpus) / name);
     fs::copy(plain, fs::path(corpus) / name);
@@ -320,6 +321,23 @@ bool Damage(const std::string& corpus)
     {
       at[1] |= 0xF0;
     }
+    std::ofstream out(entry.path(), std::ios::binary | std::ios::trunc);
+    out.write(
+      reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  }
+  // 16-bit Pixel Data under VR OB instead of OW (left unlisted: whatever the reader makes of
+  // it, the core must not read it otherwise).
+  for (const fs::directory_entry& entry : fs::directory_iterator(fs::path(corpus) / "pixel_ob"))
+  {
+    const unsigned char ow[6] = { 0xE0, 0x7F, 0x10, 0x00, 'O', 'W' };
+    const unsigned char ob[6] = { 0xE0, 0x7F, 0x10, 0x00, 'O', 'B' };
+    std::vector<unsigned char> bytes = Slurp(entry.path());
+    auto found = std::search(bytes.begin(), bytes.end(), ow, ow + 6);
+    if (found == bytes.end())
+    {
+      return false;
+    }
+    std::copy(ob, ob + 6, found);
     std::ofstream out(entry.path(), std::ios::binary | std::ios::trunc);
     out.write(
       reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
