@@ -17,8 +17,9 @@
 //   served volume; a second operation uploads nothing.
 // - a DICOM folder written by this test (the same values as int16 slices with Rescale Intercept
 //   -1000, on a plane turned 90 degrees about z, file names in reverse position order), served
-//   (vtkMedicalDICOMSeriesReader) and picked in the page's folder box (setInputFiles on the
-//   webkitdirectory input): the same facts, view, triangles and primitives, nothing sent; a copy
+//   (vtkMedicalDICOMSeriesReader), picked in the page's folder box (setInputFiles on the
+//   webkitdirectory input) and dropped (Chromium's drag of the folder's path through CDP's
+//   Input.dispatchDragEvent): the same facts, view, triangles and primitives, nothing sent; a copy
 //   of it with one file in the RLE transfer syntax refused by name, the volume shown kept.
 import { mkdirSync, mkdtempSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
@@ -320,6 +321,21 @@ const dicomServer = await startServer([dicom]);
     (after.bytesReceived - before.bytesReceived) + " bytes)");
   const local = await measure(page, iso);
   compare("the DICOM folder (picked)", served, local);
+  // Dropped: Chromium's own drag of the folder's path (CDP), as a drop from the desktop.
+  {
+    await page.evaluate(() => { document.getElementById("local-note").textContent = ""; });
+    const cdp = await context.newCDPSession(page);
+    const data = { items: [], files: [dicom], dragOperationsMask: 1 };
+    for (const type of ["dragEnter", "dragOver", "drop"]) {
+      await cdp.send("Input.dispatchDragEvent", { type, x: 1200, y: 600, data });
+    }
+    await page.waitForFunction(() => /^(Opened|Not opened)/.test(document.getElementById("local-note").textContent),
+      null, { timeout: 60000 });
+    await page.evaluate(() => window.mediso.drawn());
+    const dropNote = await page.evaluate(() => document.getElementById("local-note").textContent);
+    checks.check(/^Opened dicom-series/.test(dropNote), "the DICOM folder (dropped): " + dropNote);
+    compare("the DICOM folder (dropped)", served, await measure(page, iso));
+  }
   const refused = await openFolder(page, dicomRLE);
   const now = await measure(page, iso);
   checks.check(/^Not opened: /.test(refused) && /"RLE Lossless" \(1\.2\.840\.10008\.1\.2\.5\) is not read in the page/.test(refused) &&
