@@ -664,10 +664,10 @@ void Cross(const double a[3], const double b[3], double c[3])
   c[2] = z;
 }
 
-struct Stack
+struct SliceStack
 {
-  std::vector<const Instance*> Slices; // in increasing position
-  std::vector<double> Distances;       // along the normal
+  std::vector<const DICOMSlice*> Slices; // in increasing position
+  std::vector<double> Distances;         // along the normal
   double Row[3] = { 1, 0, 0 };
   double Column[3] = { 0, 1, 0 };
   double Normal[3] = { 0, 0, 1 };
@@ -681,9 +681,9 @@ struct Stack
   }
 };
 
-std::string CheckSlices(Stack& stack)
+std::string CheckSlices(SliceStack& stack)
 {
-  const Instance& reference = *stack.Slices.front();
+  const DICOMSlice& reference = *stack.Slices.front();
   const std::string& referenceName = reference.Name;
   const bool single = stack.Slices.size() == 1;
   if (reference.HasOrientation)
@@ -699,7 +699,7 @@ std::string CheckSlices(Stack& stack)
     }
   }
   Cross(stack.Row, stack.Column, stack.Normal);
-  for (const Instance* slice : stack.Slices)
+  for (const DICOMSlice* slice : stack.Slices)
   {
     const std::string& name = slice->Name;
     if (!single && !slice->HasPosition)
@@ -743,9 +743,8 @@ std::string CheckSlices(Stack& stack)
   return std::string();
 }
 
-std::string StackSlices(const std::vector<const Instance*>& instances, Stack& stack)
+std::string StackSlices(SliceStack& stack)
 {
-  stack.Slices = instances;
   std::string error = CheckSlices(stack);
   if (!error.empty())
   {
@@ -753,14 +752,14 @@ std::string StackSlices(const std::vector<const Instance*>& instances, Stack& st
   }
   const double* normal = stack.Normal;
   std::stable_sort(stack.Slices.begin(), stack.Slices.end(),
-    [normal](const Instance* a, const Instance* b)
+    [normal](const DICOMSlice* a, const DICOMSlice* b)
     {
       const double da = Dot(a->Position, normal);
       const double db = Dot(b->Position, normal);
       return da != db ? da < db : a->InstanceNumber < b->InstanceNumber;
     });
   const std::size_t count = stack.Slices.size();
-  for (const Instance* slice : stack.Slices)
+  for (const DICOMSlice* slice : stack.Slices)
   {
     stack.Distances.push_back(Dot(slice->Position, normal));
   }
@@ -830,6 +829,12 @@ std::string StackSlices(const std::vector<const Instance*>& instances, Stack& st
   }
   return std::string();
 }
+
+// The series' files in the stack's order, for decoding.
+struct Stack
+{
+  std::vector<const Instance*> Slices; // in increasing position
+};
 
 // Stored values: masked to Bits Stored, sign-extended when signed.
 template <typename Stored>
@@ -1005,6 +1010,23 @@ std::string Decode(const Stack& stack, DICOMSeriesVolume& volume)
   return std::string();
 }
 
+// The DICOM slices of one instance each, as the rules see them.
+DICOMSlice SliceOf(const Instance& instance)
+{
+  DICOMSlice slice;
+  slice.Name = instance.Name;
+  slice.HasPosition = instance.HasPosition;
+  slice.HasOrientation = instance.HasOrientation;
+  slice.HasPixelSpacing = instance.HasPixelSpacing;
+  std::copy(instance.Position, instance.Position + 3, slice.Position);
+  std::copy(instance.Orientation, instance.Orientation + 6, slice.Orientation);
+  std::copy(instance.PixelSpacing, instance.PixelSpacing + 2, slice.PixelSpacing);
+  slice.Slope = instance.Slope;
+  slice.Intercept = instance.Intercept;
+  slice.InstanceNumber = instance.InstanceNumber;
+  return slice;
+}
+
 const struct
 {
   const char* UID;
@@ -1114,30 +1136,40 @@ std::string ReadSeries(
     instances.push_back(&images[i]);
   }
   std::string error = CheckInstances(instances);
-  Stack stack;
+  std::vector<DICOMSlice> slices;
+  for (const Instance* instance : instances)
+  {
+    slices.push_back(SliceOf(*instance));
+  }
+  DICOMStack sorted;
   if (error.empty())
   {
-    error = StackSlices(instances, stack);
+    error = StackDICOMSlices(slices, sorted);
   }
   if (!error.empty())
   {
     return error;
   }
+  Stack stack;
+  for (std::size_t k : sorted.Order)
+  {
+    stack.Slices.push_back(instances[k]);
+  }
   const Instance& first = *instances.front();
-  if (!stack.ValidPixelSpacing)
+  if (!sorted.ValidPixelSpacing)
   {
     volume.Warnings.push_back(
       first.Name + ": no valid Pixel Spacing; 1 mm between rows and columns assumed");
   }
-  if (!stack.Uneven.empty())
+  if (!sorted.Uneven.empty())
   {
-    std::vector<std::string> listed(
-      stack.Uneven.begin(), stack.Uneven.begin() + std::min<std::size_t>(stack.Uneven.size(), 5));
-    if (stack.Uneven.size() > 5)
+    std::vector<std::string> listed(sorted.Uneven.begin(),
+      sorted.Uneven.begin() + std::min<std::size_t>(sorted.Uneven.size(), 5));
+    if (sorted.Uneven.size() > 5)
     {
-      listed.push_back("and " + std::to_string(stack.Uneven.size() - 5) + " more");
+      listed.push_back("and " + std::to_string(sorted.Uneven.size() - 5) + " more");
     }
-    return "the slices are not evenly spaced (median step " + Number(stack.Median) +
+    return "the slices are not evenly spaced (median step " + Number(sorted.Median) +
       " mm): " + JoinList(listed, "; ") + ". The page does not resample them.";
   }
 
@@ -1158,7 +1190,7 @@ std::string ReadSeries(
 
   // Placement.
   const std::size_t count = stack.Slices.size();
-  const std::vector<double>& distances = stack.Distances;
+  const std::vector<double>& distances = sorted.Distances;
   const double step = count > 1 ? (distances.back() - distances.front()) / (count - 1) : 0.0;
   const Instance& base = *stack.Slices.front();
   volume.SeriesUID = read.UID;
@@ -1168,16 +1200,52 @@ std::string ReadSeries(
   for (int c = 0; c < 3; ++c)
   {
     volume.Origin[c] = base.HasPosition ? base.Position[c] : 0.0;
-    volume.Direction[3 * c + 0] = stack.Row[c];
-    volume.Direction[3 * c + 1] = stack.Column[c];
-    volume.Direction[3 * c + 2] = stack.Normal[c];
+    volume.Direction[3 * c + 0] = sorted.Row[c];
+    volume.Direction[3 * c + 1] = sorted.Column[c];
+    volume.Direction[3 * c + 2] = sorted.Normal[c];
   }
-  volume.Spacing[0] = stack.ValidPixelSpacing ? base.PixelSpacing[1] : 1.0;
-  volume.Spacing[1] = stack.ValidPixelSpacing ? base.PixelSpacing[0] : 1.0;
+  volume.Spacing[0] = sorted.ValidPixelSpacing ? base.PixelSpacing[1] : 1.0;
+  volume.Spacing[1] = sorted.ValidPixelSpacing ? base.PixelSpacing[0] : 1.0;
   volume.Spacing[2] = count > 1 ? step : (first.SliceThickness > 0.0 ? first.SliceThickness : 1.0);
   return std::string();
 }
 } // namespace
+
+std::string StackDICOMSlices(const std::vector<DICOMSlice>& slices, DICOMStack& stack)
+{
+  stack = DICOMStack();
+  if (slices.empty())
+  {
+    return "no slices";
+  }
+  SliceStack work;
+  for (const DICOMSlice& slice : slices)
+  {
+    work.Slices.push_back(&slice);
+  }
+  const std::string error = StackSlices(work);
+  if (!error.empty())
+  {
+    return error;
+  }
+  for (const DICOMSlice* slice : work.Slices)
+  {
+    stack.Order.push_back(static_cast<std::size_t>(slice - slices.data()));
+  }
+  stack.Distances = work.Distances;
+  std::copy(work.Row, work.Row + 3, stack.Row);
+  std::copy(work.Column, work.Column + 3, stack.Column);
+  std::copy(work.Normal, work.Normal + 3, stack.Normal);
+  stack.Median = work.Median;
+  stack.Uneven = work.Uneven;
+  stack.ValidPixelSpacing = work.ValidPixelSpacing;
+  return std::string();
+}
+
+ScalarType DICOMIntegerType(double least, double greatest)
+{
+  return SmallestIntegerType(least, greatest);
+}
 
 const char* DICOMTransferSyntaxName(const std::string& uid)
 {

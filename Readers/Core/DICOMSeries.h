@@ -47,9 +47,11 @@
  * resample uneven slices is not offered: the page refuses them as the reader
  * does by default.
  *
- * TestDICOMSeriesMatchesReader runs both on every folder of the reader's
- * test corpus and requires the same volume, byte for byte, or the same
- * refusal.
+ * The slice rules (StackDICOMSlices) and the integer output type
+ * (DICOMIntegerType) are the reader's own: it calls them. The rest is written
+ * again here over the parser's attributes, and TestDICOMSeriesMatchesReader
+ * runs both on every folder of the reader's test corpus and requires the same
+ * volume, byte for byte, or the same refusal.
  */
 #ifndef MedicalIsosurfaces_DICOMSeries_h
 #define MedicalIsosurfaces_DICOMSeries_h
@@ -84,6 +86,50 @@ struct DICOMSeriesVolume
   std::string SeriesUID;
   std::vector<std::string> Warnings; ///< what the reader would warn about
 };
+
+/// One slice as the series rules see it (a single-frame file, or one frame of
+/// a multi-frame file in vtkMedicalDICOMSeriesReader).
+struct DICOMSlice
+{
+  std::string Name; ///< the file (and frame), in messages
+  bool HasPosition = false;
+  bool HasOrientation = false;
+  bool HasPixelSpacing = false;
+  double Position[3] = { 0, 0, 0 };
+  double Orientation[6] = { 1, 0, 0, 0, 1, 0 };
+  double PixelSpacing[2] = { 1, 1 }; ///< DICOM order: between rows, between columns
+  double Slope = 1.0;
+  double Intercept = 0.0;
+  long InstanceNumber = 0;
+};
+
+/// The slices ordered and spaced along the normal.
+struct DICOMStack
+{
+  std::vector<std::size_t> Order; ///< indices of the slices, in increasing position
+  std::vector<double> Distances;  ///< along the normal, in that order
+  double Row[3] = { 1, 0, 0 };
+  double Column[3] = { 0, 1, 0 };
+  double Normal[3] = { 0, 0, 1 };
+  double Median = 0.0;             ///< median step
+  std::vector<std::string> Uneven; ///< gaps and uneven steps, in words (not refused here)
+  bool ValidPixelSpacing = false;
+};
+
+/**
+ * The slice rules, shared with vtkMedicalDICOMSeriesReader: every slice
+ * checked against the first (orientation, pixel spacing, position and
+ * orientation present when there are several, slope not 0), sorted along the
+ * normal (ties by Instance Number), duplicates and a tilted or sheared stack
+ * refused; gaps and uneven steps listed in `stack.Uneven` for the caller to
+ * refuse or resample. Returns "" or the reason.
+ */
+std::string StackDICOMSlices(const std::vector<DICOMSlice>& slices, DICOMStack& stack);
+
+/// The smallest integer type that holds every value in [least, greatest]
+/// (unsigned when least >= 0), Float64 beyond 32 bits: the reader's output
+/// type for integral rescaling.
+ScalarType DICOMIntegerType(double least, double greatest);
 
 /**
  * Reads the series of `files` (the regular files of one folder; `folder`
