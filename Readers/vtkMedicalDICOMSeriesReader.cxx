@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "vtkMedicalDICOMSeriesReader.h"
 
+#include "DICOMSeries.h"
 #include "ProcessMemory.h"
 
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
-#include "vtkMath.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
@@ -450,37 +450,27 @@ void Convert(const In* in, vtkDataArray* out, bool resample, std::size_t sliceSi
   }
 }
 
+// The smallest integer type that holds the rescaled values (the rule the page
+// shares: mediso::DICOMIntegerType), double beyond 32 bits.
 int SmallestIntegerType(double least, double greatest)
 {
-  if (least >= 0.0)
+  switch (mediso::DICOMIntegerType(least, greatest))
   {
-    if (greatest <= 255.0)
-    {
+    case mediso::ScalarType::UInt8:
       return VTK_UNSIGNED_CHAR;
-    }
-    if (greatest <= 65535.0)
-    {
+    case mediso::ScalarType::UInt16:
       return VTK_UNSIGNED_SHORT;
-    }
-    if (greatest <= 4294967295.0)
-    {
+    case mediso::ScalarType::UInt32:
       return VTK_UNSIGNED_INT;
-    }
-    return VTK_DOUBLE;
+    case mediso::ScalarType::Int8:
+      return VTK_SIGNED_CHAR;
+    case mediso::ScalarType::Int16:
+      return VTK_SHORT;
+    case mediso::ScalarType::Int32:
+      return VTK_INT;
+    default:
+      return VTK_DOUBLE;
   }
-  if (least >= -128.0 && greatest <= 127.0)
-  {
-    return VTK_SIGNED_CHAR;
-  }
-  if (least >= -32768.0 && greatest <= 32767.0)
-  {
-    return VTK_SHORT;
-  }
-  if (least >= -2147483648.0 && greatest <= 2147483647.0)
-  {
-    return VTK_INT;
-  }
-  return VTK_DOUBLE;
 }
 
 // An array of `tuples` values of `type`, or nullptr with the message when
@@ -743,8 +733,10 @@ std::string CheckInstances(const std::vector<Instance*>& instances)
   return std::string();
 }
 
-// Steps 3 and 5: every slice of the series, checked against the first one
-// and sorted along the normal; its steps checked against the median step.
+// Steps 3 and 5: every slice of the series, checked against the first one,
+// sorted along the normal and its steps measured against the median step, by
+// the rules the web page's DICOM reading shares (mediso::StackDICOMSlices,
+// Readers/Core/DICOMSeries.h).
 struct Stack
 {
   std::vector<std::pair<const Instance*, const Slice*>> Slices; // in increasing position
@@ -755,167 +747,48 @@ struct Stack
   double Median = 0.0;             // median step
   std::vector<std::string> Uneven; // gaps and uneven steps, in words
   bool ValidPixelSpacing = false;
-
-  std::string Name(std::size_t k) const { return SliceName(*Slices[k].first, *Slices[k].second); }
-  std::string Where(std::size_t k) const
-  {
-    return Number(this->Distances[k]) + " mm (" + this->Name(k) + ")";
-  }
 };
-
-std::string CheckSlices(Stack& stack)
-{
-  const Slice& reference = *stack.Slices.front().second;
-  const std::string referenceName = stack.Name(0);
-  const bool single = stack.Slices.size() == 1;
-  if (reference.HasOrientation)
-  {
-    std::copy(reference.Orientation, reference.Orientation + 3, stack.Row);
-    std::copy(reference.Orientation + 3, reference.Orientation + 6, stack.Column);
-    const double rowLength = vtkMath::Normalize(stack.Row);
-    const double columnLength = vtkMath::Normalize(stack.Column);
-    if (std::abs(rowLength - 1.0) > 1e-3 || std::abs(columnLength - 1.0) > 1e-3 ||
-      std::abs(vtkMath::Dot(stack.Row, stack.Column)) > 1e-3)
-    {
-      return referenceName + ": Image Orientation (Patient) is not two orthogonal unit vectors";
-    }
-  }
-  vtkMath::Cross(stack.Row, stack.Column, stack.Normal);
-  for (std::size_t k = 0; k < stack.Slices.size(); ++k)
-  {
-    const Slice& slice = *stack.Slices[k].second;
-    const std::string name = stack.Name(k);
-    if (!single && !slice.HasPosition)
-    {
-      return name + ": no Image Position (Patient): the slices' order and spacing are unknown";
-    }
-    if (!single && !slice.HasOrientation)
-    {
-      return name + ": no Image Orientation (Patient): the slices' order and spacing are unknown";
-    }
-    for (int c = 0; c < 6 && slice.HasOrientation; ++c)
-    {
-      if (std::abs(slice.Orientation[c] - reference.Orientation[c]) > 1e-4)
-      {
-        std::string a, b;
-        for (int d = 0; d < 6; ++d)
-        {
-          a += (d ? "\\" : "") + Number(slice.Orientation[d]);
-          b += (d ? "\\" : "") + Number(reference.Orientation[d]);
-        }
-        return name + ": Image Orientation (Patient) " + a + ", but " + referenceName + " has " +
-          b + ": slices of different orientations are not read";
-      }
-    }
-    if (slice.HasPixelSpacing != reference.HasPixelSpacing ||
-      std::abs(slice.PixelSpacing[0] - reference.PixelSpacing[0]) > 1e-4 ||
-      std::abs(slice.PixelSpacing[1] - reference.PixelSpacing[1]) > 1e-4)
-    {
-      return name + ": Pixel Spacing " + Number(slice.PixelSpacing[0]) + "\\" +
-        Number(slice.PixelSpacing[1]) + ", but " + referenceName + " has " +
-        Number(reference.PixelSpacing[0]) + "\\" + Number(reference.PixelSpacing[1]) +
-        ": slices of different pixel spacings are not read";
-    }
-    if (slice.Slope == 0.0)
-    {
-      return name + ": Rescale Slope 0";
-    }
-  }
-  stack.ValidPixelSpacing =
-    reference.HasPixelSpacing && reference.PixelSpacing[0] > 0.0 && reference.PixelSpacing[1] > 0.0;
-  return std::string();
-}
 
 std::string StackSlices(const std::vector<Instance*>& instances, Stack& stack)
 {
+  std::vector<std::pair<const Instance*, const Slice*>> slices;
+  std::vector<mediso::DICOMSlice> rules;
   for (const Instance* instance : instances)
   {
     for (const Slice& slice : instance->Slices)
     {
-      stack.Slices.emplace_back(instance, &slice);
+      slices.emplace_back(instance, &slice);
+      mediso::DICOMSlice rule;
+      rule.Name = SliceName(*instance, slice);
+      rule.HasPosition = slice.HasPosition;
+      rule.HasOrientation = slice.HasOrientation;
+      rule.HasPixelSpacing = slice.HasPixelSpacing;
+      std::copy(slice.Position, slice.Position + 3, rule.Position);
+      std::copy(slice.Orientation, slice.Orientation + 6, rule.Orientation);
+      std::copy(slice.PixelSpacing, slice.PixelSpacing + 2, rule.PixelSpacing);
+      rule.Slope = slice.Slope;
+      rule.Intercept = slice.Intercept;
+      rule.InstanceNumber = slice.InstanceNumber;
+      rules.push_back(std::move(rule));
     }
   }
-  std::string error = CheckSlices(stack);
+  mediso::DICOMStack sorted;
+  const std::string error = mediso::StackDICOMSlices(rules, sorted);
   if (!error.empty())
   {
     return error;
   }
-  // Sorted by position along the normal; ties (refused below) by Instance Number.
-  const double* normal = stack.Normal;
-  std::stable_sort(stack.Slices.begin(), stack.Slices.end(),
-    [normal](const auto& a, const auto& b)
-    {
-      const double da = vtkMath::Dot(a.second->Position, normal);
-      const double db = vtkMath::Dot(b.second->Position, normal);
-      return da != db ? da < db : a.second->InstanceNumber < b.second->InstanceNumber;
-    });
-  const std::size_t count = stack.Slices.size();
-  for (const auto& entry : stack.Slices)
+  for (std::size_t k : sorted.Order)
   {
-    stack.Distances.push_back(vtkMath::Dot(entry.second->Position, normal));
+    stack.Slices.push_back(slices[k]);
   }
-  if (count < 2)
-  {
-    return std::string();
-  }
-  std::vector<double> steps(count - 1);
-  for (std::size_t k = 0; k + 1 < count; ++k)
-  {
-    steps[k] = stack.Distances[k + 1] - stack.Distances[k];
-  }
-  std::vector<double> sorted = steps;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  stack.Median = sorted[sorted.size() / 2];
-  const double tolerance = 0.01 * stack.Median;
-  for (std::size_t k = 0; k + 1 < count; ++k)
-  {
-    if (!(steps[k] > std::max(tolerance, 1e-6)))
-    {
-      return "two slices at the same position along the normal, " + stack.Where(k) + " and " +
-        stack.Where(k + 1) + ": duplicate slices are not read";
-    }
-  }
-  // A stack that leaves the line through the first slice along the normal
-  // (gantry tilt, shear) would need a sheared grid: refused.
-  const double* origin = stack.Slices.front().second->Position;
-  const double* pixel = stack.Slices.front().second->PixelSpacing;
-  const double lateral = std::max(1e-3, 0.01 * std::min(pixel[0], pixel[1]));
-  for (std::size_t k = 1; k < count; ++k)
-  {
-    double offset[3];
-    vtkMath::Subtract(stack.Slices[k].second->Position, origin, offset);
-    const double along = vtkMath::Dot(offset, normal);
-    for (int c = 0; c < 3; ++c)
-    {
-      offset[c] -= along * normal[c];
-    }
-    const double off = vtkMath::Norm(offset);
-    if (off > lateral)
-    {
-      return stack.Name(k) + ": its Image Position (Patient) is " + Number(off) +
-        " mm off the line through " + stack.Name(0) +
-        " along the slice normal (a gantry tilt or a sheared stack): not read";
-    }
-  }
-  for (std::size_t k = 0; k + 1 < count; ++k)
-  {
-    if (std::abs(steps[k] - stack.Median) <= tolerance)
-    {
-      continue;
-    }
-    const double whole = std::round(steps[k] / stack.Median);
-    const std::string between = " mm between " + stack.Where(k) + " and " + stack.Where(k + 1);
-    if (whole >= 2.0 && std::abs(steps[k] - whole * stack.Median) <= tolerance)
-    {
-      const int missing = static_cast<int>(whole) - 1;
-      stack.Uneven.push_back("a gap of " + Number(steps[k]) + between + " (" +
-        std::to_string(missing) + (missing == 1 ? " slice missing)" : " slices missing)"));
-    }
-    else
-    {
-      stack.Uneven.push_back("a step of " + Number(steps[k]) + between);
-    }
-  }
+  stack.Distances = sorted.Distances;
+  std::copy(sorted.Row, sorted.Row + 3, stack.Row);
+  std::copy(sorted.Column, sorted.Column + 3, stack.Column);
+  std::copy(sorted.Normal, sorted.Normal + 3, stack.Normal);
+  stack.Median = sorted.Median;
+  stack.Uneven = sorted.Uneven;
+  stack.ValidPixelSpacing = sorted.ValidPixelSpacing;
   return std::string();
 }
 

@@ -84,7 +84,10 @@
  * export of it. The point array is named "DICOMImage".
  *
  * Every refusal is one vtkErrorMacro and an empty output; see
- * docs/readers.md for the messages.
+ * docs/readers.md for the messages. The slice rules of step 5 and the integer
+ * type of step 7 are the readers' VTK-free core's (mediso::StackDICOMSlices,
+ * mediso::DICOMIntegerType in Readers/Core/DICOMSeries.h), which the web page
+ * reads an uncompressed DICOM folder with.
  *
  * @warning Files without the Part 10 preamble (bare datasets, ACR-NEMA) are
  * skipped. Colour images, Bits Allocated 1 or 32 and multi-frame files

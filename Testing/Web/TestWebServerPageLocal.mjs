@@ -15,7 +15,13 @@
 // - a server operation on the local MetaImage uploads it once (one POST /api/upload, the page saying
 //   how many bytes before and after) and gives the triangles the same operation gives on the
 //   served volume; a second operation uploads nothing.
-import { mkdtempSync, writeFileSync } from "node:fs";
+// - a DICOM folder written by this test (the same values as int16 slices with Rescale Intercept
+//   -1000, on a plane turned 90 degrees about z, file names in reverse position order), served
+//   (vtkMedicalDICOMSeriesReader), picked in the page's folder box (setInputFiles on the
+//   webkitdirectory input) and dropped (Chromium's drag of the folder's path through CDP's
+//   Input.dispatchDragEvent): the same facts, view, triangles and primitives, nothing sent; a copy
+//   of it with one file in the RLE transfer syntax refused by name, the volume shown kept.
+import { mkdirSync, mkdtempSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
 import { gzipSync } from "node:zlib";
@@ -83,6 +89,61 @@ writeFileSync(files.raw, values());
 writeFileSync(files.truncated, nifti().subarray(0, 352 + 1000));
 writeFileSync(files.badHeader, nifti({ sizeOfHeader: 123 }));
 writeFileSync(files.other, "not a volume\n");
+
+// A DICOM Part 10 file, explicit VR little endian: slice k of values(), signed 16-bit, Rescale
+// Intercept -1000, rows along y, columns along -x (a plane turned 90 degrees about z).
+function dicomSlice(k, syntax = "1.2.840.10008.1.2.1") {
+  const element = (group, number, vr, value) => {
+    let bytes = Buffer.isBuffer(value) ? value : Buffer.from(value, "latin1");
+    if (bytes.length % 2) {
+      bytes = Buffer.concat([bytes, Buffer.from(vr === "UI" ? "\0" : " ", "latin1")]);
+    }
+    const long = ["OB", "OW", "SQ", "UN", "UT"].includes(vr);
+    const head = Buffer.alloc(long ? 12 : 8);
+    head.writeUInt16LE(group, 0);
+    head.writeUInt16LE(number, 2);
+    head.write(vr, 4, "latin1");
+    if (long) {
+      head.writeUInt32LE(bytes.length, 8);
+    } else {
+      head.writeUInt16LE(bytes.length, 6);
+    }
+    return Buffer.concat([head, bytes]);
+  };
+  const us = (v) => { const b = Buffer.alloc(2); b.writeUInt16LE(v, 0); return b; };
+  const instance = "2.25.4242" + String(k + 1).padStart(3, "0");
+  const meta = Buffer.concat([element(2, 1, "OB", Buffer.from([0, 1])),
+    element(2, 2, "UI", "1.2.840.10008.5.1.4.1.1.2"), element(2, 3, "UI", instance),
+    element(2, 0x10, "UI", syntax), element(2, 0x12, "UI", "2.25.4242")]);
+  const length = Buffer.alloc(4);
+  length.writeUInt32LE(meta.length, 0);
+  const all = values();
+  const slice = all.subarray(2 * NX * NY * k, 2 * NX * NY * (k + 1));
+  const data = Buffer.concat([element(8, 0x16, "UI", "1.2.840.10008.5.1.4.1.1.2"),
+    element(8, 0x18, "UI", instance), element(8, 0x60, "CS", "CT"),
+    element(0x10, 0x10, "PN", "Local^Test"), element(0x18, 0x50, "DS", "1.25"),
+    element(0x20, 0x0d, "UI", "2.25.4241"), element(0x20, 0x0e, "UI", "2.25.4240"),
+    element(0x20, 0x13, "IS", String(k + 1)), element(0x20, 0x32, "DS", [10, -20, 30 + 1.25 * k].join("\\")),
+    element(0x20, 0x37, "DS", "0\\1\\0\\-1\\0\\0"), element(0x28, 2, "US", us(1)),
+    element(0x28, 4, "CS", "MONOCHROME2"), element(0x28, 0x10, "US", us(NY)),
+    element(0x28, 0x11, "US", us(NX)), element(0x28, 0x30, "DS", "0.9\\0.8"),
+    element(0x28, 0x100, "US", us(16)), element(0x28, 0x101, "US", us(16)),
+    element(0x28, 0x102, "US", us(15)), element(0x28, 0x103, "US", us(1)),
+    element(0x28, 0x1052, "DS", "-1000"), element(0x28, 0x1053, "DS", "1"),
+    element(0x7fe0, 0x10, "OW", Buffer.from(slice))]);
+  return Buffer.concat([Buffer.alloc(128), Buffer.from("DICM", "latin1"),
+    element(2, 0, "UL", length), meta, data]);
+}
+
+const dicom = path.join(folder, "dicom-series");
+const dicomRLE = path.join(folder, "dicom-rle");
+mkdirSync(dicom);
+mkdirSync(dicomRLE);
+for (let k = 0; k < NZ; ++k) {
+  const name = "img_" + String(NZ - 1 - k).padStart(3, "0") + ".dcm"; // reverse position order
+  writeFileSync(path.join(dicom, name), dicomSlice(k));
+  writeFileSync(path.join(dicomRLE, name), dicomSlice(k, k === 3 ? "1.2.840.10008.1.2.5" : undefined));
+}
 
 const near = (a, b) => Math.abs(a - b) <= 1e-5 * Math.max(1, Math.abs(b));
 const same = (a, b) => Array.isArray(a) ? a.length === b.length && a.every((x, i) => near(x, b[i])) : a === b;
@@ -234,4 +295,54 @@ for (const [server, kind, locals] of [
   await context.close();
 }
 
-await checks.finish(browser, niftiServer, metaServer);
+// A DICOM folder: served (the server's reader) and picked in the page's folder box.
+async function openFolder(page, dir) {
+  await page.evaluate(() => { document.getElementById("local-note").textContent = ""; });
+  await page.setInputFiles("#local-folder", dir);
+  await page.waitForFunction(() => /^(Opened|Not opened)/.test(document.getElementById("local-note").textContent),
+    null, { timeout: 60000 });
+  await page.evaluate(() => window.mediso.drawn());
+  return page.evaluate(() => document.getElementById("local-note").textContent);
+}
+const dicomServer = await startServer([dicom]);
+{
+  const context = await browser.newContext({ viewport: { width: 1400, height: 900 } });
+  const page = await context.newPage();
+  await openPage(page, dicomServer);
+  const iso = ISOVALUES.nii;
+  const served = await measure(page, iso);
+  checks.check(served.d.format.name === "DICOM", "the served DICOM folder: " + JSON.stringify(served.d.format));
+  const before = await page.evaluate(() => window.mediso.stats());
+  const note = await openFolder(page, dicom);
+  const after = await page.evaluate(() => window.mediso.stats());
+  checks.check(/^Opened/.test(note), "the DICOM folder (picked): " + note);
+  checks.check(after.bytesSent === before.bytesSent && after.bytesReceived === before.bytesReceived,
+    "the DICOM folder: nothing sent or received (" + (after.bytesSent - before.bytesSent) + " and " +
+    (after.bytesReceived - before.bytesReceived) + " bytes)");
+  const local = await measure(page, iso);
+  compare("the DICOM folder (picked)", served, local);
+  // Dropped: Chromium's own drag of the folder's path (CDP), as a drop from the desktop.
+  {
+    await page.evaluate(() => { document.getElementById("local-note").textContent = ""; });
+    const cdp = await context.newCDPSession(page);
+    const data = { items: [], files: [dicom], dragOperationsMask: 1 };
+    for (const type of ["dragEnter", "dragOver", "drop"]) {
+      await cdp.send("Input.dispatchDragEvent", { type, x: 1200, y: 600, data });
+    }
+    await page.waitForFunction(() => /^(Opened|Not opened)/.test(document.getElementById("local-note").textContent),
+      null, { timeout: 60000 });
+    await page.evaluate(() => window.mediso.drawn());
+    const dropNote = await page.evaluate(() => document.getElementById("local-note").textContent);
+    checks.check(/^Opened dicom-series/.test(dropNote), "the DICOM folder (dropped): " + dropNote);
+    compare("the DICOM folder (dropped)", served, await measure(page, iso));
+  }
+  const refused = await openFolder(page, dicomRLE);
+  const now = await measure(page, iso);
+  checks.check(/^Not opened: /.test(refused) && /"RLE Lossless" \(1\.2\.840\.10008\.1\.2\.5\) is not read in the page/.test(refused) &&
+    /The volume shown stays/.test(refused), "the DICOM folder with an RLE file: refused with " + JSON.stringify(refused));
+  checks.check(JSON.stringify(now.d) === JSON.stringify(local.d) && now.full === local.full,
+    "the DICOM folder with an RLE file: the volume shown stays (" + now.d.name + ", " + now.full + " triangles)");
+  await context.close();
+}
+
+await checks.finish(browser, niftiServer, metaServer, dicomServer);

@@ -6,14 +6,18 @@
 // decompressed a .gz (DecompressionStream); the page then shows it as it shows a served volume:
 // the dataset the module describes stands where /api/datasets' would, and its levels (every
 // 2nd, 4th, 8th point, as the server samples them) are made here from the values.
+// A DICOM folder (picked with the folder box, or dropped) goes the same way: its files (those
+// directly in it, as the server's reader scans a folder) are read by the module's DICOM series
+// core (Readers/Core/DICOMSeries.h), which reads uncompressed series as the server's reader does
+// and refuses the rest (compressed, big endian, multi-frame) by name.
 
 import { $, state } from "./state.js";
 import { countBytes, sessionToken } from "./volume.js";
 
 const VOLUME = /\.(nii|nii\.gz|mha|mhd)$/i;
-const REFUSED_HERE = "The page reads a NIfTI (.nii, .nii.gz) or a MetaImage (.mha, or .mhd with " +
-  "its data file) itself; open anything else (a DICOM series among them) through the server " +
-  "(Scripts/serve.sh --data)";
+const REFUSED_HERE = "The page reads a NIfTI (.nii, .nii.gz), a MetaImage (.mha, or .mhd with " +
+  "its data file) or a DICOM folder (picked with the folder box, or dropped) itself; open anything " +
+  "else through the server (Scripts/serve.sh --data)";
 
 async function bytesOf(file) {
   if (/\.gz$/i.test(file.name)) {
@@ -118,22 +122,88 @@ export async function readLocalFiles(files, budgetBytes) {
 }
 
 /**
+ * Reads the DICOM folder `name` (its files: File objects directly in it) with the module; the
+ * dataset, or an Error with the reason. `budgetBytes` as for readLocalFiles.
+ */
+export async function readLocalFolder(name, files, budgetBytes) {
+  const list = [...files];
+  const total = list.reduce((n, f) => n + f.size, 0);
+  if (total > budgetBytes) {
+    throw new Error(name + ": its files take " + (total / 1e6).toFixed(1) + " MB, over the page's " +
+      "memory budget of " + budgetBytes / 1e6 + " MB (raise the budget, or open it through the " +
+      "server, which sends a coarser level).");
+  }
+  if (!list.length) {
+    throw new Error(name + ": the folder holds no files.");
+  }
+  const M = state.module;
+  const folder = "/local-dicom";
+  if (!M.FS.analyzePath(folder).exists) {
+    M.FS.mkdir(folder);
+  }
+  const written = [];
+  let read;
+  try {
+    for (const file of list) {
+      const path = folder + "/" + file.name;
+      M.FS.writeFile(path, new Uint8Array(await file.arrayBuffer()));
+      written.push(path);
+    }
+    read = M.readLocalDICOM(folder, name);
+  } finally {
+    for (const path of written) {
+      M.FS.unlink(path);
+    }
+  }
+  if (read.error) {
+    throw new Error(read.error.startsWith(name + ":") ? read.error + "." : name + ": " + read.error + ".");
+  }
+  if (read.bytes > budgetBytes) {
+    M._free(read.pointer);
+    throw new Error(name + ": its " + read.type + " values take " + (read.bytes / 1e6).toFixed(1) +
+      " MB, over the page's memory budget of " + budgetBytes / 1e6 + " MB (raise the " +
+      "budget, or open it through the server, which sends a coarser level).");
+  }
+  const values = M.HEAPU8.slice(read.pointer, read.pointer + read.bytes);
+  M._free(read.pointer);
+  return localDataset(name, read, values);
+}
+
+// The files directly in a dropped folder (FileSystemDirectoryEntry), not those of its subfolders.
+async function folderFiles(entry) {
+  const reader = entry.createReader();
+  const entries = [];
+  for (;;) {
+    const batch = await new Promise((resolve, reject) => reader.readEntries(resolve, reject));
+    if (!batch.length) {
+      break;
+    }
+    entries.push(...batch);
+  }
+  return Promise.all(entries.filter((e) => e.isFile).map((e) =>
+    new Promise((resolve, reject) => e.file(resolve, reject))));
+}
+
+/**
  * The file box and dropping on the page. `open(dataset)` (app.js) shows the volume read; a file
  * that cannot be read is said in #local-note and the volume shown stays.
  */
 export function setupLocalFiles(open) {
   const note = $("local-note");
   let busy = false;
-  const take = async (files) => {
-    if (busy || !files || !files.length) {
+  // `folder`: a DICOM folder's name (its files in `files`), else files to read by their names.
+  const take = async (files, folder = null) => {
+    if (busy || !files || (!files.length && !folder)) {
       return;
     }
     busy = true;
-    note.textContent = "Reading " + [...files].map((f) => f.name).join(", ") + " in the page...";
+    note.textContent = "Reading " + (folder !== null ? "the DICOM folder " + folder :
+      [...files].map((f) => f.name).join(", ")) + " in the page...";
     note.classList.remove("error");
     try {
       const budget = (Number($("budget").value) || 1024) * 1e6;
-      const d = await readLocalFiles(files, budget);
+      const d = folder !== null ? await readLocalFolder(folder, files, budget) :
+        await readLocalFiles(files, budget);
       await open(d);
       note.textContent = "Opened " + d.name + " from this computer, read in the page (nothing was " +
         "sent)." + (d.warnings.length ? " Note: " + d.warnings.join(" ") : "");
@@ -145,14 +215,37 @@ export function setupLocalFiles(open) {
     }
   };
   $("local-file").onchange = () => take($("local-file").files);
+  // A picked folder: the files directly in it (webkitRelativePath "folder/name").
+  $("local-folder").onchange = () => {
+    const files = [...$("local-folder").files];
+    if (files.length) {
+      const name = files[0].webkitRelativePath.split("/")[0];
+      take(files.filter((f) => f.webkitRelativePath.split("/").length === 2), name);
+    }
+  };
   document.addEventListener("dragover", (e) => {
     if (e.dataTransfer && [...e.dataTransfer.types].includes("Files")) {
       e.preventDefault();
     }
   });
   document.addEventListener("drop", (e) => {
-    if (e.dataTransfer && e.dataTransfer.files.length) {
-      e.preventDefault();
+    if (!e.dataTransfer || !e.dataTransfer.files.length) {
+      return;
+    }
+    e.preventDefault();
+    // The entries are only available during the event: taken before any await.
+    const entries = [...e.dataTransfer.items].map((item) => item.webkitGetAsEntry && item.webkitGetAsEntry());
+    const folders = entries.filter((entry) => entry && entry.isDirectory);
+    if (folders.length === 1 && entries.length === 1) {
+      folderFiles(folders[0]).then((files) => take(files, folders[0].name), (error) => {
+        note.textContent = "Not opened: " + folders[0].name + ": its files cannot be listed (" +
+          error.message + "). The volume shown stays.";
+        note.classList.add("error");
+      });
+    } else if (folders.length) {
+      note.textContent = "Not opened: drop one DICOM folder at a time, alone. The volume shown stays.";
+      note.classList.add("error");
+    } else {
       take(e.dataTransfer.files);
     }
   });

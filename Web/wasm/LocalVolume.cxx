@@ -13,11 +13,16 @@
  * - `.mha`, `.mhd` (its data file written beside it): mediso::headless::ReadMetaImage
  *   (Headless/MetaImage.h, the reader mediso-render uses), its TransformMatrix as the direction;
  *   world space LPS, as ITK and the server take it.
+ * - a DICOM folder (`readLocalDICOM(folder, name)`: the folder's files written under it):
+ *   mediso::ReadDICOMSeries (Readers/Core/DICOMSeries.h), vtkMedicalDICOMSeriesReader's rules over
+ *   uncompressed little-endian single-frame files (TestDICOMSeriesMatchesReader compares the two),
+ *   anything else refused by name; world space LPS.
  *
  * The answer is what the server's /api/datasets says of a volume (dims, spacing, origin,
  * direction, type, range, bytes, format {name, space}) and, in `pointer`, the values (x fastest,
  * in the type named) in the module's heap, which the page copies out and frees; or `{error}`.
  */
+#include "DICOMSeries.h"
 #include "MetaImage.h"
 #include "NIfTIImage.h"
 #include "ScalarTypes.h"
@@ -26,6 +31,7 @@
 #include <emscripten/val.h>
 
 #include <cmath>
+#include <dirent.h>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -159,9 +165,51 @@ val ReadLocalVolume(const std::string& path)
   }
   return Failure("not a file the page reads (.nii, .nii.gz, .mha, .mhd with its data file)");
 }
+
+/// The series of the DICOM folder at `folder` in the module's file system (its regular files,
+/// not its subfolders, as the server's reader scans a folder), or {error}. `name` names the
+/// folder in messages.
+val ReadLocalDICOM(const std::string& folder, const std::string& name)
+{
+  DIR* directory = opendir(folder.c_str());
+  if (!directory)
+  {
+    return Failure("the folder cannot be listed");
+  }
+  std::vector<std::string> names;
+  while (const dirent* entry = readdir(directory))
+  {
+    const std::string file = entry->d_name;
+    if (file != "." && file != ".." && entry->d_type == DT_REG)
+    {
+      names.push_back(file);
+    }
+  }
+  closedir(directory);
+  std::vector<std::vector<unsigned char>> contents(names.size());
+  std::vector<mediso::DICOMFileBytes> files(names.size());
+  for (std::size_t i = 0; i < names.size(); ++i)
+  {
+    std::ifstream in(folder + "/" + names[i], std::ios::binary);
+    contents[i].assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    files[i].Name = names[i];
+    files[i].Bytes = contents[i].data();
+    files[i].Size = contents[i].size();
+  }
+  mediso::DICOMSeriesVolume volume;
+  const std::string error = mediso::ReadDICOMSeries(name, files, volume);
+  contents.clear(); // the files' copies, before the values are copied
+  if (!error.empty())
+  {
+    return Failure(error);
+  }
+  return Describe(volume.Dimensions, volume.Spacing, volume.Origin, volume.Direction, volume.Type,
+    volume.Values, "DICOM", "LPS", volume.Warnings);
+}
 } // namespace
 
 EMSCRIPTEN_BINDINGS(mediso_local_volume)
 {
   emscripten::function("readLocalVolume", &ReadLocalVolume);
+  emscripten::function("readLocalDICOM", &ReadLocalDICOM);
 }
