@@ -83,6 +83,14 @@ export async function startViewer(canvas, probe) {
   if (!state.viewer.ready()) {
     return false;
   }
+  // Where the GPU path keeps the volume as bricks (tests): a texture limit below the context's
+  // and a GPU budget in MB (the core's defaults otherwise: the context's limit, 1 GiB).
+  if (params.get("maxTextureSize")) {
+    state.viewer.setMaxTextureSize(Number(params.get("maxTextureSize")) || 0);
+  }
+  if (params.get("gpuBudgetMB")) {
+    state.viewer.setGPUBudget(1e6 * (Number(params.get("gpuBudgetMB")) || 0));
+  }
   const debug = probe.getExtension("WEBGL_debug_renderer_info");
   state.unmaskedRenderer = debug ? probe.getParameter(debug.UNMASKED_RENDERER_WEBGL)
                                  : state.viewer.info().renderer;
@@ -167,9 +175,25 @@ function recordFrame(ms, stats) {
   }
 }
 
+/**
+ * Called with the core's reason when the GPU path refused a frame because the bricks the
+ * isovalues cross exceed the GPU budget (path.js falls back to the CPU path, saying why).
+ */
+export const gpuRefused = [];
+function refusedOnGPU(stats) {
+  if (stats.overBudget) {
+    for (const call of gpuRefused) {
+      call(stats.error);
+    }
+  }
+}
+
 // The worker's answer to a frame (remote.js).
 function frameAnswered(stats) {
   recordFrame(stats.ms, stats);
+  if (!stats.ok) {
+    refusedOnGPU(stats);
+  }
 }
 
 // The newest frame asked of the worker ({id, first, settled}: remote.js).
@@ -193,7 +217,12 @@ export function renderNow(interactive = false) {
   }
   const start = performance.now();
   if (!viewer.render()) {
-    throw new Error("render failed: " + viewer.stats().error);
+    const stats = viewer.stats();
+    if (stats.overBudget && gpuRefused.length) {
+      refusedOnGPU(stats);
+      return 0;
+    }
+    throw new Error("render failed: " + stats.error);
   }
   viewer.finish();
   const ms = performance.now() - start;
