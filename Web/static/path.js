@@ -7,7 +7,7 @@ import { showPathNote } from "./readout.js";
 import { $, state } from "./state.js";
 import { loadVolume } from "./volume.js";
 import { canStream, startStream, stopStream } from "./stream.js";
-import { gpuRefused, renderNow } from "./viewer.js";
+import { renderNow } from "./viewer.js";
 
 // The CPU path keeps the volume within 1 / CPU_VOLUME_SHARE of the budget: its surfaces and
 // their cache take the rest.
@@ -23,7 +23,7 @@ export function ordinal(n) {
 // The finest level of the volume a path can afford. GPU: the volume itself within the budget
 // (the core keeps a volume over the 3D texture limit or its GPU budget as bricks, only those the
 // isovalues cross on the GPU; where even those exceed its budget it says so at the frame, and
-// the page falls back: gpuRefused below). CPU: the volume within its share.
+// the page falls back: fallBackFromGPU below). CPU: the volume within its share.
 function chooseLevel(dataset, info, budgetMB, path) {
   const { count, strides } = state.facts.levels;
   const full = count - 1;
@@ -89,15 +89,17 @@ export async function applyPath() {
   state.viewer.setBudget(Math.max(0, budgetMB * 1e6 - volumeBytes));
 }
 
-// The core refused a GPU frame (the bricks the isovalues cross exceed the GPU budget): the
-// CPU path for this dataset, the reason said in the path note, and the frame again.
-gpuRefused.push((why) => {
+/**
+ * The core refused a GPU frame (the bricks the isovalues cross exceed the GPU budget; viewer.js):
+ * the CPU path for this dataset, the reason said in the path note, and the frame again.
+ */
+export function fallBackFromGPU(why) {
   if (state.path !== "gpu" || (state.gpuRefused && state.gpuRefused.dataset === state.dataset)) {
     return;
   }
   state.gpuRefused = { dataset: state.dataset, why };
   applyPath().then(() => renderNow());
-});
+}
 
 /** A new requested path ("auto", "gpu" or "cpu"), applied. */
 export async function requestPath(path) {

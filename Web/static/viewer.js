@@ -4,6 +4,7 @@
 // also states the facts the page needs of the cores (scalar types, levels of detail and their
 // strides, the isovalue limit, the GPU path's memory of a volume), read once into state.facts.
 
+import { fallBackFromGPU } from "./path.js";
 import { parsePLY } from "./ply.js";
 import { RemoteViewer, offscreenWebGL2 } from "./remote.js";
 import { updateReadout } from "./readout.js";
@@ -175,16 +176,11 @@ function recordFrame(ms, stats) {
   }
 }
 
-/**
- * Called with the core's reason when the GPU path refused a frame because the bricks the
- * isovalues cross exceed the GPU budget (path.js falls back to the CPU path, saying why).
- */
-export const gpuRefused = [];
+// A frame the GPU path refused because the bricks the isovalues cross exceed its GPU budget:
+// path.js falls back to the CPU path, saying why (the core's reason).
 function refusedOnGPU(stats) {
   if (stats.overBudget) {
-    for (const call of gpuRefused) {
-      call(stats.error);
-    }
+    fallBackFromGPU(stats.error);
   }
 }
 
@@ -218,7 +214,7 @@ export function renderNow(interactive = false) {
   const start = performance.now();
   if (!viewer.render()) {
     const stats = viewer.stats();
-    if (stats.overBudget && gpuRefused.length) {
+    if (stats.overBudget) {
       refusedOnGPU(stats);
       return 0;
     }
