@@ -151,7 +151,7 @@ std::shared_ptr<GLApi> GLApi::Load(ProcLookup lookup, void* user, std::string& e
     atiMemory |= std::strcmp(text, "GL_ATI_meminfo") == 0;
   }
   // Both report kilobytes (GL_ATI_meminfo: four values, the first the pool's total free memory).
-  const GLenum dedicatedNVX = 0x9047; // GL_GPU_MEMORY_INFO_DEDICATED_VIDMEM_NVX
+  const GLenum dedicatedNVX = 0x9047;   // GL_GPU_MEMORY_INFO_DEDICATED_VIDMEM_NVX
   const GLenum textureFreeATI = 0x87FC; // GL_TEXTURE_FREE_MEMORY_ATI
   GLint kilobytes[4] = { 0, 0, 0, 0 };
   if (nvxMemory)

@@ -127,8 +127,11 @@ struct IsosurfaceScene::Internals
     // Half of what the device has leaves the rest to the host's other textures, its frame
     // buffers and other programs.
     const std::uint64_t device = this->GL ? this->GL->GetDeviceMemoryBytes() : 0;
-    return this->Budget > 0 ? this->Budget
-                            : device > 0 ? device / 2 : IsosurfaceScene::DefaultGPUMemoryBudget;
+    if (this->Budget > 0)
+    {
+      return this->Budget;
+    }
+    return device > 0 ? device / 2 : IsosurfaceScene::DefaultGPUMemoryBudget;
   }
   // The texture of a brick: its cells' points with the apron.
   void BrickTexture(std::int64_t brick, int extent[6], int points[3]) const

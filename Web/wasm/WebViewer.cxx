@@ -776,7 +776,8 @@ public:
     // The GPU path's bricks (0 where the volume is one texture), those the isovalues cross and
     // those on the GPU; overBudget: the last update failed because the crossed ones exceed the
     // GPU budget (the page then falls back to the CPU path with the error as its reason).
-    const IsosurfaceSceneStats bricks = this->Scene ? this->Scene->GetStats() : IsosurfaceSceneStats();
+    const IsosurfaceSceneStats bricks =
+      this->Scene ? this->Scene->GetStats() : IsosurfaceSceneStats();
     stats.set("bricks", static_cast<double>(bricks.Bricks));
     stats.set("activeBricks", static_cast<double>(bricks.ActiveBricks));
     stats.set("residentBricks", static_cast<double>(bricks.ResidentBricks));
