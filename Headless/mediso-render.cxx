@@ -96,7 +96,9 @@ Context:
                         context's GL_MAX_3D_TEXTURE_SIZE); a volume over it is kept
                         as bricks, only those the isovalues cross on the GPU
   --gpu-budget-mb M     GPU memory for the volume's textures and pyramids, in MB
-                        (default 1024); a volume over it is kept as bricks
+                        (default: half the device's memory where OpenGL tells it,
+                        GL_NVX_gpu_memory_info or GL_ATI_meminfo, else 1024); a
+                        volume over it is kept as bricks
 MEDISO_EGL_PLATFORM=surfaceless|device|default picks the EGL display.
 )";
 
@@ -773,7 +775,8 @@ int Run(int argc, char* argv[])
            << ", \"sample_distance\": " << stats.SampleDistance << ", \"bricks\": " << stats.Bricks
            << ", \"brick_points\": " << stats.BrickPoints
            << ", \"active_bricks\": " << stats.ActiveBricks
-           << ", \"resident_bricks\": " << stats.ResidentBricks << "}";
+           << ", \"resident_bricks\": " << stats.ResidentBricks << ", \"gpu_budget_mb\": "
+           << scene.Scene.GetGPUMemoryBudget() / (1024.0 * 1024.0) << "}";
       std::printf("%s\n", json.str().c_str());
     }
   }

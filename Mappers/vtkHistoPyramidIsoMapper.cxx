@@ -548,6 +548,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     };
   }
   gpu->SetVolumeLevel(gpuLevel);
+  gpu->SetGPUMemoryBudget(static_cast<std::uint64_t>(1.0e6 * this->GPUMemoryBudget));
   const std::uint64_t buildsBefore = gpu->GetStats().PyramidBuilds + gpu->GetStats().CoarseBuilds;
   const std::uint64_t uploadsBefore = gpu->GetStats().VolumeUploads;
   const Clock::time_point gpuStart = Clock::now();
@@ -671,6 +672,7 @@ void vtkHistoPyramidIsoMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "GPUMemoryBytes: " << this->GetGPUMemoryBytes() << "\n";
   os << indent << "InteractiveAdjust: " << this->InteractiveAdjust << "\n";
   os << indent << "InteractiveFrameBudget: " << this->InteractiveFrameBudget << "\n";
+  os << indent << "GPUMemoryBudget: " << this->GPUMemoryBudget << " MB\n";
   os << indent << "InteractiveTriangleLevels: " << this->InteractiveTriangleLevels << "\n";
   os << indent << "InteractiveVolumeLevels: " << this->InteractiveVolumeLevels << "\n";
   os << indent << "LastInteractive: " << this->LastInteractive << "\n";

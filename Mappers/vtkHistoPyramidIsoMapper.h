@@ -235,6 +235,28 @@ public:
 
   ///@{
   /**
+   * GPU memory, in MB (10^6 bytes), that the volume's textures and pyramids
+   * may take (mediso::IsosurfaceScene::SetGPUMemoryBudget). 0, the default:
+   * half of the device's memory where OpenGL tells it
+   * (GL_NVX_gpu_memory_info, GL_ATI_meminfo), else 1 GiB. A volume whose one
+   * texture exceeds it (or GL_MAX_3D_TEXTURE_SIZE) is kept as bricks, only
+   * those the isovalues cross on the GPU (GetLastBricks()); where even those
+   * exceed it the CPU fallback draws, with that reason.
+   */
+  vtkSetClampMacro(GPUMemoryBudget, double, 0.0, VTK_DOUBLE_MAX);
+  vtkGetMacro(GPUMemoryBudget, double);
+  ///@}
+
+  /**
+   * The last GPU frame's bricks: how many the volume is kept as (0 where it
+   * is one texture), how many the isovalues cross, how many are on the GPU.
+   */
+  std::uint64_t GetLastBricks() const { return this->GPUStats.Bricks; }
+  std::uint64_t GetLastActiveBricks() const { return this->GPUStats.ActiveBricks; }
+  std::uint64_t GetLastResidentBricks() const { return this->GPUStats.ResidentBricks; }
+
+  ///@{
+  /**
    * Let an interactive GPU frame whose coarsest sample distance is still
    * predicted over the budget draw a coarser Block LOD level's triangles
    * instead (see the class description). Off: interactive GPU frames stay
@@ -409,6 +431,7 @@ private:
   bool FirstHitPass = true;
   bool InteractiveAdjust = true;
   double InteractiveFrameBudget = 0.1;
+  double GPUMemoryBudget = 0.0;
   bool InteractiveTriangleLevels = true;
   bool InteractiveVolumeLevels = true;
   bool LastInteractive = false;

@@ -132,6 +132,12 @@ void vtkOpenGLHistoPyramidIsosurfaces::SetVolumeLevel(int level)
 }
 
 //------------------------------------------------------------------------------
+void vtkOpenGLHistoPyramidIsosurfaces::SetGPUMemoryBudget(std::uint64_t bytes)
+{
+  this->Impl->Scene.SetGPUMemoryBudget(bytes);
+}
+
+//------------------------------------------------------------------------------
 std::uint64_t vtkOpenGLHistoPyramidIsosurfaces::GetActivePairs(int level) const
 {
   return this->Impl->Scene.GetActivePairs(level);

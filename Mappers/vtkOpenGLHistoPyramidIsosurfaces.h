@@ -86,6 +86,9 @@ public:
    */
   void SetVolumeLevel(int level);
 
+  /// The scene's GPU budget in bytes (0: its default; IsosurfaceScene::SetGPUMemoryBudget).
+  void SetGPUMemoryBudget(std::uint64_t bytes);
+
   /// The active pairs of a level built for the last frame's surfaces (0 when not built).
   std::uint64_t GetActivePairs(int level) const;
 

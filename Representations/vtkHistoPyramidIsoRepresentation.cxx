@@ -249,6 +249,31 @@ const char* vtkHistoPyramidIsoRepresentation::GetRenderPath()
 }
 
 //------------------------------------------------------------------------------
+void vtkHistoPyramidIsoRepresentation::SetGPUMemoryBudget(double megabytes)
+{
+  if (megabytes != this->IsoMapper->GetGPUMemoryBudget())
+  {
+    this->IsoMapper->SetGPUMemoryBudget(megabytes);
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+double vtkHistoPyramidIsoRepresentation::GetGPUMemoryBudget()
+{
+  return this->IsoMapper->GetGPUMemoryBudget();
+}
+
+//------------------------------------------------------------------------------
+double* vtkHistoPyramidIsoRepresentation::GetLastBricks()
+{
+  this->LastBricks[0] = static_cast<double>(this->IsoMapper->GetLastBricks());
+  this->LastBricks[1] = static_cast<double>(this->IsoMapper->GetLastActiveBricks());
+  this->LastBricks[2] = static_cast<double>(this->IsoMapper->GetLastResidentBricks());
+  return this->LastBricks;
+}
+
+//------------------------------------------------------------------------------
 const char* vtkHistoPyramidIsoRepresentation::GetFallbackReason()
 {
   return this->IsoMapper->GetFallbackReason().c_str();

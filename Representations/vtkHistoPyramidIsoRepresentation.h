@@ -138,6 +138,18 @@ public:
 
   ///@{
   /**
+   * The GPU memory budget in MB (vtkHistoPyramidIsoMapper::SetGPUMemoryBudget;
+   * 0, the default: half the device's memory where OpenGL tells it, else
+   * 1 GiB), and the last GPU frame's bricks: how many the volume is kept as
+   * (0: one texture), how many the isovalues cross, how many are resident.
+   */
+  void SetGPUMemoryBudget(double megabytes);
+  double GetGPUMemoryBudget();
+  double* GetLastBricks() VTK_SIZEHINT(3);
+  ///@}
+
+  ///@{
+  /**
    * What the last frame on this process did: interactive (1) or still (0),
    * its image sample distance and Block LOD level, the seconds predicted
    * and measured (see vtkHistoPyramidIsoMapper). Doubles for the
@@ -244,6 +256,7 @@ private:
   double ClipPlaneOrigin[3] = { 0.0, 0.0, 0.0 };
   double ClipPlaneNormal[3] = { 1.0, 0.0, 0.0 };
   bool ClipPlaneInvert = true;
+  double LastBricks[3] = { 0.0, 0.0, 0.0 };
   vtkNew<vtkPlane> MapperClipPlane; // the plane as the mapper takes it (world, kept side)
   std::string LastResampleMessage;
   std::string LastRangeMessage;

@@ -133,17 +133,36 @@ std::shared_ptr<GLApi> GLApi::Load(ProcLookup lookup, void* user, std::string& e
     GLfloat granularity = 1.0f;
     f.GetFloatv(GL_POINT_SIZE_GRANULARITY, &granularity);
     api->PointSizeGranularity = std::max(0.0f, std::min(granularity, 1.0f));
-    GLint count = 0;
-    f.GetIntegerv(GL_NUM_EXTENSIONS, &count);
-    for (GLint e = 0; e < count; ++e)
-    {
-      const GLubyte* name = f.GetStringi(GL_EXTENSIONS, static_cast<GLuint>(e));
-      if (name && std::strcmp(reinterpret_cast<const char*>(name), "GL_ARB_conservative_depth") == 0)
-      {
-        api->ConservativeDepth = true;
-      }
-    }
   }
+  // The extensions: conservative depth (desktop GL), and the two that tell the device's memory.
+  bool nvxMemory = false, atiMemory = false;
+  GLint count = 0;
+  f.GetIntegerv(GL_NUM_EXTENSIONS, &count);
+  for (GLint e = 0; e < count; ++e)
+  {
+    const GLubyte* name = f.GetStringi(GL_EXTENSIONS, static_cast<GLuint>(e));
+    const char* text = reinterpret_cast<const char*>(name);
+    if (!name)
+    {
+      continue;
+    }
+    api->ConservativeDepth |= !api->ES && std::strcmp(text, "GL_ARB_conservative_depth") == 0;
+    nvxMemory |= std::strcmp(text, "GL_NVX_gpu_memory_info") == 0;
+    atiMemory |= std::strcmp(text, "GL_ATI_meminfo") == 0;
+  }
+  // Both report kilobytes (GL_ATI_meminfo: four values, the first the pool's total free memory).
+  const GLenum dedicatedNVX = 0x9047;   // GL_GPU_MEMORY_INFO_DEDICATED_VIDMEM_NVX
+  const GLenum textureFreeATI = 0x87FC; // GL_TEXTURE_FREE_MEMORY_ATI
+  GLint kilobytes[4] = { 0, 0, 0, 0 };
+  if (nvxMemory)
+  {
+    f.GetIntegerv(dedicatedNVX, kilobytes);
+  }
+  else if (atiMemory)
+  {
+    f.GetIntegerv(textureFreeATI, kilobytes);
+  }
+  api->DeviceMemoryBytes = static_cast<std::uint64_t>(std::max<GLint>(0, kilobytes[0])) * 1024;
   api->MaxPointSize = sizes[1];
   const std::string errors = api->TakeErrors();
   if (!errors.empty())

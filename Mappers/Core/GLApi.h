@@ -21,6 +21,7 @@
 #ifndef MedicalIsosurfaces_GLApi_h
 #define MedicalIsosurfaces_GLApi_h
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -73,6 +74,15 @@ public:
   bool HasConservativeDepth() const { return this->ConservativeDepth; }
 
   /**
+   * The device's memory in bytes where the context can tell (0 where not):
+   * GL_NVX_gpu_memory_info's dedicated video memory, else GL_ATI_meminfo's
+   * free texture memory at context creation. Neither OpenGL ES nor WebGL2
+   * has a query of its own, and Mesa's llvmpipe exposes neither extension.
+   * IsosurfaceScene's default GPU budget is half of it.
+   */
+  std::uint64_t GetDeviceMemoryBytes() const { return this->DeviceMemoryBytes; }
+
+  /**
    * The first lines of every shader the core compiles for this context:
    * `#version 150`, or `#version 300 es` with highp default precisions;
    * then MEDISO_GLSL_ES where it is GL ES, and the MEDISO_OUTPUT(n) macro
@@ -109,6 +119,7 @@ private:
   float MaxPointSize = 1.0f;
   float PointSizeGranularity = 1.0f;
   bool ConservativeDepth = false;
+  std::uint64_t DeviceMemoryBytes = 0;
 };
 
 } // namespace mediso

@@ -124,7 +124,14 @@ struct IsosurfaceScene::Internals
   }
   std::uint64_t GetBudget() const
   {
-    return this->Budget > 0 ? this->Budget : IsosurfaceScene::DefaultGPUMemoryBudget;
+    // Half of what the device has leaves the rest to the host's other textures, its frame
+    // buffers and other programs.
+    const std::uint64_t device = this->GL ? this->GL->GetDeviceMemoryBytes() : 0;
+    if (this->Budget > 0)
+    {
+      return this->Budget;
+    }
+    return device > 0 ? device / 2 : IsosurfaceScene::DefaultGPUMemoryBudget;
   }
   // The texture of a brick: its cells' points with the apron.
   void BrickTexture(std::int64_t brick, int extent[6], int points[3]) const

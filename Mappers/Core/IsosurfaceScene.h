@@ -128,7 +128,9 @@ public:
    * texture side the scene uses (0, the default: the context's
    * GL_MAX_3D_TEXTURE_SIZE; a smaller one makes tests brick a small volume).
    * SetGPUMemoryBudget(): the bytes the volume's textures and pyramids may
-   * take on the GPU (0, the default: DefaultGPUMemoryBudget). A volume whose
+   * take on the GPU (0, the default: half of the device's memory where the
+   * context tells it, GLApi::GetDeviceMemoryBytes(), else
+   * DefaultGPUMemoryBudget; GetGPUMemoryBudget() says which). A volume whose
    * one texture exceeds either is kept as bricks. A change takes effect at
    * the next SetVolume(), which then uploads again.
    */
@@ -136,7 +138,8 @@ public:
   int GetMaxTextureSize() const;
   void SetGPUMemoryBudget(std::uint64_t bytes);
   std::uint64_t GetGPUMemoryBudget() const;
-  /// The budget where none is set: 1 GiB, what a WebGL2 page can expect of most devices.
+  /// The budget where none is set and the context does not tell the device's memory (WebGL2,
+  /// OpenGL ES, Mesa): 1 GiB, what a WebGL2 page can expect of most devices.
   static constexpr std::uint64_t DefaultGPUMemoryBudget = std::uint64_t(1) << 30;
   /// Whether the current volume is kept as bricks.
   bool IsBricked() const;

@@ -53,6 +53,10 @@
 //              over several renders) and nothing drawn, never a crash; a
 //              volume over GL_MAX_3D_TEXTURE_SIZE is drawn as bricks on the
 //              GPU path with no message.
+//  Budget    - SetGPUMemoryBudget: 0.45 MB keeps the 64^3 phantom as bricks
+//              on the GPU path (dense bone, 1000 HU) with the primitives of
+//              one texture and no message; 0.001 MB, which its bricks
+//              exceed, falls back with that reason in one warning.
 #include "HistoPyramid.h"
 #include "IsoMapperTestScenes.h"
 #include "MedicalTestUtilities.h"
@@ -976,6 +980,65 @@ void BadInput()
   ExpectMessage("2100 slices (bricks)", SmallImage(4, 4, 2100, tall), { 40.0 }, false, "",
     vtkHistoPyramidIsoMapper::GPUPath);
 }
+
+// The GPU memory budget (issue 31): a budget below the 64^3 phantom's one texture (0.57 MB) keeps
+// it as bricks with the primitives of one texture, on the GPU path with no message, where the
+// bricks the isovalue crosses fit (1000 HU: the densest bone, a few bricks); one that they cannot
+// fit falls back with that reason, said once. (Bone at 400 HU crosses most bricks, whose aprons
+// and pyramids take more than the one texture: no budget bricks it.)
+void Budget()
+{
+  auto phantom = iso_test::Phantom(64);
+  const auto render = [&](double megabytes, vtkHistoPyramidIsoMapper* mapper)
+  {
+    mapper->SetGPUMemoryBudget(megabytes);
+    auto volume = iso_test::MakeVolume(phantom, { { 1000.0, { 1, 1, 1 }, 1.0 } }, mapper);
+    Scene scene(100, 100);
+    scene.Show(volume);
+    scene.Window->Render();
+    scene.Renderer->GetActiveCamera()->Azimuth(30);
+    scene.Window->Render();
+  };
+  vtkNew<vtkHistoPyramidIsoMapper> whole;
+  render(0.0, whole);
+  vtkNew<vtkHistoPyramidIsoMapper> bricked;
+  MessageCounter messages(bricked);
+  render(0.45, bricked);
+  std::printf("default budget: %s, %llu primitives, %llu bricks; 0.45 MB: %s, %llu primitives, "
+              "%llu bricks (%llu active, %llu resident), %d messages\n",
+    whole->GetLastRenderPathAsString(),
+    static_cast<unsigned long long>(whole->GetNumberOfPrimitives()),
+    static_cast<unsigned long long>(whole->GetLastBricks()), bricked->GetLastRenderPathAsString(),
+    static_cast<unsigned long long>(bricked->GetNumberOfPrimitives()),
+    static_cast<unsigned long long>(bricked->GetLastBricks()),
+    static_cast<unsigned long long>(bricked->GetLastActiveBricks()),
+    static_cast<unsigned long long>(bricked->GetLastResidentBricks()),
+    messages.Errors + messages.Warnings);
+  Check(whole->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
+      whole->GetLastBricks() == 0 && whole->GetNumberOfPrimitives() > 0,
+    "the default budget: one texture");
+  Check(bricked->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
+      bricked->GetLastBricks() > 1 && bricked->GetLastActiveBricks() > 0 &&
+      bricked->GetLastActiveBricks() <= bricked->GetLastResidentBricks() &&
+      messages.Errors + messages.Warnings == 0,
+    "a 0.45 MB budget: the GPU path over bricks, no message");
+  Check(bricked->GetNumberOfPrimitives() == whole->GetNumberOfPrimitives(),
+    "as bricks, the primitives of one texture");
+
+  vtkNew<vtkHistoPyramidIsoMapper> over;
+  MessageCounter overMessages(over);
+  render(0.001, over);
+  std::printf("0.001 MB: %s, reason '%s', %llu triangles, %d warnings\n",
+    over->GetLastRenderPathAsString(), over->GetFallbackReason().c_str(),
+    static_cast<unsigned long long>(over->GetNumberOfFallbackTriangles()), overMessages.Warnings);
+  Check(over->GetLastRenderPath() == vtkHistoPyramidIsoMapper::FallbackPath &&
+      over->GetNumberOfFallbackTriangles() > 0,
+    "a budget the active bricks exceed: the fallback draws");
+  Check(over->GetFallbackReason().find("over the budget") != std::string::npos &&
+      overMessages.Warnings == 1 && overMessages.Errors == 0 &&
+      overMessages.Text.find("GPU isosurface path unavailable") != std::string::npos,
+    "one warning gives the reason");
+}
 } // namespace
 
 int TestHistoPyramidIsoMapperChecks(int argc, char* argv[])
@@ -1019,6 +1082,10 @@ int TestHistoPyramidIsoMapperChecks(int argc, char* argv[])
   else if (which == "BadInput")
   {
     BadInput();
+  }
+  else if (which == "Budget")
+  {
+    Budget();
   }
   else
   {

@@ -138,6 +138,8 @@ def render_info(display, location=vtkPVSession.RENDER_SERVER):
         "builds": int(value("HistoPyramidBuilds")),
         "gpu_bytes": int(value("HistoPyramidGPUMemoryBytes")),
         "framebuffer_bytes": int(value("HistoPyramidFrameBufferBytes")),
+        # the bricks the volume is kept as (0: one texture), those the isovalues cross, resident
+        "bricks": [int(b) for b in display.GetProperty("HistoPyramidLastBricks")],
     }
 
 

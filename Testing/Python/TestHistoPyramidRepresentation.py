@@ -157,6 +157,40 @@ else:
     check(onepass == 0.0, "the first-hit pass and one pass give the same image (%.3f%% of pixels "
           "differ)" % (100 * onepass))
     display.HistoPyramidFirstHitPass = 1
+
+    # The GPU memory budget (issue 31): 0.45 MB, below the 64^3 phantom's one texture (0.57 MB),
+    # keeps it as bricks where the bricks the isovalue crosses fit (dense bone at 1000 HU: a few;
+    # bone at 400 HU crosses most bricks, which with their aprons exceed the one texture), drawn
+    # with the primitives and the image of one texture; 0.001 MB falls back with that reason;
+    # 0 (the default) gives one texture again.
+    display.IsosurfaceValues = [1000.0]
+    Render(view)
+    dense = hp.render_info(display)
+    dense_shot = hp.screenshot(view, os.path.join(args.out, "TestHistoPyramidRepresentationDense.png"))
+    display.HistoPyramidGPUMemoryBudget = 0.45
+    _, bricked_output = hp.captured(lambda: Render(view))
+    bricked = hp.render_info(display)
+    check(bricked_output.strip() == "" and bricked["path"] == "gpu" and bricked["bricks"][0] > 1
+          and 0 < bricked["bricks"][1] <= bricked["bricks"][2],
+          "a 0.45 MB budget: the GPU path over bricks, no message (%s, bricks %s)"
+          % (bricked["path"], bricked["bricks"]))
+    check(dense["path"] == "gpu" and dense["bricks"][0] == 0 and
+          bricked["primitives"] == dense["primitives"] > 0,
+          "as bricks, the primitives of one texture (%d, %d)" % (bricked["primitives"], dense["primitives"]))
+    as_bricks = hp.screenshot(view, os.path.join(args.out, "TestHistoPyramidRepresentationBricks.png"))
+    check(hp.changed_fraction(dense_shot, as_bricks) < 0.002, "as bricks, the image of one texture "
+          "(%.3f%% of pixels differ)" % (100 * hp.changed_fraction(dense_shot, as_bricks)))
+    display.HistoPyramidGPUMemoryBudget = 0.001
+    _, over_output = hp.captured(lambda: Render(view))
+    over = hp.render_info(display)
+    check(over["path"] == "fallback" and over["triangles"] > 0 and "over the budget" in over["reason"]
+          and over_output.count("Warning") <= 1 and "ERROR" not in over_output,
+          "a 0.001 MB budget: the fallback, with the reason (%s, %r)" % (over["path"], over["reason"]))
+    display.HistoPyramidGPUMemoryBudget = 0
+    Render(view)
+    whole = hp.render_info(display)
+    check(whole["path"] == "gpu" and whole["bricks"][0] == 0,
+          "the default budget: one texture again (%s, bricks %s)" % (whole["path"], whole["bricks"]))
     print("gpu: %d primitives (skin+bone), %d (bone); fallback %d triangles; %.1f%% covered; "
           "points vs boxes: %.3f%% of pixels differ; first-hit buffers %d bytes"
           % (info["primitives"], bone["primitives"], forced["triangles"], 100 * fraction,

@@ -270,6 +270,16 @@ elif args.case == "gpu":
             {"call": "setSurfaces", "args": [[BONE]]},
             {"call": "cpuCount", "args": [[BONE["value"]]]},
             {"call": "shot", "args": [shot]}], "gpu")
+        # The same page with a forced texture limit of 32 (the 72^3 phantom as 27 bricks of 24)
+        # and a 3 MB GPU budget, and with a budget that the bricks bone crosses cannot fit.
+        bricked_shot = os.path.join(args.out, "page-gpu-bricks.png")
+        bricked = run_page(url + "&path=gpu&maxTextureSize=32&gpuBudgetMB=3", common + [
+            {"call": "setSurfaces", "args": [[BONE]]},
+            {"call": "shot", "args": [bricked_shot]}], "gpu-bricks")
+        # (the refused frame's answer starts the fallback; the second call waits for its frame)
+        refused = run_page(url + "&path=gpu&maxTextureSize=32&gpuBudgetMB=0.01", common + [
+            {"call": "setSurfaces", "args": [[BONE]]},
+            {"call": "setSurfaces", "args": [[BONE]]}], "gpu-over-budget")
     finally:
         stop_server(server)
     check(result["state"] == "ready", "the page is ready (%s)" % result["state"])
@@ -291,6 +301,22 @@ elif args.case == "gpu":
     check(stats["primitives"] == ours,
           "the page's primitives (%d) equal the ParaView mapper's (%d)" % (stats["primitives"], ours))
     compare(shot, reference, "the GPU path against ParaView's HistoPyramid Isosurface")
+    b = bricked["stats"]
+    print("bricked page stats: " + json.dumps({k: b[k] for k in ("path", "primitives", "bricks", "activeBricks",
+                                                                "residentBricks")}))
+    check(bricked["state"] == "ready" and b["path"] == "gpu" and b["bricks"] == 27 and
+          0 < b["activeBricks"] <= b["residentBricks"] <= 27,
+          "under a texture limit of 32 the page draws the phantom on the GPU path as 27 bricks "
+          "(%d, %d active, %d resident)" % (b["bricks"], b["activeBricks"], b["residentBricks"]))
+    check(b["primitives"] == stats["primitives"],
+          "as bricks, the page's primitives (%d) are those of one texture (%d)" % (b["primitives"], stats["primitives"]))
+    compare(bricked_shot, reference, "the GPU path as bricks against ParaView's HistoPyramid Isosurface")
+    r = refused["stats"]
+    print("over-budget page stats: " + json.dumps({k: r[k] for k in ("path", "reason", "triangles")}))
+    check(refused["state"] == "ready" and r["path"] == "cpu" and r["triangles"] > 0 and
+          "over the budget" in r["reason"],
+          "with the bricks bone crosses over a 0.01 MB GPU budget the page falls back to the CPU "
+          "path and says why (%s, %s)" % (r["path"], r["reason"]))
 else:
     server, url = start_server()
     try:

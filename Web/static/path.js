@@ -7,6 +7,7 @@ import { showPathNote } from "./readout.js";
 import { $, state } from "./state.js";
 import { loadVolume } from "./volume.js";
 import { canStream, startStream, stopStream } from "./stream.js";
+import { renderNow } from "./viewer.js";
 
 // The CPU path keeps the volume within 1 / CPU_VOLUME_SHARE of the budget: its surfaces and
 // their cache take the rest.
@@ -19,23 +20,21 @@ export function ordinal(n) {
   return n + suffix;
 }
 
-// The finest level of the volume a path can afford. GPU: its texture within the WebGL limits,
-// the volume texture and the pyramid within the budget. CPU: the volume within its share.
+// The finest level of the volume a path can afford. GPU: the volume itself within the budget
+// (the core keeps a volume over the 3D texture limit or its GPU budget as bricks, only those the
+// isovalues cross on the GPU; where even those exceed its budget it says so at the frame, and
+// the page falls back: fallBackFromGPU below). CPU: the volume within its share.
 function chooseLevel(dataset, info, budgetMB, path) {
   const { count, strides } = state.facts.levels;
   const full = count - 1;
-  const type = state.facts.scalarTypes.get(dataset.type);
   for (let k = full; k >= 0; --k) {
     const level = dataset.levels[k];
     const d = level.dims;
-    const gpu = path === "cpu" ? null : state.facts.gpuVolume(type.value, d);
-    const fitsGL = !gpu || Math.max(...gpu.texture) <= info.max3DTextureSize;
-    const fitsBudget = (gpu ? gpu.bytes : CPU_VOLUME_SHARE * level.bytes) <= budgetMB * 1e6;
-    if (fitsGL && fitsBudget) {
+    const bytes = path === "cpu" ? CPU_VOLUME_SHARE * level.bytes : level.bytes;
+    if (bytes <= budgetMB * 1e6) {
       const why = k === full ? "" :
         "The volume is sent at level " + k + " (every " + ordinal(strides[k]) + " point, " +
-        d.join("x") + "): the full " + dataset.dims.join("x") + " volume exceeds " +
-        (fitsGL ? "the memory budget." : "this WebGL's 3D texture limit.");
+        d.join("x") + "): the full " + dataset.dims.join("x") + " volume exceeds the memory budget.";
       return { level: k, why };
     }
   }
@@ -48,6 +47,12 @@ function chooseLevel(dataset, info, budgetMB, path) {
 function choosePath(requested, info, dataset, budgetMB) {
   const gpu = chooseLevel(dataset, info, budgetMB, "gpu");
   const cpu = chooseLevel(dataset, info, budgetMB, "cpu");
+  // The GPU path refused this dataset's surfaces (the bricks they cross exceed its GPU budget):
+  // the CPU path, with the core's reason, whatever was asked for.
+  if (state.gpuRefused && state.gpuRefused.dataset === dataset) {
+    return { path: "cpu", level: cpu, why: "the GPU path cannot draw these surfaces: " +
+      state.gpuRefused.why };
+  }
   if (requested === "gpu" || requested === "cpu") {
     return { path: requested, level: requested === "gpu" ? gpu : cpu, why: "chosen by the user" };
   }
@@ -82,6 +87,18 @@ export async function applyPath() {
   }
   const volumeBytes = state.dataset.levels[state.stream ? state.stream.level : state.level].bytes;
   state.viewer.setBudget(Math.max(0, budgetMB * 1e6 - volumeBytes));
+}
+
+/**
+ * The core refused a GPU frame (the bricks the isovalues cross exceed the GPU budget; viewer.js):
+ * the CPU path for this dataset, the reason said in the path note, and the frame again.
+ */
+export function fallBackFromGPU(why) {
+  if (state.path !== "gpu" || (state.gpuRefused && state.gpuRefused.dataset === state.dataset)) {
+    return;
+  }
+  state.gpuRefused = { dataset: state.dataset, why };
+  applyPath().then(() => renderNow());
 }
 
 /** A new requested path ("auto", "gpu" or "cpu"), applied. */

@@ -184,6 +184,8 @@ export class RemoteViewer {
   setPath(path) { this.call("setPath", path); }
   setCPULevel(level) { this.call("setCPULevel", level); }
   setBudget(bytes) { this.call("setBudget", bytes); }
+  setMaxTextureSize(texels) { this.call("setMaxTextureSize", texels); }
+  setGPUBudget(bytes) { this.call("setGPUBudget", bytes); }
   /** The estimator's table, from the worker (a promise). */
   estimates() { return this.ask("estimates"); }
   clearResultMesh() { this.call("clearResultMesh"); }

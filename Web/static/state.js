@@ -43,6 +43,9 @@ export const state = Object.seal({
   path: "gpu",
   reason: "",
   levelNote: "",
+  // {dataset, why}: the GPU path refused this dataset's surfaces (the bricks they cross exceed
+  // its GPU budget), so the CPU path draws it.
+  gpuRefused: null,
 
   // surfaces.js (and app.js's automation, through surfaces.js): the isosurfaces
   // [{value, color: [r, g, b], opacity}], and hidden: true on the source of a server result

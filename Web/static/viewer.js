@@ -4,6 +4,7 @@
 // also states the facts the page needs of the cores (scalar types, levels of detail and their
 // strides, the isovalue limit, the GPU path's memory of a volume), read once into state.facts.
 
+import { fallBackFromGPU } from "./path.js";
 import { parsePLY } from "./ply.js";
 import { RemoteViewer, offscreenWebGL2 } from "./remote.js";
 import { updateReadout } from "./readout.js";
@@ -82,6 +83,14 @@ export async function startViewer(canvas, probe) {
   setInterval(() => state.frameTimes.length && updateReadout(), 1000);
   if (!state.viewer.ready()) {
     return false;
+  }
+  // Where the GPU path keeps the volume as bricks (tests): a texture limit below the context's
+  // and a GPU budget in MB (the core's defaults otherwise: the context's limit, 1 GiB).
+  if (params.get("maxTextureSize")) {
+    state.viewer.setMaxTextureSize(Number(params.get("maxTextureSize")) || 0);
+  }
+  if (params.get("gpuBudgetMB")) {
+    state.viewer.setGPUBudget(1e6 * (Number(params.get("gpuBudgetMB")) || 0));
   }
   const debug = probe.getExtension("WEBGL_debug_renderer_info");
   state.unmaskedRenderer = debug ? probe.getParameter(debug.UNMASKED_RENDERER_WEBGL)
@@ -167,9 +176,20 @@ function recordFrame(ms, stats) {
   }
 }
 
+// A frame the GPU path refused because the bricks the isovalues cross exceed its GPU budget:
+// path.js falls back to the CPU path, saying why (the core's reason).
+function refusedOnGPU(stats) {
+  if (stats.overBudget) {
+    fallBackFromGPU(stats.error);
+  }
+}
+
 // The worker's answer to a frame (remote.js).
 function frameAnswered(stats) {
   recordFrame(stats.ms, stats);
+  if (!stats.ok) {
+    refusedOnGPU(stats);
+  }
 }
 
 // The newest frame asked of the worker ({id, first, settled}: remote.js).
@@ -193,7 +213,12 @@ export function renderNow(interactive = false) {
   }
   const start = performance.now();
   if (!viewer.render()) {
-    throw new Error("render failed: " + viewer.stats().error);
+    const stats = viewer.stats();
+    if (stats.overBudget) {
+      refusedOnGPU(stats);
+      return 0;
+    }
+    throw new Error("render failed: " + stats.error);
   }
   viewer.finish();
   const ms = performance.now() - start;

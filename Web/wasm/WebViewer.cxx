@@ -280,6 +280,28 @@ public:
   void SetBudget(double bytes) { this->Budget = std::max(0.0, bytes); }
 
   /**
+   * Where the GPU path keeps the volume as bricks (IsosurfaceScene::SetMaxTextureSize and
+   * SetGPUMemoryBudget): a texture limit below the context's and a GPU budget in bytes, 0 for
+   * the defaults (the context's limit, 1 GiB). The page sets them from ?maxTextureSize= and
+   * ?gpuBudgetMB= (tests) before the volume; they take effect at the next setVolume.
+   */
+  void SetMaxTextureSize(int texels)
+  {
+    if (this->Scene)
+    {
+      this->Scene->SetMaxTextureSize(std::max(0, texels));
+    }
+  }
+  void SetGPUBudget(double bytes)
+  {
+    if (this->Scene)
+    {
+      this->Scene->SetGPUMemoryBudget(
+        std::isfinite(bytes) && bytes > 0.0 ? static_cast<std::uint64_t>(bytes) : 0);
+    }
+  }
+
+  /**
    * The image sample distance of the next frames, 1 to 8: above 1 the
    * surfaces are drawn into a framebuffer 1/distance the size along each
    * axis and scaled up to the canvas, as VTK's volume mappers do with
@@ -768,6 +790,15 @@ public:
     stats.set("frameBufferBytes",
       this->Scene ? static_cast<double>(this->Scene->GetFrameBufferBytes()) : 0.0);
     stats.set("error", this->LastError);
+    // The GPU path's bricks (0 where the volume is one texture), those the isovalues cross and
+    // those on the GPU; overBudget: the last update failed because the crossed ones exceed the
+    // GPU budget (the page then falls back to the CPU path with the error as its reason).
+    const IsosurfaceSceneStats bricks =
+      this->Scene ? this->Scene->GetStats() : IsosurfaceSceneStats();
+    stats.set("bricks", static_cast<double>(bricks.Bricks));
+    stats.set("activeBricks", static_cast<double>(bricks.ActiveBricks));
+    stats.set("residentBricks", static_cast<double>(bricks.ResidentBricks));
+    stats.set("overBudget", !this->CPUPath && bricks.OverBudget);
     // Per surface of the last CPU frame, in the order drawn (IsosurfaceScene::Normalize's): its
     // isovalue, whether it came from the coarse volume (streaming), and its triangles.
     val values = val::array(), coarse = val::array(), triangles = val::array();
@@ -1332,6 +1363,8 @@ EMSCRIPTEN_BINDINGS(mediso_web)
     .function("setPath", &WebViewer::SetPath)
     .function("setCPULevel", &WebViewer::SetCPULevel)
     .function("setBudget", &WebViewer::SetBudget)
+    .function("setMaxTextureSize", &WebViewer::SetMaxTextureSize)
+    .function("setGPUBudget", &WebViewer::SetGPUBudget)
     .function("setSampleDistance", &WebViewer::SetSampleDistance)
     .function("setGPULevel", &WebViewer::SetGPULevel)
     .function("chooseFrame", &WebViewer::ChooseFrame)
