@@ -262,14 +262,7 @@ async def list_datasets(request):
 async def volume(request):
     state = request.app[STATE]
     d = state.by_id.get(request.match_info["ident"])
-    if d is None:
-        raise web.HTTPNotFound(text="no such dataset\n")
-    try:
-        k = int(request.query.get("level", "3"))
-    except ValueError:
-        k = -1
-    if not 0 <= k < len(LEVEL_STRIDES):
-        raise web.HTTPBadRequest(text="level is 0, 1, 2 or 3\n")
+    k = serve_bricks.requested_level(request, d)
     loop = asyncio.get_running_loop()
     if d.digest is None:  # once per dataset, off the event loop
         if d.ident not in state.fingerprints:

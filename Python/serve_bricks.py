@@ -108,6 +108,20 @@ def parse_ids(text, count):
     return ids
 
 
+def requested_level(request, d):
+    """The level a GET of dataset `d` asks for ("level", 3 when left out), shared by /api/volume
+    and /api/bricks: 404 where `d` is None, 400 where the level is not 0-3."""
+    if d is None:
+        raise web.HTTPNotFound(text="no such dataset\n")
+    try:
+        k = int(request.query.get("level", "3"))
+    except ValueError:
+        k = -1
+    if not 0 <= k < len(LEVEL_STRIDES):
+        raise web.HTTPBadRequest(text="level is 0, 1, 2 or 3\n")
+    return k
+
+
 def handler(find, not_modified, cache_control):
     """The route's handler; `find(request)` gives the request's dataset or None. Bricks are kept
     by the browser and revalidated like /api/volume (docs/web.md, Caching): `not_modified(request,
@@ -119,14 +133,7 @@ def handler(find, not_modified, cache_control):
 
     async def bricks(request):
         d = find(request)
-        if d is None:
-            raise web.HTTPNotFound(text="no such dataset\n")
-        try:
-            k = int(request.query.get("level", "3"))
-        except ValueError:
-            k = -1
-        if not 0 <= k < len(LEVEL_STRIDES):
-            raise web.HTTPBadRequest(text="level is 0, 1, 2 or 3\n")
+        k = requested_level(request, d)
         loop = asyncio.get_running_loop()
         key = (d.ident, k)
         if key not in manifests:  # once per level, off the event loop

@@ -261,6 +261,22 @@ std::string ChooseVariant(
   v.Cull = !BoxInsideClipVolume(v.IndexToClip, v.Cells);
   return ChooseClipPlanes(frame, v);
 }
+
+// The state of a surface pass, drawn into the host's framebuffer with its
+// depth test: no culling (cells are drawn as they come), no scissor, stencil
+// or discard, every colour channel, and the pass's blending. Both the surface
+// and the hits composited after it are drawn in it.
+void SetSurfacePassState(const GLApi& gl, bool translucent)
+{
+  const GLApi::Functions& f = gl.F();
+  f.Enable(GL_DEPTH_TEST);
+  f.Disable(GL_CULL_FACE);
+  f.Disable(GL_SCISSOR_TEST);
+  f.Disable(GL_STENCIL_TEST);
+  f.Disable(GL_RASTERIZER_DISCARD);
+  f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  SetSurfacePassBlending(gl, translucent);
+}
 } // namespace
 
 struct IsosurfaceRendererGL::Internals
@@ -513,13 +529,7 @@ void IsosurfaceRendererGL::Internals::SetUniforms(Program& program, const HistoP
 {
   const GLApi& gl = *this->GL;
   const GLApi::Functions& f = gl.F();
-  f.Enable(GL_DEPTH_TEST);
-  f.Disable(GL_CULL_FACE);
-  f.Disable(GL_SCISSOR_TEST);
-  f.Disable(GL_STENCIL_TEST);
-  f.Disable(GL_RASTERIZER_DISCARD);
-  f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  SetSurfacePassBlending(gl, v.Translucent);
+  SetSurfacePassState(gl, v.Translucent);
   if (v.Points && !gl.IsES())
   {
     f.Enable(GL_PROGRAM_POINT_SIZE); // gl_PointSize (always honoured on GL ES)
@@ -761,13 +771,7 @@ bool IsosurfaceRendererGL::Render(const std::vector<IsosurfacePiece>& pieces,
   if (drawn && stats.FirstHit)
   {
     // The hits into the host's framebuffer, in the state of an opaque surface pass.
-    f.Enable(GL_DEPTH_TEST);
-    f.Disable(GL_CULL_FACE);
-    f.Disable(GL_SCISSOR_TEST);
-    f.Disable(GL_STENCIL_TEST);
-    f.Disable(GL_RASTERIZER_DISCARD);
-    f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    SetSurfacePassBlending(gl, false);
+    SetSurfacePassState(gl, false);
     if (!impl.VertexArray)
     {
       impl.VertexArray = Name(gl, NameKind::VertexArray);

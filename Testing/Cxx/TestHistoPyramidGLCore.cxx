@@ -12,7 +12,7 @@
 // count on that level's samples (MakeCoarseCopy, odd sizes: a shorter last
 // cell on some axes), each level is built once per set of isovalues and again
 // after a change, and a level outside 0..3 is refused with a reason.
-#include "HeadlessContext.h"
+#include "HeadlessTestUtilities.h"
 #include "HistoPyramidGLChecks.h"
 
 #include "BlockLOD.h"
@@ -90,20 +90,8 @@ void CheckCoarseLevels(const std::shared_ptr<const mediso::GLApi>& gl)
 
 int main(int argc, char* argv[])
 {
-  if (argc != 2 || (std::strcmp(argv[1], "es") != 0 && std::strcmp(argv[1], "gl") != 0))
-  {
-    std::cerr << "usage: " << argv[0] << " es|gl\n";
-    return 2;
-  }
-  const bool es = std::strcmp(argv[1], "es") == 0;
-  std::string error;
-  auto context = mediso::headless::HeadlessContext::Create(
-    es ? mediso::headless::ContextApi::ES3 : mediso::headless::ContextApi::GL32, error);
-  if (!context)
-  {
-    std::cout << "SKIP: " << error << "\n";
-    return 125;
-  }
+  bool es = false;
+  auto context = medical_test::OpenTestContext(argc, argv, es);
   std::cout << "EGL platform: " << context->GetPlatform() << "\n";
   CheckCoarseLevels(context->GetGLApi());
   return pyramid_checks::RunAll(context->GetGLApi(),

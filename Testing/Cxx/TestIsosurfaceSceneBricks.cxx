@@ -12,7 +12,7 @@
 // give one texture again. Exit 125 (skip) where no such context can be made.
 #include "GLApi.h"
 #include "GLApiFunctions.h"
-#include "HeadlessContext.h"
+#include "HeadlessTestUtilities.h"
 #include "HistoPyramidGLChecks.h" // MakePhantom
 #include "IsosurfaceScene.h"
 #include "MedicalTestUtilities.h"
@@ -70,49 +70,21 @@ class Target
 {
 public:
   explicit Target(const GLApi& gl)
-    : GL(gl)
+    : Framebuffer(gl, Width, Height)
   {
-    const GLApi::Functions& f = gl.F();
-    f.GenFramebuffers(1, &this->FBO);
-    f.GenRenderbuffers(2, this->Buffers);
-    f.BindRenderbuffer(GL_RENDERBUFFER, this->Buffers[0]);
-    f.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, Width, Height);
-    f.BindRenderbuffer(GL_RENDERBUFFER, this->Buffers[1]);
-    f.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, Width, Height);
-    f.BindFramebuffer(GL_FRAMEBUFFER, this->FBO);
-    f.FramebufferRenderbuffer(
-      GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, this->Buffers[0]);
-    f.FramebufferRenderbuffer(
-      GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, this->Buffers[1]);
-  }
-  ~Target()
-  {
-    this->GL.F().DeleteFramebuffers(1, &this->FBO);
-    this->GL.F().DeleteRenderbuffers(2, this->Buffers);
   }
 
   // One frame of `scene` (cleared to black); its RGB pixels, or empty with `error`.
   std::vector<unsigned char> Draw(
     IsosurfaceScene& scene, const IsosurfaceFrame& frame, std::string& error)
   {
-    const GLApi::Functions& f = this->GL.F();
-    f.BindFramebuffer(GL_FRAMEBUFFER, this->FBO);
-    f.Viewport(0, 0, Width, Height);
-    f.Enable(GL_DEPTH_TEST);
-    f.DepthFunc(GL_LEQUAL);
-    f.DepthMask(GL_TRUE);
     const GLfloat black[4] = { 0.0f, 0.0f, 0.0f, 1.0f };
-    const GLfloat one = 1.0f;
-    f.ClearBufferfv(GL_COLOR, 0, black);
-    f.ClearBufferfv(GL_DEPTH, 0, &one);
+    this->Framebuffer.Begin(black);
     if (!scene.Render(frame, error))
     {
       return {};
     }
-    std::vector<unsigned char> rgba(4 * static_cast<std::size_t>(Width) * Height);
-    f.ReadBuffer(GL_COLOR_ATTACHMENT0);
-    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    f.ReadPixels(0, 0, Width, Height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+    const std::vector<unsigned char> rgba = this->Framebuffer.ReadRGBA();
     std::vector<unsigned char> rgb;
     for (std::size_t p = 0; p < rgba.size(); p += 4)
     {
@@ -122,9 +94,7 @@ public:
   }
 
 private:
-  const GLApi& GL;
-  GLuint FBO = 0;
-  GLuint Buffers[2] = { 0, 0 };
+  medical_test::TestFramebuffer Framebuffer;
 };
 
 IsosurfaceFrame View(const int dims[3], double azimuth, double elevation, bool parallel)
@@ -267,20 +237,9 @@ void RunCases(const std::shared_ptr<const GLApi>& gl, Target& target, const std:
 
 int main(int argc, char* argv[])
 {
-  if (argc != 2 || (std::strcmp(argv[1], "es") != 0 && std::strcmp(argv[1], "gl") != 0))
-  {
-    std::cerr << "usage: " << argv[0] << " es|gl\n";
-    return 2;
-  }
-  const bool es = std::strcmp(argv[1], "es") == 0;
+  bool es = false;
+  auto context = medical_test::OpenTestContext(argc, argv, es);
   std::string error;
-  auto context = headless::HeadlessContext::Create(
-    es ? headless::ContextApi::ES3 : headless::ContextApi::GL32, error);
-  if (!context)
-  {
-    std::cout << "SKIP: " << error << "\n";
-    return 125;
-  }
   const std::shared_ptr<const GLApi> gl = context->GetGLApi();
   Target target(*gl);
 

@@ -17,7 +17,7 @@
 //  - exit 1 on any difference or failure.
 #include "GLApi.h"
 #include "GLApiFunctions.h"
-#include "HeadlessContext.h"
+#include "HeadlessTestUtilities.h"
 #include "IsosurfaceScene.h"
 #include "SceneView.h"
 #include "VolumeSources.h"
@@ -41,52 +41,24 @@ class Target
 public:
   explicit Target(std::shared_ptr<const GLApi> gl)
     : GL(std::move(gl))
+    , Framebuffer(*this->GL, Width, Height)
   {
-    const GLApi::Functions& f = this->GL->F();
-    f.GenFramebuffers(1, &this->FBO);
-    f.GenRenderbuffers(2, this->Buffers);
-    f.BindRenderbuffer(GL_RENDERBUFFER, this->Buffers[0]);
-    f.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, Width, Height);
-    f.BindRenderbuffer(GL_RENDERBUFFER, this->Buffers[1]);
-    f.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, Width, Height);
-    f.BindFramebuffer(GL_FRAMEBUFFER, this->FBO);
-    f.FramebufferRenderbuffer(
-      GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, this->Buffers[0]);
-    f.FramebufferRenderbuffer(
-      GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, this->Buffers[1]);
-    this->Complete = f.CheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
   }
-  ~Target()
-  {
-    const GLApi::Functions& f = this->GL->F();
-    f.DeleteFramebuffers(1, &this->FBO);
-    f.DeleteRenderbuffers(2, this->Buffers);
-  }
+
+  bool IsComplete() const { return this->Framebuffer.IsComplete(); }
 
   // One frame of `scene` with `surfaces`: the picture, or empty with the reason in `error`.
   std::vector<unsigned char> Draw(IsosurfaceScene& scene,
     const std::vector<IsosurfaceLook>& surfaces, const IsosurfaceFrame& frame, std::string& error)
   {
-    const GLApi::Functions& f = this->GL->F();
     scene.SetSurfaces(surfaces);
-    f.BindFramebuffer(GL_FRAMEBUFFER, this->FBO);
-    f.Viewport(0, 0, Width, Height);
-    f.Enable(GL_DEPTH_TEST);
-    f.DepthFunc(GL_LEQUAL);
-    f.DepthMask(GL_TRUE);
     const GLfloat background[4] = { 0.1f, 0.12f, 0.16f, 1.0f };
-    const GLfloat one = 1.0f;
-    f.ClearBufferfv(GL_COLOR, 0, background);
-    f.ClearBufferfv(GL_DEPTH, 0, &one);
+    this->Framebuffer.Begin(background);
     if (!scene.Render(frame, error))
     {
       return {};
     }
-    std::vector<unsigned char> rgba(4 * Width * Height);
-    f.BindFramebuffer(GL_FRAMEBUFFER, this->FBO);
-    f.ReadBuffer(GL_COLOR_ATTACHMENT0);
-    f.PixelStorei(GL_PACK_ALIGNMENT, 1);
-    f.ReadPixels(0, 0, Width, Height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+    std::vector<unsigned char> rgba = this->Framebuffer.ReadRGBA();
     const std::string errors = this->GL->TakeErrors();
     if (!errors.empty())
     {
@@ -96,12 +68,9 @@ public:
     return rgba;
   }
 
-  bool Complete = false;
-
 private:
   std::shared_ptr<const GLApi> GL;
-  GLuint FBO = 0;
-  GLuint Buffers[2] = { 0, 0 };
+  medical_test::TestFramebuffer Framebuffer;
 };
 
 // Pixels of `a` and `b` that differ at all.
@@ -118,20 +87,9 @@ int Differing(const std::vector<unsigned char>& a, const std::vector<unsigned ch
 
 int main(int argc, char* argv[])
 {
-  if (argc != 2 || (std::strcmp(argv[1], "es") != 0 && std::strcmp(argv[1], "gl") != 0))
-  {
-    std::cerr << "usage: " << argv[0] << " es|gl\n";
-    return 2;
-  }
-  const bool es = std::strcmp(argv[1], "es") == 0;
+  bool es = false;
+  auto context = medical_test::OpenTestContext(argc, argv, es);
   std::string error;
-  auto context = headless::HeadlessContext::Create(
-    es ? headless::ContextApi::ES3 : headless::ContextApi::GL32, error);
-  if (!context)
-  {
-    std::cout << "SKIP: " << error << "\n";
-    return 125;
-  }
   std::cout << "EGL platform: " << context->GetPlatform() << "\n";
   const std::shared_ptr<const GLApi>& gl = context->GetGLApi();
 
@@ -170,7 +128,7 @@ int main(int argc, char* argv[])
   int failures = 0;
   {
     Target target(gl);
-    if (!target.Complete)
+    if (!target.IsComplete())
     {
       std::cerr << "FAIL: the target framebuffer cannot be made\n";
       return 1;

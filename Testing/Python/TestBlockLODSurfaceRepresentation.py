@@ -22,10 +22,10 @@ import sys
 
 from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 from paraview import servermanager
-from paraview.modules.vtkRemotingCore import vtkPVSession
 from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
 from vtkmodules.util.numpy_support import vtk_to_numpy
 
+import blocklod_display
 import checks
 
 parser = argparse.ArgumentParser()
@@ -86,19 +86,7 @@ view.ResetCamera()
 
 
 def frame_info():
-    """What the rendering process's representation drew (builtin: this process; client/server
-    with local rendering: the client)."""
-    sub = display.SMProxy.GetProperty("BlockLODInteractiveLevel").GetParent()
-    previous = sub.GetLocation()
-    sub.SetLocation(vtkPVSession.CLIENT)
-    try:
-        sub.UpdatePropertyInformation()
-    finally:
-        sub.SetLocation(previous)
-    value = lambda name: display.GetProperty(name)[0]  # noqa: E731
-    return {"level": int(value("BlockLODInteractiveLevel")),
-            "triangles": int(value("BlockLODInteractiveTriangles")),
-            "lod": int(value("BlockLODLastRenderUsedLOD"))}
+    return blocklod_display.frame_info(display)
 
 
 def window_pixels():

@@ -11,11 +11,11 @@ import argparse
 import os
 
 from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
-from paraview.modules.vtkRemotingCore import vtkPVSession
 from vtkmodules.vtkCommonDataModel import vtkImageData
 from vtkmodules.vtkCommonTransforms import vtkTransform
 from vtkmodules.vtkFiltersCore import vtkFlyingEdges3D
 
+import blocklod_display
 import checks
 
 parser = argparse.ArgumentParser()
@@ -69,17 +69,7 @@ view.ResetCamera()
 
 
 def frame_info():
-    sub = display.SMProxy.GetProperty("BlockLODInteractiveLevel").GetParent()
-    previous = sub.GetLocation()
-    sub.SetLocation(vtkPVSession.CLIENT)
-    try:
-        sub.UpdatePropertyInformation()
-    finally:
-        sub.SetLocation(previous)
-    value = lambda name: display.GetProperty(name)[0]  # noqa: E731
-    return {"level": int(value("BlockLODInteractiveLevel")),
-            "triangles": int(value("BlockLODInteractiveTriangles")),
-            "lod": int(value("BlockLODLastRenderUsedLOD"))}
+    return blocklod_display.frame_info(display)
 
 
 Render(view)

@@ -26,7 +26,7 @@ import { spawnSync } from "node:child_process";
 import { existsSync, mkdirSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
-import { Checks, ROOT, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
+import { Checks, ROOT, drawnCentroid, launchBrowser, niftiBytes, openPage, startServer } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 const BASELINES = path.join(ROOT, "Testing", "Data", "Baseline");
@@ -77,19 +77,6 @@ function writeMetaImage(file, values, matrix, offset) {
 // The same head in RAS index order for NIfTI: i towards the patient's right... as a scanner in
 // RAS stores it, i: +x (right), j: +y (anterior), k: +z (superior); the sform an identity at 2 mm.
 function writeNIfTI(file) {
-  const header = Buffer.alloc(352);
-  header.writeInt32LE(348, 0);
-  [3, NX, NY, NZ, 1, 1, 1, 1].forEach((v, i) => header.writeInt16LE(v, 40 + 2 * i));
-  header.writeInt16LE(4, 70); // DT_INT16
-  header.writeInt16LE(16, 72);
-  [1, S, S, S, 1, 1, 1, 1].forEach((v, i) => header.writeFloatLE(v, 76 + 4 * i));
-  header.writeFloatLE(352, 108); // vox_offset
-  header.writeFloatLE(1, 112); // scl_slope
-  header.writeUInt8(10, 123); // xyzt_units: mm, s
-  header.writeInt16LE(1, 254); // sform_code: scanner
-  [[S, 0, 0, 0], [0, S, 0, 0], [0, 0, S, 0]].forEach((row, r) =>
-    row.forEach((v, c) => header.writeFloatLE(v, 280 + 16 * r + 4 * c)));
-  header.write("n+1\0", 344, "latin1");
   // RAS (i', j', k) = LPS (NX-1-i', NY-1-j', k): left-right and anterior-posterior reversed.
   const data = new Int16Array(NX * NY * NZ);
   for (let k = 0; k < NZ; ++k) {
@@ -99,7 +86,7 @@ function writeNIfTI(file) {
       }
     }
   }
-  writeFileSync(file, Buffer.concat([header, Buffer.from(data.buffer)]));
+  writeFileSync(file, niftiBytes([NX, NY, NZ], [S, S, S], [[S, 0, 0, 0], [0, S, 0, 0], [0, 0, S, 0]], data));
 }
 
 // The mirrored MetaImage: its voxels flipped along j in memory (j anterior now), with a
@@ -195,28 +182,6 @@ async function againstBaseline(name, png) {
       "%, at most " + 100 * BASELINE_RATIO + "%)"
     : "sizes differ " + JSON.stringify(r.size)) + "; the shot: " + path.join(OUT, file));
 }
-
-// The centroid of the pixels the surfaces cover, from the canvas's centre (x right, y up).
-const drawnCentroid = (page) => page.evaluate(() => {
-  const view = document.getElementById("view");
-  const copy = Object.assign(document.createElement("canvas"), { width: view.width, height: view.height });
-  const g = copy.getContext("2d");
-  g.drawImage(view, 0, 0);
-  const pixels = g.getImageData(0, 0, view.width, view.height).data;
-  const bg = [pixels[0], pixels[1], pixels[2]];
-  let n = 0, sx = 0, sy = 0;
-  for (let y = 0; y < view.height; ++y) {
-    for (let x = 0; x < view.width; ++x) {
-      const o = 4 * (x + view.width * y);
-      if (Math.abs(pixels[o] - bg[0]) + Math.abs(pixels[o + 1] - bg[1]) + Math.abs(pixels[o + 2] - bg[2]) > 30) {
-        ++n;
-        sx += x;
-        sy += y;
-      }
-    }
-  }
-  return { n, x: n ? sx / n - view.width / 2 : 0, y: n ? view.height / 2 - sy / n : 0 };
-});
 
 const browser = await launchBrowser();
 comparer = await browser.newPage();

@@ -27,7 +27,7 @@
 import { mkdtempSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
-import { Checks, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
+import { Checks, launchBrowser, niftiBytes, openPage, startServer } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 const fmt = (a) => "(" + a.map((x) => x.toFixed(3)).join(", ") + ")";
@@ -51,21 +51,8 @@ for (let k = 0; k < DIMS[2]; ++k) {
   }
 }
 function writeNIfTI(file) {
-  const header = Buffer.alloc(352);
-  header.writeInt32LE(348, 0);
-  [3, ...DIMS, 1, 1, 1, 1].forEach((v, i) => header.writeInt16LE(v, 40 + 2 * i));
-  header.writeInt16LE(16, 70); // DT_FLOAT32
-  header.writeInt16LE(32, 72);
-  [1, ...SPACING, 1, 1, 1, 1].forEach((v, i) => header.writeFloatLE(v, 76 + 4 * i));
-  header.writeFloatLE(352, 108); // vox_offset
-  header.writeFloatLE(1, 112); // scl_slope
-  header.writeUInt8(10, 123); // xyzt_units: mm, s
-  header.writeInt16LE(0, 252); // qform_code
-  header.writeInt16LE(1, 254); // sform_code: scanner
-  [0, 1, 2].forEach((r) => [0, 1, 2, 3].forEach((c) =>
-    header.writeFloatLE(c === 3 ? OFFSET[r] : (r === c ? SPACING[r] : 0), 280 + 16 * r + 4 * c)));
-  header.write("n+1\0", 344, "latin1");
-  writeFileSync(file, Buffer.concat([header, Buffer.from(values.buffer)]));
+  const sform = [0, 1, 2].map((r) => [0, 1, 2, 3].map((c) => c === 3 ? OFFSET[r] : (r === c ? SPACING[r] : 0)));
+  writeFileSync(file, niftiBytes(DIMS, SPACING, sform, values));
 }
 const folder = mkdtempSync(path.join(tmpdir(), "mediso-slices-"));
 const nifti = path.join(folder, "sphere.nii");

@@ -15,7 +15,7 @@
 import { mkdtempSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
-import { Checks, countWire, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
+import { Checks, countWire, launchBrowser, niftiBytes, openPage, startServer } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 // Two blobs in a 256^3 int16 NIfTI (bricks of 64: 4 per axis): a large one in the middle, whose
@@ -35,19 +35,7 @@ function writeVolume(file) {
       }
     }
   }
-  const header = Buffer.alloc(352);
-  header.writeInt32LE(348, 0);
-  [3, N, N, N, 1, 1, 1, 1].forEach((v, i) => header.writeInt16LE(v, 40 + 2 * i));
-  header.writeInt16LE(4, 70); // DT_INT16
-  header.writeInt16LE(16, 72);
-  [1, 1, 1, 1, 1, 1, 1, 1].forEach((v, i) => header.writeFloatLE(v, 76 + 4 * i));
-  header.writeFloatLE(352, 108); // vox_offset
-  header.writeFloatLE(1, 112); // scl_slope
-  header.writeUInt8(10, 123); // xyzt_units: mm, s
-  header.writeInt16LE(1, 254); // sform_code: scanner
-  [0, 1, 2].forEach((r) => [0, 1, 2, 3].forEach((c) => header.writeFloatLE(r === c ? 1 : 0, 280 + 16 * r + 4 * c)));
-  header.write("n+1\0", 344, "latin1");
-  writeFileSync(file, Buffer.concat([header, Buffer.from(values.buffer)]));
+  writeFileSync(file, niftiBytes([N, N, N], [1, 1, 1], [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]], values));
 }
 const folder = mkdtempSync(path.join(tmpdir(), "mediso-stream-"));
 const nifti = path.join(folder, "blobs.nii");

@@ -30,7 +30,7 @@
 import { mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
-import { Checks, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
+import { Checks, drawnCentroid, launchBrowser, niftiBytes, openPage, startServer } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 const near = (a, b, tol) => a.every((x, i) => Math.abs(x - b[i]) <= tol);
@@ -44,20 +44,6 @@ const fmt = (a) => "(" + a.map((x) => x.toFixed(4)).join(", ") + ")";
 // RAS x negative, that is left; k superior. The cube at high i, j, k: anterior, left, superior.
 const N = 32;
 function writeNIfTI(file) {
-  const header = Buffer.alloc(352);
-  header.writeInt32LE(348, 0);
-  [3, N, N, N, 1, 1, 1, 1].forEach((v, i) => header.writeInt16LE(v, 40 + 2 * i));
-  header.writeInt16LE(4, 70); // DT_INT16
-  header.writeInt16LE(16, 72);
-  [1, 2, 2, 2, 1, 1, 1, 1].forEach((v, i) => header.writeFloatLE(v, 76 + 4 * i));
-  header.writeFloatLE(352, 108); // vox_offset
-  header.writeFloatLE(1, 112); // scl_slope
-  header.writeUInt8(10, 123); // xyzt_units: mm, s
-  header.writeInt16LE(0, 252); // qform_code
-  header.writeInt16LE(1, 254); // sform_code: scanner
-  [[0, -2, 0, 0], [2, 0, 0, 0], [0, 0, 2, 0]].forEach((row, r) =>
-    row.forEach((v, c) => header.writeFloatLE(v, 280 + 16 * r + 4 * c)));
-  header.write("n+1\0", 344, "latin1");
   const data = Buffer.alloc(2 * N * N * N);
   for (let k = 0; k < N; ++k) {
     for (let j = 0; j < N; ++j) {
@@ -67,34 +53,11 @@ function writeNIfTI(file) {
       }
     }
   }
-  writeFileSync(file, Buffer.concat([header, data]));
+  writeFileSync(file, niftiBytes([N, N, N], [2, 2, 2], [[0, -2, 0, 0], [2, 0, 0, 0], [0, 0, 2, 0]], data));
 }
 const folder = mkdtempSync(path.join(tmpdir(), "mediso-view-"));
 const nifti = path.join(folder, "turned.nii");
 writeNIfTI(nifti);
-
-// The centroid of the pixels the surfaces cover, from the canvas's centre, in CSS pixels
-// (x right, y up), and how many.
-const drawnCentroid = (page) => page.evaluate(() => {
-  const view = document.getElementById("view");
-  const copy = Object.assign(document.createElement("canvas"), { width: view.width, height: view.height });
-  const g = copy.getContext("2d");
-  g.drawImage(view, 0, 0);
-  const pixels = g.getImageData(0, 0, view.width, view.height).data;
-  const bg = [pixels[0], pixels[1], pixels[2]];
-  let n = 0, sx = 0, sy = 0;
-  for (let y = 0; y < view.height; ++y) {
-    for (let x = 0; x < view.width; ++x) {
-      const o = 4 * (x + view.width * y);
-      if (Math.abs(pixels[o] - bg[0]) + Math.abs(pixels[o + 1] - bg[1]) + Math.abs(pixels[o + 2] - bg[2]) > 30) {
-        ++n;
-        sx += x;
-        sy += y;
-      }
-    }
-  }
-  return { n, x: n ? sx / n - view.width / 2 : 0, y: n ? view.height / 2 - sy / n : 0 };
-});
 
 const server = await startServer([nifti]);
 const browser = await launchBrowser();

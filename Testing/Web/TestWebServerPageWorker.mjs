@@ -13,22 +13,16 @@
 // How long the main thread is busy is a timing, so it is measured by the benchmark
 // (Python/benchmark_web.py --interactive: the longest main-thread task, PerformanceObserver
 // "longtask"), not asserted here.
-import { Checks, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
+import { Checks, launchBrowser, openInContext, pageFrames, pageStats, startServer } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 const small = await startServer(["phantom:64"]);
 const browser = await launchBrowser();
 
 // The page, with `query` after the token.
-async function open(server, query) {
-  const context = await browser.newContext({ viewport: { width: 1000, height: 700 } });
-  const page = await context.newPage();
-  await openPage(page, { url: server.url + query });
-  return page;
-}
-
-const stats = (page) => page.evaluate(() => window.mediso.stats());
-const frames = (page) => page.evaluate(() => window.mediso.frames());
+const open = (server, query) => openInContext(browser, server.url + query);
+const stats = pageStats;
+const frames = pageFrames;
 const settle = (page) => page.waitForFunction(() => window.mediso.stats().settled, null, { timeout: 120000 });
 const BONE = { value: 400, color: [1, 1, 1], opacity: 1 };
 

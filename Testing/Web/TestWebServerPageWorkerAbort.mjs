@@ -13,22 +13,16 @@
 //   same core, not in a worker);
 // - without the generation word (?abort=0, as on a page that is not cross-origin isolated),
 //   stats() says a refinement runs to its end, and it does.
-import { Checks, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
+import { Checks, installIsovalueTyping, launchBrowser, openInContext, pageFrames, pageStats, startServer } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 const server = await startServer(["phantom:64"]);
 const browser = await launchBrowser();
 const SLOW_MS = 6000;
 
-async function open(query) {
-  const context = await browser.newContext({ viewport: { width: 1000, height: 700 } });
-  const page = await context.newPage();
-  await openPage(page, { url: server.url + query });
-  return page;
-}
-
-const stats = (page) => page.evaluate(() => window.mediso.stats());
-const frames = (page) => page.evaluate(() => window.mediso.frames());
+const open = (query) => openInContext(browser, server.url + query);
+const stats = pageStats;
+const frames = pageFrames;
 
 // The main thread's triangles at level 3 (the reference).
 const main = await open("&path=cpu&worker=0");
@@ -48,21 +42,9 @@ for (const [name, mode] of Object.entries(MODES)) {
     name + ": the worker can stop a running refinement (cross-origin isolated): " +
     JSON.stringify({ renderer: s0.renderer, abortable: s0.abortable, abortNote: s0.abortNote }));
   const before = (await frames(page)).length;
+  await installIsovalueTyping(page);
   const timing = await page.evaluate(async () => {
-    const box = document.querySelector("#surfaces .isovalue");
-    const type = (v) => {
-      box.value = String(v);
-      box.dispatchEvent(new Event("input"));
-    };
-    const waitFor = (test) => new Promise((resolve) => {
-      const poll = setInterval(() => {
-        const f = window.mediso.frames();
-        if (f.length && test(f[f.length - 1])) {
-          clearInterval(poll);
-          resolve();
-        }
-      }, 1);
-    });
+    const { type, waitFor } = window.medisoTyping;
     type(250);
     await waitFor((f) => f.values[0] === 250);
     // The coarse frame of 250 is shown; its refinement starts 40 ms later and lasts the hook's

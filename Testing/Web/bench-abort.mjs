@@ -8,7 +8,7 @@
 //   newer one; the newer one's first visible answer and full level, and the refinements aborted.
 //   MEDISO_PLUGIN=build/lib/.../MedicalIsosurfaces.so node Testing/Web/bench-abort.mjs phantom:256 PATH.mha
 // (arguments: serve.py --data values; prints a Markdown table).
-import { launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
+import { installIsovalueTyping, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
 
 const inputs = process.argv.slice(2);
 const median = (a) => {
@@ -36,21 +36,9 @@ for (const input of inputs) {
     const aborted0 = (await page.evaluate(() => window.mediso.stats())).refinementsAborted;
     for (let i = 0; i < 4; ++i) {
       const [a, b] = [value(5 + 2 * i), value(6 + 2 * i)];
+      await installIsovalueTyping(page);
       superseded.push(await page.evaluate(async ([a, b]) => {
-        const box = document.querySelector("#surfaces .isovalue");
-        const type = (v) => {
-          box.value = String(v);
-          box.dispatchEvent(new Event("input"));
-        };
-        const waitFor = (test) => new Promise((resolve) => {
-          const poll = setInterval(() => {
-            const f = window.mediso.frames();
-            if (f.length && test(f[f.length - 1])) {
-              clearInterval(poll);
-              resolve(performance.now());
-            }
-          }, 1);
-        });
+        const { type, waitFor } = window.medisoTyping;
         type(a);
         await waitFor((f) => f.values[0] === a);
         await new Promise((resolve) => setTimeout(resolve, 150));

@@ -153,6 +153,92 @@ export async function openPage(page, server) {
   await page.evaluate(() => window.mediso.ready);
 }
 
+/** A new browser context of `viewport` (CSS pixels) with the page at `url` opened and ready. */
+export async function openInContext(browser, url, viewport = { width: 1000, height: 700 }) {
+  const context = await browser.newContext({ viewport });
+  const page = await context.newPage();
+  await openPage(page, { url });
+  return page;
+}
+
+/** The page's window.mediso.stats() and frames(). */
+export const pageStats = (page) => page.evaluate(() => window.mediso.stats());
+export const pageFrames = (page) => page.evaluate(() => window.mediso.frames());
+
+/**
+ * Gives the page window.medisoTyping, for steps timed inside it: type(v) puts v in the first
+ * surface's isovalue box as a person typing would (an "input" event); waitFor(test) resolves, with
+ * performance.now(), once the newest of window.mediso.frames() passes `test` (polled every ms).
+ */
+export const installIsovalueTyping = (page) => page.evaluate(() => {
+  const box = document.querySelector("#surfaces .isovalue");
+  window.medisoTyping = {
+    type: (v) => {
+      box.value = String(v);
+      box.dispatchEvent(new Event("input"));
+    },
+    waitFor: (test) => new Promise((resolve) => {
+      const poll = setInterval(() => {
+        const f = window.mediso.frames();
+        if (f.length && test(f[f.length - 1])) {
+          clearInterval(poll);
+          resolve(performance.now());
+        }
+      }, 1);
+    }),
+  };
+});
+
+/**
+ * The centroid of the pixels the surfaces cover (more than 30 off the corner's background, summed
+ * over R, G and B), from the canvas's centre in its pixels (x right, y up), and how many.
+ */
+export const drawnCentroid = (page) => page.evaluate(() => {
+  const view = document.getElementById("view");
+  const copy = Object.assign(document.createElement("canvas"), { width: view.width, height: view.height });
+  const g = copy.getContext("2d");
+  g.drawImage(view, 0, 0);
+  const pixels = g.getImageData(0, 0, view.width, view.height).data;
+  const bg = [pixels[0], pixels[1], pixels[2]];
+  let n = 0, sx = 0, sy = 0;
+  for (let y = 0; y < view.height; ++y) {
+    for (let x = 0; x < view.width; ++x) {
+      const o = 4 * (x + view.width * y);
+      if (Math.abs(pixels[o] - bg[0]) + Math.abs(pixels[o + 1] - bg[1]) + Math.abs(pixels[o + 2] - bg[2]) > 30) {
+        ++n;
+        sx += x;
+        sy += y;
+      }
+    }
+  }
+  return { n, x: n ? sx / n - view.width / 2 : 0, y: n ? view.height / 2 - sy / n : 0 };
+});
+
+/**
+ * The bytes of a NIfTI-1 file (.nii), in mm, with an sform of code 1 (scanner) and no qform:
+ * `dims` [i, j, k], `spacing` its pixdim, `sform` the three rows (4 numbers each) of the
+ * index-to-RAS matrix, `values` the i-fastest values: a Float32Array (float32), else int16 (an
+ * Int16Array or their bytes).
+ */
+export function niftiBytes(dims, spacing, sform, values) {
+  const header = Buffer.alloc(352);
+  header.writeInt32LE(348, 0);
+  [3, ...dims, 1, 1, 1, 1].forEach((v, i) => header.writeInt16LE(v, 40 + 2 * i));
+  const float = values instanceof Float32Array;
+  header.writeInt16LE(float ? 16 : 4, 70); // DT_FLOAT32 or DT_INT16
+  header.writeInt16LE(float ? 32 : 16, 72);
+  [1, ...spacing, 1, 1, 1, 1].forEach((v, i) => header.writeFloatLE(v, 76 + 4 * i));
+  header.writeFloatLE(352, 108); // vox_offset
+  header.writeFloatLE(1, 112); // scl_slope
+  header.writeUInt8(10, 123); // xyzt_units: mm, s
+  header.writeInt16LE(0, 252); // qform_code
+  header.writeInt16LE(1, 254); // sform_code: scanner
+  sform.forEach((row, r) => row.forEach((v, c) => header.writeFloatLE(v, 280 + 16 * r + 4 * c)));
+  header.write("n+1\0", 344, "latin1");
+  const data = Buffer.isBuffer(values) ? values : Buffer.from(values.buffer, values.byteOffset, values.byteLength);
+  return Buffer.concat([header, data]);
+}
+
 export class Checks {
   constructor() {
     this.failures = 0;
