@@ -97,8 +97,8 @@ Context:
                         as bricks, only those the isovalues cross on the GPU
   --gpu-budget-mb M     GPU memory for the volume's textures and pyramids, in MB
                         (default: half the device's memory where OpenGL tells it,
-                        GL_NVX_gpu_memory_info or GL_ATI_meminfo, else 1024); a
-                        volume over it is kept as bricks
+                        GL_NVX_gpu_memory_info or GL_ATI_meminfo, else 1 GiB);
+                        MB are 10^6 bytes, as in ParaView; a volume over it is kept as bricks
 MEDISO_EGL_PLATFORM=surfaceless|device|default picks the EGL display.
 )";
 
@@ -383,7 +383,7 @@ Options Parse(int argc, char* argv[])
       {
         throw UsageError{ "--gpu-budget-mb must be a positive number of megabytes" };
       }
-      opt.GPUBudget = static_cast<std::uint64_t>(mb * 1024.0 * 1024.0);
+      opt.GPUBudget = static_cast<std::uint64_t>(mb * 1e6);
     }
     else if (!arg.empty() && arg[0] == '-')
     {
@@ -776,7 +776,7 @@ int Run(int argc, char* argv[])
            << ", \"brick_points\": " << stats.BrickPoints
            << ", \"active_bricks\": " << stats.ActiveBricks
            << ", \"resident_bricks\": " << stats.ResidentBricks << ", \"gpu_budget_mb\": "
-           << scene.Scene.GetGPUMemoryBudget() / (1024.0 * 1024.0) << "}";
+           << scene.Scene.GetGPUMemoryBudget() / 1e6 << "}";
       std::printf("%s\n", json.str().c_str());
     }
   }

@@ -45,7 +45,7 @@ std::string Megabytes(std::uint64_t bytes)
 {
   std::ostringstream text;
   text.precision(3);
-  text << static_cast<double>(bytes) / (1024.0 * 1024.0) << " MB";
+  text << static_cast<double>(bytes) / 1e6 << " MB";
   return text.str();
 }
 
