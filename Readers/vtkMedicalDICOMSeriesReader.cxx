@@ -120,19 +120,14 @@ struct Slice
   long InstanceNumber = 0;
 };
 
-// What the scan keeps of one image file.
-struct Instance
+// What the scan keeps of one image file: what the shared per-file rules see
+// (Name is the file's base name) and what DCMTK's decoding needs.
+struct Instance : mediso::DICOMImageFormat
 {
   std::string Path;
-  std::string SeriesUID;
-  std::string SeriesDescription;
   std::string TransferSyntaxUID;
   E_TransferSyntax Syntax = EXS_Unknown;
-  Uint16 Rows = 0, Columns = 0, BitsAllocated = 0, BitsStored = 0, HighBit = 0;
-  Uint16 PixelRepresentation = 0, SamplesPerPixel = 1;
-  std::string Photometric;
   double SliceThickness = 0.0;
-  unsigned long Frames = 1;
   bool PerFramePositions = true;
   // The Pixel Data's length in the file when uncompressed, else -1.
   long long NativePixelBytes = -1;
@@ -227,6 +222,7 @@ HeaderStatus ReadHeader(const std::string& path, Instance& instance, std::string
     return HeaderStatus::NotImage;
   }
   instance.Path = path;
+  instance.Name = BaseName(path);
   OFString text;
   if (data->findAndGetOFString(DCM_SeriesInstanceUID, text).good())
   {
@@ -334,68 +330,6 @@ HeaderStatus ReadHeader(const std::string& path, Instance& instance, std::string
   return HeaderStatus::Image;
 }
 
-struct Series
-{
-  std::string UID;
-  std::string Description;
-  std::vector<std::size_t> Instances; // indices into the scan
-  std::size_t Slices = 0;
-};
-
-std::string Describe(const Series& series)
-{
-  std::string text = series.UID.empty() ? std::string("(no Series Instance UID)") : series.UID;
-  text += " (";
-  if (!series.Description.empty())
-  {
-    text += "\"" + series.Description + "\", ";
-  }
-  text += std::to_string(series.Slices) + (series.Slices == 1 ? " slice)" : " slices)");
-  return text;
-}
-
-// Stored values: masked to Bits Stored, sign-extended when signed, and the
-// least and greatest of each slice.
-template <typename Raw, typename Stored>
-void Unpack(const Raw* raw, Stored* out, std::size_t count, const Instance& instance,
-  std::int64_t& least, std::int64_t& greatest)
-{
-  const unsigned shift = instance.HighBit + 1u - instance.BitsStored;
-  const std::uint32_t mask =
-    instance.BitsStored >= 32 ? 0xffffffffu : ((1u << instance.BitsStored) - 1u);
-  const std::uint32_t sign = 1u << (instance.BitsStored - 1u);
-  const bool isSigned = instance.PixelRepresentation == 1;
-  for (std::size_t p = 0; p < count; ++p)
-  {
-    const std::uint32_t bits = (static_cast<std::uint32_t>(raw[p]) >> shift) & mask;
-    std::int64_t value = bits;
-    if (isSigned && (bits & sign))
-    {
-      value -= static_cast<std::int64_t>(mask) + 1;
-    }
-    out[p] = static_cast<Stored>(value);
-    least = std::min(least, value);
-    greatest = std::max(greatest, value);
-  }
-}
-
-template <typename In, typename Out>
-void RescaleSlices(const In* in, Out* out, std::size_t sliceSize, const std::vector<double>& slopes,
-  const std::vector<double>& intercepts)
-{
-  for (std::size_t k = 0; k < slopes.size(); ++k)
-  {
-    const In* from = in + k * sliceSize;
-    Out* to = out + k * sliceSize;
-    const double slope = slopes[k];
-    const double intercept = intercepts[k];
-    for (std::size_t p = 0; p < sliceSize; ++p)
-    {
-      to[p] = static_cast<Out>(slope * static_cast<double>(from[p]) + intercept);
-    }
-  }
-}
-
 // Linear interpolation along the normal from the sorted slices at
 // `distances` onto `count` slices from distances[0] with `step`.
 template <typename In, typename Out>
@@ -445,16 +379,16 @@ void Convert(const In* in, vtkDataArray* out, bool resample, std::size_t sliceSi
   }
   switch (out->GetDataType())
   {
-    vtkTemplateMacro(RescaleSlices(
+    vtkTemplateMacro(mediso::RescaleDICOMSlices(
       in, static_cast<VTK_TT*>(out->GetVoidPointer(0)), sliceSize, slopes, intercepts));
   }
 }
 
-// The smallest integer type that holds the rescaled values (the rule the page
-// shares: mediso::DICOMIntegerType), double beyond 32 bits.
-int SmallestIntegerType(double least, double greatest)
+// The VTK type of the rescaled output type (mediso::DICOMRescaledType, the
+// rule the page shares).
+int VTKTypeOf(mediso::ScalarType type)
 {
-  switch (mediso::DICOMIntegerType(least, greatest))
+  switch (type)
   {
     case mediso::ScalarType::UInt8:
       return VTK_UNSIGNED_CHAR;
@@ -468,6 +402,8 @@ int SmallestIntegerType(double least, double greatest)
       return VTK_SHORT;
     case mediso::ScalarType::Int32:
       return VTK_INT;
+    case mediso::ScalarType::Float32:
+      return VTK_FLOAT;
     default:
       return VTK_DOUBLE;
   }
@@ -504,21 +440,6 @@ std::string JoinList(const std::vector<std::string>& items, const char* separato
     text += (text.empty() ? "" : separator) + item;
   }
   return text;
-}
-
-// The bytes of pixel data an image needs, and the message when it has fewer.
-std::uint64_t PixelBytes(const Instance& instance)
-{
-  return static_cast<std::uint64_t>(instance.Rows) * instance.Columns * instance.Frames *
-    (instance.BitsAllocated / 8);
-}
-
-std::string ShortPixelData(const Instance& instance, std::uint64_t have)
-{
-  return BaseName(instance.Path) + ": Pixel Data holds " + std::to_string(have) + " bytes, " +
-    std::to_string(PixelBytes(instance)) + " expected (" + std::to_string(instance.Columns) +
-    " x " + std::to_string(instance.Rows) + " x " + std::to_string(instance.Frames) +
-    " frame(s) x " + std::to_string(instance.BitsAllocated / 8) + " byte(s))";
 }
 
 // Step 1: the image files of the folder of `path` (or of the folder `path`).
@@ -604,30 +525,19 @@ std::string ScanFolder(const std::string& path, FolderScan& scan)
 // (so that every list of series reads the same way), and the one to read.
 struct SeriesChoice
 {
-  std::vector<Series> All;
+  std::vector<mediso::DICOMSeriesGroup> All;
   std::size_t Chosen = 0;
   std::string Reason;
 };
 
 std::string ChooseSeries(const FolderScan& scan, const std::string& wanted, SeriesChoice& choice)
 {
-  std::map<std::string, std::size_t> index;
-  for (std::size_t i = 0; i < scan.Images.size(); ++i)
+  std::vector<const mediso::DICOMImageFormat*> images;
+  for (const Instance& image : scan.Images)
   {
-    const Instance& image = scan.Images[i];
-    auto found = index.find(image.SeriesUID);
-    if (found == index.end())
-    {
-      found = index.emplace(image.SeriesUID, choice.All.size()).first;
-      choice.All.emplace_back();
-      choice.All.back().UID = image.SeriesUID;
-      choice.All.back().Description = image.SeriesDescription;
-    }
-    choice.All[found->second].Instances.push_back(i);
-    choice.All[found->second].Slices += image.Frames;
+    images.push_back(&image);
   }
-  std::stable_sort(choice.All.begin(), choice.All.end(),
-    [](const Series& a, const Series& b) { return a.Slices > b.Slices; });
+  choice.All = mediso::GroupDICOMSeries(images);
   const std::string* uid = nullptr;
   if (!wanted.empty())
   {
@@ -654,9 +564,9 @@ std::string ChooseSeries(const FolderScan& scan, const std::string& wanted, Seri
     }
   }
   std::vector<std::string> list;
-  for (const Series& s : choice.All)
+  for (const mediso::DICOMSeriesGroup& s : choice.All)
   {
-    list.push_back(Describe(s));
+    list.push_back(mediso::DescribeDICOMSeries(s));
   }
   return scan.Folder + ": no series with Series Instance UID " + *uid + "; the folder holds " +
     JoinList(list, "; ");
@@ -676,29 +586,10 @@ std::string CheckInstances(const std::vector<Instance*>& instances)
         instance->TransferSyntaxUID + ") is not read (this reader decodes uncompressed, " +
         "deflated, JPEG baseline, extended and lossless, JPEG-LS and RLE pixel data)";
     }
-    if (instance->SamplesPerPixel != 1 ||
-      (instance->Photometric != "MONOCHROME1" && instance->Photometric != "MONOCHROME2"))
+    std::string error = mediso::CheckDICOMImageFormat(*instance);
+    if (!error.empty())
     {
-      return name + ": " + std::to_string(instance->SamplesPerPixel) + " sample(s) per pixel, " +
-        "Photometric Interpretation \"" + instance->Photometric +
-        "\": only greyscale (MONOCHROME1/2) images are read";
-    }
-    if (instance->BitsAllocated != 8 && instance->BitsAllocated != 16)
-    {
-      return name + ": Bits Allocated " + std::to_string(instance->BitsAllocated) +
-        " is not read (8 or 16)";
-    }
-    if (instance->BitsStored == 0 || instance->BitsStored > instance->BitsAllocated ||
-      instance->HighBit + 1 < instance->BitsStored || instance->HighBit >= instance->BitsAllocated)
-    {
-      return name + ": Bits Stored " + std::to_string(instance->BitsStored) + " and High Bit " +
-        std::to_string(instance->HighBit) + " do not fit Bits Allocated " +
-        std::to_string(instance->BitsAllocated);
-    }
-    if (instance->Rows == 0 || instance->Columns == 0)
-    {
-      return name + ": an image of " + std::to_string(instance->Columns) + " x " +
-        std::to_string(instance->Rows) + " pixels";
+      return error;
     }
     if (!instance->PerFramePositions)
     {
@@ -709,25 +600,15 @@ std::string CheckInstances(const std::vector<Instance*>& instances)
     // Uncompressed pixel data shorter than the header says, known before
     // anything is allocated for it.
     if (instance->NativePixelBytes >= 0 &&
-      static_cast<std::uint64_t>(instance->NativePixelBytes) < PixelBytes(*instance))
+      static_cast<std::uint64_t>(instance->NativePixelBytes) < mediso::DICOMPixelBytes(*instance))
     {
-      return ShortPixelData(*instance, static_cast<std::uint64_t>(instance->NativePixelBytes));
+      return mediso::DICOMShortPixelData(
+        *instance, static_cast<std::uint64_t>(instance->NativePixelBytes));
     }
-    if (instance->Rows != first.Rows || instance->Columns != first.Columns)
+    error = mediso::CheckDICOMImageLikeFirst(*instance, first);
+    if (!error.empty())
     {
-      return name + ": " + std::to_string(instance->Columns) + " x " +
-        std::to_string(instance->Rows) + " pixels, but " + BaseName(first.Path) + " has " +
-        std::to_string(first.Columns) + " x " + std::to_string(first.Rows) +
-        ": slices of different sizes are not read";
-    }
-    if (instance->BitsAllocated != first.BitsAllocated ||
-      instance->PixelRepresentation != first.PixelRepresentation)
-    {
-      return name + ": pixel format " + std::to_string(instance->BitsAllocated) + " bits " +
-        (instance->PixelRepresentation ? "signed" : "unsigned") + ", but " + BaseName(first.Path) +
-        " has " + std::to_string(first.BitsAllocated) + " bits " +
-        (first.PixelRepresentation ? "signed" : "unsigned") +
-        ": slices of different pixel formats are not read";
+      return error;
     }
   }
   return std::string();
@@ -792,6 +673,15 @@ std::string StackSlices(const std::vector<Instance*>& instances, Stack& stack)
   return std::string();
 }
 
+// Stored values of DCMTK's pixel words (host order), by the shared rule.
+template <typename Raw, typename Stored>
+void Unpack(const Raw* raw, Stored* out, std::size_t count, const Instance& instance,
+  std::int64_t& least, std::int64_t& greatest)
+{
+  mediso::UnpackDICOMValues(
+    instance, count, [raw](std::size_t p) { return raw[p]; }, out, least, greatest);
+}
+
 // Step 6: every file decoded (DCMTK's codecs for the compressed ones) and
 // its frames unpacked into `stored` at their place in the stack, with the
 // least and greatest stored value of each slice.
@@ -845,9 +735,9 @@ std::string DecodeSlices(const std::vector<Instance*>& instances, const Stack& s
       status = pixels->getUint16Array(values);
       raw = values;
     }
-    if (status.bad() || !raw || pixels->getLength() < PixelBytes(*instance))
+    if (status.bad() || !raw || pixels->getLength() < mediso::DICOMPixelBytes(*instance))
     {
-      return ShortPixelData(*instance, raw ? pixels->getLength() : 0);
+      return mediso::DICOMShortPixelData(*instance, raw ? pixels->getLength() : 0);
     }
     for (const Slice& slice : instance->Slices)
     {
@@ -939,7 +829,7 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   {
     return error;
   }
-  const Series& read = choice.All[choice.Chosen];
+  const mediso::DICOMSeriesGroup& read = choice.All[choice.Chosen];
   std::vector<std::string> others;
   this->SeriesList->InsertNextValue(
     read.UID + " | " + read.Description + " | " + std::to_string(read.Slices) + " slices");
@@ -947,8 +837,8 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   {
     if (s != choice.Chosen)
     {
-      const Series& other = choice.All[s];
-      others.push_back(Describe(other));
+      const mediso::DICOMSeriesGroup& other = choice.All[s];
+      others.push_back(mediso::DescribeDICOMSeries(other));
       this->SeriesList->InsertNextValue(
         other.UID + " | " + other.Description + " | " + std::to_string(other.Slices) + " slices");
     }
@@ -956,7 +846,7 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   if (!others.empty())
   {
     vtkWarningMacro(<< scan.Folder << ": the folder holds " << choice.All.size() << " series; read "
-                    << Describe(read) << ", " << choice.Reason << "; not read: "
+                    << mediso::DescribeDICOMSeries(read) << ", " << choice.Reason << "; not read: "
                     << JoinList(others, "; ") << ". SeriesInstanceUID chooses another.");
   }
 
@@ -982,13 +872,7 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
     vtkWarningMacro(<< BaseName(first.Path)
                     << ": no valid Pixel Spacing; 1 mm between rows and columns assumed");
   }
-  std::vector<std::string> listed(
-    stack.Uneven.begin(), stack.Uneven.begin() + std::min<std::size_t>(stack.Uneven.size(), 5));
-  if (stack.Uneven.size() > 5)
-  {
-    listed.push_back("and " + std::to_string(stack.Uneven.size() - 5) + " more");
-  }
-  const std::string unevenList = JoinList(listed, "; ");
+  const std::string unevenList = mediso::DICOMUnevenList(stack.Uneven);
   const bool resample = !stack.Uneven.empty();
   if (resample && !this->ResampleUnevenSlices)
   {
@@ -1008,7 +892,7 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   {
     if (DcmXfer(instance->Syntax).isEncapsulated())
     {
-      decoding = std::max(decoding, PixelBytes(*instance));
+      decoding = std::max(decoding, mediso::DICOMPixelBytes(*instance));
     }
   }
   vtkSmartPointer<vtkDataArray> stored = NewVolume(storedType, sliceSize * count, decoding,
@@ -1026,24 +910,15 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
 
   // 7. Rescale (or resample) into the output type.
   std::vector<double> slopes(count), intercepts(count);
-  bool uniform = true, integral = true;
-  double low = 0.0, high = 0.0;
   for (std::size_t k = 0; k < count; ++k)
   {
     slopes[k] = stack.Slices[k].second->Slope;
     intercepts[k] = stack.Slices[k].second->Intercept;
-    uniform = uniform && slopes[k] == slopes[0] && intercepts[k] == intercepts[0];
-    integral =
-      integral && slopes[k] == std::round(slopes[k]) && intercepts[k] == std::round(intercepts[k]);
-    const double a = slopes[k] * static_cast<double>(least[k]) + intercepts[k];
-    const double b = slopes[k] * static_cast<double>(greatest[k]) + intercepts[k];
-    low = k == 0 ? std::min(a, b) : std::min(low, std::min(a, b));
-    high = k == 0 ? std::max(a, b) : std::max(high, std::max(a, b));
   }
-  // Float holds every stored value (at most 16 bits) times a slope exactly
-  // when the slope has a short binary fraction, and to 24 bits otherwise.
-  const int outputType =
-    (resample || !uniform || !integral) ? VTK_FLOAT : SmallestIntegerType(low, high);
+  // Resampled values are interpolated: float, whatever the rescaling.
+  const int outputType = resample
+    ? VTK_FLOAT
+    : VTKTypeOf(mediso::DICOMRescaledType(slopes, intercepts, least, greatest));
   const std::vector<double>& distances = stack.Distances;
   int slicesOut = static_cast<int>(count);
   double step = count > 1 ? (distances.back() - distances.front()) / (count - 1) : 0.0;

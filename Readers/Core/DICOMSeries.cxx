@@ -439,15 +439,9 @@ HeaderStatus ParseHeader(
 // ---------------------------------------------------------------------------
 // The reader's rules (vtkMedicalDICOMSeriesReader.cxx), for single-frame files.
 
-struct Instance
+struct Instance : DICOMImageFormat
 {
-  std::string Name;
   const unsigned char* Bytes = nullptr;
-  std::string SeriesUID;
-  std::string SeriesDescription;
-  std::uint16_t Rows = 0, Columns = 0, BitsAllocated = 0, BitsStored = 0, HighBit = 0;
-  std::uint16_t PixelRepresentation = 0, SamplesPerPixel = 1;
-  std::string Photometric;
   double SliceThickness = 0.0;
   std::uint64_t PixelOffset = 0;
   std::uint64_t PixelLength = 0;
@@ -462,12 +456,6 @@ struct Instance
   double Intercept = 0.0;
   long InstanceNumber = 0;
 };
-
-std::uint64_t PixelBytes(const Instance& instance)
-{
-  return static_cast<std::uint64_t>(instance.Rows) * instance.Columns *
-    (instance.BitsAllocated / 8);
-}
 
 // The attributes the rules use, as DCMTK's findAndGet* gives them.
 void Describe(const Header& header, Instance& instance)
@@ -552,83 +540,23 @@ void Describe(const Header& header, Instance& instance)
   instance.PixelLength = header.PixelLength;
 }
 
-struct Series
-{
-  std::string UID;
-  std::string Description;
-  std::vector<std::size_t> Instances;
-  std::size_t Slices = 0;
-};
-
-std::string DescribeSeries(const Series& series)
-{
-  std::string text = series.UID.empty() ? std::string("(no Series Instance UID)") : series.UID;
-  text += " (";
-  if (!series.Description.empty())
-  {
-    text += "\"" + series.Description + "\", ";
-  }
-  text += std::to_string(series.Slices) + (series.Slices == 1 ? " slice)" : " slices)");
-  return text;
-}
-
-std::string ShortPixelData(const Instance& instance, std::uint64_t have)
-{
-  return instance.Name + ": Pixel Data holds " + std::to_string(have) + " bytes, " +
-    std::to_string(PixelBytes(instance)) + " expected (" + std::to_string(instance.Columns) +
-    " x " + std::to_string(instance.Rows) + " x 1 frame(s) x " +
-    std::to_string(instance.BitsAllocated / 8) + " byte(s))";
-}
-
 std::string CheckInstances(const std::vector<const Instance*>& instances)
 {
   const Instance& first = *instances.front();
   for (const Instance* instance : instances)
   {
-    const std::string& name = instance->Name;
-    if (instance->SamplesPerPixel != 1 ||
-      (instance->Photometric != "MONOCHROME1" && instance->Photometric != "MONOCHROME2"))
+    std::string error = CheckDICOMImageFormat(*instance);
+    if (error.empty() && instance->PixelLength < DICOMPixelBytes(*instance))
     {
-      return name + ": " + std::to_string(instance->SamplesPerPixel) + " sample(s) per pixel, " +
-        "Photometric Interpretation \"" + instance->Photometric +
-        "\": only greyscale (MONOCHROME1/2) images are read";
+      error = DICOMShortPixelData(*instance, instance->PixelLength);
     }
-    if (instance->BitsAllocated != 8 && instance->BitsAllocated != 16)
+    if (error.empty())
     {
-      return name + ": Bits Allocated " + std::to_string(instance->BitsAllocated) +
-        " is not read (8 or 16)";
+      error = CheckDICOMImageLikeFirst(*instance, first);
     }
-    if (instance->BitsStored == 0 || instance->BitsStored > instance->BitsAllocated ||
-      instance->HighBit + 1 < instance->BitsStored || instance->HighBit >= instance->BitsAllocated)
+    if (!error.empty())
     {
-      return name + ": Bits Stored " + std::to_string(instance->BitsStored) + " and High Bit " +
-        std::to_string(instance->HighBit) + " do not fit Bits Allocated " +
-        std::to_string(instance->BitsAllocated);
-    }
-    if (instance->Rows == 0 || instance->Columns == 0)
-    {
-      return name + ": an image of " + std::to_string(instance->Columns) + " x " +
-        std::to_string(instance->Rows) + " pixels";
-    }
-    if (instance->PixelLength < PixelBytes(*instance))
-    {
-      return ShortPixelData(*instance, instance->PixelLength);
-    }
-    if (instance->Rows != first.Rows || instance->Columns != first.Columns)
-    {
-      return name + ": " + std::to_string(instance->Columns) + " x " +
-        std::to_string(instance->Rows) + " pixels, but " + first.Name + " has " +
-        std::to_string(first.Columns) + " x " + std::to_string(first.Rows) +
-        ": slices of different sizes are not read";
-    }
-    if (instance->BitsAllocated != first.BitsAllocated ||
-      instance->PixelRepresentation != first.PixelRepresentation)
-    {
-      return name + ": pixel format " + std::to_string(instance->BitsAllocated) + " bits " +
-        (instance->PixelRepresentation ? "signed" : "unsigned") + ", but " + first.Name + " has " +
-        std::to_string(first.BitsAllocated) + " bits " +
-        (first.PixelRepresentation ? "signed" : "unsigned") +
-        ": slices of different pixel formats are not read";
+      return error;
     }
   }
   return std::string();
@@ -836,65 +764,26 @@ struct Stack
   std::vector<const Instance*> Slices; // in increasing position
 };
 
-// Stored values: masked to Bits Stored, sign-extended when signed.
+// Stored values: the little endian words of the file's pixel data.
 template <typename Stored>
 void Unpack(const Instance& instance, std::size_t count, Stored* out, std::int64_t& least,
   std::int64_t& greatest)
 {
-  const unsigned shift = instance.HighBit + 1u - instance.BitsStored;
-  const std::uint32_t mask =
-    instance.BitsStored >= 32 ? 0xffffffffu : ((1u << instance.BitsStored) - 1u);
-  const std::uint32_t sign = 1u << (instance.BitsStored - 1u);
-  const bool isSigned = instance.PixelRepresentation == 1;
   const unsigned char* raw = instance.Bytes + instance.PixelOffset;
-  const bool wide = instance.BitsAllocated == 16;
-  for (std::size_t p = 0; p < count; ++p)
+  if (instance.BitsAllocated == 16)
   {
-    const std::uint32_t word = wide ? static_cast<std::uint32_t>(raw[2 * p] | (raw[2 * p + 1] << 8))
-                                    : static_cast<std::uint32_t>(raw[p]);
-    const std::uint32_t bits = (word >> shift) & mask;
-    std::int64_t value = bits;
-    if (isSigned && (bits & sign))
-    {
-      value -= static_cast<std::int64_t>(mask) + 1;
-    }
-    out[p] = static_cast<Stored>(value);
-    least = std::min(least, value);
-    greatest = std::max(greatest, value);
+    UnpackDICOMValues(
+      instance, count,
+      [raw](std::size_t p)
+      { return static_cast<std::uint32_t>(raw[2 * p] | (raw[2 * p + 1] << 8)); },
+      out, least, greatest);
   }
-}
-
-ScalarType SmallestIntegerType(double least, double greatest)
-{
-  if (least >= 0.0)
+  else
   {
-    if (greatest <= 255.0)
-    {
-      return ScalarType::UInt8;
-    }
-    if (greatest <= 65535.0)
-    {
-      return ScalarType::UInt16;
-    }
-    if (greatest <= 4294967295.0)
-    {
-      return ScalarType::UInt32;
-    }
-    return ScalarType::Float64;
+    UnpackDICOMValues(
+      instance, count, [raw](std::size_t p) { return static_cast<std::uint32_t>(raw[p]); }, out,
+      least, greatest);
   }
-  if (least >= -128.0 && greatest <= 127.0)
-  {
-    return ScalarType::Int8;
-  }
-  if (least >= -32768.0 && greatest <= 32767.0)
-  {
-    return ScalarType::Int16;
-  }
-  if (least >= -2147483648.0 && greatest <= 2147483647.0)
-  {
-    return ScalarType::Int32;
-  }
-  return ScalarType::Float64;
 }
 
 std::size_t SizeOf(ScalarType type)
@@ -916,21 +805,6 @@ std::size_t SizeOf(ScalarType type)
   }
 }
 
-template <typename In, typename Out>
-void RescaleSlices(const In* in, Out* out, std::size_t sliceSize, const std::vector<double>& slopes,
-  const std::vector<double>& intercepts)
-{
-  for (std::size_t k = 0; k < slopes.size(); ++k)
-  {
-    const In* from = in + k * sliceSize;
-    Out* to = out + k * sliceSize;
-    for (std::size_t p = 0; p < sliceSize; ++p)
-    {
-      to[p] = static_cast<Out>(slopes[k] * static_cast<double>(from[p]) + intercepts[k]);
-    }
-  }
-}
-
 template <typename In>
 void Rescale(const In* in, void* out, ScalarType type, std::size_t sliceSize,
   const std::vector<double>& slopes, const std::vector<double>& intercepts)
@@ -938,28 +812,28 @@ void Rescale(const In* in, void* out, ScalarType type, std::size_t sliceSize,
   switch (type)
   {
     case ScalarType::Int8:
-      RescaleSlices(in, static_cast<std::int8_t*>(out), sliceSize, slopes, intercepts);
+      RescaleDICOMSlices(in, static_cast<std::int8_t*>(out), sliceSize, slopes, intercepts);
       break;
     case ScalarType::UInt8:
-      RescaleSlices(in, static_cast<std::uint8_t*>(out), sliceSize, slopes, intercepts);
+      RescaleDICOMSlices(in, static_cast<std::uint8_t*>(out), sliceSize, slopes, intercepts);
       break;
     case ScalarType::Int16:
-      RescaleSlices(in, static_cast<std::int16_t*>(out), sliceSize, slopes, intercepts);
+      RescaleDICOMSlices(in, static_cast<std::int16_t*>(out), sliceSize, slopes, intercepts);
       break;
     case ScalarType::UInt16:
-      RescaleSlices(in, static_cast<std::uint16_t*>(out), sliceSize, slopes, intercepts);
+      RescaleDICOMSlices(in, static_cast<std::uint16_t*>(out), sliceSize, slopes, intercepts);
       break;
     case ScalarType::Int32:
-      RescaleSlices(in, static_cast<std::int32_t*>(out), sliceSize, slopes, intercepts);
+      RescaleDICOMSlices(in, static_cast<std::int32_t*>(out), sliceSize, slopes, intercepts);
       break;
     case ScalarType::UInt32:
-      RescaleSlices(in, static_cast<std::uint32_t*>(out), sliceSize, slopes, intercepts);
+      RescaleDICOMSlices(in, static_cast<std::uint32_t*>(out), sliceSize, slopes, intercepts);
       break;
     case ScalarType::Float32:
-      RescaleSlices(in, static_cast<float*>(out), sliceSize, slopes, intercepts);
+      RescaleDICOMSlices(in, static_cast<float*>(out), sliceSize, slopes, intercepts);
       break;
     case ScalarType::Float64:
-      RescaleSlices(in, static_cast<double*>(out), sliceSize, slopes, intercepts);
+      RescaleDICOMSlices(in, static_cast<double*>(out), sliceSize, slopes, intercepts);
       break;
   }
 }
@@ -979,23 +853,13 @@ std::string Decode(const Stack& stack, DICOMSeriesVolume& volume)
     Unpack(*stack.Slices[k], sliceSize, stored.data() + k * sliceSize, least[k], greatest[k]);
   }
   std::vector<double> slopes(count), intercepts(count);
-  bool uniform = true, integral = true;
-  double low = 0.0, high = 0.0;
   for (std::size_t k = 0; k < count; ++k)
   {
     slopes[k] = stack.Slices[k]->Slope;
     intercepts[k] = stack.Slices[k]->Intercept;
-    uniform = uniform && slopes[k] == slopes[0] && intercepts[k] == intercepts[0];
-    integral =
-      integral && slopes[k] == std::round(slopes[k]) && intercepts[k] == std::round(intercepts[k]);
-    const double a = slopes[k] * static_cast<double>(least[k]) + intercepts[k];
-    const double b = slopes[k] * static_cast<double>(greatest[k]) + intercepts[k];
-    low = k == 0 ? std::min(a, b) : std::min(low, std::min(a, b));
-    high = k == 0 ? std::max(a, b) : std::max(high, std::max(a, b));
   }
   const ScalarType storedType = ScalarTypeOf<Stored>();
-  const ScalarType outputType =
-    (!uniform || !integral) ? ScalarType::Float32 : SmallestIntegerType(low, high);
+  const ScalarType outputType = DICOMRescaledType(slopes, intercepts, least, greatest);
   volume.Type = outputType;
   if (outputType != storedType || slopes[0] != 1.0 || intercepts[0] != 0.0)
   {
@@ -1099,33 +963,22 @@ std::string ReadSeries(
   }
 
   // 2. Choose the series with the most slices.
-  std::vector<Series> all;
-  std::map<std::string, std::size_t> index;
-  for (std::size_t i = 0; i < images.size(); ++i)
+  std::vector<const DICOMImageFormat*> formats;
+  for (const Instance& image : images)
   {
-    auto found = index.find(images[i].SeriesUID);
-    if (found == index.end())
-    {
-      found = index.emplace(images[i].SeriesUID, all.size()).first;
-      all.emplace_back();
-      all.back().UID = images[i].SeriesUID;
-      all.back().Description = images[i].SeriesDescription;
-    }
-    all[found->second].Instances.push_back(i);
-    all[found->second].Slices += 1;
+    formats.push_back(&image);
   }
-  std::stable_sort(
-    all.begin(), all.end(), [](const Series& a, const Series& b) { return a.Slices > b.Slices; });
-  const Series& read = all.front();
+  const std::vector<DICOMSeriesGroup> all = GroupDICOMSeries(formats);
+  const DICOMSeriesGroup& read = all.front();
   if (all.size() > 1)
   {
     std::vector<std::string> others;
     for (std::size_t s = 1; s < all.size(); ++s)
     {
-      others.push_back(DescribeSeries(all[s]));
+      others.push_back(DescribeDICOMSeries(all[s]));
     }
     volume.Warnings.push_back(folder + ": the folder holds " + std::to_string(all.size()) +
-      " series; read " + DescribeSeries(read) +
+      " series; read " + DescribeDICOMSeries(read) +
       ", the series with the most slices; not read: " + JoinList(others, "; "));
   }
 
@@ -1163,14 +1016,8 @@ std::string ReadSeries(
   }
   if (!sorted.Uneven.empty())
   {
-    std::vector<std::string> listed(sorted.Uneven.begin(),
-      sorted.Uneven.begin() + std::min<std::size_t>(sorted.Uneven.size(), 5));
-    if (sorted.Uneven.size() > 5)
-    {
-      listed.push_back("and " + std::to_string(sorted.Uneven.size() - 5) + " more");
-    }
     return "the slices are not evenly spaced (median step " + Number(sorted.Median) +
-      " mm): " + JoinList(listed, "; ") + ". The page does not resample them.";
+      " mm): " + DICOMUnevenList(sorted.Uneven) + ". The page does not resample them.";
   }
 
   // 6-7. Decode and rescale.
@@ -1244,7 +1091,166 @@ std::string StackDICOMSlices(const std::vector<DICOMSlice>& slices, DICOMStack& 
 
 ScalarType DICOMIntegerType(double least, double greatest)
 {
-  return SmallestIntegerType(least, greatest);
+  if (least >= 0.0)
+  {
+    if (greatest <= 255.0)
+    {
+      return ScalarType::UInt8;
+    }
+    if (greatest <= 65535.0)
+    {
+      return ScalarType::UInt16;
+    }
+    if (greatest <= 4294967295.0)
+    {
+      return ScalarType::UInt32;
+    }
+    return ScalarType::Float64;
+  }
+  if (least >= -128.0 && greatest <= 127.0)
+  {
+    return ScalarType::Int8;
+  }
+  if (least >= -32768.0 && greatest <= 32767.0)
+  {
+    return ScalarType::Int16;
+  }
+  if (least >= -2147483648.0 && greatest <= 2147483647.0)
+  {
+    return ScalarType::Int32;
+  }
+  return ScalarType::Float64;
+}
+
+ScalarType DICOMRescaledType(const std::vector<double>& slopes,
+  const std::vector<double>& intercepts, const std::vector<std::int64_t>& least,
+  const std::vector<std::int64_t>& greatest)
+{
+  bool uniform = true, integral = true;
+  double low = 0.0, high = 0.0;
+  for (std::size_t k = 0; k < slopes.size(); ++k)
+  {
+    uniform = uniform && slopes[k] == slopes[0] && intercepts[k] == intercepts[0];
+    integral =
+      integral && slopes[k] == std::round(slopes[k]) && intercepts[k] == std::round(intercepts[k]);
+    const double a = slopes[k] * static_cast<double>(least[k]) + intercepts[k];
+    const double b = slopes[k] * static_cast<double>(greatest[k]) + intercepts[k];
+    low = k == 0 ? std::min(a, b) : std::min(low, std::min(a, b));
+    high = k == 0 ? std::max(a, b) : std::max(high, std::max(a, b));
+  }
+  // Float holds every stored value (at most 16 bits) times a slope exactly
+  // when the slope has a short binary fraction, and to 24 bits otherwise.
+  return (!uniform || !integral) ? ScalarType::Float32 : DICOMIntegerType(low, high);
+}
+
+std::uint64_t DICOMPixelBytes(const DICOMImageFormat& image)
+{
+  return static_cast<std::uint64_t>(image.Rows) * image.Columns * image.Frames *
+    (image.BitsAllocated / 8);
+}
+
+std::string DICOMShortPixelData(const DICOMImageFormat& image, std::uint64_t have)
+{
+  return image.Name + ": Pixel Data holds " + std::to_string(have) + " bytes, " +
+    std::to_string(DICOMPixelBytes(image)) + " expected (" + std::to_string(image.Columns) + " x " +
+    std::to_string(image.Rows) + " x " + std::to_string(image.Frames) + " frame(s) x " +
+    std::to_string(image.BitsAllocated / 8) + " byte(s))";
+}
+
+std::string CheckDICOMImageFormat(const DICOMImageFormat& image)
+{
+  const std::string& name = image.Name;
+  if (image.SamplesPerPixel != 1 ||
+    (image.Photometric != "MONOCHROME1" && image.Photometric != "MONOCHROME2"))
+  {
+    return name + ": " + std::to_string(image.SamplesPerPixel) + " sample(s) per pixel, " +
+      "Photometric Interpretation \"" + image.Photometric +
+      "\": only greyscale (MONOCHROME1/2) images are read";
+  }
+  if (image.BitsAllocated != 8 && image.BitsAllocated != 16)
+  {
+    return name + ": Bits Allocated " + std::to_string(image.BitsAllocated) +
+      " is not read (8 or 16)";
+  }
+  if (image.BitsStored == 0 || image.BitsStored > image.BitsAllocated ||
+    image.HighBit + 1 < image.BitsStored || image.HighBit >= image.BitsAllocated)
+  {
+    return name + ": Bits Stored " + std::to_string(image.BitsStored) + " and High Bit " +
+      std::to_string(image.HighBit) + " do not fit Bits Allocated " +
+      std::to_string(image.BitsAllocated);
+  }
+  if (image.Rows == 0 || image.Columns == 0)
+  {
+    return name + ": an image of " + std::to_string(image.Columns) + " x " +
+      std::to_string(image.Rows) + " pixels";
+  }
+  return std::string();
+}
+
+std::string CheckDICOMImageLikeFirst(const DICOMImageFormat& image, const DICOMImageFormat& first)
+{
+  if (image.Rows != first.Rows || image.Columns != first.Columns)
+  {
+    return image.Name + ": " + std::to_string(image.Columns) + " x " + std::to_string(image.Rows) +
+      " pixels, but " + first.Name + " has " + std::to_string(first.Columns) + " x " +
+      std::to_string(first.Rows) + ": slices of different sizes are not read";
+  }
+  if (image.BitsAllocated != first.BitsAllocated ||
+    image.PixelRepresentation != first.PixelRepresentation)
+  {
+    return image.Name + ": pixel format " + std::to_string(image.BitsAllocated) + " bits " +
+      (image.PixelRepresentation ? "signed" : "unsigned") + ", but " + first.Name + " has " +
+      std::to_string(first.BitsAllocated) + " bits " +
+      (first.PixelRepresentation ? "signed" : "unsigned") +
+      ": slices of different pixel formats are not read";
+  }
+  return std::string();
+}
+
+std::vector<DICOMSeriesGroup> GroupDICOMSeries(const std::vector<const DICOMImageFormat*>& images)
+{
+  std::vector<DICOMSeriesGroup> all;
+  std::map<std::string, std::size_t> index;
+  for (std::size_t i = 0; i < images.size(); ++i)
+  {
+    const DICOMImageFormat& image = *images[i];
+    auto found = index.find(image.SeriesUID);
+    if (found == index.end())
+    {
+      found = index.emplace(image.SeriesUID, all.size()).first;
+      all.emplace_back();
+      all.back().UID = image.SeriesUID;
+      all.back().Description = image.SeriesDescription;
+    }
+    all[found->second].Instances.push_back(i);
+    all[found->second].Slices += image.Frames;
+  }
+  std::stable_sort(all.begin(), all.end(),
+    [](const DICOMSeriesGroup& a, const DICOMSeriesGroup& b) { return a.Slices > b.Slices; });
+  return all;
+}
+
+std::string DescribeDICOMSeries(const DICOMSeriesGroup& series)
+{
+  std::string text = series.UID.empty() ? std::string("(no Series Instance UID)") : series.UID;
+  text += " (";
+  if (!series.Description.empty())
+  {
+    text += "\"" + series.Description + "\", ";
+  }
+  text += std::to_string(series.Slices) + (series.Slices == 1 ? " slice)" : " slices)");
+  return text;
+}
+
+std::string DICOMUnevenList(const std::vector<std::string>& uneven)
+{
+  std::vector<std::string> listed(
+    uneven.begin(), uneven.begin() + std::min<std::size_t>(uneven.size(), 5));
+  if (uneven.size() > 5)
+  {
+    listed.push_back("and " + std::to_string(uneven.size() - 5) + " more");
+  }
+  return JoinList(listed, "; ");
 }
 
 const char* DICOMTransferSyntaxName(const std::string& uid)

@@ -47,18 +47,22 @@
  * resample uneven slices is not offered: the page refuses them as the reader
  * does by default.
  *
- * The slice rules (StackDICOMSlices) and the integer output type
- * (DICOMIntegerType) are the reader's own: it calls them. The rest is written
- * again here over the parser's attributes, and TestDICOMSeriesMatchesReader
- * runs both on every folder of the reader's test corpus and requires the same
- * volume, byte for byte, or the same refusal.
+ * The rules below the parser are the reader's own: it calls them (the
+ * per-file checks, the grouping into series, the unpacking of stored values,
+ * the slice rules StackDICOMSlices, the rescaling and its output type), and
+ * reads only the tags (DCMTK), the multi-frame placement, the compressed
+ * syntaxes and the resampling itself. TestDICOMSeriesMatchesReader runs both
+ * on every folder of the reader's test corpus and requires the same volume,
+ * byte for byte, or the same refusal.
  */
 #ifndef MedicalIsosurfaces_DICOMSeries_h
 #define MedicalIsosurfaces_DICOMSeries_h
 
 #include "ScalarTypes.h"
 
+#include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -86,6 +90,112 @@ struct DICOMSeriesVolume
   std::string SeriesUID;
   std::vector<std::string> Warnings; ///< what the reader would warn about
 };
+
+/// What the per-file rules see of one image file (the reader's Instance and
+/// the page's are this and what their own decoding needs).
+struct DICOMImageFormat
+{
+  std::string Name; ///< the file, in messages
+  std::string SeriesUID;
+  std::string SeriesDescription;
+  std::uint16_t Rows = 0, Columns = 0, BitsAllocated = 0, BitsStored = 0, HighBit = 0;
+  std::uint16_t PixelRepresentation = 0, SamplesPerPixel = 1;
+  std::string Photometric;
+  unsigned long Frames = 1;
+};
+
+/// The bytes of pixel data the image needs (every frame).
+std::uint64_t DICOMPixelBytes(const DICOMImageFormat& image);
+
+/// The message for pixel data of `have` bytes, fewer than DICOMPixelBytes.
+std::string DICOMShortPixelData(const DICOMImageFormat& image, std::uint64_t have);
+
+/// The image's own pixel format: greyscale, Bits Allocated 8 or 16, Bits
+/// Stored and High Bit inside it, not empty. Returns "" or the reason.
+std::string CheckDICOMImageFormat(const DICOMImageFormat& image);
+
+/// The image against the series' first: the same size and pixel format.
+/// Returns "" or the reason.
+std::string CheckDICOMImageLikeFirst(const DICOMImageFormat& image, const DICOMImageFormat& first);
+
+/// One series of a folder: its images (indices into the caller's list) and
+/// its slices (frames).
+struct DICOMSeriesGroup
+{
+  std::string UID;
+  std::string Description;
+  std::vector<std::size_t> Instances;
+  std::size_t Slices = 0;
+};
+
+/// The images grouped by Series Instance UID, the series with the most
+/// slices first (ties in the order first seen), so that every list of series
+/// reads the same way.
+std::vector<DICOMSeriesGroup> GroupDICOMSeries(const std::vector<const DICOMImageFormat*>& images);
+
+/// A series in messages: its UID, description and slice count.
+std::string DescribeDICOMSeries(const DICOMSeriesGroup& series);
+
+/**
+ * The stored values of `count` pixels: the word of pixel p (`word(p)`, the
+ * Bits Allocated container in host order) shifted down from High Bit, masked
+ * to Bits Stored and sign-extended when Pixel Representation is 1, into
+ * `out`, widening [least, greatest] to the values met.
+ */
+template <typename Stored, typename Word>
+void UnpackDICOMValues(const DICOMImageFormat& image, std::size_t count, Word word, Stored* out,
+  std::int64_t& least, std::int64_t& greatest)
+{
+  const unsigned shift = image.HighBit + 1u - image.BitsStored;
+  const std::uint32_t mask = image.BitsStored >= 32 ? 0xffffffffu : ((1u << image.BitsStored) - 1u);
+  const std::uint32_t sign = 1u << (image.BitsStored - 1u);
+  const bool isSigned = image.PixelRepresentation == 1;
+  for (std::size_t p = 0; p < count; ++p)
+  {
+    const std::uint32_t bits = (static_cast<std::uint32_t>(word(p)) >> shift) & mask;
+    std::int64_t value = bits;
+    if (isSigned && (bits & sign))
+    {
+      value -= static_cast<std::int64_t>(mask) + 1;
+    }
+    out[p] = static_cast<Stored>(value);
+    least = std::min(least, value);
+    greatest = std::max(greatest, value);
+  }
+}
+
+/**
+ * The output type of rescaled slices whose stored values of slice k lie in
+ * [least[k], greatest[k]]: Float32 when the slopes and intercepts differ
+ * between slices or are not integers, else DICOMIntegerType of the rescaled
+ * range.
+ */
+ScalarType DICOMRescaledType(const std::vector<double>& slopes,
+  const std::vector<double>& intercepts, const std::vector<std::int64_t>& least,
+  const std::vector<std::int64_t>& greatest);
+
+/// Slice k of `in` (sliceSize values each) times slopes[k] plus
+/// intercepts[k], into `out`.
+template <typename In, typename Out>
+void RescaleDICOMSlices(const In* in, Out* out, std::size_t sliceSize,
+  const std::vector<double>& slopes, const std::vector<double>& intercepts)
+{
+  for (std::size_t k = 0; k < slopes.size(); ++k)
+  {
+    const In* from = in + k * sliceSize;
+    Out* to = out + k * sliceSize;
+    const double slope = slopes[k];
+    const double intercept = intercepts[k];
+    for (std::size_t p = 0; p < sliceSize; ++p)
+    {
+      to[p] = static_cast<Out>(slope * static_cast<double>(from[p]) + intercept);
+    }
+  }
+}
+
+/// The gaps and uneven steps of a stack in a message: the first five, then
+/// how many more.
+std::string DICOMUnevenList(const std::vector<std::string>& uneven);
 
 /// One slice as the series rules see it (a single-frame file, or one frame of
 /// a multi-frame file in vtkMedicalDICOMSeriesReader).
