@@ -105,19 +105,11 @@ std::string BaseName(const std::string& path)
   return vtksys::SystemTools::GetFilenameName(path);
 }
 
-// One slice: a single-frame file, or one frame of a multi-frame file.
-struct Slice
+// One slice: a single-frame file, or one frame of a multi-frame file, as
+// the shared slice rules see it (its Name is given when they run).
+struct Slice : mediso::DICOMSlice
 {
   unsigned long Frame = 0;
-  bool HasPosition = false;
-  bool HasOrientation = false;
-  bool HasPixelSpacing = false;
-  double Position[3] = { 0, 0, 0 };
-  double Orientation[6] = { 1, 0, 0, 0, 1, 0 };
-  double PixelSpacing[2] = { 1, 1 }; // DICOM order: between rows, between columns
-  double Slope = 1.0;
-  double Intercept = 0.0;
-  long InstanceNumber = 0;
 };
 
 // What the scan keeps of one image file: what the shared per-file rules see
@@ -618,16 +610,9 @@ std::string CheckInstances(const std::vector<Instance*>& instances)
 // sorted along the normal and its steps measured against the median step, by
 // the rules the web page's DICOM reading shares (mediso::StackDICOMSlices,
 // Readers/Core/DICOMSeries.h).
-struct Stack
+struct Stack : mediso::DICOMStack
 {
   std::vector<std::pair<const Instance*, const Slice*>> Slices; // in increasing position
-  std::vector<double> Distances;                                // along the normal
-  double Row[3] = { 1, 0, 0 };
-  double Column[3] = { 0, 1, 0 };
-  double Normal[3] = { 0, 0, 1 };
-  double Median = 0.0;             // median step
-  std::vector<std::string> Uneven; // gaps and uneven steps, in words
-  bool ValidPixelSpacing = false;
 };
 
 std::string StackSlices(const std::vector<Instance*>& instances, Stack& stack)
@@ -639,37 +624,19 @@ std::string StackSlices(const std::vector<Instance*>& instances, Stack& stack)
     for (const Slice& slice : instance->Slices)
     {
       slices.emplace_back(instance, &slice);
-      mediso::DICOMSlice rule;
-      rule.Name = SliceName(*instance, slice);
-      rule.HasPosition = slice.HasPosition;
-      rule.HasOrientation = slice.HasOrientation;
-      rule.HasPixelSpacing = slice.HasPixelSpacing;
-      std::copy(slice.Position, slice.Position + 3, rule.Position);
-      std::copy(slice.Orientation, slice.Orientation + 6, rule.Orientation);
-      std::copy(slice.PixelSpacing, slice.PixelSpacing + 2, rule.PixelSpacing);
-      rule.Slope = slice.Slope;
-      rule.Intercept = slice.Intercept;
-      rule.InstanceNumber = slice.InstanceNumber;
-      rules.push_back(std::move(rule));
+      rules.push_back(slice);
+      rules.back().Name = SliceName(*instance, slice);
     }
   }
-  mediso::DICOMStack sorted;
-  const std::string error = mediso::StackDICOMSlices(rules, sorted);
+  const std::string error = mediso::StackDICOMSlices(rules, stack);
   if (!error.empty())
   {
     return error;
   }
-  for (std::size_t k : sorted.Order)
+  for (std::size_t k : stack.Order)
   {
     stack.Slices.push_back(slices[k]);
   }
-  stack.Distances = sorted.Distances;
-  std::copy(sorted.Row, sorted.Row + 3, stack.Row);
-  std::copy(sorted.Column, sorted.Column + 3, stack.Column);
-  std::copy(sorted.Normal, sorted.Normal + 3, stack.Normal);
-  stack.Median = sorted.Median;
-  stack.Uneven = sorted.Uneven;
-  stack.ValidPixelSpacing = sorted.ValidPixelSpacing;
   return std::string();
 }
 
@@ -978,17 +945,8 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   this->Dimensions[0] = first.Columns;
   this->Dimensions[1] = first.Rows;
   this->Dimensions[2] = slicesOut;
-  const Slice& base = *stack.Slices.front().second;
-  for (int c = 0; c < 3; ++c)
-  {
-    this->Origin[c] = base.HasPosition ? base.Position[c] : 0.0;
-    this->Direction[3 * c + 0] = stack.Row[c];
-    this->Direction[3 * c + 1] = stack.Column[c];
-    this->Direction[3 * c + 2] = stack.Normal[c];
-  }
-  this->Spacing[0] = stack.ValidPixelSpacing ? base.PixelSpacing[1] : 1.0;
-  this->Spacing[1] = stack.ValidPixelSpacing ? base.PixelSpacing[0] : 1.0;
-  this->Spacing[2] = count > 1 ? step : (first.SliceThickness > 0.0 ? first.SliceThickness : 1.0);
+  mediso::PlaceDICOMStack(stack, *stack.Slices.front().second, count, step, first.SliceThickness,
+    this->Origin, this->Direction, this->Spacing);
   return std::string();
 }
 

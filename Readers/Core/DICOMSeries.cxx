@@ -437,7 +437,8 @@ HeaderStatus ParseHeader(
 }
 
 // ---------------------------------------------------------------------------
-// The reader's rules (vtkMedicalDICOMSeriesReader.cxx), for single-frame files.
+// The page's series: the shared rules (below, public) over the parser's attributes, for
+// single-frame files.
 
 struct Instance : DICOMImageFormat
 {
@@ -445,16 +446,7 @@ struct Instance : DICOMImageFormat
   double SliceThickness = 0.0;
   std::uint64_t PixelOffset = 0;
   std::uint64_t PixelLength = 0;
-  // The one slice.
-  bool HasPosition = false;
-  bool HasOrientation = false;
-  bool HasPixelSpacing = false;
-  double Position[3] = { 0, 0, 0 };
-  double Orientation[6] = { 1, 0, 0, 0, 1, 0 };
-  double PixelSpacing[2] = { 1, 1 }; // DICOM order: between rows, between columns
-  double Slope = 1.0;
-  double Intercept = 0.0;
-  long InstanceNumber = 0;
+  DICOMSlice Slice; // the one slice
 };
 
 // The attributes the rules use, as DCMTK's findAndGet* gives them.
@@ -513,7 +505,7 @@ void Describe(const Header& header, Instance& instance)
   if (text(InstanceNumberTag, value) && NumberAt(value, 0, read[0]) &&
     read[0] == std::floor(read[0]) && std::abs(read[0]) < 2147483648.0)
   {
-    instance.InstanceNumber = static_cast<long>(read[0]);
+    instance.Slice.InstanceNumber = static_cast<long>(read[0]);
   }
   const bool hasThickness = text(SliceThicknessTag, value);
   if (Doubles(value, hasThickness, read, 1))
@@ -521,20 +513,20 @@ void Describe(const Header& header, Instance& instance)
     instance.SliceThickness = read[0];
   }
   bool present = text(PositionTag, value);
-  instance.HasPosition = Doubles(value, present, instance.Position, 3);
+  instance.Slice.HasPosition = Doubles(value, present, instance.Slice.Position, 3);
   present = text(OrientationTag, value);
-  instance.HasOrientation = Doubles(value, present, instance.Orientation, 6);
+  instance.Slice.HasOrientation = Doubles(value, present, instance.Slice.Orientation, 6);
   present = text(PixelSpacingTag, value);
-  instance.HasPixelSpacing = Doubles(value, present, instance.PixelSpacing, 2);
+  instance.Slice.HasPixelSpacing = Doubles(value, present, instance.Slice.PixelSpacing, 2);
   present = text(SlopeTag, value);
   if (Doubles(value, present, read, 1))
   {
-    instance.Slope = read[0];
+    instance.Slice.Slope = read[0];
   }
   present = text(InterceptTag, value);
   if (Doubles(value, present, read, 1))
   {
-    instance.Intercept = read[0];
+    instance.Slice.Intercept = read[0];
   }
   instance.PixelOffset = header.PixelOffset;
   instance.PixelLength = header.PixelLength;
@@ -855,8 +847,8 @@ std::string Decode(const Stack& stack, DICOMSeriesVolume& volume)
   std::vector<double> slopes(count), intercepts(count);
   for (std::size_t k = 0; k < count; ++k)
   {
-    slopes[k] = stack.Slices[k]->Slope;
-    intercepts[k] = stack.Slices[k]->Intercept;
+    slopes[k] = stack.Slices[k]->Slice.Slope;
+    intercepts[k] = stack.Slices[k]->Slice.Intercept;
   }
   const ScalarType storedType = ScalarTypeOf<Stored>();
   const ScalarType outputType = DICOMRescaledType(slopes, intercepts, least, greatest);
@@ -872,23 +864,6 @@ std::string Decode(const Stack& stack, DICOMSeriesVolume& volume)
     std::memcpy(volume.Values.data(), stored.data(), volume.Values.size());
   }
   return std::string();
-}
-
-// The DICOM slices of one instance each, as the rules see them.
-DICOMSlice SliceOf(const Instance& instance)
-{
-  DICOMSlice slice;
-  slice.Name = instance.Name;
-  slice.HasPosition = instance.HasPosition;
-  slice.HasOrientation = instance.HasOrientation;
-  slice.HasPixelSpacing = instance.HasPixelSpacing;
-  std::copy(instance.Position, instance.Position + 3, slice.Position);
-  std::copy(instance.Orientation, instance.Orientation + 6, slice.Orientation);
-  std::copy(instance.PixelSpacing, instance.PixelSpacing + 2, slice.PixelSpacing);
-  slice.Slope = instance.Slope;
-  slice.Intercept = instance.Intercept;
-  slice.InstanceNumber = instance.InstanceNumber;
-  return slice;
 }
 
 const struct
@@ -992,7 +967,8 @@ std::string ReadSeries(
   std::vector<DICOMSlice> slices;
   for (const Instance* instance : instances)
   {
-    slices.push_back(SliceOf(*instance));
+    slices.push_back(instance->Slice);
+    slices.back().Name = instance->Name;
   }
   DICOMStack sorted;
   if (error.empty())
@@ -1039,21 +1015,12 @@ std::string ReadSeries(
   const std::size_t count = stack.Slices.size();
   const std::vector<double>& distances = sorted.Distances;
   const double step = count > 1 ? (distances.back() - distances.front()) / (count - 1) : 0.0;
-  const Instance& base = *stack.Slices.front();
   volume.SeriesUID = read.UID;
   volume.Dimensions[0] = first.Columns;
   volume.Dimensions[1] = first.Rows;
   volume.Dimensions[2] = static_cast<int>(count);
-  for (int c = 0; c < 3; ++c)
-  {
-    volume.Origin[c] = base.HasPosition ? base.Position[c] : 0.0;
-    volume.Direction[3 * c + 0] = sorted.Row[c];
-    volume.Direction[3 * c + 1] = sorted.Column[c];
-    volume.Direction[3 * c + 2] = sorted.Normal[c];
-  }
-  volume.Spacing[0] = sorted.ValidPixelSpacing ? base.PixelSpacing[1] : 1.0;
-  volume.Spacing[1] = sorted.ValidPixelSpacing ? base.PixelSpacing[0] : 1.0;
-  volume.Spacing[2] = count > 1 ? step : (first.SliceThickness > 0.0 ? first.SliceThickness : 1.0);
+  PlaceDICOMStack(sorted, stack.Slices.front()->Slice, count, step, first.SliceThickness,
+    volume.Origin, volume.Direction, volume.Spacing);
   return std::string();
 }
 } // namespace
@@ -1240,6 +1207,21 @@ std::string DescribeDICOMSeries(const DICOMSeriesGroup& series)
   }
   text += std::to_string(series.Slices) + (series.Slices == 1 ? " slice)" : " slices)");
   return text;
+}
+
+void PlaceDICOMStack(const DICOMStack& stack, const DICOMSlice& first, std::size_t slices,
+  double step, double thickness, double origin[3], double direction[9], double spacing[3])
+{
+  for (int c = 0; c < 3; ++c)
+  {
+    origin[c] = first.HasPosition ? first.Position[c] : 0.0;
+    direction[3 * c + 0] = stack.Row[c];
+    direction[3 * c + 1] = stack.Column[c];
+    direction[3 * c + 2] = stack.Normal[c];
+  }
+  spacing[0] = stack.ValidPixelSpacing ? first.PixelSpacing[1] : 1.0;
+  spacing[1] = stack.ValidPixelSpacing ? first.PixelSpacing[0] : 1.0;
+  spacing[2] = slices > 1 ? step : (thickness > 0.0 ? thickness : 1.0);
 }
 
 std::string DICOMUnevenList(const std::vector<std::string>& uneven)

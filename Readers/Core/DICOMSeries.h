@@ -236,6 +236,17 @@ struct DICOMStack
  */
 std::string StackDICOMSlices(const std::vector<DICOMSlice>& slices, DICOMStack& stack);
 
+/**
+ * Where the volume of a stack lies, in LPS millimetres: the origin at
+ * `first`'s Image Position (Patient) (0 without one), the axes (columns of
+ * the row-major `direction`) the stack's row, column and normal, the spacing
+ * Pixel Spacing swapped into (column, row) (1 mm without a valid one) and
+ * `step` between the `slices` slices, or for one slice `thickness` (Slice
+ * Thickness; 1 mm when not positive).
+ */
+void PlaceDICOMStack(const DICOMStack& stack, const DICOMSlice& first, std::size_t slices,
+  double step, double thickness, double origin[3], double direction[9], double spacing[3]);
+
 /// The smallest integer type that holds every value in [least, greatest]
 /// (unsigned when least >= 0), Float64 beyond 32 bits: the reader's output
 /// type for integral rescaling.
