@@ -12,6 +12,7 @@
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStringArray.h"
+#include "vtkMedicalVTKType.h"
 
 #include <vtksys/Directory.hxx>
 #include <vtksys/SystemTools.hxx>
@@ -373,31 +374,6 @@ void Convert(const In* in, vtkDataArray* out, bool resample, std::size_t sliceSi
   {
     vtkTemplateMacro(mediso::RescaleDICOMSlices(
       in, static_cast<VTK_TT*>(out->GetVoidPointer(0)), sliceSize, slopes, intercepts));
-  }
-}
-
-// The VTK type of the rescaled output type (mediso::DICOMRescaledType, the
-// rule the page shares).
-int VTKTypeOf(mediso::ScalarType type)
-{
-  switch (type)
-  {
-    case mediso::ScalarType::UInt8:
-      return VTK_UNSIGNED_CHAR;
-    case mediso::ScalarType::UInt16:
-      return VTK_UNSIGNED_SHORT;
-    case mediso::ScalarType::UInt32:
-      return VTK_UNSIGNED_INT;
-    case mediso::ScalarType::Int8:
-      return VTK_SIGNED_CHAR;
-    case mediso::ScalarType::Int16:
-      return VTK_SHORT;
-    case mediso::ScalarType::Int32:
-      return VTK_INT;
-    case mediso::ScalarType::Float32:
-      return VTK_FLOAT;
-    default:
-      return VTK_DOUBLE;
   }
 }
 
@@ -885,7 +861,7 @@ std::string vtkMedicalDICOMSeriesReader::ReadSeries()
   // Resampled values are interpolated: float, whatever the rescaling.
   const int outputType = resample
     ? VTK_FLOAT
-    : VTKTypeOf(mediso::DICOMRescaledType(slopes, intercepts, least, greatest));
+    : vtkMedicalVTKType(mediso::DICOMRescaledType(slopes, intercepts, least, greatest));
   const std::vector<double>& distances = stack.Distances;
   int slicesOut = static_cast<int>(count);
   double step = count > 1 ? (distances.back() - distances.front()) / (count - 1) : 0.0;

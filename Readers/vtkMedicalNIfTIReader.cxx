@@ -12,6 +12,7 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkMatrix4x4.h"
+#include "vtkMedicalVTKType.h"
 #include "vtkNIFTIImageHeader.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
@@ -64,22 +65,6 @@ int StoredVTKType(const mediso::NIfTIDataType& type)
       return VTK_TYPE_FLOAT32;
     default:
       return VTK_TYPE_FLOAT64;
-  }
-}
-
-// The VTK type of a calibrated scalar type (int16, int32, float32 or float64).
-int CalibratedVTKType(mediso::ScalarType type)
-{
-  switch (type)
-  {
-    case mediso::ScalarType::Int16:
-      return VTK_SHORT;
-    case mediso::ScalarType::Int32:
-      return VTK_INT;
-    case mediso::ScalarType::Float32:
-      return VTK_FLOAT;
-    default:
-      return VTK_DOUBLE;
   }
 }
 
@@ -340,7 +325,7 @@ std::string vtkMedicalNIfTIReader::CheckFile()
     vtkWarningMacro(<< this->FileLabel << ": " << warning);
   }
   this->OutputScalarType = this->Calibrate
-    ? CalibratedVTKType(mediso::NIfTICalibratedType(h.DataType, this->Slope, this->Intercept))
+    ? vtkMedicalVTKType(mediso::NIfTICalibratedType(h.DataType, this->Slope, this->Intercept))
     : this->StoredScalarType;
 
   this->TimeSteps.clear();

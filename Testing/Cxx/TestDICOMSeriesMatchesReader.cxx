@@ -23,6 +23,7 @@
 // Exit 125 (skipped) when /usr/bin/python3 cannot write the corpus.
 #include "DICOMSeries.h"
 #include "vtkMedicalDICOMSeriesReader.h"
+#include "vtkMedicalVTKType.h"
 
 #include "vtkCommand.h"
 #include "vtkDataArray.h"
@@ -117,29 +118,6 @@ ReaderResult RunReader(const std::string& folder)
   }
   result.Image = reader->GetOutput();
   return result;
-}
-
-int VTKType(mediso::ScalarType type)
-{
-  switch (type)
-  {
-    case mediso::ScalarType::Int8:
-      return VTK_SIGNED_CHAR;
-    case mediso::ScalarType::UInt8:
-      return VTK_UNSIGNED_CHAR;
-    case mediso::ScalarType::Int16:
-      return VTK_SHORT;
-    case mediso::ScalarType::UInt16:
-      return VTK_UNSIGNED_SHORT;
-    case mediso::ScalarType::Int32:
-      return VTK_INT;
-    case mediso::ScalarType::UInt32:
-      return VTK_UNSIGNED_INT;
-    case mediso::ScalarType::Float32:
-      return VTK_FLOAT;
-    default:
-      return VTK_DOUBLE;
-  }
 }
 
 std::vector<unsigned char> Slurp(const fs::path& path)
@@ -255,7 +233,7 @@ bool Compare(const std::string& folder, const Expected& expected, std::string& w
     }
   }
   vtkDataArray* scalars = image->GetPointData()->GetScalars();
-  if (!scalars || scalars->GetDataType() != VTKType(volume.Type))
+  if (!scalars || scalars->GetDataType() != vtkMedicalVTKType(volume.Type))
   {
     why =
       std::string("different types: reader ") + (scalars ? scalars->GetDataTypeAsString() : "none");
