@@ -53,7 +53,10 @@ for (const level of [0, 1, 2, 3]) {
 await worker.close();
 
 // --- refinement: a coarse first answer, then the full level ------------------------------------------
-const fast = await open(small, "&path=cpu&frameBudget=1");
+// ?refineDelay=2000: a coarse frame's refinement waits 2 s before it begins (40 ms otherwise), so
+// that the superseding change below surely comes first, however loaded the machine (a running
+// refinement would be aborted instead: TestWebServerPageWorkerAbort).
+const fast = await open(small, "&path=cpu&frameBudget=1&refineDelay=2000");
 await fast.evaluate(() => window.mediso.setCPULevel(-1));
 {
   const before = (await frames(fast)).length;

@@ -23,9 +23,9 @@ export class RemoteViewer {
    * Starts the worker on `canvas` (its control handed over for good) with the module `M` of
    * this thread (the camera, the CPU model's count); `threads`: the worker loads the threaded
    * module; `budgetMs`: the frame budget (0: the worker's); `abort`: false to let a running
-   * refinement run to its end; `slowExtractionMs`, `slowPass`: a test hook (render-worker.js). Resolves to the viewer, or rejects.
+   * refinement run to its end; `slowExtractionMs`, `slowPass`, `refineDelayMs`: test hooks (render-worker.js). Resolves to the viewer, or rejects.
    */
-  static async start(canvas, M, { threads, budgetMs, abort, slowExtractionMs, slowPass }, onFrame) {
+  static async start(canvas, M, { threads, budgetMs, abort, slowExtractionMs, slowPass, refineDelayMs }, onFrame) {
     const worker = new Worker("static/render-worker.js");
     const offscreen = canvas.transferControlToOffscreen();
     const viewer = new RemoteViewer(worker, M, onFrame);
@@ -34,7 +34,7 @@ export class RemoteViewer {
       viewer.onReady = resolve;
       worker.onerror = (e) => reject(new Error("the render worker failed: " + (e.message || "no reason given")));
       worker.postMessage({ op: "init", canvas: offscreen, base, threads, budgetMs, abort, slowExtractionMs,
-        slowPass },
+        slowPass, refineDelayMs },
         [offscreen]);
     });
     viewer.readyState = ready;

@@ -65,9 +65,10 @@ function applySize() {
 
 // The frame budget of interactive frames and of a change's first frame (the page's
 // ?frameBudget=MS, else 100 ms), and how long a coarse frame waits before its refinement starts,
-// so that the next change of a burst (typing, a slider) finds it not yet begun.
+// so that the next change of a burst (typing, a slider) finds it not yet begun (the page's
+// ?refineDelay=MS, a test hook: a test's next change then surely comes before it begins).
 let budgetSeconds = 0.1;
-const REFINE_DELAY_MS = 40;
+let refineDelayMs = 40;
 
 function post(message, transfer) {
   self.postMessage(message, transfer || []);
@@ -85,6 +86,9 @@ async function init(m) {
   M.specialHTMLTargets["#view"] = m.canvas;
   if (m.budgetMs > 0) {
     budgetSeconds = m.budgetMs / 1000;
+  }
+  if (m.refineDelayMs > 0) {
+    refineDelayMs = m.refineDelayMs;
   }
   viewer = new M.WebViewer("#view");
   shareGeneration(m.abort !== false, m.slowExtractionMs, m.slowPass);
@@ -215,7 +219,7 @@ function pump() {
     stats.note = note;
     if (!stats.settled && !frame.interactive && stats.ok) {
       refine = { id: frame.id, key, frame };
-      refine.timer = setTimeout(refineNow, REFINE_DELAY_MS);
+      refine.timer = setTimeout(refineNow, refineDelayMs);
     }
     post({ op: "frame", id: frame.id, stats });
   }

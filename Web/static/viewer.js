@@ -67,7 +67,8 @@ export async function startViewer(canvas, probe) {
     state.viewer = await RemoteViewer.start(canvas, state.module,
       { threads: state.threads > 1, budgetMs: Number(params.get("frameBudget")) || 0,
         abort: params.get("abort") !== "0", slowExtractionMs: Number(params.get("slowExtraction")) || 0,
-        slowPass: Number(params.get("slowPass")) || 1 },
+        slowPass: Number(params.get("slowPass")) || 1,
+        refineDelayMs: Number(params.get("refineDelay")) || 0 },
       frameAnswered);
     state.remote = true;
     state.rendererNote = "Drawn in a worker (OffscreenCanvas): turning, typing and the panel do " +
