@@ -481,6 +481,104 @@ bool HistoPyramidGL::UploadVolume(ScalarType type, const void* values, const int
   return true;
 }
 
+void HistoPyramidGL::EmptyTiles()
+{
+  Internals& impl = *this->Impl;
+  if (impl.Volume)
+  {
+    impl.Tiles.Empty(impl.Type, impl.Layout);
+  }
+  impl.Built = false;
+  impl.Total = 0;
+}
+
+bool HistoPyramidGL::UploadRegion(const void* values, const int first[3], const int last[3],
+  const PointsArrived& arrived, std::string& error)
+{
+  Internals& impl = *this->Impl;
+  if (!impl.Volume || !values)
+  {
+    error = "a region needs a volume uploaded first";
+    return false;
+  }
+  int lo[3], hi[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] = std::max(0, first[a]);
+    hi[a] = std::min(impl.Points[a] - 1, last[a]);
+    if (lo[a] > hi[a])
+    {
+      error = "the region is outside the volume";
+      return false;
+    }
+  }
+  // The texels of the region's rows: each holds points 4 t .. 4 t + 3 of its row, the row's
+  // last point repeated past its end (PackVolumeRows()); doubles become floats as in
+  // UploadVolume().
+  const VolumeFormat format = VolumeFormatOf(impl.Type);
+  const int t0 = lo[0] / 4, t1 = hi[0] / 4;
+  const int texels[3] = { t1 - t0 + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1 };
+  const int bytes = format.BytesPerValue;
+  const int size = ScalarTypeSize(impl.Type);
+  std::vector<unsigned char> staging;
+  try
+  {
+    staging.resize(static_cast<std::size_t>(4 * texels[0]) * texels[1] * texels[2] *
+      static_cast<std::size_t>(bytes));
+  }
+  catch (const std::bad_alloc&)
+  {
+    error = "memory ran out while copying a region for the GPU upload";
+    return false;
+  }
+  const unsigned char* in = static_cast<const unsigned char*>(values);
+  unsigned char* out = staging.data();
+  for (int z = lo[2]; z <= hi[2]; ++z)
+  {
+    for (int y = lo[1]; y <= hi[1]; ++y)
+    {
+      const std::size_t row = (static_cast<std::size_t>(z) * impl.Points[1] + y) * impl.Points[0];
+      for (int x = 4 * t0; x < 4 * (t1 + 1); ++x, out += bytes)
+      {
+        const unsigned char* from = in + (row + std::min(x, impl.Points[0] - 1)) * size;
+        if (impl.Type == ScalarType::Float64)
+        {
+          double d;
+          std::memcpy(&d, from, sizeof d);
+          const float value = static_cast<float>(d);
+          std::memcpy(out, &value, sizeof value);
+        }
+        else
+        {
+          std::copy(from, from + bytes, out);
+        }
+      }
+    }
+  }
+  const GLApi& gl = *impl.GL;
+  const GLApi::Functions& f = gl.F();
+  {
+    ScopedGLState saved(gl, 1);
+    gl.TakeErrors();
+    BindTextureUnit(gl, 0, GL_TEXTURE_3D, impl.Volume.Get());
+    f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    f.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    f.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
+    f.TexSubImage3D(GL_TEXTURE_3D, 0, t0, lo[1], lo[2], texels[0], texels[1], texels[2],
+      format.Format, format.Type, staging.data());
+    const std::string errors = gl.TakeErrors();
+    if (!errors.empty())
+    {
+      error = "cannot upload a region of the volume: " + errors;
+      return false;
+    }
+  }
+  impl.Tiles.ComputeRegion(impl.Type, values, impl.Points, lo, hi, arrived);
+  impl.Built = false;
+  impl.Total = 0;
+  return true;
+}
+
 void HistoPyramidGL::SetOwnedCells(const int first[3], const int end[3])
 {
   Internals& impl = *this->Impl;

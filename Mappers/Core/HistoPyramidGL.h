@@ -108,6 +108,28 @@ public:
   bool UploadVolume(ScalarType type, const void* values, const int points[3],
     const GLParallelFor& parallel, std::string& error);
 
+  ///@{
+  /**
+   * A volume whose values arrive region by region (a streamed one,
+   * IsosurfaceScene::BeginStreaming()), after UploadVolume() of its first
+   * values (the page's empty buffer). EmptyTiles(): every level-1 tile gets
+   * an empty range, so that a build counts nothing. UploadRegion(): the
+   * points [first, last] (inclusive, per axis) of `values`, the whole volume
+   * as UploadVolume() took it (the same type and size, the region's points
+   * now holding their values), go into the volume texture as one
+   * glTexSubImage3D of the texels that hold them (x widened to whole texels
+   * of 4 points), not a whole upload; the tiles whose points meet the region
+   * get their range again where `arrived` says every point their cells read
+   * holds its value (VolumeTiles::ComputeRegion()). Both invalidate the
+   * pyramid: the next Build() counts exactly the cells of the arrived tiles.
+   * False, with the reason, without a volume, for a region outside it, or
+   * when a GL call fails.
+   */
+  void EmptyTiles();
+  bool UploadRegion(const void* values, const int first[3], const int last[3],
+    const PointsArrived& arrived, std::string& error);
+  ///@}
+
   /**
    * Count only the cells [first, end) per axis of the uploaded volume (cell
    * indices; cut to the volume): the others count nothing, in the build and

@@ -125,6 +125,10 @@ struct IsosurfaceSceneStats
   std::uint64_t VolumeUploads = 0;
   ///@}
 
+  /// Regions of a streaming volume uploaded so far (IsosurfaceScene::RegionArrived(): each a
+  /// sub-region of the texture, not a whole upload).
+  std::uint64_t RegionUploads = 0;
+
   /// Builds of a coarse level's pyramid so far (IsosurfaceFrame::Level below 3), the level's
   /// sampling and upload included when it was the level's first.
   std::uint64_t CoarseBuilds = 0;

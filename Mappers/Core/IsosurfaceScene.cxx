@@ -77,6 +77,22 @@ struct IsosurfaceScene::Internals
     std::vector<double> BuiltValues;
   };
   std::array<CoarseLevel, FullLevel> Coarse;
+  // A coarse level's samples from the host (SetCoarseSource(); null Data: sampled here).
+  std::array<VolumeDescription, FullLevel> CoarseSources;
+
+  // Streaming (BeginStreaming()): the runs of BlockCells points per axis that hold their values.
+  struct Streaming
+  {
+    bool On = false;
+    int Runs[3] = { 0, 0, 0 };
+    std::vector<std::uint8_t> Resident;
+    std::int64_t Missing = 0;
+  };
+  Streaming Stream;
+  // Whether every point of [first, last] has arrived.
+  bool PointsHaveArrived(const int first[3], const int last[3]) const;
+  // A coarse level's texture, from the host's samples or the volume's.
+  bool UploadCoarse(int level, std::string& error);
 
   std::vector<IsosurfaceLook> Surfaces;
   IsosurfaceSceneStats Stats;
@@ -237,6 +253,8 @@ bool IsosurfaceScene::SetVolume(const VolumeDescription& volume, std::string& er
   impl.BuiltValues.clear();
   impl.ReleaseCoarse();
   impl.ReleaseBricks();
+  impl.CoarseSources.fill(VolumeDescription());
+  impl.Stream = Internals::Streaming();
   const auto start = Clock::now();
   // One texture where it fits the texture limit and the budget; else bricks.
   std::string why;
@@ -674,30 +692,9 @@ bool IsosurfaceScene::UpdateLevel(int level, std::string& error)
     return false;
   }
   coarse.BuiltValues.clear();
-  if (!coarse.Pyramid || !coarse.Pyramid->HasVolume())
+  if ((!coarse.Pyramid || !coarse.Pyramid->HasVolume()) && !impl.UploadCoarse(level, error))
   {
-    // The level's samples, as vtkBlockLODContour's level reads them: a copy the texture
-    // takes, not kept (the host's values are the source of every level).
-    coarse.Pyramid.reset(new HistoPyramidGL(impl.GL));
-    bool uploaded = false;
-    VisitScalarType(impl.Volume.Type,
-      [&](auto zero)
-      {
-        using T = decltype(zero);
-        Volume<T> full;
-        full.Data = static_cast<const T*>(impl.Volume.Data);
-        std::copy(impl.Volume.Dims, impl.Volume.Dims + 3, full.Dims);
-        std::vector<T> samples;
-        const Volume<T> sampled =
-          MakeCoarseCopy(full, level, samples, SerialIfEmpty(impl.Parallel));
-        uploaded = coarse.Pyramid->UploadVolume(
-          impl.Volume.Type, samples.data(), sampled.Dims, impl.Parallel, error);
-      });
-    if (!uploaded)
-    {
-      coarse.Pyramid.reset();
-      return false;
-    }
+    return false;
   }
   if (!coarse.Pyramid->Build(values, error))
   {
@@ -706,6 +703,233 @@ bool IsosurfaceScene::UpdateLevel(int level, std::string& error)
   ++impl.Stats.CoarseBuilds;
   coarse.BuiltValues = std::move(values);
   return true;
+}
+
+// The level's samples: the host's (SetCoarseSource()), else the volume's as vtkBlockLODContour's
+// level reads them, a copy the texture takes, not kept (the host's values are the source of
+// every level). A streaming volume's values are not all there: only a host's samples then.
+bool IsosurfaceScene::Internals::UploadCoarse(int level, std::string& error)
+{
+  CoarseLevel& coarse = this->Coarse[static_cast<std::size_t>(level)];
+  const VolumeDescription& source = this->CoarseSources[static_cast<std::size_t>(level)];
+  coarse.Pyramid.reset(new HistoPyramidGL(this->GL));
+  bool uploaded = false;
+  if (source.Data)
+  {
+    uploaded =
+      coarse.Pyramid->UploadVolume(source.Type, source.Data, source.Dims, this->Parallel, error);
+  }
+  else if (this->Stream.On)
+  {
+    error = "volume level " + std::to_string(level) +
+      " samples every point, and the streaming volume's have not all arrived";
+  }
+  else
+  {
+    VisitScalarType(this->Volume.Type,
+      [&](auto zero)
+      {
+        using T = decltype(zero);
+        mediso::Volume<T> full;
+        full.Data = static_cast<const T*>(this->Volume.Data);
+        std::copy(this->Volume.Dims, this->Volume.Dims + 3, full.Dims);
+        std::vector<T> samples;
+        const mediso::Volume<T> sampled =
+          MakeCoarseCopy(full, level, samples, SerialIfEmpty(this->Parallel));
+        uploaded = coarse.Pyramid->UploadVolume(
+          this->Volume.Type, samples.data(), sampled.Dims, this->Parallel, error);
+      });
+  }
+  if (!uploaded)
+  {
+    coarse.Pyramid.reset();
+  }
+  return uploaded;
+}
+
+bool IsosurfaceScene::SetCoarseSource(
+  int level, const VolumeDescription& samples, std::string& error)
+{
+  Internals& impl = *this->Impl;
+  if (level < 0 || level >= FullLevel)
+  {
+    error = "no coarse volume level " + std::to_string(level) + " (coarse levels are 0 to 2)";
+    return false;
+  }
+  if (samples.Data && (samples.Dims[0] < 2 || samples.Dims[1] < 2 || samples.Dims[2] < 2))
+  {
+    error = "a coarse level's samples need at least 2 points per axis, not " + Size(samples.Dims);
+    return false;
+  }
+  impl.CoarseSources[static_cast<std::size_t>(level)] = samples;
+  Internals::CoarseLevel& coarse = impl.Coarse[static_cast<std::size_t>(level)];
+  if (coarse.Pyramid)
+  {
+    coarse.Pyramid->Release();
+  }
+  coarse.Pyramid.reset();
+  coarse.BuiltValues.clear();
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool IsosurfaceScene::Internals::PointsHaveArrived(const int first[3], const int last[3]) const
+{
+  if (!this->Stream.On)
+  {
+    return true;
+  }
+  int r0[3], r1[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    r0[a] = std::max(0, first[a]) / BlockCells;
+    r1[a] = std::min(this->Volume.Dims[a] - 1, last[a]) / BlockCells;
+  }
+  for (int z = r0[2]; z <= r1[2]; ++z)
+  {
+    for (int y = r0[1]; y <= r1[1]; ++y)
+    {
+      for (int x = r0[0]; x <= r1[0]; ++x)
+      {
+        if (!this->Stream.Resident[(static_cast<std::size_t>(z) * this->Stream.Runs[1] + y) *
+                this->Stream.Runs[0] +
+              x])
+        {
+          return false;
+        }
+      }
+    }
+  }
+  return true;
+}
+
+bool IsosurfaceScene::BeginStreaming(std::string& error)
+{
+  Internals& impl = *this->Impl;
+  if (!impl.HasVolume)
+  {
+    error = "streaming needs a volume first";
+    return false;
+  }
+  if (impl.Bricked)
+  {
+    error = impl.BrickReason + ": it is kept as bricks, which read the values as they become " +
+      "active, so it does not stream";
+    return false;
+  }
+  Internals::Streaming stream;
+  stream.On = true;
+  std::size_t runs = 1;
+  for (int a = 0; a < 3; ++a)
+  {
+    stream.Runs[a] = (impl.Volume.Dims[a] + BlockCells - 1) / BlockCells;
+    runs *= static_cast<std::size_t>(stream.Runs[a]);
+  }
+  try
+  {
+    stream.Resident.assign(runs, 0);
+  }
+  catch (const std::bad_alloc&)
+  {
+    error = "memory ran out while keeping the streaming volume's residency";
+    return false;
+  }
+  stream.Missing = static_cast<std::int64_t>(runs);
+  impl.Stream = std::move(stream);
+  impl.Pyramid->EmptyTiles();
+  impl.BuiltValues.clear();
+  for (std::size_t level = 1; level < impl.Coarse.size(); ++level)
+  {
+    // Levels 1 and 2 were sampled from values that have not arrived.
+    if (!impl.CoarseSources[level].Data)
+    {
+      this->SetCoarseSource(static_cast<int>(level), VolumeDescription(), error);
+    }
+  }
+  return true;
+}
+
+bool IsosurfaceScene::RegionArrived(const int first[3], const int last[3], std::string& error)
+{
+  Internals& impl = *this->Impl;
+  if (!impl.Stream.On)
+  {
+    error = "the volume is not streaming";
+    return false;
+  }
+  Internals::Streaming& stream = impl.Stream;
+  // The runs the region covers whole, per axis: [r0, r1] (BlockLODVolume::RegionArrived's rule).
+  int r0[3], r1[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    const int n = impl.Volume.Dims[a];
+    const int lo = std::max(0, first[a]);
+    const int hi = std::min(n - 1, last[a]);
+    if (lo > hi)
+    {
+      error = "the region is outside the volume";
+      return false;
+    }
+    r0[a] = (lo + BlockCells - 1) / BlockCells;
+    r1[a] = hi == n - 1 ? stream.Runs[a] - 1 : (hi + 1) / BlockCells - 1;
+  }
+  for (int z = r0[2]; z <= r1[2]; ++z)
+  {
+    for (int y = r0[1]; y <= r1[1]; ++y)
+    {
+      for (int x = r0[0]; x <= r1[0]; ++x)
+      {
+        std::uint8_t& run =
+          stream.Resident[(static_cast<std::size_t>(z) * stream.Runs[1] + y) * stream.Runs[0] + x];
+        stream.Missing -= run ? 0 : 1;
+        run = 1;
+      }
+    }
+  }
+  const Internals* self = &impl;
+  if (!impl.Pyramid->UploadRegion(
+        impl.Volume.Data, first, last,
+        [self](const int a[3], const int b[3]) { return self->PointsHaveArrived(a, b); }, error))
+  {
+    return false;
+  }
+  impl.BuiltValues.clear(); // built again when next drawn
+  ++impl.Stats.RegionUploads;
+  return true;
+}
+
+bool IsosurfaceScene::EndStreaming(std::string& error)
+{
+  Internals& impl = *this->Impl;
+  if (!impl.Stream.On)
+  {
+    return true;
+  }
+  const bool whole = impl.Stream.Missing == 0;
+  impl.Stream = Internals::Streaming();
+  for (int level = 0; level < FullLevel; ++level)
+  {
+    this->SetCoarseSource(level, VolumeDescription(), error);
+  }
+  if (whole)
+  {
+    return true;
+  }
+  // Some points never came through RegionArrived(): the whole texture from the host's values.
+  impl.BuiltValues.clear();
+  if (!impl.Pyramid->UploadVolume(
+        impl.Volume.Type, impl.Volume.Data, impl.Volume.Dims, impl.Parallel, error))
+  {
+    impl.HasVolume = false;
+    return false;
+  }
+  ++impl.Stats.VolumeUploads;
+  return true;
+}
+
+bool IsosurfaceScene::IsStreaming() const
+{
+  return this->Impl->Stream.On;
 }
 
 bool IsosurfaceScene::Render(const IsosurfaceFrame& frame, std::string& error)

@@ -153,6 +153,54 @@ public:
    */
   static int ChooseBrickPoints(ScalarType type, int maxTextureSize, std::uint64_t budget);
 
+  ///@{
+  /**
+   * Streaming: a volume whose values arrive region by region (the web page's
+   * bricks, docs/web.md "Streaming"), kept as one texture. The host adopts
+   * the volume's buffer with SetVolume() before its values are there (the
+   * page's buffer of zeros), then calls BeginStreaming(): from then on no
+   * point is resident, and the full level's pyramid counts no cell (its
+   * level-1 tiles are empty). RegionArrived(): the host has written points
+   * [first, last] (inclusive, per axis) into the buffer; they go into the
+   * texture as a sub-region (HistoPyramidGL::UploadRegion(), a
+   * glTexSubImage3D of those texels, not a whole upload), and each tile
+   * whose points have all arrived gets its value range. Residency is kept
+   * per run of 8 points along each axis, as BlockLODVolume keeps it (a
+   * region covers a run only when it covers all of it; the last run of an
+   * axis may be shorter). The pyramid is built again only at the next
+   * Update(), which a host calls when it draws the full level (the page:
+   * once every brick its surfaces need has arrived), so a brick costs its
+   * upload and not a build; it then counts exactly the dense volume's cells
+   * wherever every point they read has arrived, and nothing elsewhere (no
+   * cell of a point still to come). Levels 2 and 1 sample every point and
+   * are refused while streaming; level 0 is drawn from the host's samples
+   * (SetCoarseSource()). EndStreaming(): every point has arrived (any run
+   * the regions did not cover is uploaded then, with the whole texture);
+   * the coarse levels are sampled from the volume again. A volume kept as
+   * bricks (IsBricked()) does not stream: BeginStreaming() refuses it with
+   * the reason (its bricks read the values as they become active).
+   */
+  bool BeginStreaming(std::string& error);
+  bool RegionArrived(const int first[3], const int last[3], std::string& error);
+  bool EndStreaming(std::string& error);
+  bool IsStreaming() const;
+  ///@}
+
+  /**
+   * The samples of coarse level `level` (0, 1 or 2) from the host instead of
+   * from the volume: `samples` is the volume at that level's stride
+   * (LevelStride(level)), its point c standing for the volume's point
+   * stride * c (the server's levels sample so, without the last partial
+   * layer MakeCoarseCopy() adds), its Data kept valid by the host while the
+   * scene holds it. A streaming volume draws its first frames from the
+   * server's level 0 this way, before its own values are there. A null Data
+   * goes back to sampling the volume. The level's texture and pyramid are
+   * made again at its next frame. Forgotten with the volume (a SetVolume()
+   * that uploads) and at EndStreaming(). False, with the reason, for a level
+   * outside 0..2 or samples of under 2 points on an axis.
+   */
+  bool SetCoarseSource(int level, const VolumeDescription& samples, std::string& error);
+
   /**
    * The surfaces `looks` say, as every host draws them: NaN values left out,
    * sorted by value (stably: a repeated value keeps its first look), each

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <type_traits>
 
 namespace mediso
 {
@@ -88,6 +89,81 @@ void ComputeTileRanges(const T* data, const int points[3], const PyramidLayout& 
     });
 }
 
+// What an empty tile holds: least above greatest, which no threshold lies between.
+template <typename R>
+R EmptyLow()
+{
+  return std::numeric_limits<R>::has_infinity ? std::numeric_limits<R>::infinity()
+                                              : std::numeric_limits<R>::max();
+}
+template <typename R>
+R EmptyHigh()
+{
+  return std::numeric_limits<R>::has_infinity ? -std::numeric_limits<R>::infinity()
+                                              : std::numeric_limits<R>::lowest();
+}
+
+// The ranges of the tiles whose points meet [first, last], each from its own points where they
+// have all arrived, else empty (ComputeTileRanges' tiles: cells [t span, (t + 1) span) along an
+// axis, cut to the volume, and their points one further).
+template <typename T, typename R>
+void ComputeRegionRanges(const T* data, const int points[3], const PyramidLayout& layout,
+  const int first[3], const int last[3], const PointsArrived& arrived, std::vector<R>& out)
+{
+  const auto tiles = layout.TileCounts();
+  const auto factor = layout.Factor(1);
+  const int cells[3] = { points[0] - 1, points[1] - 1, points[2] - 1 };
+  const int span[3] = { 2 * PyramidLayout::TileTexels * factor[0],
+    2 * PyramidLayout::TileTexels * factor[1], factor[2] };
+  const int count[3] = { tiles[0], tiles[1], tiles[2] };
+  int t0[3], t1[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    // Tile t holds points [t span, (t + 1) span]: a point on a boundary is in two tiles.
+    t0[a] = std::max(0, std::max(0, first[a]) - 1) / span[a];
+    t1[a] = std::min(count[a] - 1, std::min(last[a], cells[a]) / span[a]);
+  }
+  for (int tz = t0[2]; tz <= t1[2]; ++tz)
+  {
+    for (int ty = t0[1]; ty <= t1[1]; ++ty)
+    {
+      for (int tx = t0[0]; tx <= t1[0]; ++tx)
+      {
+        const int t[3] = { tx, ty, tz };
+        int lo[3], hi[3];
+        bool real = true;
+        for (int a = 0; a < 3; ++a)
+        {
+          lo[a] = t[a] * span[a];
+          hi[a] = std::min(lo[a] + span[a], cells[a]);
+          real = real && lo[a] < cells[a];
+        }
+        R low = EmptyLow<R>(), high = EmptyHigh<R>();
+        if (real && arrived(lo, hi))
+        {
+          for (int z = lo[2]; z <= hi[2]; ++z)
+          {
+            for (int y = lo[1]; y <= hi[1]; ++y)
+            {
+              const T* row = data + (static_cast<std::size_t>(z) * points[1] + y) * points[0];
+              for (int x = lo[0]; x <= hi[0]; ++x)
+              {
+                const R v = static_cast<R>(row[x]);
+                low = v < low ? v : low; // NaN compares false: left out
+                high = v > high ? v : high;
+              }
+            }
+          }
+        }
+        const std::size_t index =
+          (static_cast<std::size_t>(tz) * count[1] + ty) * count[0] + static_cast<std::size_t>(tx);
+        out[2 * index] = low;
+        out[2 * index + 1] = high;
+      }
+    }
+  }
+}
+
 void SerialFor(
   std::int64_t begin, std::int64_t end, const std::function<void(std::int64_t, std::int64_t)>& body)
 {
@@ -161,6 +237,64 @@ void VolumeTiles::Compute(ScalarType type, const void* data, const int points[3]
       }
     });
   this->Layout = layout;
+}
+
+void VolumeTiles::Empty(ScalarType type, const PyramidLayout& layout)
+{
+  this->Clear();
+  const auto tiles = layout.TileCounts();
+  const std::size_t values = 2 * static_cast<std::size_t>(tiles[0]) * tiles[1] * tiles[2];
+  const auto fill = [values](auto& ranges)
+  {
+    using R = typename std::decay_t<decltype(ranges)>::value_type;
+    ranges.resize(values);
+    for (std::size_t i = 0; i < values; i += 2)
+    {
+      ranges[i] = EmptyLow<R>();
+      ranges[i + 1] = EmptyHigh<R>();
+    }
+  };
+  switch (ValueKindOf(type))
+  {
+    case ValueKind::Signed:
+      fill(this->IntRanges);
+      break;
+    case ValueKind::Unsigned:
+      fill(this->UIntRanges);
+      break;
+    case ValueKind::Float:
+      fill(this->FloatRanges);
+      break;
+  }
+  this->Layout = layout;
+}
+
+void VolumeTiles::ComputeRegion(ScalarType type, const void* data, const int points[3],
+  const int first[3], const int last[3], const PointsArrived& arrived)
+{
+  if (this->GetNumberOfTiles() == 0)
+  {
+    return; // no layout: Compute() or Empty() first
+  }
+  // Values of their own type: double ones become the float they are on the GPU, one by one.
+  VisitScalarType(type,
+    [&](auto tag)
+    {
+      using T = decltype(tag);
+      const T* typed = static_cast<const T*>(data);
+      switch (ValueKindOf(type))
+      {
+        case ValueKind::Signed:
+          ComputeRegionRanges(typed, points, this->Layout, first, last, arrived, this->IntRanges);
+          break;
+        case ValueKind::Unsigned:
+          ComputeRegionRanges(typed, points, this->Layout, first, last, arrived, this->UIntRanges);
+          break;
+        case ValueKind::Float:
+          ComputeRegionRanges(typed, points, this->Layout, first, last, arrived, this->FloatRanges);
+          break;
+      }
+    });
 }
 
 void VolumeTiles::Clear()

@@ -38,6 +38,10 @@ namespace mediso
 using GLParallelFor = std::function<void(
   std::int64_t, std::int64_t, const std::function<void(std::int64_t, std::int64_t)>&)>;
 
+/// Whether every point of [first, last] (inclusive, per axis) holds its value: a volume whose
+/// values arrive region by region (VolumeTiles::ComputeRegion()).
+using PointsArrived = std::function<bool(const int first[3], const int last[3])>;
+
 /// The parallel-for to use: `parallel`, or one that runs the whole range at once when it is empty.
 GLParallelFor SerialIfEmpty(const GLParallelFor& parallel);
 
@@ -70,6 +74,23 @@ public:
     const GLParallelFor& parallel);
 
   void Clear();
+
+  ///@{
+  /**
+   * A volume whose values arrive region by region (a streamed one): Empty()
+   * gives every tile of `layout` an empty range, so that a build draws no
+   * tile; ComputeRegion() gives the tiles whose points meet [first, last]
+   * (inclusive, per axis) their range again from `data` (of the volume's
+   * own type: Float64 values are taken as the floats they become), each where
+   * `arrived` says every point its cells read holds its value, and leaves
+   * the others empty. A tile's cells then count exactly the dense volume's
+   * once its points have arrived, and nothing before (not the values of
+   * points still to come).
+   */
+  void Empty(ScalarType type, const PyramidLayout& layout);
+  void ComputeRegion(ScalarType type, const void* data, const int points[3], const int first[3],
+    const int last[3], const PointsArrived& arrived);
+  ///@}
 
   /// Tiles of the last Compute() (0 after Clear()).
   std::uint64_t GetNumberOfTiles() const;
