@@ -79,7 +79,7 @@ export async function applyPath() {
   $("path").value = state.requestedPath;
   state.viewer.setPath(choice.path);
   if (!state.volumePointer || (state.level !== choice.level.level && !state.stream) ||
-      (state.stream && (state.stream.level !== choice.level.level || choice.path !== "cpu"))) {
+      (state.stream && (state.stream.level !== choice.level.level || choice.path !== state.stream.path))) {
     stopStream();
     // Streamed (stream.js: level 0 first, then the bricks) where the path allows it.
     await (canStream(choice.path, choice.level.level) && !state.volumePointer

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Streaming (docs/web.md, Streaming): on the CPU path with the viewer in a worker, the page does
+// Streaming (docs/web.md, Streaming): with the viewer in a worker (either path), the page does
 // not wait for the whole level. It fetches the server's level 0 (1/512 of the points) and draws
 // every surface from it at once, then fetches the full level's bricks (/api/bricks, the cores'
 // BrickGrid bricks; the brick size is the server's manifest's) a few requests at a time, the
@@ -23,9 +23,14 @@ import { fetchLevel, loadVolume, request, requestJSON, typedValues, unshuffle } 
 // revalidates it (304) instead of fetching it again.
 const IN_FLIGHT = 6;
 
-/** Whether the page streams level `level` on `path` (?stream=0: the whole level at once). */
+/**
+ * Whether the page streams level `level` on `path` (?stream=0: the whole level at once). Both
+ * paths stream in the worker: the GPU path's scene takes each brick into its texture and draws a
+ * frame at level 0 until every current surface's bricks are there (docs/web.md, Streaming).
+ */
 export function canStream(path, level) {
-  return path === "cpu" && state.remote && level > 0 && params.get("stream") !== "0" &&
+  return (path === "cpu" || path === "gpu") && state.remote && level > 0 &&
+    params.get("stream") !== "0" &&
     !(state.dataset && state.dataset.local); // a local file is in the page already
 }
 
@@ -105,13 +110,16 @@ export async function startStream(level) {
     dims, spacing: d.levels[level].spacing, origin: coarse.origin, brick: manifest.brick,
     coarse: { bytes: coarse.bytes, dims: coarse.dims, spacing: coarse.spacing, origin: coarse.origin } });
   if (refused) {
-    throw new Error("the volume cannot be streamed: " + refused);
+    // The GPU path's volume kept as bricks (over the texture limit or GPU budget) does not stream.
+    console.warn("streaming: the whole level instead (" + refused + ")");
+    await loadVolume(level);
+    return;
   }
   if (kept) {
     state.viewer.setView(kept);
   }
   const count = manifest.ranges.length;
-  state.stream = { level, manifest, type, dims, resident: new Uint8Array(count),
+  state.stream = { level, path: state.path, manifest, type, dims, resident: new Uint8Array(count),
     pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, received: 0,
     total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), requested: [],
     readyKey: "", error: "" };

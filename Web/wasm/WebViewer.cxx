@@ -25,7 +25,12 @@
  * (WriteBrick: BrickGrid's bricks, the buffer's BlockLOD ranges completed for
  * them). Each surface the page names in SetCoarseValues is drawn from the
  * coarse volume (at its own full resolution); the others, whose bricks have
- * all arrived, from the buffer at level 3.
+ * all arrived, from the buffer at level 3. On the GPU path the scene streams
+ * too (IsosurfaceScene::BeginStreaming): each brick goes into the volume
+ * texture as a sub-region, level 0 is the scene's coarse level drawn from the
+ * server's samples (SetCoarseSource), and a frame is drawn at one level for
+ * all its surfaces: level 0 while any of them is named coarse, else the full
+ * level, whose pyramid is built then (docs/web.md, Streaming).
  */
 #include "BlockLOD.h"
 #include "BlockLODSurfaces.h"
@@ -464,7 +469,42 @@ public:
       this->Coarse.ClearCache();
       return true;
     }
-    return this->Coarse.SetVolume(description);
+    return this->Coarse.SetVolume(description) && this->StreamCoarseOnGPU(description);
+  }
+
+  /// The GPU path's streaming scene draws the coarse volume as its coarse level of the same
+  /// stride (the server's level 0 of the full level: stride 8, the scene's level 0).
+  bool StreamCoarseOnGPU(const VolumeDescription& coarse)
+  {
+    if (!this->Scene || !this->Scene->IsStreaming())
+    {
+      return true;
+    }
+    const VolumePlacement& placement = this->Viewpoint.GetPlacement();
+    const int stride =
+      static_cast<int>(std::lround(coarse.Spacing[0] / std::max(1e-300, placement.Spacing[0])));
+    this->StreamLevel = -1;
+    for (int level = 0; level < NumberOfLevels - 1; ++level)
+    {
+      bool fits = LevelStride(level) == stride;
+      for (int a = 0; a < 3; ++a)
+      {
+        fits = fits && coarse.Dims[a] == (placement.Dimensions[a] - 1) / stride + 1;
+      }
+      this->StreamLevel = fits ? level : this->StreamLevel;
+    }
+    std::string error;
+    if (this->StreamLevel < 0)
+    {
+      error = "the coarse volume is not a level of the streaming one";
+    }
+    emscripten_webgl_make_context_current(this->Context);
+    if (this->StreamLevel < 0 || !this->Scene->SetCoarseSource(this->StreamLevel, coarse, error))
+    {
+      this->LastError = error;
+      return false;
+    }
+    return true;
   }
 
   /**
@@ -479,6 +519,14 @@ public:
     if (!this->Bricks.IsValid() || !this->Data)
     {
       this->LastError = "bricks of " + std::to_string(brickPoints) + " points cannot stream this volume";
+      return false;
+    }
+    // The GPU path streams into its texture too (a volume kept as bricks does not: refused).
+    std::string error;
+    emscripten_webgl_make_context_current(this->Context);
+    if (!this->CPUPath && !this->Scene->BeginStreaming(error))
+    {
+      this->LastError = error;
       return false;
     }
     this->CPU.BeginStreaming();
@@ -506,6 +554,13 @@ public:
     const int first[3] = { extent[0], extent[2], extent[4] };
     const int last[3] = { extent[1], extent[3], extent[5] };
     this->CPU.RegionArrived(first, last);
+    std::string error;
+    emscripten_webgl_make_context_current(this->Context);
+    if (this->Scene->IsStreaming() && !this->Scene->RegionArrived(first, last, error))
+    {
+      this->LastError = error;
+      return false;
+    }
     return true;
   }
 
@@ -513,13 +568,24 @@ public:
   /// the CPU path chooses its levels again.
   void EndStreaming()
   {
-    // The GPU path's texture was uploaded from the empty buffer: a new stamp uploads the values.
-    this->Described.Stamp = ++this->VolumeStamp;
     emscripten_webgl_make_context_current(this->Context);
     std::string error;
-    if (!this->Scene->SetVolume(this->Described, error))
+    // The GPU path's texture has every brick (RegionArrived); where the scene did not stream (the
+    // CPU path), it was uploaded from the empty buffer: a new stamp uploads the values.
+    if (this->Scene->IsStreaming())
     {
-      this->LastError = error;
+      if (!this->Scene->EndStreaming(error))
+      {
+        this->LastError = error;
+      }
+    }
+    else
+    {
+      this->Described.Stamp = ++this->VolumeStamp;
+      if (!this->Scene->SetVolume(this->Described, error))
+      {
+        this->LastError = error;
+      }
     }
     this->CPU.EndStreaming();
     this->CoarseValues.clear();
@@ -619,9 +685,12 @@ public:
       { return this->Scene->GetStats().PyramidBuilds + this->Scene->GetStats().CoarseBuilds; };
       const std::uint64_t before = builds();
       this->Scene->SetSurfaces(this->Frame.Surfaces);
-      this->Frame.Level = this->GPULevel;
+      this->Frame.Level = this->StreamedGPULevel();
       std::string error;
-      if (!this->Scene->Update(error) || !this->Scene->UpdateLevel(this->GPULevel, error))
+      // Streaming, the full level's pyramid is built only for a frame that draws it.
+      const bool full = this->Frame.Level == NumberOfLevels - 1 || !this->Scene->IsStreaming();
+      if ((full && !this->Scene->Update(error)) ||
+        !this->Scene->UpdateLevel(this->Frame.Level, error))
       {
         this->LastError = error;
         return false;
@@ -663,6 +732,7 @@ public:
         return false;
       }
       this->Stats = this->Scene->GetStats();
+      this->NoteGPUSurfaces();
     }
     // The CPU path's surfaces and the server's result, in world coordinates.
     if (this->Meshes->GetNumberOfMeshes() > 0)
@@ -799,6 +869,9 @@ public:
     stats.set("activeBricks", static_cast<double>(bricks.ActiveBricks));
     stats.set("residentBricks", static_cast<double>(bricks.ResidentBricks));
     stats.set("overBudget", !this->CPUPath && bricks.OverBudget);
+    // Whole volume uploads and streamed regions (sub-region uploads) of the GPU path's texture.
+    stats.set("volumeUploads", static_cast<double>(bricks.VolumeUploads));
+    stats.set("regionUploads", static_cast<double>(bricks.RegionUploads));
     // Per surface of the last CPU frame, in the order drawn (IsosurfaceScene::Normalize's): its
     // isovalue, whether it came from the coarse volume (streaming), and its triangles.
     val values = val::array(), coarse = val::array(), triangles = val::array();
@@ -823,6 +896,41 @@ public:
   }
 
 private:
+  // The GPU path's volume level: the one asked for (SetGPULevel), or while the scene streams, for
+  // all the frame's surfaces, the coarse volume's level when any of them is named coarse
+  // (SetCoarseValues: its bricks are not all there), else the full level.
+  int StreamedGPULevel() const
+  {
+    if (!this->Scene->IsStreaming())
+    {
+      return this->GPULevel;
+    }
+    for (const IsosurfaceLook& s : this->Frame.Surfaces)
+    {
+      if (std::find(this->CoarseValues.begin(), this->CoarseValues.end(), s.Value) !=
+        this->CoarseValues.end())
+      {
+        return this->StreamLevel;
+      }
+    }
+    return NumberOfLevels - 1;
+  }
+
+  // Per surface of a GPU frame, as the CPU path's (stats' surfaceValues, coarse): while streaming,
+  // coarse for every surface of a frame drawn from the coarse volume.
+  void NoteGPUSurfaces()
+  {
+    const bool coarse = this->Scene->IsStreaming() && this->Stats.Level == this->StreamLevel;
+    this->SlotValues.clear();
+    for (const IsosurfaceLook& s : this->Frame.Surfaces)
+    {
+      this->SlotValues.push_back(s.Value);
+    }
+    this->SlotCoarse.assign(this->SlotValues.size(), coarse ? 1 : 0);
+    // The GPU path counts primitives for the frame, not triangles per surface.
+    this->SlotTriangles.assign(this->SlotValues.size(), std::numeric_limits<double>::quiet_NaN());
+  }
+
   // The GPU path's candidates, finest first: the full volume at each sample distance, then the
   // coarse volume levels 2 and 1 the same way, each from its pyramid's active pairs when built
   // for these surfaces, else estimated from the full level's (IsosurfaceScene).
@@ -1184,6 +1292,7 @@ private:
   VolumeDescription Described; // the volume as SetVolume described it (EndStreaming uploads it again)
   BrickGrid Bricks;
   std::vector<double> CoarseValues;
+  int StreamLevel = 0; // the GPU scene's coarse level the coarse volume is (streaming)
   std::vector<double> SlotValues;
   std::vector<char> SlotCoarse;
   std::vector<double> SlotTriangles;
