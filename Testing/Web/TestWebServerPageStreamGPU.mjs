@@ -111,16 +111,21 @@ const info = await page.evaluate((v) => window.mediso.streamInfo(v), [SMALL]);
 if (checks.check(info !== null, "the stream was still under way after the change")) {
   const need = new Set(info.needed[0]);
   const total = info.bricks[0] * info.bricks[1] * info.bricks[2];
-  const after = info.requested.filter((r) => r.values.join() === String(SMALL));
-  const before = new Set(info.requested.filter((r) => !after.includes(r)).flatMap((r) => r.ids));
+  const before = new Set(info.requested.filter((r) => r.values.join() !== String(SMALL)).flatMap((r) => r.ids));
   const owed = [...need].filter((id) => !before.has(id));
-  const asked = after.flatMap((r) => r.ids);
-  console.log("bricks: " + total + ", asked before the change " + before.size + ", " + SMALL + " needs " +
-    need.size + " (" + owed.length + " not yet asked); asked after: " + JSON.stringify(after.map((r) => r.ids)));
   checks.check(need.size < total && owed.length > 0, "the new isovalue needs some bricks not asked for yet, " +
     "and not all of them (" + owed.length + " of " + need.size + " of " + total + ")");
-  checks.check(asked.slice(0, owed.length).every((id) => need.has(id)),
-    "after the change the next bricks asked for are those the new isovalue needs");
+  // The requests after the change, once as many as it owes have gone out (or the stream ended).
+  await page.waitForFunction(([v, n]) => {
+    const i = window.mediso.streamInfo([v]);
+    return !i || i.requested.filter((r) => r.values.join() === String(v)).length >= n;
+  }, [SMALL, owed.length], { timeout: 300000 });
+  const later = await page.evaluate((v) => window.mediso.streamInfo(v), [SMALL]);
+  const asked = later ? later.requested.filter((r) => r.values.join() === String(SMALL)).flatMap((r) => r.ids) : [];
+  console.log("bricks: " + total + ", asked before the change " + before.size + ", " + SMALL + " needs " +
+    need.size + " (" + owed.length + " not yet asked); asked after: " + JSON.stringify(asked));
+  checks.check(asked.length >= owed.length && asked.slice(0, owed.length).every((id) => need.has(id)),
+    "after the change the next " + owed.length + " bricks asked for are those the new isovalue needs");
 }
 
 const full = await page.evaluate(() => window.mediso.whenFull());
