@@ -165,7 +165,7 @@ checks.check(log.some((f) => f.gpuLevel === 0) && log.some((f) => f.gpuLevel ===
 
 const streamed = [...wire.responses.values()].filter((r) => /\/api\/bricks\/.*ids=|\/api\/volume\/.*level=0/.test(r.url));
 const streamedBytes = streamed.reduce((a, r) => a + (r.encodedDataLength || 0), 0);
-checks.check(wholeBytes > 0 && streamedBytes <= 1.05 * wholeBytes,
+checks.check(wholeBytes > 0 && streamedBytes > 0 && streamedBytes <= 1.05 * wholeBytes,
   "level 0 and the bricks: " + streamedBytes + " bytes on the wire, " + (streamedBytes / wholeBytes).toFixed(3) +
   "x the whole level's " + wholeBytes + " (at most 1.05x)");
 
