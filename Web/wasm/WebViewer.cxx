@@ -716,8 +716,8 @@ public:
    * CPU path: the finest level, at most the one the memory budget allows,
    * whose extraction and drawing fit (the coarsest when none does). GPU path:
    * the full volume at the smallest image sample distance whose frame fits
-   * (1 to 4), else the coarse volume levels 2 and 1 (strides 2, 4) the same
-   * way, from each level's active pairs (estimated from the full level's
+   * (1 to 8), else the coarse volume levels 2, 1 and 0 (strides 2, 4, 8) the
+   * same way, from each level's active pairs (estimated from the full level's
    * before its first frame). fullMs: the prediction of the full frame (level
    * the memory allows, every pixel), which the page states when it is over.
    */
@@ -824,17 +824,19 @@ public:
 
 private:
   // The GPU path's candidates, finest first: the full volume at each sample distance, then the
-  // coarse volume levels 2 and 1 the same way, each from its pyramid's active pairs when built
-  // for these surfaces, else estimated from the full level's (IsosurfaceScene).
+  // coarse volume levels 2, 1 and 0 (strides 2, 4, 8) the same way, each from its pyramid's
+  // active pairs when built for these surfaces, else estimated from the full level's
+  // (IsosurfaceScene). A software rasteriser's frame costs about its primitives, so only a
+  // coarser volume brings a large surface within the budget there.
   void AddGPUCandidates(std::vector<FrameTimeModel::Candidate>& candidates) const
   {
     const std::uint64_t full = this->Scene ? this->Scene->GetActivePairs() : 0;
-    for (int level : { NumberOfLevels - 1, 2, 1 })
+    for (int level : { NumberOfLevels - 1, 2, 1, 0 })
     {
       const std::uint64_t built = this->Scene ? this->Scene->GetActivePairs(level) : 0;
       const std::uint64_t pairs =
         built > 0 ? built : IsosurfaceScene::EstimateActivePairs(full, level);
-      for (double distance : { 1.0, 1.5, 2.0, 3.0, 4.0 })
+      for (double distance : { 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0 })
       {
         FrameTimeModel::Candidate c;
         c.Level = level;
