@@ -657,7 +657,22 @@ mediso::FrameTimeModel::Candidate vtkHistoPyramidIsoMapper::ChooseInteractiveLev
       add(level, mediso::FrameMethod::Triangles, 1.0f);
     }
   }
-  return candidates[impl.Model.Choose(candidates, budget)];
+  std::size_t chosen = impl.Model.Choose(candidates, budget);
+  // None predicted within the budget: the one predicted fastest. The list's
+  // last, level 0's triangles, is the coarsest but not always the cheapest:
+  // translucent triangles are sorted on the CPU every frame, where level 0's
+  // GPU frame of a large volume costs little more than its few primitives.
+  if (impl.Model.Predict(candidates[chosen].Work) > budget)
+  {
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+    {
+      if (impl.Model.Predict(candidates[i].Work) < impl.Model.Predict(candidates[chosen].Work))
+      {
+        chosen = i;
+      }
+    }
+  }
+  return candidates[chosen];
 }
 
 //------------------------------------------------------------------------------

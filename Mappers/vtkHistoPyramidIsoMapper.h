@@ -84,7 +84,10 @@
  * InteractiveVolumeLevels; the frame reports the "gpu" path and its level),
  * else that level's Block LOD triangles, and level 0's last (the CPU path's
  * cached levels, InteractiveTriangleLevels; such a frame reports the
- * "fallback" path with an empty FallbackReason). Other renders are full
+ * "fallback" path with an empty FallbackReason). When no candidate is
+ * predicted within the budget the frame is the one predicted fastest (the
+ * last, level 0's triangles, is not always: translucent triangles are sorted
+ * every frame). Other renders are full
  * quality, the same image as with InteractiveAdjust off. GetLastSampleDistance(), GetLastLevel(),
  * GetLastPredictedSeconds() and GetLastMeasuredSeconds() say what the last
  * frame did; frames are timed to their end (glFinish) while InteractiveAdjust

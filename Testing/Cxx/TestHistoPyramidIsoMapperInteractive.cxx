@@ -18,8 +18,10 @@
 //    the GPU path on the coarsest volume level (Block LOD level 0, stride 8)
 //    and says so (GetLastLevel, the scene's stats), with as many primitives as
 //    the CPU model (mediso::HistoPyramid) counts on Block LOD's samples of
-//    that level, behind the plane. With the triangle levels on as well (the default) a tiny
-//    budget draws a coarser Block LOD level's triangles.
+//    that level, behind the plane. With the triangle levels instead a tiny
+//    budget draws a coarser Block LOD level's triangles; with both (the
+//    default) the coarse frame predicted fastest, not always the last (the
+//    triangles).
 // 3. With a budget of 1000 s the interactive render draws every pixel (the
 //    still image); with InteractiveFrameBudget 0 the allocated render time
 //    is the budget; with InteractiveAdjust off interactive renders are the
@@ -273,8 +275,10 @@ void CheckGPUScene(
       std::abs(Covered(coarse) - stillCovered) < stillCovered / 5,
     name + ": the coarse level covers the still pixels within 20%, behind the plane");
 
-  // The same with the triangle levels (the default): a coarser Block LOD
-  // level's triangles, which are what fits a tiny budget best.
+  // The triangle levels instead: a coarser Block LOD level's triangles,
+  // which are what fits a tiny budget best without the volume levels.
+  const double coarseSeconds = mapper->GetLastPredictedSeconds();
+  mapper->InteractiveVolumeLevelsOff();
   mapper->InteractiveTriangleLevelsOn();
   std::vector<unsigned char> triangles;
   for (int frame = 0; frame < 2; ++frame)
@@ -291,6 +295,24 @@ void CheckGPUScene(
   Check(PlanePixels(triangles) == stillPlane &&
       std::abs(Covered(triangles) - stillCovered) < stillCovered / 10,
     name + ": they cover the still pixels within 10%, behind the plane");
+
+  // Both (the default): when no candidate is predicted within the budget the
+  // frame is the one predicted fastest, GPU volume level 0 or the triangles,
+  // not the list's last (the triangles) whatever they cost.
+  mapper->InteractiveVolumeLevelsOn();
+  mediso::FrameWork triangleWork;
+  triangleWork.Method = mediso::FrameMethod::Triangles;
+  triangleWork.Primitives = mapper->GetNumberOfFallbackTriangles();
+  triangleWork.Pixels = mediso::FrameTimeModel::ShadedPixels(Size, Size, 1.0);
+  triangleWork.Translucent = translucent;
+  const double trianglesPredicted = mapper->GetFrameTimeModel().Predict(triangleWork);
+  scene.Render(InteractiveRate);
+  std::printf("%s interactive, tiny budget, both levels: %s (triangles predicted %.4f s, volume "
+              "level 0 before %.4f s)\n",
+    name.c_str(), Describe(mapper).c_str(), trianglesPredicted, coarseSeconds);
+  Check(mapper->GetLastInteractive() && mapper->GetLastLevel() < 3 &&
+      mapper->GetLastPredictedSeconds() <= trianglesPredicted * 1.000001,
+    name + ": with both levels a tiny budget draws the coarse frame predicted fastest");
 
   // A still render after the interactive ones: the same image.
   const std::vector<unsigned char> after = scene.Render(StillRate);
