@@ -23,7 +23,9 @@ sample distance, and the longest main-thread task (PerformanceObserver longtask)
 and the drag. Inputs: phantom:N (the plugin's phantom) or ct. --scene skin-bone drags issue 30's
 scene (skin -500 at opacity 0.3 over bone 400) instead of the last change's surface; --stills N
 adds N still frames after the drag (the camera turned 2 degrees each) and their median, the drag
-frame's ratio to it; --before none runs this page only.
+frame's ratio to it, and the steady drag frame (without the first frame at each level and sample
+distance, which may build that level or compile its program); --move-ms the wait after each of the
+drag's --moves (a longer drag for slow frames); --before none runs this page only.
 
 --stream (issue 31): the page on the CPU path fetching its level whole (?stream=0) and streaming
 it (level 0, then the bricks the surfaces need first), each in a fresh browser context, in one
@@ -71,6 +73,8 @@ def parse_args(argv):
     p.add_argument("--paths", default="cpu,gpu", help="--interactive: the page's paths to run")
     p.add_argument("--scene", default="", choices=["", "skin-bone"],
                    help="--interactive: skin-bone drags skin -500 (opacity 0.3) over bone 400")
+    p.add_argument("--move-ms", type=int, default=30,
+                   help="--interactive: the wait after each mouse move of the drag (ms)")
     p.add_argument("--changes", type=int, default=6,
                    help="--interactive: isovalue changes timed before the drag (at most 6)")
     p.add_argument("--stills", type=int, default=0,
@@ -211,7 +215,7 @@ def run_interactive(args, name, before_root):
         isovalues = [v for v in isovalues if lo < v < hi][:max(1, args.changes) + 1]
         config = {"pages": pages, "paths": args.paths.split(","),
                   "size": [int(v) for v in args.size.split("x")], "isovalues": isovalues,
-                  "moves": args.moves, "stills": args.stills}
+                  "moves": args.moves, "stills": args.stills, "moveMs": args.move_ms}
         if args.scene == "skin-bone":
             config["surfaces"] = [{"value": -500, "opacity": 0.3, "color": [0.93, 0.75, 0.62]},
                                   {"value": 400}]
@@ -257,8 +261,9 @@ def main_interactive(args, argv):
              "- after: this tree's page (the viewer in a worker, frame budget 100 ms) only (`--before none`)", "",
              "| input | path | page | first visible answer ms, median (max) | full level ms, median | "
              "drag frame ms, median | drag frames/s | drag level / sample distance | longest main-thread task ms |"
-             + (" still frame ms, median | drag / still |" if args.stills else ""),
-             "|---|---|---|---:|---:|---:|---:|---|---:|" + ("---:|---:|" if args.stills else "")]
+             + (" still frame ms, median | drag / still | steady drag frame ms, median (frames) | steady drag / still |"
+                if args.stills else ""),
+             "|---|---|---|---:|---:|---:|---:|---|---:|" + ("---:|---:|---:|---:|" if args.stills else "")]
     if args.scene:
         lines[5:5] = ["- Drag and still frames: skin -500 at opacity 0.3 over bone 400 (`--scene skin-bone`)"]
     for name, r in results.items():
@@ -278,8 +283,12 @@ def main_interactive(args, argv):
                 "%.1f" % d["rate"] if d.get("rate") is not None else "-", how, run["longestTaskMs"])
             if args.stills:
                 still = (run.get("still") or {}).get("frameMs")
-                row += " %s | %s |" % ("%.0f" % still if still else "-",
-                                       "%.2f" % (d["frameMs"] / still) if still and d["frameMs"] else "-")
+                steady = d.get("steadyMs")
+                row += " %s | %s | %s | %s |" % (
+                    "%.0f" % still if still else "-",
+                    "%.2f" % (d["frameMs"] / still) if still and d["frameMs"] else "-",
+                    "%.0f (%d)" % (steady, d["steadyFrames"]) if steady else "-",
+                    "%.2f" % (steady / still) if still and steady else "-")
             lines.append(row)
     errors = ["%s %s: %.0f%%" % (name, run["path"], 100 * run["drag"]["predictionError"])
               for name, r in results.items() for run in r["runs"]

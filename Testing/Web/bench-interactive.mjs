@@ -8,7 +8,8 @@
 //   node bench-interactive.mjs CONFIG.json OUT.json
 // CONFIG: {pages: {name: url}, paths: ["cpu", "gpu"], size: [w, h], isovalues: [...], moves,
 //          surfaces (optional: [{value, opacity}], drawn before the drag: e.g. skin 0.3 over bone),
-//          stills (optional: still frames after the drag, the camera turned 2 degrees each)}
+//          stills (optional: still frames after the drag, the camera turned 2 degrees each),
+//          moveMs (optional: the wait after each mouse move, 30 by default)}
 import { launch } from "./page.mjs";
 import { readFileSync, writeFileSync } from "node:fs";
 
@@ -60,7 +61,7 @@ for (const path of config.paths) {
     const t0 = Date.now();
     for (let i = 1; i <= config.moves; ++i) {
       await page.mouse.move(x + 4 * i, y + i);
-      await page.waitForTimeout(30);
+      await page.waitForTimeout(config.moveMs || 30);
       sampled.push(await page.evaluate(() => window.mediso.stats().lastFrameMs));
     }
     await page.mouse.up();
@@ -70,7 +71,15 @@ for (const path of config.paths) {
     const frames = await page.evaluate((n) => (window.mediso.frames ? window.mediso.frames().slice(n) : null), before);
     if (frames) {
       const drag = frames.filter((f) => f.interactive);
+      // steady: without each (level, sample distance)'s first drag frame, which may build the
+      // level's pyramid or compile its program (one-off work a longer drag does not repeat)
+      const seen = new Set();
+      const steady = drag.filter((f) => {
+        const key = [f.cpuLevel, f.gpuLevel, f.sampleDistance].join();
+        return seen.has(key) || !seen.add(key);
+      });
       run.drag = { frameMs: median(drag.map((f) => f.ms)), frames: drag.length, rate: drag.length / dragSeconds,
+        steadyMs: median(steady.map((f) => f.ms)), steadyFrames: steady.length,
         levels: [...new Set(drag.map((f) => f.cpuLevel))], sampleDistances: [...new Set(drag.map((f) => f.sampleDistance))],
         gpuLevels: [...new Set(drag.map((f) => f.gpuLevel).filter((k) => k !== undefined))],
         predictionError: median(drag.filter((f) => f.predictedMs > 0).map((f) => Math.abs(f.predictedMs - f.ms) / f.ms)) };
