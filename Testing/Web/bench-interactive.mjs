@@ -37,6 +37,8 @@ for (const path of config.paths) {
     await page.goto(url + "&path=" + path + "&size=" + config.size.join("x"), { waitUntil: "commit" });
     await page.waitForFunction(() => window.mediso, null, { timeout: 300000 });
     await page.evaluate(() => window.mediso.ready);
+    // the volume whole (a large one streams its bricks first: until then no frame is coarse)
+    await page.waitForFunction(() => (window.mediso.stats().received ?? 1) >= 1, null, { timeout: 600000 });
     // the load's own tasks left out: a first change, a second's rest
     await page.evaluate((v) => window.mediso.setIsovalues([v]), config.isovalues[0]);
     await page.waitForTimeout(1000);
