@@ -744,8 +744,8 @@ public:
         candidates.push_back(c);
         extraSeconds.push_back(seconds);
       }
-      // A drag whose level 0 is over the budget: level 0 on fewer pixels (software WebGL's frame
-      // of a few thousand triangles costs mostly its pixels: clears, blending, the canvas).
+      // A drag whose level 0 is over the budget: level 0 on fewer pixels (on software WebGL about
+      // half of such a frame of a few thousand triangles is its pixels: shading, blending).
       const FrameTimeModel::Candidate levelZero = candidates.back();
       const double levelZeroSeconds = extraSeconds.back();
       if (interactive)
