@@ -60,8 +60,9 @@ constexpr float SampleDistances[] = { 1.0f, 1.5f, 2.0f, 2.5f, 3.0f, 4.0f, 5.0f, 
 // The full-resolution Block LOD level (vtkBlockLODContour's LOD 3: cubes of one voxel).
 constexpr int FullLevel = 3;
 
-// The coarse volume levels an interactive GPU frame chooses from, finest first (strides 2, 4).
-constexpr int VolumeLevels[] = { 2, 1 };
+// The coarse volume levels an interactive GPU frame chooses from, finest first (strides 2, 4,
+// 8): on a software rasteriser a frame costs about its primitives, 4x fewer per level.
+constexpr int VolumeLevels[] = { 2, 1, 0 };
 
 using Clock = std::chrono::steady_clock;
 } // anonymous namespace
@@ -656,7 +657,22 @@ mediso::FrameTimeModel::Candidate vtkHistoPyramidIsoMapper::ChooseInteractiveLev
       add(level, mediso::FrameMethod::Triangles, 1.0f);
     }
   }
-  return candidates[impl.Model.Choose(candidates, budget)];
+  std::size_t chosen = impl.Model.Choose(candidates, budget);
+  // None predicted within the budget: the one predicted fastest. The list's
+  // last, level 0's triangles, is the coarsest but not always the cheapest:
+  // translucent triangles are sorted on the CPU every frame, where level 0's
+  // GPU frame of a large volume costs little more than its few primitives.
+  if (impl.Model.Predict(candidates[chosen].Work) > budget)
+  {
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+    {
+      if (impl.Model.Predict(candidates[i].Work) < impl.Model.Predict(candidates[chosen].Work))
+      {
+        chosen = i;
+      }
+    }
+  }
+  return candidates[chosen];
 }
 
 //------------------------------------------------------------------------------

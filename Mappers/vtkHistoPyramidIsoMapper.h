@@ -79,12 +79,15 @@
  * predicted over the budget (its per-cell work dominates: the frame needs a
  * coarser volume), the frame draws a coarser level, finest first, each at
  * its finest distance predicted within the budget: the GPU path on the
- * volume sampled at Block LOD level 2's or 1's stride (2 or 4: a coarse
- * volume and pyramid the GPU core makes on the level's first frame;
+ * volume sampled at Block LOD level 2's, 1's or 0's stride (2, 4 or 8: a
+ * coarse volume and pyramid the GPU core makes on the level's first frame;
  * InteractiveVolumeLevels; the frame reports the "gpu" path and its level),
  * else that level's Block LOD triangles, and level 0's last (the CPU path's
  * cached levels, InteractiveTriangleLevels; such a frame reports the
- * "fallback" path with an empty FallbackReason). Other renders are full
+ * "fallback" path with an empty FallbackReason). When no candidate is
+ * predicted within the budget the frame is the one predicted fastest (the
+ * last, level 0's triangles, is not always: translucent triangles are sorted
+ * every frame). Other renders are full
  * quality, the same image as with InteractiveAdjust off. GetLastSampleDistance(), GetLastLevel(),
  * GetLastPredictedSeconds() and GetLastMeasuredSeconds() say what the last
  * frame did; frames are timed to their end (glFinish) while InteractiveAdjust
@@ -271,11 +274,11 @@ public:
   /**
    * Let an interactive GPU frame whose sample distances are all predicted
    * over the budget draw the GPU path on a coarser volume level: Block LOD
-   * level 2 or 1 (the volume sampled at stride 2 or 4, the points those
-   * levels' triangles are made from), whose coarse volume and pyramid the
-   * GPU core makes on the level's first frame (up to 1/8 + 1/64 more GPU
-   * memory). Candidates go finest first: a level's GPU frames before its
-   * triangles. Default on.
+   * level 2, 1 or 0 (the volume sampled at stride 2, 4 or 8, the points
+   * those levels' triangles are made from), whose coarse volume and pyramid
+   * the GPU core makes on the level's first frame (up to 1/8 + 1/64 + 1/512
+   * more GPU memory). Candidates go finest first: a level's GPU frames before
+   * its triangles. Default on.
    */
   vtkSetMacro(InteractiveVolumeLevels, bool);
   vtkGetMacro(InteractiveVolumeLevels, bool);

@@ -20,7 +20,12 @@ thread, served from an export of that ref with the same WebAssembly module) and 
 viewer in a worker), in one Chromium, on each path: the time from an isovalue change to its first
 visible frame and to the full level, the median frame of a mouse drag with its level or image
 sample distance, and the longest main-thread task (PerformanceObserver longtask) over the changes
-and the drag. Inputs: phantom:N (the plugin's phantom) or ct.
+and the drag. Inputs: phantom:N (the plugin's phantom) or ct. --scene skin-bone drags issue 30's
+scene (skin -500 at opacity 0.3 over bone 400) instead of the last change's surface; --stills N
+adds N still frames after the drag (the camera turned 2 degrees each) and their median, the drag
+frame's ratio to it, and the steady drag frame (without the first frame at each level and sample
+distance, which may build that level or compile its program); --move-ms the wait after each of the
+drag's --moves (a longer drag for slow frames); --before none runs this page only.
 
 --stream (issue 31): the page on the CPU path fetching its level whole (?stream=0) and streaming
 it (level 0, then the bricks the surfaces need first), each in a fresh browser context, in one
@@ -66,6 +71,14 @@ def parse_args(argv):
                         "left main, whose page takes this tree's WebAssembly module)")
     p.add_argument("--moves", type=int, default=30, help="--interactive: mouse moves of the drag")
     p.add_argument("--paths", default="cpu,gpu", help="--interactive: the page's paths to run")
+    p.add_argument("--scene", default="", choices=["", "skin-bone"],
+                   help="--interactive: skin-bone drags skin -500 (opacity 0.3) over bone 400")
+    p.add_argument("--move-ms", type=int, default=30,
+                   help="--interactive: the wait after each mouse move of the drag (ms)")
+    p.add_argument("--changes", type=int, default=6,
+                   help="--interactive: isovalue changes timed before the drag (at most 6)")
+    p.add_argument("--stills", type=int, default=0,
+                   help="--interactive: still frames after the drag (their median beside the drag's)")
     p.add_argument("--stream", action="store_true",
                    help="streaming against the whole level (issue 31): first image, full level, bytes")
     p.add_argument("--networks", default="30/40,loopback",
@@ -191,16 +204,21 @@ def run_interactive(args, name, before_root):
     os.makedirs(work, exist_ok=True)
     servers = []
     try:
-        before, before_url = start_server(before_root, args, data)
-        servers.append(before)
-        after, after_url = start_server(ROOT, args, data)
+        pages = {}
+        if before_root:
+            before, pages["before"] = start_server(before_root, args, data)
+            servers.append(before)
+        after, pages["after"] = start_server(ROOT, args, data)
         servers.append(after)
         lo, hi = (-1000, 1100) if name.startswith("phantom:") else (-1000, 2000)
         isovalues = [400, -500, 300, 500, -300, 200, 600]
-        isovalues = [v for v in isovalues if lo < v < hi]
-        config = {"pages": {"before": before_url, "after": after_url}, "paths": args.paths.split(","),
+        isovalues = [v for v in isovalues if lo < v < hi][:max(1, args.changes) + 1]
+        config = {"pages": pages, "paths": args.paths.split(","),
                   "size": [int(v) for v in args.size.split("x")], "isovalues": isovalues,
-                  "moves": args.moves}
+                  "moves": args.moves, "stills": args.stills, "moveMs": args.move_ms}
+        if args.scene == "skin-bone":
+            config["surfaces"] = [{"value": -500, "opacity": 0.3, "color": [0.93, 0.75, 0.62]},
+                                  {"value": 400}]
         config_file = os.path.join(work, "config.json")
         out_file = os.path.join(work, "result.json")
         with open(config_file, "w") as f:
@@ -223,12 +241,14 @@ def main_interactive(args, argv):
     if not args.before:
         args.before = subprocess.run(["git", "-C", ROOT, "merge-base", "HEAD", "main"], check=True,
                                      stdout=subprocess.PIPE, text=True).stdout.strip()[:12]
-    before_root = os.path.join(args.work, "before-" + args.before.replace("/", "-"))
-    shutil.rmtree(before_root, ignore_errors=True)
-    os.makedirs(before_root)
-    archive = subprocess.run(["git", "-C", ROOT, "archive", args.before, "Python", "Web/static"],
-                             check=True, stdout=subprocess.PIPE).stdout
-    subprocess.run(["tar", "-x", "-C", before_root], input=archive, check=True)
+    before_root = ""
+    if args.before != "none":
+        before_root = os.path.join(args.work, "before-" + args.before.replace("/", "-"))
+        shutil.rmtree(before_root, ignore_errors=True)
+        os.makedirs(before_root)
+        archive = subprocess.run(["git", "-C", ROOT, "archive", args.before, "Python", "Web/static"],
+                                 check=True, stdout=subprocess.PIPE).stdout
+        subprocess.run(["tar", "-x", "-C", before_root], input=archive, check=True)
     results = {name: run_interactive(args, name, before_root) for name in args.inputs.split(",")}
     lines = ["# The page before and after the worker (issue 30)", "",
              "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv),
@@ -236,11 +256,16 @@ def main_interactive(args, argv):
                  started, time.perf_counter() - t0, load_before, load_average()),
              "- Machine: nproc %d (%s); Chromium headless, SwiftShader; canvas %s" % (
                  os.cpu_count() or 0, cpu_model(), args.size),
-             "- before: `%s`'s page (the viewer on the main thread); after: this tree's (the viewer in a "
-             "worker, frame budget 100 ms); the same WebAssembly module" % args.before, "",
+             ("- before: `%s`'s page (the viewer on the main thread); after: this tree's (the viewer in a "
+              "worker, frame budget 100 ms); the same WebAssembly module" % args.before) if before_root else
+             "- after: this tree's page (the viewer in a worker, frame budget 100 ms) only (`--before none`)", "",
              "| input | path | page | first visible answer ms, median (max) | full level ms, median | "
-             "drag frame ms, median | drag frames/s | drag level / sample distance | longest main-thread task ms |",
-             "|---|---|---|---:|---:|---:|---:|---|---:|"]
+             "drag frame ms, median | drag frames/s | drag level / sample distance | longest main-thread task ms |"
+             + (" still frame ms, median | drag / still | steady drag frame ms, median (frames) | steady drag / still |"
+                if args.stills else ""),
+             "|---|---|---|---:|---:|---:|---:|---|---:|" + ("---:|---:|---:|---:|" if args.stills else "")]
+    if args.scene:
+        lines[5:5] = ["- Drag and still frames: skin -500 at opacity 0.3 over bone 400 (`--scene skin-bone`)"]
     for name, r in results.items():
         for run in r["runs"]:
             firsts = [c["firstMs"] for c in run["changes"]]
@@ -252,10 +277,19 @@ def main_interactive(args, argv):
                     ("distance %s" % ", ".join("%.2g" % s for s in d["sampleDistances"]) +
                      ("; volume level %s" % ", ".join(str(k) for k in d["gpuLevels"])
                       if d.get("gpuLevels") else ""))
-            lines.append("| %s | %s | %s | %.0f (%.0f) | %.0f | %.0f | %s | %s | %.0f |" % (
+            row = "| %s | %s | %s | %.0f (%.0f) | %.0f | %.0f | %s | %s | %.0f |" % (
                 name, run["path"], run["page"], statistics.median(firsts), max(firsts),
                 statistics.median(fulls), d["frameMs"] or 0,
-                "%.1f" % d["rate"] if d.get("rate") is not None else "-", how, run["longestTaskMs"]))
+                "%.1f" % d["rate"] if d.get("rate") is not None else "-", how, run["longestTaskMs"])
+            if args.stills:
+                still = (run.get("still") or {}).get("frameMs")
+                steady = d.get("steadyMs")
+                row += " %s | %s | %s | %s |" % (
+                    "%.0f" % still if still else "-",
+                    "%.2f" % (d["frameMs"] / still) if still and d["frameMs"] else "-",
+                    "%.0f (%d)" % (steady, d["steadyFrames"]) if steady else "-",
+                    "%.2f" % (steady / still) if still and steady else "-")
+            lines.append(row)
     errors = ["%s %s: %.0f%%" % (name, run["path"], 100 * run["drag"]["predictionError"])
               for name, r in results.items() for run in r["runs"]
               if run["page"] == "after" and run["drag"].get("predictionError") is not None

@@ -15,11 +15,13 @@
 //    reduced target drawn up to the viewport), differs from it, and keeps the
 //    depth test: an opaque plane in front of the volume's left part stays
 //    unchanged. With the volume levels on (the default) a tiny budget draws
-//    the GPU path on a coarse volume level (Block LOD level 1, stride 4) and
-//    says so (GetLastLevel, the scene's stats), with as many primitives as
+//    the GPU path on the coarsest volume level (Block LOD level 0, stride 8)
+//    and says so (GetLastLevel, the scene's stats), with as many primitives as
 //    the CPU model (mediso::HistoPyramid) counts on Block LOD's samples of
-//    that level, behind the plane. With the triangle levels on as well (the default) a tiny
-//    budget draws a coarser Block LOD level's triangles.
+//    that level, behind the plane. With the triangle levels instead a tiny
+//    budget draws a coarser Block LOD level's triangles; with both (the
+//    default) the coarse frame predicted fastest, not always the last (the
+//    triangles).
 // 3. With a budget of 1000 s the interactive render draws every pixel (the
 //    still image); with InteractiveFrameBudget 0 the allocated render time
 //    is the budget; with InteractiveAdjust off interactive renders are the
@@ -239,7 +241,7 @@ void CheckGPUScene(
     name + ": the plane in front keeps every pixel (the reduced surfaces' depth is tested)");
 
   // The volume levels on: the GPU path on the coarsest volume level (Block
-  // LOD level 1: the volume sampled at stride 4), its primitives the CPU
+  // LOD level 0: the volume sampled at stride 8), its primitives the CPU
   // model's count on that level's samples.
   mapper->InteractiveVolumeLevelsOn();
   std::vector<double> isovalues;
@@ -255,26 +257,28 @@ void CheckGPUScene(
     coarse = scene.Render(InteractiveRate);
   }
   std::printf("%s interactive, tiny budget, GPU volume levels: %s, %llu primitives (CPU model "
-              "at stride 4: %llu)\n",
+              "at stride 8: %llu)\n",
     name.c_str(),
     Describe(mapper).c_str(),
     static_cast<unsigned long long>(mapper->GetNumberOfPrimitives()),
-    static_cast<unsigned long long>(CountOnLevel(input, isovalues, 1)));
+    static_cast<unsigned long long>(CountOnLevel(input, isovalues, 0)));
   Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
-      mapper->GetLastInteractive() && mapper->GetLastLevel() == 1 &&
-      mapper->GetGPUStats().Level == 1,
-    name + ": a tiny budget draws the GPU path on the coarsest volume level (1) and says so");
+      mapper->GetLastInteractive() && mapper->GetLastLevel() == 0 &&
+      mapper->GetGPUStats().Level == 0,
+    name + ": a tiny budget draws the GPU path on the coarsest volume level (0) and says so");
   Check(mapper->GetGPUStats().CoarseBuilds == coarseBuilds + 1,
     name + ": the coarse level is built once for these isovalues, not per frame");
-  Check(mapper->GetNumberOfPrimitives() == CountOnLevel(input, isovalues, 1) &&
-      mapper->GetNumberOfPrimitives() > 0 && mapper->GetNumberOfPrimitives() < primitives / 4,
-    name + ": its primitives are the CPU model's count at stride 4, far fewer than the volume's");
+  Check(mapper->GetNumberOfPrimitives() == CountOnLevel(input, isovalues, 0) &&
+      mapper->GetNumberOfPrimitives() > 0 && mapper->GetNumberOfPrimitives() < primitives / 16,
+    name + ": its primitives are the CPU model's count at stride 8, far fewer than the volume's");
   Check(PlanePixels(coarse) == stillPlane &&
       std::abs(Covered(coarse) - stillCovered) < stillCovered / 5,
     name + ": the coarse level covers the still pixels within 20%, behind the plane");
 
-  // The same with the triangle levels (the default): a coarser Block LOD
-  // level's triangles, which are what fits a tiny budget best.
+  // The triangle levels instead: a coarser Block LOD level's triangles,
+  // which are what fits a tiny budget best without the volume levels.
+  const double coarseSeconds = mapper->GetLastPredictedSeconds();
+  mapper->InteractiveVolumeLevelsOff();
   mapper->InteractiveTriangleLevelsOn();
   std::vector<unsigned char> triangles;
   for (int frame = 0; frame < 2; ++frame)
@@ -291,6 +295,24 @@ void CheckGPUScene(
   Check(PlanePixels(triangles) == stillPlane &&
       std::abs(Covered(triangles) - stillCovered) < stillCovered / 10,
     name + ": they cover the still pixels within 10%, behind the plane");
+
+  // Both (the default): when no candidate is predicted within the budget the
+  // frame is the one predicted fastest, GPU volume level 0 or the triangles,
+  // not the list's last (the triangles) whatever they cost.
+  mapper->InteractiveVolumeLevelsOn();
+  mediso::FrameWork triangleWork;
+  triangleWork.Method = mediso::FrameMethod::Triangles;
+  triangleWork.Primitives = mapper->GetNumberOfFallbackTriangles();
+  triangleWork.Pixels = mediso::FrameTimeModel::ShadedPixels(Size, Size, 1.0);
+  triangleWork.Translucent = translucent;
+  const double trianglesPredicted = mapper->GetFrameTimeModel().Predict(triangleWork);
+  scene.Render(InteractiveRate);
+  std::printf("%s interactive, tiny budget, both levels: %s (triangles predicted %.4f s, volume "
+              "level 0 before %.4f s)\n",
+    name.c_str(), Describe(mapper).c_str(), trianglesPredicted, coarseSeconds);
+  Check(mapper->GetLastInteractive() && mapper->GetLastLevel() < 3 &&
+      mapper->GetLastPredictedSeconds() <= trianglesPredicted * 1.000001,
+    name + ": with both levels a tiny budget draws the coarse frame predicted fastest");
 
   // A still render after the interactive ones: the same image.
   const std::vector<unsigned char> after = scene.Render(StillRate);

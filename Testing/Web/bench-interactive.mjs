@@ -6,7 +6,10 @@
 // the frames of the drag (their times, their level or sample distance, the rate), and the longest
 // main-thread task (PerformanceObserver longtask) over the changes and the drag.
 //   node bench-interactive.mjs CONFIG.json OUT.json
-// CONFIG: {pages: {name: url}, paths: ["cpu", "gpu"], size: [w, h], isovalues: [...], moves}
+// CONFIG: {pages: {name: url}, paths: ["cpu", "gpu"], size: [w, h], isovalues: [...], moves,
+//          surfaces (optional: [{value, opacity}], drawn before the drag: e.g. skin 0.3 over bone),
+//          stills (optional: still frames after the drag, the camera turned 2 degrees each),
+//          moveMs (optional: the wait after each mouse move, 30 by default)}
 import { launch } from "./page.mjs";
 import { readFileSync, writeFileSync } from "node:fs";
 
@@ -34,6 +37,8 @@ for (const path of config.paths) {
     await page.goto(url + "&path=" + path + "&size=" + config.size.join("x"), { waitUntil: "commit" });
     await page.waitForFunction(() => window.mediso, null, { timeout: 300000 });
     await page.evaluate(() => window.mediso.ready);
+    // the volume whole (a large one streams its bricks first: until then no frame is coarse)
+    await page.waitForFunction(() => (window.mediso.stats().received ?? 1) >= 1, null, { timeout: 600000 });
     // the load's own tasks left out: a first change, a second's rest
     await page.evaluate((v) => window.mediso.setIsovalues([v]), config.isovalues[0]);
     await page.waitForTimeout(1000);
@@ -44,6 +49,11 @@ for (const path of config.paths) {
       run.changes.push({ value: v, firstMs: s.lastChangeMs, fullMs: s.lastRefinedMs || s.lastChangeMs,
         level: s.cpuLevel, elements: path === "gpu" ? s.primitives : s.triangles });
     }
+    if (config.surfaces) {
+      // the drag's scene (issue 30's: skin 0.3 over bone), drawn at its full level first
+      await page.evaluate((surfaces) => window.mediso.setSurfaces(surfaces), config.surfaces);
+      await page.waitForFunction(() => window.mediso.stats().settled !== false, null, { timeout: 300000 });
+    }
     const before = await page.evaluate(() => (window.mediso.frames ? window.mediso.frames().length : 0));
     const box = await page.locator("#view").boundingBox();
     const x = box.x + box.width / 2, y = box.y + box.height / 2;
@@ -53,7 +63,7 @@ for (const path of config.paths) {
     const t0 = Date.now();
     for (let i = 1; i <= config.moves; ++i) {
       await page.mouse.move(x + 4 * i, y + i);
-      await page.waitForTimeout(30);
+      await page.waitForTimeout(config.moveMs || 30);
       sampled.push(await page.evaluate(() => window.mediso.stats().lastFrameMs));
     }
     await page.mouse.up();
@@ -63,7 +73,15 @@ for (const path of config.paths) {
     const frames = await page.evaluate((n) => (window.mediso.frames ? window.mediso.frames().slice(n) : null), before);
     if (frames) {
       const drag = frames.filter((f) => f.interactive);
+      // steady: without each (level, sample distance)'s first drag frame, which may build the
+      // level's pyramid or compile its program (one-off work a longer drag does not repeat)
+      const seen = new Set();
+      const steady = drag.filter((f) => {
+        const key = [f.cpuLevel, f.gpuLevel, f.sampleDistance].join();
+        return seen.has(key) || !seen.add(key);
+      });
       run.drag = { frameMs: median(drag.map((f) => f.ms)), frames: drag.length, rate: drag.length / dragSeconds,
+        steadyMs: median(steady.map((f) => f.ms)), steadyFrames: steady.length,
         levels: [...new Set(drag.map((f) => f.cpuLevel))], sampleDistances: [...new Set(drag.map((f) => f.sampleDistance))],
         gpuLevels: [...new Set(drag.map((f) => f.gpuLevel).filter((k) => k !== undefined))],
         predictionError: median(drag.filter((f) => f.predictedMs > 0).map((f) => Math.abs(f.predictedMs - f.ms) / f.ms)) };
@@ -71,9 +89,31 @@ for (const path of config.paths) {
       run.drag = { frameMs: median(sampled), frames: null, rate: null, levels: null, sampleDistances: [1] };
     }
     run.longestTaskMs = await page.evaluate(() => Math.max(0, ...window.longTasks));
+    if (config.stills) {
+      // still frames of the same scene: the camera turned about its view-up by 2 degrees each,
+      // every frame awaited at its full level (the frames' own times, as the drag's)
+      const n = await page.evaluate(() => window.mediso.frames().length);
+      await page.evaluate(async (count) => {
+        for (let i = 0; i < count; ++i) {
+          const v = window.mediso.getView();
+          const a = 2 * Math.PI / 180, f = v.focalPoint, u = v.viewUp;
+          const d = [0, 1, 2].map((k) => v.position[k] - f[k]);
+          const dot = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
+          const cross = [u[1] * d[2] - u[2] * d[1], u[2] * d[0] - u[0] * d[2], u[0] * d[1] - u[1] * d[0]];
+          const r = [0, 1, 2].map((k) => d[k] * Math.cos(a) + cross[k] * Math.sin(a) + u[k] * dot * (1 - Math.cos(a)));
+          await window.mediso.setView({ position: [0, 1, 2].map((k) => f[k] + r[k]), focalPoint: f, viewUp: u,
+            viewAngle: v.viewAngle, parallelScale: v.parallelScale });
+        }
+      }, config.stills);
+      const stills = (await page.evaluate(() => window.mediso.frames())).slice(n)
+        .filter((f) => !f.interactive && f.settled);
+      run.still = { frameMs: median(stills.map((f) => f.ms)), frames: stills.length,
+        levels: [...new Set(stills.map((f) => (path === "gpu" ? f.gpuLevel : f.cpuLevel)))],
+        sampleDistances: [...new Set(stills.map((f) => f.sampleDistance))] };
+    }
     run.stats = await page.evaluate(() => window.mediso.stats());
     console.log(JSON.stringify({ page: name, path, first: median(run.changes.map((c) => c.firstMs)),
-      drag: run.drag.frameMs, longest: run.longestTaskMs }));
+      drag: run.drag.frameMs, still: run.still ? run.still.frameMs : null, longest: run.longestTaskMs }));
     result.runs.push(run);
     await page.close();
   }

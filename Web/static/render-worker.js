@@ -135,7 +135,7 @@ function choose(frame) {
   applySize();
   viewer.setSurfaces(frame.surfaces);
   viewer.setCPULevel(requestedLevel);
-  return viewer.chooseFrame(budgetSeconds);
+  return viewer.chooseFrame(budgetSeconds, !!frame.interactive);
 }
 
 function keyOf(surfaces) {
@@ -197,7 +197,7 @@ function pump() {
     if (coarse || (path === "gpu" && frame.interactive)) {
       choice = choose(frame);
       level = path === "cpu" ? choice.level : requestedLevel;
-      distance = path === "gpu" ? choice.sampleDistance : 1;
+      distance = choice.sampleDistance; // CPU path: above 1 only for a drag's level 0
       gpuLevel = path === "gpu" ? choice.level : gpuLevel;
     }
     const stats = draw(frame, level, distance, gpuLevel);
@@ -207,6 +207,7 @@ function pump() {
         "client, over the " + Math.round(1000 * budgetSeconds) + " ms budget";
       if (path === "cpu" && stats.cpuLevel < choice.memoryLevel) {
         note = (frame.interactive ? "While dragging" : "First answer") + ": level " + stats.cpuLevel +
+          (distance > 1 ? ", one pixel in " + distance + " along each axis, scaled up" : "") +
           " (" + over + ")" + (frame.interactive ? "." : "; refining.");
       } else if (path === "gpu" && (distance > 1 || stats.gpuLevel < M.NumberOfLevels - 1)) {
         note = "While dragging: " + gpuFrameNote(stats.gpuLevel, distance) + " (" + over + ").";

@@ -784,14 +784,16 @@ public:
    * the CPU path, the estimator's seconds for an extraction not yet cached:
    * {level, sampleDistance, predictedMs, fullMs} for the current isovalues.
    * CPU path: the finest level, at most the one the memory budget allows,
-   * whose extraction and drawing fit (the coarsest when none does). GPU path:
+   * whose extraction and drawing fit, then (`interactive`: a drag's frame)
+   * level 0 at image sample distances 1.5 to 8 (the coarsest when none
+   * does). GPU path:
    * the full volume at the smallest image sample distance whose frame fits
-   * (1 to 4), else the coarse volume levels 2 and 1 (strides 2, 4) the same
-   * way, from each level's active pairs (estimated from the full level's
+   * (1 to 8), else the coarse volume levels 2, 1 and 0 (strides 2, 4, 8) the
+   * same way, from each level's active pairs (estimated from the full level's
    * before its first frame). fullMs: the prediction of the full frame (level
    * the memory allows, every pixel), which the page states when it is over.
    */
-  val ChooseFrame(double budgetSeconds)
+  val ChooseFrame(double budgetSeconds, bool interactive)
   {
     std::vector<FrameTimeModel::Candidate> candidates;
     std::vector<double> extraSeconds;
@@ -811,6 +813,21 @@ public:
         c.Work = this->Work(static_cast<std::uint64_t>(triangles), 1.0);
         candidates.push_back(c);
         extraSeconds.push_back(seconds);
+      }
+      // A drag whose level 0 is over the budget: level 0 on fewer pixels (on software WebGL about
+      // half of such a frame of a few thousand triangles is its pixels: shading, blending).
+      const FrameTimeModel::Candidate levelZero = candidates.back();
+      const double levelZeroSeconds = extraSeconds.back();
+      if (interactive)
+      {
+        for (double distance : { 1.5, 2.0, 3.0, 4.0, 6.0, 8.0 })
+        {
+          FrameTimeModel::Candidate c = levelZero;
+          c.SampleDistance = static_cast<float>(distance);
+          c.Work = this->Work(levelZero.Work.Primitives, distance);
+          candidates.push_back(c);
+          extraSeconds.push_back(levelZeroSeconds);
+        }
       }
     }
     else
@@ -932,17 +949,19 @@ private:
   }
 
   // The GPU path's candidates, finest first: the full volume at each sample distance, then the
-  // coarse volume levels 2 and 1 the same way, each from its pyramid's active pairs when built
-  // for these surfaces, else estimated from the full level's (IsosurfaceScene).
+  // coarse volume levels 2, 1 and 0 (strides 2, 4, 8) the same way, each from its pyramid's
+  // active pairs when built for these surfaces, else estimated from the full level's
+  // (IsosurfaceScene). A software rasteriser's frame costs about its primitives, so only a
+  // coarser volume brings a large surface within the budget there.
   void AddGPUCandidates(std::vector<FrameTimeModel::Candidate>& candidates) const
   {
     const std::uint64_t full = this->Scene ? this->Scene->GetActivePairs() : 0;
-    for (int level : { NumberOfLevels - 1, 2, 1 })
+    for (int level : { NumberOfLevels - 1, 2, 1, 0 })
     {
       const std::uint64_t built = this->Scene ? this->Scene->GetActivePairs(level) : 0;
       const std::uint64_t pairs =
         built > 0 ? built : IsosurfaceScene::EstimateActivePairs(full, level);
-      for (double distance : { 1.0, 1.5, 2.0, 3.0, 4.0 })
+      for (double distance : { 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0 })
       {
         FrameTimeModel::Candidate c;
         c.Level = level;
