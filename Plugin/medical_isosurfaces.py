@@ -23,6 +23,11 @@ like any filter. What is not a proxy lives here:
     is waiting: the refinement is then aborted (the filter's AbortExecute) and counted, and the
     coarse answer stays shown. ParaView 5.11's update is synchronous: the refinement blocks the
     caller while it runs (docs/blocklod.md).
+
+``RefineHistoPyramidChange(display, values, view=None)``
+    an isovalue change of a *HistoPyramid Isosurface* display drawn first by an interactive
+    render (a coarse volume level or sample distance within the display's interactive budget,
+    only that level's pyramid built), then by the still render (the full volume).
 """
 
 import math
@@ -293,3 +298,36 @@ class RefineAfterChange:
     def _restore(self):
         self.contour.AutoLOD = self.auto_lod
         self.contour.LOD = self.lod
+
+
+def RefineHistoPyramidChange(display, values, view=None):
+    """Answers an isovalue change of a *HistoPyramid Isosurface* display at a coarse level first,
+    then at full quality (issue 30; docs/blocklod.md, The first answer's frame counted).
+
+    Sets ``display.IsosurfaceValues`` to ``values``, draws an interactive render (the mapper's
+    interactive choice within its HistoPyramidInteractiveFrameBudget: a coarse volume level, a
+    sample distance or a Block LOD level's triangles, predicted from the last values' active
+    pairs; only the drawn level's pyramid is built), then the still render (the full volume,
+    its pyramid built for the new values). With HistoPyramidInteractiveAdjust off both are the
+    still frame. Returns ``{"values", "first_level", "first_sample_distance", "first_seconds",
+    "level", "seconds"}``: what the first render drew and the seconds from the change to it, the
+    still render's level and the seconds to it.
+    """
+    view = view or simple.GetActiveView()
+    start = time.perf_counter()
+    display.IsosurfaceValues = [float(v) for v in values]
+    view.InteractiveRender()
+    first_seconds = time.perf_counter() - start
+
+    def drawn():
+        display.UpdatePropertyInformation()
+        return (int(display.GetProperty("HistoPyramidLastLevel")[0]),
+                float(display.GetProperty("HistoPyramidLastSampleDistance")[0]))
+
+    first_level, first_distance = drawn()
+    view.StillRender()
+    seconds = time.perf_counter() - start
+    level, _ = drawn()
+    return {"values": [float(v) for v in values], "first_level": first_level,
+            "first_sample_distance": first_distance, "first_seconds": first_seconds,
+            "level": level, "seconds": seconds}
