@@ -988,6 +988,23 @@ double* vtkBlockLODContour::GetCurrentEstimatedMegabytes()
   return this->CurrentEstimatedMegabytes;
 }
 
+double* vtkBlockLODContour::GetCurrentEstimatedTriangles()
+{
+  const int n = this->ContourValues->GetNumberOfContours();
+  for (int level = 0; level < 4; ++level)
+  {
+    double sum = n > 0 ? 0.0 : -1.0;
+    for (int i = 0; i < n && sum >= 0.0; ++i)
+    {
+      const mediso::SurfaceEstimate e =
+        this->Internals->Surfaces.Estimate(this->ContourValues->GetValue(i), level);
+      sum = e.Method == mediso::EstimateMethod::None ? -1.0 : sum + e.Counts.Triangles;
+    }
+    this->CurrentEstimatedTriangles[level] = sum;
+  }
+  return this->CurrentEstimatedTriangles;
+}
+
 //------------------------------------------------------------------------------
 int vtkBlockLODContour::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)

@@ -282,6 +282,14 @@ public:
   ///@}
 
   /**
+   * The estimated triangles per level (0..3) for the isovalues set now, as
+   * GetCurrentEstimatedSeconds() estimates (-1 where there is no estimate):
+   * what a first answer's frame would draw, which the display's frame-time
+   * model predicts (vtkBlockLODSurfaceRepresentation::GetPredictedStillSeconds()).
+   */
+  double* GetCurrentEstimatedTriangles() VTK_SIZEHINT(4);
+
+  /**
    * Level used by the last execution (-1 before any, or when nothing was made).
    */
   vtkGetMacro(ChosenLevel, int);
@@ -367,6 +375,7 @@ protected:
   double EstimatedSeconds[4] = { 0, 0, 0, 0 };
   double CurrentEstimatedSeconds[4] = { -1, -1, -1, -1 };
   double CurrentEstimatedMegabytes[4] = { -1, -1, -1, -1 };
+  double CurrentEstimatedTriangles[4] = { -1, -1, -1, -1 };
   vtkIdType NumberOfExtractions = 0;
   vtkIdType NumberOfCacheHits = 0;
   vtkIdType NumberOfBlockRangeComputations = 0;

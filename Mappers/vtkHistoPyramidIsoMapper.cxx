@@ -448,8 +448,17 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   if (drawnValues != impl.CountedValues || scalars->GetMTime() != impl.CountedStamp)
   {
     impl.LevelTriangles.fill(-1.0);
-    impl.Primitives = 0;
     impl.LevelPairs.fill(0);
+    // New isovalues of the same data keep the last full level's active pairs
+    // as the prior of the next interactive choice (a nearby isovalue crosses
+    // about as many cells), so that an interactive render right after a
+    // change (a histogram line dragged, medical_isosurfaces.
+    // RefineHistoPyramidChange) draws a coarse level at once, building only
+    // that level's pyramid, instead of the full volume; new data forgets it.
+    if (scalars->GetMTime() != impl.CountedStamp)
+    {
+      impl.Primitives = 0;
+    }
     impl.CountedValues = drawnValues;
     impl.CountedStamp = scalars->GetMTime();
   }

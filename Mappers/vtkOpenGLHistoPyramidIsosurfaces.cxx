@@ -233,7 +233,9 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
     looks.push_back(look);
   }
   impl.Scene.SetSurfaces(looks);
-  if (!impl.Scene.Update(reason) || !impl.Scene.UpdateLevel(impl.VolumeLevel, reason))
+  // Only the level drawn is built: an interactive frame on a coarse level right after a change
+  // leaves the full volume's pyramid to the still frame.
+  if (!impl.Scene.UpdateLevel(impl.VolumeLevel, reason))
   {
     return false;
   }

@@ -16,12 +16,18 @@ like any filter. What is not a proxy lives here:
 ``RefineAfterChange(contour, view=None, frame_budget=0.1)``
     isovalue changes of a Block LOD Contour answered coarse first, then refined (issue 30):
     ``change(values, newer=None)`` draws the new isovalues at once at the finest level whose
-    extraction the filter's estimator fits in ``frame_budget`` seconds, then updates the filter
+    extraction (the filter's estimator) and frame (the display's frame-time model) fit in
+    ``frame_budget`` seconds together, then updates the filter
     at the level the user set (Auto LOD's memory choice, or LOD) and draws that, unless
     ``newer()``, polled at the filter's progress events (builtin session), says a newer change
     is waiting: the refinement is then aborted (the filter's AbortExecute) and counted, and the
     coarse answer stays shown. ParaView 5.11's update is synchronous: the refinement blocks the
     caller while it runs (docs/blocklod.md).
+
+``RefineHistoPyramidChange(display, values, view=None)``
+    an isovalue change of a *HistoPyramid Isosurface* display drawn first by an interactive
+    render (a coarse volume level or sample distance within the display's interactive budget,
+    only that level's pyramid built), then by the still render (the full volume).
 """
 
 import math
@@ -170,9 +176,11 @@ class RefineAfterChange:
     ``contour``: a BlockLODContour proxy; its AutoLOD, LOD and MemoryBudget as they are now give
     the refinement's level (the helper restores them after each first answer). ``view``: the
     view that shows it (default: the active view). ``frame_budget``: the seconds the first
-    answer's extraction may take, as the filter's estimator predicts them for the new isovalues
-    (its CurrentEstimatedSeconds: 0 for a cached surface; its cost model learns from the
-    filter's updates); the drawing is not in that prediction.
+    answer's extraction and frame may take together: the extraction as the filter's estimator
+    predicts it for the new isovalues (its CurrentEstimatedSeconds: 0 for a cached surface; its
+    cost model learns from the filter's updates), the frame as the Block LOD display's
+    frame-time model predicts it for the level's estimated triangles (its
+    BlockLODPredictedStillSeconds; 0 before the display has drawn a frame).
 
     ``change(values, newer=None)`` returns ``{"values", "first_level", "first_seconds",
     "level", "seconds", "aborted", "note", "first_note"}``: the level the first render drew and
@@ -194,26 +202,39 @@ class RefineAfterChange:
         self.refinements_aborted = 0
         self.last = None
 
-    def _estimates(self, name):
+    def _estimates(self):
+        """The filter's estimated MB and extraction seconds per level for the isovalues set now
+        (one information update for both: each computes the estimates anew), and the display's
+        predicted still frame per level for them (-1 each where it has none: no Block LOD
+        display, no frame drawn yet)."""
         self.contour.UpdatePropertyInformation()
-        return [float(x) for x in self.contour.GetProperty(name)]
+        megabytes = [float(x) for x in self.contour.GetProperty("CurrentEstimatedMB")]
+        seconds = [float(x) for x in self.contour.GetProperty("CurrentEstimatedSeconds")]
+        drawing = [-1.0] * 4
+        display = simple.GetDisplayProperties(self.contour, self.view)
+        found = display.SMProxy.GetProperty("BlockLODPredictedStillSeconds") if display else None
+        if found is not None:
+            found.GetParent().UpdatePropertyInformation()
+            drawing = [float(found.GetElement(i)) for i in range(4)]
+        return megabytes, seconds, drawing
 
     def levels(self):
         """For the isovalues set now: (the refinement's level, the first answer's level, its
         predicted seconds). The refinement's: LOD, or with Auto LOD the finest level whose
         estimated surfaces fit the Memory Budget (the choice the filter makes; 0 when none does).
-        The first answer's: the finest at or below it whose estimated extraction fits the frame
-        budget (level 0 when none does)."""
-        megabytes = self._estimates("CurrentEstimatedMB")
-        seconds = self._estimates("CurrentEstimatedSeconds")
+        The first answer's: the finest at or below it whose estimated extraction and predicted
+        frame (the display's frame-time model, where it has a prediction) fit the frame budget
+        together (level 0 when none does)."""
+        megabytes, seconds, drawing = self._estimates()
         if min(seconds) < 0 or min(megabytes) < 0:
             return self.lod, self.lod, -1.0  # no estimate (no update yet): no coarse answer
         memory = self.lod
         if self.auto_lod:
             budget = float(self.contour.MemoryBudget)
             memory = next((l for l in range(3, 0, -1) if megabytes[l] <= budget), 0)
-        first = next((l for l in range(memory, -1, -1) if seconds[l] <= self.frame_budget), 0)
-        return memory, first, seconds[first]
+        total = [s + max(0.0, d) for s, d in zip(seconds, drawing)]
+        first = next((l for l in range(memory, -1, -1) if total[l] <= self.frame_budget), 0)
+        return memory, first, total[first]
 
     def change(self, values, newer=None):
         start = time.perf_counter()
@@ -277,3 +298,36 @@ class RefineAfterChange:
     def _restore(self):
         self.contour.AutoLOD = self.auto_lod
         self.contour.LOD = self.lod
+
+
+def RefineHistoPyramidChange(display, values, view=None):
+    """Answers an isovalue change of a *HistoPyramid Isosurface* display at a coarse level first,
+    then at full quality (issue 30; docs/blocklod.md, The first answer's frame counted).
+
+    Sets ``display.IsosurfaceValues`` to ``values``, draws an interactive render (the mapper's
+    interactive choice within its HistoPyramidInteractiveFrameBudget: a coarse volume level, a
+    sample distance or a Block LOD level's triangles, predicted from the last values' active
+    pairs; only the drawn level's pyramid is built), then the still render (the full volume,
+    its pyramid built for the new values). With HistoPyramidInteractiveAdjust off both are the
+    still frame. Returns ``{"values", "first_level", "first_sample_distance", "first_seconds",
+    "level", "seconds"}``: what the first render drew and the seconds from the change to it, the
+    still render's level and the seconds to it.
+    """
+    view = view or simple.GetActiveView()
+    start = time.perf_counter()
+    display.IsosurfaceValues = [float(v) for v in values]
+    view.InteractiveRender()
+    first_seconds = time.perf_counter() - start
+
+    def drawn():
+        display.UpdatePropertyInformation()
+        return (int(display.GetProperty("HistoPyramidLastLevel")[0]),
+                float(display.GetProperty("HistoPyramidLastSampleDistance")[0]))
+
+    first_level, first_distance = drawn()
+    view.StillRender()
+    seconds = time.perf_counter() - start
+    level, _ = drawn()
+    return {"values": [float(v) for v in values], "first_level": first_level,
+            "first_sample_distance": first_distance, "first_seconds": first_seconds,
+            "level": level, "seconds": seconds}

@@ -392,6 +392,40 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
 }
 
 //------------------------------------------------------------------------------
+double* vtkBlockLODSurfaceRepresentation::GetPredictedStillSeconds()
+{
+  std::fill(this->PredictedStillSeconds, this->PredictedStillSeconds + Levels, -1.0);
+  vtkBlockLODContour* contour = this->FindContour();
+  if (!contour)
+  {
+    return this->PredictedStillSeconds;
+  }
+  const double* triangles = contour->GetCurrentEstimatedTriangles();
+  mediso::FrameWork work;
+  work.Method = mediso::FrameMethod::Triangles;
+  work.Translucent = this->Property->GetOpacity() < 1.0;
+  if (auto* view = vtkPVRenderView::SafeDownCast(this->GetView()))
+  {
+    const int* size = view->GetSize();
+    work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
+      static_cast<std::uint64_t>(std::max(0, size[1]));
+  }
+  std::lock_guard<std::mutex> lock(Frames().Mutex);
+  const void* renderer = this->ObservedRenderer.GetPointer();
+  work.Translucent = work.Translucent || (renderer && Frames().OthersTranslucent(renderer, this));
+  for (int level = 0; level < Levels; ++level)
+  {
+    if (triangles[level] >= 0.0)
+    {
+      const double others = renderer ? Frames().OthersAt(renderer, this, level) : 0.0;
+      work.Primitives = static_cast<std::uint64_t>(triangles[level] + others);
+      this->PredictedStillSeconds[level] = Frames().Model.Predict(work) + this->FrameOverhead();
+    }
+  }
+  return this->PredictedStillSeconds;
+}
+
+//------------------------------------------------------------------------------
 vtkDataObject* vtkBlockLODSurfaceRepresentation::WrapLikePiece(vtkDataObject* piece)
 {
   // The view moves LOD geometry between processes as data of the piece's

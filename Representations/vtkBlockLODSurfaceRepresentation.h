@@ -133,6 +133,20 @@ public:
    */
   vtkGetMacro(PredictedInteractiveSeconds, double);
 
+  /**
+   * The seconds a still frame drawing each level (0..3) of the isovalues set
+   * now would take: the frame-time model's prediction (fitted to this
+   * process's frames, as for the interactive level) for the filter's
+   * estimated triangles of those isovalues at that level
+   * (vtkBlockLODContour::GetCurrentEstimatedTriangles()), at the view's size,
+   * with the other displays' last triangles and the window's overhead added;
+   * -1 where there is no estimate (no filter, no update yet). An isovalue
+   * change answered coarse first (medical_isosurfaces.RefineAfterChange)
+   * adds them to the extraction's seconds, so that its first answer's level
+   * fits the budget with its frame, not the extraction alone.
+   */
+  double* GetPredictedStillSeconds() VTK_SIZEHINT(4);
+
   ///@{
   /**
    * What the LOD geometry on this process is: its Block LOD level (-1 when
@@ -190,6 +204,7 @@ protected:
   double InteractiveFrameBudget = 0.1;
   double InteractiveTriangleBudget = 0.0;
   double PredictedInteractiveSeconds = 0.0;
+  double PredictedStillSeconds[4] = { -1.0, -1.0, -1.0, -1.0 };
   unsigned long StartObserver = 0;
   unsigned long EndObserver = 0;
   unsigned long RendererStartObserver = 0;

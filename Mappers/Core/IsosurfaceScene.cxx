@@ -1036,6 +1036,21 @@ std::uint64_t IsosurfaceScene::GetActivePairs(int level) const
     : 0;
 }
 
+std::vector<double> IsosurfaceScene::GetBuiltValues(int level) const
+{
+  const Internals& impl = *this->Impl;
+  if (level == FullLevel)
+  {
+    return impl.BuiltValues;
+  }
+  if (level < 0 || level > FullLevel)
+  {
+    return {};
+  }
+  const Internals::CoarseLevel& coarse = impl.Coarse[static_cast<std::size_t>(level)];
+  return coarse.Pyramid && coarse.Pyramid->IsBuilt() ? coarse.BuiltValues : std::vector<double>();
+}
+
 std::uint64_t IsosurfaceScene::EstimateActivePairs(std::uint64_t fullPairs, int level)
 {
   if (level >= FullLevel || fullPairs == 0)

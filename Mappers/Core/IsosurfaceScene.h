@@ -251,6 +251,15 @@ public:
   std::uint64_t GetActivePairs(int level) const;
 
   /**
+   * The isovalues a level's pyramid was last built for (normalised, as
+   * GetSurfaces() holds them; empty before its first build and after a
+   * volume upload): a host compares them with the surfaces it is about to
+   * draw to know whether a frame at that level must build first, and so
+   * predict an isovalue change's first frame (its build) before choosing it.
+   */
+  std::vector<double> GetBuiltValues(int level) const;
+
+  /**
    * A level's active pairs before it is built, from the volume's: a surface
    * crosses about 1 / stride^2 as many cells of stride^3 voxels (at least 1
    * when the volume's are not 0). Hosts predict a coarse level's first frame with it.

@@ -11,7 +11,9 @@
 // at Block LOD levels 0, 1 and 2 the pyramid's total equals the CPU model's
 // count on that level's samples (MakeCoarseCopy, odd sizes: a shorter last
 // cell on some axes), each level is built once per set of isovalues and again
-// after a change, and a level outside 0..3 is refused with a reason.
+// after a change, a change's update of a coarse level builds that level
+// only (GetBuiltValues() says which values each level is built for), and a
+// level outside 0..3 is refused with a reason.
 #include "HeadlessTestUtilities.h"
 #include "HistoPyramidGLChecks.h"
 
@@ -79,6 +81,26 @@ void CheckCoarseLevels(const std::shared_ptr<const mediso::GLApi>& gl)
         "coarse level " + std::to_string(level) +
           ": the pyramid's total differs from the CPU model's count on the level's samples");
     }
+  }
+  // An isovalue change's first answer on a coarse level: its pyramid alone is built, and
+  // GetBuiltValues() says which levels are built for which values (a host predicts a change's
+  // build from it).
+  {
+    const std::vector<double> before = scene.GetBuiltValues(3);
+    const std::uint64_t fullBuilds = scene.GetStats().PyramidBuilds;
+    std::vector<mediso::IsosurfaceLook> looks(1);
+    looks[0].Value = 100.0;
+    scene.SetSurfaces(looks);
+    Check(scene.UpdateLevel(1, error), "coarse level 1 after a change did not build: " + error);
+    Check(scene.GetBuiltValues(1) == std::vector<double>{ 100.0 } &&
+        scene.GetBuiltValues(3) == before && before == std::vector<double>{ -500.0, 300.0 } &&
+        scene.GetStats().PyramidBuilds == fullBuilds,
+      "a change's coarse level: only level 1 is built for the new value, the full level keeps "
+      "the old ones");
+    Check(scene.GetBuiltValues(2) == before && scene.GetBuiltValues(-1).empty(),
+      "coarse level 2 still holds the old values, level -1 none");
+    Check(scene.Update(error) && scene.GetBuiltValues(3) == std::vector<double>{ 100.0 },
+      "the full level's build after it: " + error);
   }
   Check(scene.GetGPUMemoryBytes() >
       mediso::IsosurfaceScene::EstimateGPUMemoryBytes(mediso::ScalarType::Int16, dims),

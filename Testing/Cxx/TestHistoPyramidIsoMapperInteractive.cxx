@@ -18,10 +18,12 @@
 //    the GPU path on the coarsest volume level (Block LOD level 0, stride 8)
 //    and says so (GetLastLevel, the scene's stats), with as many primitives as
 //    the CPU model (mediso::HistoPyramid) counts on Block LOD's samples of
-//    that level, behind the plane. With the triangle levels instead a tiny
-//    budget draws a coarser Block LOD level's triangles; with both (the
-//    default) the coarse frame predicted fastest, not always the last (the
-//    triangles).
+//    that level, behind the plane. Right after an isovalue change an
+//    interactive render draws that coarse level too (the last values' pairs
+//    its prior), building only its pyramid; the still render after it the
+//    full volume. With the triangle levels instead a tiny budget draws a
+//    coarser Block LOD level's triangles; with both (the default) the coarse
+//    frame predicted fastest, not always the last (the triangles).
 // 3. With a budget of 1000 s the interactive render draws every pixel (the
 //    still image); with InteractiveFrameBudget 0 the allocated render time
 //    is the budget; with InteractiveAdjust off interactive renders are the
@@ -38,6 +40,7 @@
 
 #include "vtkActor.h"
 #include "vtkCamera.h"
+#include "vtkContourValues.h"
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
 #include "vtkPlaneSource.h"
@@ -47,6 +50,8 @@
 #include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkUnsignedCharArray.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
 
 #include <cmath>
 #include <cstdio>
@@ -275,9 +280,49 @@ void CheckGPUScene(
       std::abs(Covered(coarse) - stillCovered) < stillCovered / 5,
     name + ": the coarse level covers the still pixels within 20%, behind the plane");
 
+  const double coarseSeconds = mapper->GetLastPredictedSeconds();
+
+  // An isovalue change answered by an interactive render (a histogram line
+  // dragged, RefineHistoPyramidChange): the last values' active pairs are the
+  // prior of its choice, so it draws the coarse volume level at once, that
+  // level's pyramid built for the new values and not the full volume's; the
+  // still render after it builds and draws the full volume.
+  {
+    vtkContourValues* contours = scene.Volume->GetProperty()->GetIsoSurfaceValues();
+    std::vector<double> changed;
+    for (std::size_t i = 0; i < looks.size(); ++i)
+    {
+      changed.push_back(looks[i].Value + 40.0);
+      contours->SetValue(static_cast<int>(i), changed.back());
+    }
+    const std::uint64_t fullBuilds = mapper->GetGPUStats().PyramidBuilds;
+    scene.Render(InteractiveRate);
+    std::printf("%s interactive right after a change: %s, %llu primitives, full builds %llu -> "
+                "%llu\n",
+      name.c_str(), Describe(mapper).c_str(),
+      static_cast<unsigned long long>(mapper->GetNumberOfPrimitives()),
+      static_cast<unsigned long long>(fullBuilds),
+      static_cast<unsigned long long>(mapper->GetGPUStats().PyramidBuilds));
+    Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
+        mapper->GetLastInteractive() && mapper->GetLastLevel() == 0 &&
+        mapper->GetGPUStats().PyramidBuilds == fullBuilds &&
+        mapper->GetNumberOfPrimitives() == CountOnLevel(input, changed, 0),
+      name + ": an interactive render right after a change draws the coarse volume level (the "
+             "CPU model's count on its samples), building no full-volume pyramid");
+    scene.Render(StillRate);
+    Check(!mapper->GetLastInteractive() && mapper->GetLastLevel() == 3 &&
+        mapper->GetGPUStats().PyramidBuilds == fullBuilds + 1 &&
+        mapper->GetNumberOfPrimitives() == CountOnLevel(input, changed, 3),
+      name + ": the still render after it builds and draws the full volume of the new values");
+    for (std::size_t i = 0; i < looks.size(); ++i)
+    {
+      contours->SetValue(static_cast<int>(i), looks[i].Value);
+    }
+    scene.Render(StillRate);
+  }
+
   // The triangle levels instead: a coarser Block LOD level's triangles,
   // which are what fits a tiny budget best without the volume levels.
-  const double coarseSeconds = mapper->GetLastPredictedSeconds();
   mapper->InteractiveVolumeLevelsOff();
   mapper->InteractiveTriangleLevelsOn();
   std::vector<unsigned char> triangles;

@@ -11,6 +11,8 @@ shown in a render view:
 - a newer change waiting (``newer`` true at the refinement's first progress event) aborts the
   refinement: counted, the filter's output after it is the coarse answer again (not the empty
   output of the aborted update), and the next change refines to level 3;
+- a budget the full level's extraction fits but not its extraction and its frame (the display's
+  predicted still frame, BlockLODPredictedStillSeconds) is answered at a coarser level first;
 - with a budget every level fits (the surfaces cached), the first answer is the full level and
   there is no refinement;
 - the filter's settings (Auto LOD) are as the user set them after each refinement.
@@ -128,6 +130,28 @@ check(chosen() == 0 and shown() == exact(250.0, 0),
 result = refine.change([260.0])
 check(result["level"] == 3 and shown() == exact(260.0, 3) and not result["aborted"],
       "the next change refines to level 3 (%r)" % result)
+
+# The first answer's frame counts: a budget that the full level's extraction fits but not its
+# extraction and its frame (the display's frame-time model, BlockLODPredictedStillSeconds, for
+# the level's estimated triangles) is answered at a coarser level first.
+contour.Isosurfaces = [320.0]
+contour.UpdatePropertyInformation()
+extraction = [float(x) for x in contour.GetProperty("CurrentEstimatedSeconds")]
+display = GetDisplayProperties(contour, view)
+display.SMProxy.GetProperty("BlockLODPredictedStillSeconds").GetParent().UpdatePropertyInformation()
+drawing = [float(x) for x in display.GetProperty("BlockLODPredictedStillSeconds")]
+print("change to 320: extraction %s s, frame %s s" % (extraction, drawing))
+check(min(drawing) > 0 and drawing[3] > drawing[0],
+      "the display predicts a still frame of each level of the isovalues set now, level 3's the "
+      "longest (%s)" % drawing)
+refine.frame_budget = extraction[3] + 0.5 * drawing[3]
+memory, first, predicted = refine.levels()
+check(memory == 3 and first < 3 and abs(predicted - extraction[first] - drawing[first]) < 1e-9,
+      "a budget level 3's extraction fits (%g s) but not with its frame (%g s) chooses a coarser "
+      "first answer (level %d, predicted %g s)" % (extraction[3], drawing[3], first, predicted))
+result = refine.change([320.0])
+check(result["first_level"] == first and result["level"] == 3 and not result["aborted"],
+      "that change is drawn first at level %d, then refined to level 3 (%r)" % (first, result))
 
 # A budget every level fits: the full level at once, no refinement.
 refine.frame_budget = 1e9

@@ -9,7 +9,10 @@
 // - a drag draws coarser (CPU path: a level, then level 0 on fewer pixels; GPU path: an image
 //   sample distance and a coarse volume level, the volume sampled every 2nd, 4th or 8th point,
 //   whose primitives are the CPU model's count on that level's samples), says so in
-//   window.mediso.stats(), and the still frame after it is back at full level and every pixel.
+//   window.mediso.stats(), and the still frame after it is back at full level and every pixel;
+// - on the GPU path a change is drawn first on a coarse volume level (its primitives the CPU
+//   model's count on the level's samples) and refined to the full volume, and a change superseded
+//   while that refinement is owed is never refined.
 // How long the main thread is busy is a timing, so it is measured by the benchmark
 // (Python/benchmark_web.py --interactive: the longest main-thread task, PerformanceObserver
 // "longtask"), not asserted here.
@@ -185,6 +188,66 @@ async function drag(page, moves = 12) {
   checks.check(s.gpuLevel === 3 && s.primitives === fullCount,
     "GPU path: the still frame after the drag draws the full volume (level " + s.gpuLevel + ", " +
     s.primitives + " primitives)");
+}
+
+// --- the GPU path's change: a coarse volume level first, then the full volume ------------------------
+// ?frameBudget=1: no frame fits 1 ms, so a change's first answer is the coarsest candidate (volume
+// level 1: its pyramid built, not the volume's); the refinement builds and draws the full volume.
+{
+  const before = (await frames(fast)).length;
+  const s = await fast.evaluate((v) => window.mediso.setSurfaces([Object.assign({}, v, { value: 300 })]), BONE);
+  const steps = (await frames(fast)).slice(before);
+  const first = steps[0] || {};
+  const coarseCount = first.gpuLevel >= 0 ? await fast.evaluate(([v, k]) => window.mediso.cpuCount(v, k),
+    [[300], first.gpuLevel]) : -1;
+  const fullCount = await fast.evaluate(() => window.mediso.cpuCount([300]));
+  console.log("GPU change frames [values, gpuLevel, sampleDistance, primitives, settled]: " +
+    JSON.stringify(steps.map((f) => [f.values, f.gpuLevel, f.sampleDistance, f.primitives, f.settled])));
+  checks.check(first.values && first.values[0] === 300 && first.gpuLevel < 3 && !first.settled &&
+    !first.interactive && first.primitives === coarseCount && coarseCount > 0,
+    "GPU path: a change is drawn first on a coarse volume level (" + first.gpuLevel + ", " + first.primitives +
+    " primitives; the CPU model's count on its samples: " + coarseCount + ")");
+  checks.check(s.settled && s.gpuLevel === 3 && s.sampleDistance === 1 && s.primitives === fullCount,
+    "GPU path: the refinement reaches the full volume (level " + s.gpuLevel + ", " + s.primitives +
+    " primitives; the CPU model's count: " + fullCount + ")");
+}
+// A change typed while that refinement is owed: the old one is skipped, the newer one refined.
+{
+  const skippedBefore = (await stats(fast)).refinementsSkipped;
+  const before = (await frames(fast)).length;
+  await fast.evaluate(async () => {
+    const box = document.querySelector("#surfaces .isovalue");
+    const type = (v) => {
+      box.value = String(v);
+      box.dispatchEvent(new Event("input"));
+    };
+    type(250);
+    await new Promise((resolve) => {
+      const poll = setInterval(() => {
+        const f = window.mediso.frames();
+        if (f.length && f[f.length - 1].values[0] === 250) {
+          clearInterval(poll);
+          resolve();
+        }
+      }, 1);
+    });
+    type(350);
+  });
+  await fast.waitForFunction(() => {
+    const f = window.mediso.frames();
+    return f.length && f[f.length - 1].values[0] === 350 && f[f.length - 1].settled;
+  }, null, { timeout: 120000 });
+  await fast.waitForTimeout(300);
+  const steps = (await frames(fast)).slice(before);
+  const s = await stats(fast);
+  const fullCount = await fast.evaluate(() => window.mediso.cpuCount([350]));
+  console.log("GPU superseded frames: " + JSON.stringify(steps.map((f) => [f.values, f.gpuLevel, f.settled])));
+  checks.check(steps.length > 0 && steps[0].values[0] === 250 && steps[0].gpuLevel < 3 &&
+    !steps.some((f) => f.values[0] === 250 && (f.settled || f.gpuLevel === 3)),
+    "GPU path: the superseded change was drawn coarse only, never refined");
+  checks.check(s.settled && s.gpuLevel === 3 && s.primitives === fullCount && s.refinementsSkipped > skippedBefore,
+    "GPU path: the newer change ends on the full volume (" + s.primitives + " primitives, " + fullCount +
+    " by the CPU model), the older refinement skipped (" + skippedBefore + " -> " + s.refinementsSkipped + ")");
 }
 
 await checks.finish(browser, small);

@@ -35,7 +35,7 @@ import { setupPresets } from "./presets.js";
 import { fps, showDataset, unsupported, updateReadout } from "./readout.js";
 import { $, params, state } from "./state.js";
 import { drawCrosshair3D, setupCrosshair3D } from "./crosshair3d.js";
-import { crosshairInfo, drawSlices, pick, resetSlices, setCrosshair, setSliceWindow, setupSlices,
+import { crosshairInfo, drawSlicesApart, pick, resetSlices, setCrosshair, setSliceWindow, setupSlices,
   slicesInfo } from "./slices.js";
 import { replaceSurfaces, setupSurfaceList } from "./surfaces.js";
 import { afterFrame, change, clearMesh, drawn, fitCanvas, renderNow, requestFrame, showMesh, startViewer }
@@ -111,9 +111,9 @@ async function start() {
     const key = JSON.stringify([state.surfaces, state.level]);
     if (key !== drawnKey) {
       drawnKey = key;
-      // Each in its own task, so that neither adds to the frame's answer a main-thread task of
-      // both (the longtask budget: docs/web.md, The worker).
-      setTimeout(drawSlices);
+      // Each in its own task (each slice view too), so that none adds to the frame's answer a
+      // main-thread task of all (the longtask budget: docs/web.md, The worker).
+      drawSlicesApart();
       setTimeout(drawHistogram);
     }
   });

@@ -21,7 +21,9 @@
 // are all applied first, and the frames they asked for collapse into the last one. On the CPU
 // path, with the estimator choosing the level (setCPULevel(-1)), a new set of isovalues is drawn
 // first at the finest level whose predicted frame fits the frame budget, and refined to the
-// level the memory budget allows in a later task, which a newer change makes obsolete: the
+// level the memory budget allows in a later task (the GPU path likewise: first on the volume
+// level and sample distance whose pyramid build and frame fit, then the full volume), which a
+// newer change makes obsolete: the
 // refinement is then skipped (counted in stats.refinementsSkipped); one already running is
 // aborted where the page is cross-origin isolated (the generation word, below; counted in
 // stats.refinementsAborted), else it runs to its end. During a drag
@@ -192,9 +194,12 @@ function pump() {
     }
     const auto = path === "cpu" && requestedLevel < 0;
     const coarse = auto && !streaming && (frame.interactive || key !== shownKey);
+    // The GPU path's change: its first answer on the volume level and sample distance that fit
+    // the budget, its pyramid build counted (chooseFrame), the full volume in the refinement.
+    const gpuChange = path === "gpu" && !streaming && !frame.interactive && key !== shownKey;
     let level = requestedLevel, distance = 1, gpuLevel = M.NumberOfLevels - 1, note = "";
     let choice = null;
-    if (coarse || (path === "gpu" && frame.interactive)) {
+    if (coarse || gpuChange || (path === "gpu" && frame.interactive)) {
       choice = choose(frame);
       level = path === "cpu" ? choice.level : requestedLevel;
       distance = choice.sampleDistance; // CPU path: above 1 only for a drag's level 0
@@ -210,13 +215,16 @@ function pump() {
           (distance > 1 ? ", one pixel in " + distance + " along each axis, scaled up" : "") +
           " (" + over + ")" + (frame.interactive ? "." : "; refining.");
       } else if (path === "gpu" && (distance > 1 || stats.gpuLevel < M.NumberOfLevels - 1)) {
-        note = "While dragging: " + gpuFrameNote(stats.gpuLevel, distance) + " (" + over + ").";
+        note = (frame.interactive ? "While dragging: " : "First answer: ") +
+          gpuFrameNote(stats.gpuLevel, distance) + " (" + over + ")" +
+          (frame.interactive ? "." : "; refining.");
       }
     }
     shownKey = key;
     stats.interactive = !!frame.interactive;
     // A coarse level that is the one the memory allows leaves nothing to refine.
-    stats.settled = !frame.interactive && (!coarse || stats.cpuLevel >= choice.memoryLevel);
+    stats.settled = !frame.interactive && (!coarse || stats.cpuLevel >= choice.memoryLevel) &&
+      (!gpuChange || (stats.gpuLevel >= M.NumberOfLevels - 1 && distance === 1));
     stats.note = note;
     if (!stats.settled && !frame.interactive && stats.ok) {
       refine = { id: frame.id, key, frame };
@@ -263,6 +271,13 @@ function refineNow() {
 // change made it obsolete while it ran (its extraction stopped, nothing drawn: the coarse frame
 // stays on the canvas until the newer change's).
 function drawWatched(frame) {
+  // The GPU path's refinement (the full volume's pyramid) cannot be stopped once begun (the build
+  // is GL passes the module does not poll between); one whose frame a newer change or drag made
+  // obsolete before it began is skipped, even when that change's message has not arrived yet.
+  if (path === "gpu" && generationWord && Atomics.load(generationWord, 0) !== (frame.generation | 0)) {
+    ++skipped;
+    return null;
+  }
   const watch = !!generationWord && path === "cpu";
   viewer.watchGeneration(watch, watch ? frame.generation | 0 : 0);
   try {

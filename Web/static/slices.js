@@ -267,9 +267,31 @@ export function drawSlices() {
     chooseAxes();
   }
   for (const view of views) {
-    view.index = Math.min(state.grid.dims[view.axes.n] - 1,
-      Math.max(0, Math.round(indexOf(crosshair)[view.axes.n])));
-    drawView(view);
+    drawAtCrosshair(view);
+  }
+}
+
+function drawAtCrosshair(view) {
+  view.index = Math.min(state.grid.dims[view.axes.n] - 1,
+    Math.max(0, Math.round(indexOf(crosshair)[view.axes.n])));
+  drawView(view);
+}
+
+/**
+ * drawSlices, each view in a task of its own (after a frame whose surfaces changed): on a 512^3
+ * volume the three views' pictures and contours in one task made the page's one main-thread
+ * task over the longtask budget during isovalue changes (docs/web.md, The worker).
+ */
+export function drawSlicesApart() {
+  for (const view of views) {
+    setTimeout(() => {
+      if (state.values && views.includes(view)) {
+        if (geometry !== state.grid) {
+          chooseAxes();
+        }
+        drawAtCrosshair(view);
+      }
+    });
   }
 }
 

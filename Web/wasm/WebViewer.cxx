@@ -253,6 +253,8 @@ public:
     }
     this->CPU.SetVolume(description);
     this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
+    std::fill(std::begin(this->GPUBuildTimes), std::end(this->GPUBuildTimes), -1.0);
+    std::fill(std::begin(this->GPUBuildsSeen), std::end(this->GPUBuildsSeen), 0);
     this->Viewpoint.ResetCamera();
     return true;
   }
@@ -680,17 +682,18 @@ public:
     }
     else if (!values.empty())
     {
-      // The scene builds only when the isovalues changed (a coarse level: also on its first frame).
+      // The scene builds only when the isovalues changed (a coarse level: also on its first frame),
+      // and only the level drawn: a change's first answer on a coarse level leaves the full
+      // volume's pyramid to its refinement.
       const auto builds = [this]()
       { return this->Scene->GetStats().PyramidBuilds + this->Scene->GetStats().CoarseBuilds; };
       const std::uint64_t before = builds();
       this->Scene->SetSurfaces(this->Frame.Surfaces);
       this->Frame.Level = this->StreamedGPULevel();
       std::string error;
-      // Streaming, the full level's pyramid is built only for a frame that draws it.
-      const bool full = this->Frame.Level == NumberOfLevels - 1 || !this->Scene->IsStreaming();
-      if ((full && !this->Scene->Update(error)) ||
-        !this->Scene->UpdateLevel(this->Frame.Level, error))
+      // Streaming, the full level's pyramid is built only for a frame that draws it (UpdateLevel of
+      // the full level is Update); otherwise only the level drawn is built.
+      if (!this->Scene->UpdateLevel(this->Frame.Level, error))
       {
         this->LastError = error;
         return false;
@@ -698,6 +701,7 @@ public:
       if (builds() != before)
       {
         this->LastBuildMs = emscripten_get_now() - start;
+        this->ObserveGPUBuild(this->GPULevel, this->LastBuildMs / 1000.0);
       }
     }
     Camera& camera = this->Viewpoint.GetCamera();
@@ -833,7 +837,10 @@ public:
     else
     {
       this->AddGPUCandidates(candidates);
-      extraSeconds.resize(candidates.size(), 0.0);
+      for (const FrameTimeModel::Candidate& c : candidates)
+      {
+        extraSeconds.push_back(this->GPUBuildSeconds(c.Level));
+      }
     }
     std::size_t chosen = candidates.size() - 1;
     for (std::size_t i = 0; i < candidates.size(); ++i)
@@ -946,6 +953,46 @@ private:
     this->SlotCoarse.assign(this->SlotValues.size(), coarse ? 1 : 0);
     // The GPU path counts primitives for the frame, not triangles per surface.
     this->SlotTriangles.assign(this->SlotValues.size(), std::numeric_limits<double>::quiet_NaN());
+  }
+
+  // An isovalue change's build on the GPU path: a level's pyramid is built for the new values
+  // before its first frame, on a software WebGL2 a cost of seconds for the full volume, which a
+  // change's first answer must count. Each level's last build (not its first: that one also
+  // samples and uploads the level's volume) is kept; GPUBuildSeconds() is 0 while the full
+  // volume is built for the surfaces drawn (a drag: its frames keep choosing on their drawing
+  // alone) or the level is, else that level's last build, else the full volume's scaled by the
+  // level's samples (1 / stride^3), else 0 (nothing built yet: the first frame is not coarse).
+  void ObserveGPUBuild(int level, double seconds)
+  {
+    if (level >= 0 && level < NumberOfLevels)
+    {
+      if (this->GPUBuildsSeen[level]++ > 0 || level == NumberOfLevels - 1)
+      {
+        this->GPUBuildTimes[level] = seconds;
+      }
+    }
+  }
+
+  double GPUBuildSeconds(int level) const
+  {
+    std::vector<double> values;
+    for (const IsosurfaceLook& s : this->Frame.Surfaces)
+    {
+      values.push_back(s.Value);
+    }
+    const int full = NumberOfLevels - 1;
+    if (!this->Scene || values.empty() || this->Scene->GetBuiltValues(full) == values ||
+      this->Scene->GetBuiltValues(level) == values)
+    {
+      return 0.0;
+    }
+    if (this->GPUBuildTimes[level] >= 0.0)
+    {
+      return this->GPUBuildTimes[level];
+    }
+    const double stride = LevelStride(level);
+    return this->GPUBuildTimes[full] >= 0.0 ? this->GPUBuildTimes[full] / (stride * stride * stride)
+                                            : 0.0;
   }
 
   // The GPU path's candidates, finest first: the full volume at each sample distance, then the
@@ -1283,6 +1330,8 @@ private:
   double LastBuildMs = 0.0, LastFrameMs = 0.0;
   double SampleDistance = 1.0, DrawnSampleDistance = 1.0;
   int GPULevel = NumberOfLevels - 1; // the GPU path's volume level (SetGPULevel)
+  double GPUBuildTimes[NumberOfLevels] = { -1.0, -1.0, -1.0, -1.0 }; // ObserveGPUBuild
+  int GPUBuildsSeen[NumberOfLevels] = { 0, 0, 0, 0 };
   FrameTimeModel Times; // this client's frames: the time each level or sample distance takes
   double FrameStart = 0.0;
   bool FrameDrawn = false; // a frame was drawn since the last Finish
