@@ -820,7 +820,7 @@ int main(int argc, char* argv[])
             hp->SetInteractiveTriangleLevels(
               opt.InteractiveLevels.find("triangles") != std::string::npos);
             scene.Window->SetDesiredUpdateRate(1000.0);
-            std::vector<double> frameTimes, distances, predicted, measured, errors, levels;
+            std::vector<double> frameTimes, distances, predicted, measured, errors, levels, paths;
             int within = 0;
             int triangleFrames = 0;
             int volumeLevelFrames = 0;
@@ -830,6 +830,7 @@ int main(int argc, char* argv[])
               frameTimes.push_back(scene.Frame());
               distances.push_back(hp->GetLastSampleDistance());
               levels.push_back(hp->GetLastLevel());
+              paths.push_back(static_cast<double>(hp->GetLastRenderPath()));
               triangleFrames +=
                 hp->GetLastRenderPath() == vtkHistoPyramidIsoMapper::FallbackPath ? 1 : 0;
               volumeLevelFrames +=
@@ -869,6 +870,15 @@ int main(int argc, char* argv[])
               .Add("error_median", Summarise(errors).Median)
               .Add("within_25", static_cast<double>(within) / std::max(1, opt.Frames))
               .Add("still_after_s", stillAfter)
+              // Per frame, for classifying the model's misses (issue 30): the
+              // frame's wall time, the mapper's prediction and its own timing,
+              // level, sample distance and path (GetLastRenderPath()).
+              .Add("frame_s", frameTimes)
+              .Add("frame_predicted_s", predicted)
+              .Add("frame_measured_s", measured)
+              .Add("frame_level", levels)
+              .Add("frame_distance", distances)
+              .Add("frame_path", paths)
               .Add("still_after_distance", hp->GetLastSampleDistance())
               .Print();
             std::printf("%s %s interactive (budget %g s): median %.4f s against still %.4f s, "
