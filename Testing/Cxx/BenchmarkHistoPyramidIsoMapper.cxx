@@ -820,7 +820,8 @@ int main(int argc, char* argv[])
             hp->SetInteractiveTriangleLevels(
               opt.InteractiveLevels.find("triangles") != std::string::npos);
             scene.Window->SetDesiredUpdateRate(1000.0);
-            std::vector<double> frameTimes, distances, predicted, measured, errors, levels, paths;
+            std::vector<double> frameTimes, distances, predicted, measured, errors, levels, paths,
+              oneOff;
             int within = 0;
             int triangleFrames = 0;
             int volumeLevelFrames = 0;
@@ -837,7 +838,10 @@ int main(int argc, char* argv[])
                 hp->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath && hp->GetLastLevel() < 3
                 ? 1
                 : 0;
-              predicted.push_back(hp->GetLastPredictedSeconds());
+              // The whole frame's prediction: its drawing and its one-off work.
+              predicted.push_back(
+                hp->GetLastPredictedSeconds() + hp->GetLastPredictedOneOffSeconds());
+              oneOff.push_back(hp->GetLastPredictedOneOffSeconds());
               measured.push_back(hp->GetLastMeasuredSeconds());
               const double error =
                 std::abs(predicted.back() - measured.back()) / std::max(measured.back(), 1e-9);
@@ -879,6 +883,7 @@ int main(int argc, char* argv[])
               .Add("frame_level", levels)
               .Add("frame_distance", distances)
               .Add("frame_path", paths)
+              .Add("frame_predicted_one_off_s", oneOff)
               .Add("still_after_distance", hp->GetLastSampleDistance())
               .Print();
             std::printf("%s %s interactive (budget %g s): median %.4f s against still %.4f s, "
