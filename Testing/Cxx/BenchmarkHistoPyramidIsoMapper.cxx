@@ -823,6 +823,9 @@ int main(int argc, char* argv[])
             std::vector<double> frameTimes, distances, predicted, measured, errors, levels, paths,
               oneOff;
             int within = 0;
+            // Frames that made something before drawing (a level's build or
+            // extraction, a program), and how many of them were within 25%.
+            int oneOffFrames = 0, oneOffWithin = 0;
             int triangleFrames = 0;
             int volumeLevelFrames = 0;
             for (int f = 0; f < opt.Frames; ++f)
@@ -847,6 +850,11 @@ int main(int argc, char* argv[])
                 std::abs(predicted.back() - measured.back()) / std::max(measured.back(), 1e-9);
               errors.push_back(error);
               within += error <= 0.25 ? 1 : 0;
+              if (oneOff.back() > 0.0)
+              {
+                ++oneOffFrames;
+                oneOffWithin += error <= 0.25 ? 1 : 0;
+              }
             }
             scene.Window->SetDesiredUpdateRate(0.0001);
             const double stillAfter = scene.Frame();
@@ -884,6 +892,8 @@ int main(int argc, char* argv[])
               .Add("frame_distance", distances)
               .Add("frame_path", paths)
               .Add("frame_predicted_one_off_s", oneOff)
+              .Add("one_off_frames", static_cast<double>(oneOffFrames))
+              .Add("one_off_within_25", static_cast<double>(oneOffWithin))
               .Add("still_after_distance", hp->GetLastSampleDistance())
               .Print();
             std::printf("%s %s interactive (budget %g s): median %.4f s against still %.4f s, "
