@@ -267,11 +267,12 @@ void FrameTimeModel::Observe(const FrameWork& work, double seconds)
   if (work.HasOneOff())
   {
     // Kept apart from the drawing frames. A pair without a drawing frame yet
-    // (else the next frame would again be predicted from the prior) learns from this one too: the frame less its predicted one-off work
-    // (the estimator's seconds, or a rate learnt from other levels, are
-    // nearer this machine than an unseen pair's prior), but never less than
-    // half its share in proportion to the two predictions (a one-off work
-    // predicted too long must not leave the drawing nothing).
+    // learns from this one too (else its next frame would again be predicted
+    // from the prior): the frame less its predicted one-off work (the
+    // estimator's seconds, or a rate learnt from other levels, are nearer
+    // this machine than an unseen pair's prior), but never less than half its
+    // share in proportion to the two predictions (one-off work predicted too
+    // long must not leave the drawing nothing).
     if (pair.Samples.empty())
     {
       const double drawing = this->PredictDrawing(work);
