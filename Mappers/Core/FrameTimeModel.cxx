@@ -373,8 +373,8 @@ FrameTimeModel::Coefficients FrameTimeModel::Anchor(FrameMethod method, bool tra
   return prior;
 }
 
-FrameTimeModel::Vector3 FrameTimeModel::Solve(
-  const std::deque<Sample>& samples, const Vector3& prior, const Vector3& anchor, double& priorScale)
+FrameTimeModel::Vector3 FrameTimeModel::Solve(const std::deque<Sample>& samples,
+  const Vector3& prior, const Vector3& anchor, double& priorScale)
 {
   // Rows in relative terms: frame i asks (a, b, c) . (1, P, X) / p_i = t_i /
   // p_i, p_i the prior's seconds for its work, weighted by recency. Dividing by

@@ -337,7 +337,8 @@ int main()
   // set up + e per cell of a volume level built.
   const double drawA = 0.004, drawB = 1.2e-7, drawC = 4e-8;
   const double perProgram = 0.02, perCell = 5e-8;
-  const auto drawing = [&](const mediso::FrameWork& work) { return Cost(drawA, drawB, drawC, work); };
+  const auto drawing = [&](const mediso::FrameWork& work)
+  { return Cost(drawA, drawB, drawC, work); };
   const auto whole = [&](const mediso::FrameWork& work)
   {
     return drawing(work) + perProgram * work.Programs +
