@@ -75,11 +75,26 @@ struct vtkHistoPyramidIsoMapper::Internals
   vtkNew<vtkBlockLODIsosurfaces> Fallback;
   std::set<std::string> Said;
 
-  // The frame-time model and what it is fed: the first frame of each sample
-  // distance and translucency pays for shader builds and buffers, so it is
-  // not observed (Warm says which were seen).
+  // The frame-time model and what it is fed: every frame, with the one-off
+  // work it did (a level's pyramid or extraction, the programs and buffers of
+  // a level, distance and translucency not drawn before: Warm says which
+  // were), so that the model predicts the frames that switch level too.
   mediso::FrameTimeModel Model;
   std::set<std::pair<int, bool>> Warm;
+  // The Block LOD level the fallback drew last (-1: none): another level's
+  // triangles are uploaded again (one vtkPolyDataMapper draws them all).
+  int LastTriangleLevel = -1;
+
+  // Warm's key of a GPU frame at a volume level and distance, and of a
+  // fallback frame at a level.
+  static std::pair<int, bool> GPUKey(int level, double distance, bool translucent)
+  {
+    return { 1000 * level + static_cast<int>(std::lround(100.0 * distance)), translucent };
+  }
+  static std::pair<int, bool> TrianglesKey(int level, bool translucent)
+  {
+    return { -1 - level, translucent };
+  }
   // The fallback's triangles per level for the current values and input
   // (-1: not drawn yet), which its interactive choice predicts from.
   std::array<double, 4> LevelTriangles = { { -1.0, -1.0, -1.0, -1.0 } };
@@ -115,6 +130,20 @@ struct vtkHistoPyramidIsoMapper::Internals
     const double drawn = this->TrianglesAt(level);
     return static_cast<std::uint64_t>(
       drawn > 0.0 ? drawn : 2.0 * static_cast<double>(this->Primitives) * std::pow(4.0, level - 3));
+  }
+
+  // Cells of a GPU volume level of a volume of `dims` points (the coarse
+  // copy keeps every stride-th point and the last of each axis): what its
+  // pyramid's build covers.
+  static std::uint64_t LevelCells(const int dims[3], int level)
+  {
+    const int stride = 1 << (FullLevel - level);
+    std::uint64_t cells = 1;
+    for (int a = 0; a < 3; ++a)
+    {
+      cells *= static_cast<std::uint64_t>(std::max(0, (dims[a] - 1 + stride - 1) / stride));
+    }
+    return cells;
   }
 
   // Active pairs of a GPU volume level: drawn, else estimated from the full level's.
@@ -254,6 +283,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   this->LastSampleDistance = 1.0;
   this->LastLevel = FullLevel;
   this->LastPredictedSeconds = 0.0;
+  this->LastPredictedOneOffSeconds = 0.0;
   this->LastMeasuredSeconds = 0.0;
 
   // Say a message once (per distinct text), as an error or a warning.
@@ -484,6 +514,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     candidate.Work.Primitives = trianglesAt(level);
     candidate.Work.Pixels = fullPixels;
     candidate.Work.Translucent = translucent;
+    this->AddOneOffWork(candidate, dims);
     return candidate;
   };
 
@@ -498,23 +529,26 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     this->NumberOfFallbackTriangles = impl.Fallback->GetNumberOfTriangles();
     this->LastRenderPath = FallbackPath;
     this->LastLevel = level;
-    impl.LevelTriangles[static_cast<std::size_t>(level)] =
-      static_cast<double>(this->NumberOfFallbackTriangles);
     if (adjust)
     {
-      mediso::FrameWork work;
-      work.Method = mediso::FrameMethod::Triangles;
-      work.Primitives = this->NumberOfFallbackTriangles;
-      work.Pixels = fullPixels;
-      work.Translucent = translucent;
-      this->LastPredictedSeconds = impl.Model.Predict(work);
+      // Predicted as known before the frame (the one-off work the level
+      // would need), observed with what the frame did.
+      const mediso::FrameTimeModel::Candidate predicted = triangleCandidate(level);
+      this->LastPredictedSeconds = impl.Model.PredictDrawing(predicted.Work);
+      this->LastPredictedOneOffSeconds = impl.Model.PredictOneOff(predicted.Work);
       glFinish();
       this->LastMeasuredSeconds = std::chrono::duration<double>(Clock::now() - start).count();
-      if (!impl.Fallback->GetLastFrameExtracted())
-      {
-        impl.Model.Observe(work, this->LastMeasuredSeconds);
-      }
+      mediso::FrameWork work = predicted.Work;
+      work.Primitives = this->NumberOfFallbackTriangles;
+      const bool uploaded =
+        impl.Fallback->GetLastFrameExtracted() || level != impl.LastTriangleLevel;
+      work.BuildElements = uploaded ? this->NumberOfFallbackTriangles : 0;
+      work.Programs = impl.Warm.insert(Internals::TrianglesKey(level, translucent)).second ? 1 : 0;
+      impl.Model.Observe(work, this->LastMeasuredSeconds);
     }
+    impl.LevelTriangles[static_cast<std::size_t>(level)] =
+      static_cast<double>(this->NumberOfFallbackTriangles);
+    impl.LastTriangleLevel = level;
   };
 
   // 5. An interactive frame whose GPU distances are all predicted over the
@@ -528,7 +562,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     !this->ForceCPUFallback && impl.Primitives > 0 && this->LastGPUPathWorked)
   {
     const mediso::FrameTimeModel::Candidate& chosen =
-      this->ChooseInteractiveLevel(translucent, width, height, budget);
+      this->ChooseInteractiveLevel(translucent, width, height, budget, dims);
     if (chosen.Work.Method == mediso::FrameMethod::Triangles)
     {
       this->FallbackReason.clear();
@@ -550,17 +584,18 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       for (float distance : SampleDistances)
       {
         candidates.push_back(gpuCandidate(gpuLevel, distance, primitives));
+        this->AddOneOffWork(candidates.back(), dims);
       }
       const std::size_t chosen = interactive ? impl.Model.Choose(candidates, budget) : 0;
       chosenWork = candidates[chosen].Work;
-      this->LastPredictedSeconds = impl.Model.Predict(chosenWork);
+      this->LastPredictedSeconds = impl.Model.PredictDrawing(chosenWork);
+      this->LastPredictedOneOffSeconds = impl.Model.PredictOneOff(chosenWork);
       return candidates[chosen].SampleDistance;
     };
   }
   gpu->SetVolumeLevel(gpuLevel);
   gpu->SetGPUMemoryBudget(static_cast<std::uint64_t>(1.0e6 * this->GPUMemoryBudget));
-  const std::uint64_t buildsBefore = gpu->GetStats().PyramidBuilds + gpu->GetStats().CoarseBuilds;
-  const std::uint64_t uploadsBefore = gpu->GetStats().VolumeUploads;
+  const mediso::IsosurfaceSceneStats statsBefore = gpu->GetStats();
   const Clock::time_point gpuStart = Clock::now();
   if (this->ForceCPUFallback)
   {
@@ -583,26 +618,37 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       // Timed to the frame's end: a GL frame's calls return before its work is done.
       glFinish();
       this->LastMeasuredSeconds = std::chrono::duration<double>(Clock::now() - gpuStart).count();
-      const bool rebuilt =
-        this->GPUStats.PyramidBuilds + this->GPUStats.CoarseBuilds != buildsBefore ||
-        this->GPUStats.VolumeUploads != uploadsBefore;
-      // The first frame of each level, distance and translucency builds its program.
-      const std::pair<int, bool> key(
-        1000 * this->LastLevel + static_cast<int>(std::lround(100.0 * this->LastSampleDistance)),
-        chosenWork.Translucent);
-      if (!rebuilt && !impl.Warm.insert(key).second)
+      // Observed with the one-off work it did: the full level's pyramid (the
+      // first frame, with the volume's upload, or after an isovalue change),
+      // a coarse level's on its first frame of these values, the programs
+      // and buffers of a level, distance and translucency not drawn before.
+      mediso::FrameWork work = chosenWork;
+      work.Primitives = this->GPUStats.Primitives;
+      work.BuildElements = 0;
+      if (this->GPUStats.VolumeUploads != statsBefore.VolumeUploads ||
+        this->GPUStats.PyramidBuilds != statsBefore.PyramidBuilds)
       {
-        impl.Model.Observe(chosenWork, this->LastMeasuredSeconds);
+        work.BuildElements += Internals::LevelCells(dims, FullLevel);
       }
+      if (this->GPUStats.CoarseBuilds != statsBefore.CoarseBuilds)
+      {
+        work.BuildElements += Internals::LevelCells(dims, this->LastLevel);
+      }
+      const std::pair<int, bool> key =
+        Internals::GPUKey(this->LastLevel, this->LastSampleDistance, chosenWork.Translucent);
+      work.Programs = impl.Warm.insert(key).second ? 1 : 0;
+      impl.Model.Observe(work, this->LastMeasuredSeconds);
     }
     else
     {
       this->LastPredictedSeconds = 0.0;
+      this->LastPredictedOneOffSeconds = 0.0;
     }
     return;
   }
   this->LastGPUPathWorked = false;
   this->LastPredictedSeconds = 0.0;
+  this->LastPredictedOneOffSeconds = 0.0;
   if (!this->ForceCPUFallback)
   {
     sayOnce(false,
@@ -627,8 +673,40 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 }
 
 //------------------------------------------------------------------------------
+void vtkHistoPyramidIsoMapper::AddOneOffWork(mediso::FrameTimeModel::Candidate& candidate,
+  const int dims[3]) const
+{
+  // What a candidate would make before it draws, as known before the frame:
+  // a GPU level not built for these values (its pairs unknown) builds its
+  // pyramid; a Block LOD level not drawn for them extracts, and a level other
+  // than the last one drawn uploads its triangles; a level, distance and
+  // translucency not drawn before sets up its program and buffers.
+  const Internals& impl = *this->Impl;
+  mediso::FrameWork& work = candidate.Work;
+  const std::size_t level = static_cast<std::size_t>(candidate.Level);
+  if (work.Method == mediso::FrameMethod::CellRasterisation)
+  {
+    const bool built =
+      candidate.Level == FullLevel ? impl.Primitives > 0 : impl.LevelPairs[level] > 0;
+    work.BuildElements = built ? 0 : Internals::LevelCells(dims, candidate.Level);
+    work.Programs = impl.Warm.count(Internals::GPUKey(
+                      candidate.Level, candidate.SampleDistance, work.Translucent))
+      ? 0
+      : 1;
+  }
+  else
+  {
+    const bool drawn =
+      impl.LevelTriangles[level] >= 0.0 && candidate.Level == impl.LastTriangleLevel;
+    work.BuildElements = drawn ? 0 : work.Primitives;
+    work.Programs =
+      impl.Warm.count(Internals::TrianglesKey(candidate.Level, work.Translucent)) ? 0 : 1;
+  }
+}
+
+//------------------------------------------------------------------------------
 mediso::FrameTimeModel::Candidate vtkHistoPyramidIsoMapper::ChooseInteractiveLevel(
-  bool translucent, int width, int height, double budget)
+  bool translucent, int width, int height, double budget, const int dims[3])
 {
   // Finest first: the full volume at each sample distance, then per coarser
   // level its GPU frames (InteractiveVolumeLevels) and its triangles
@@ -646,6 +724,7 @@ mediso::FrameTimeModel::Candidate vtkHistoPyramidIsoMapper::ChooseInteractiveLev
       : impl.EstimatedPairs(level);
     candidate.Work.Pixels = mediso::FrameTimeModel::ShadedPixels(width, height, distance);
     candidate.Work.Translucent = translucent;
+    this->AddOneOffWork(candidate, dims);
     candidates.push_back(candidate);
   };
   for (int level = FullLevel; level >= 0; --level)
@@ -704,5 +783,6 @@ void vtkHistoPyramidIsoMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LastSampleDistance: " << this->LastSampleDistance << "\n";
   os << indent << "LastLevel: " << this->LastLevel << "\n";
   os << indent << "LastPredictedSeconds: " << this->LastPredictedSeconds << "\n";
+  os << indent << "LastPredictedOneOffSeconds: " << this->LastPredictedOneOffSeconds << "\n";
   os << indent << "LastMeasuredSeconds: " << this->LastMeasuredSeconds << "\n";
 }

@@ -290,13 +290,18 @@ public:
    * What the last frame did: whether it was an interactive render, the image
    * sample distance (1: every pixel) and Block LOD level (3: full
    * resolution; on the GPU path, below 3, the coarse volume level) it drew at, the
-   * seconds the frame-time model predicted for it and the seconds it took
-   * (0 while InteractiveAdjust is off or nothing was drawn).
+   * seconds the frame-time model predicted for its drawing, those it
+   * predicted for the one-off work the frame did before drawing (a level's
+   * pyramid or extraction, the program of a level, distance or translucency
+   * not drawn before; 0 when it made nothing), and the seconds it took, both
+   * included (0 while InteractiveAdjust is off or nothing was drawn). The
+   * frame's predicted time is the sum of the two predictions.
    */
   vtkGetMacro(LastInteractive, bool);
   vtkGetMacro(LastSampleDistance, double);
   vtkGetMacro(LastLevel, int);
   vtkGetMacro(LastPredictedSeconds, double);
+  vtkGetMacro(LastPredictedOneOffSeconds, double);
   vtkGetMacro(LastMeasuredSeconds, double);
   ///@}
 
@@ -424,7 +429,10 @@ private:
   // of the candidates, finest first, that the frame-time model predicts
   // within `budget` (the last when none is).
   mediso::FrameTimeModel::Candidate ChooseInteractiveLevel(
-    bool translucent, int width, int height, double budget);
+    bool translucent, int width, int height, double budget, const int dims[3]);
+  // The one-off work a candidate would do (a level to build or extract, a
+  // program to set up), for the model to predict its whole frame.
+  void AddOneOffWork(mediso::FrameTimeModel::Candidate& candidate, const int dims[3]) const;
 
   int LastRenderPath = NoPath;
   std::string FallbackReason;
@@ -441,6 +449,7 @@ private:
   double LastSampleDistance = 1.0;
   int LastLevel = 3;
   double LastPredictedSeconds = 0.0;
+  double LastPredictedOneOffSeconds = 0.0;
   double LastMeasuredSeconds = 0.0;
   bool LastGPUPathWorked = false;
   mediso::IsosurfaceSceneStats GPUStats;

@@ -46,7 +46,7 @@ struct ProcessFrames
   struct Frame
   {
     double Triangles = 0.0;
-    bool Learn = true; // false when a display drew new data (its upload)
+    double Uploaded = 0.0; // the triangles of data new to its display (their upload)
     bool Translucent = false;
     double Start = 0.0;         // the render window's StartEvent
     double RendererStart = 0.0; // the view's renderer's StartEvent
@@ -499,8 +499,8 @@ int vtkBlockLODSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKe
       this->InteractiveTriangles = 0.0;
     }
     // What the coming frame draws, for the frame-time model: the LOD's
-    // triangles or the full data's, unless that data is new here (its upload
-    // is not a frame's cost).
+    // triangles or the full data's, and those of them new here (their upload,
+    // one-off work the model keeps apart from the drawing).
     vtkDataObject* drawn =
       this->LastRenderUsedLOD ? lod : vtkPVView::GetDeliveredPiece(inInfo, this);
     if (drawn && this->GetVisibility() && this->ObservedRenderer)
@@ -510,7 +510,12 @@ int vtkBlockLODSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKe
       DescribeLOD(drawn, level, triangles);
       // A display's levels, for the others' choices, once per new data it
       // shows (their triangles in a frame at a level they choose too).
-      const bool newData = drawn->GetMTime() != this->DrawnDataTime;
+      // The actor keeps the full data's and the LOD's buffers apart (ParaView's
+      // LOD actor has a mapper for each): each is new when it changed since
+      // it was drawn last.
+      vtkMTimeType& drawnTime =
+        this->LastRenderUsedLOD ? this->DrawnLODTime : this->DrawnDataTime;
+      const bool newData = drawn->GetMTime() != drawnTime;
       std::array<double, Levels> levels;
       levels.fill(-1.0);
       if (newData && !this->LastRenderUsedLOD && this->InteractiveLevels)
@@ -520,7 +525,7 @@ int vtkBlockLODSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKe
       std::lock_guard<std::mutex> lock(Frames().Mutex);
       ProcessFrames::Frame& frame = Frames().Pending[this->ObservedRenderer.GetPointer()];
       frame.Triangles += triangles;
-      frame.Learn = frame.Learn && !newData;
+      frame.Uploaded += newData ? triangles : 0.0;
       frame.Translucent = frame.Translucent || this->Property->GetOpacity() < 1.0;
       Frames().Drawn[this->ObservedRenderer.GetPointer()][this] = triangles;
       Frames().Translucent[this->ObservedRenderer.GetPointer()][this] =
@@ -529,7 +534,7 @@ int vtkBlockLODSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKe
       {
         Frames().AtLevel[this->ObservedRenderer.GetPointer()][this] = levels;
       }
-      this->DrawnDataTime = drawn->GetMTime();
+      drawnTime = drawn->GetMTime();
     }
   }
   return 1;
@@ -648,13 +653,14 @@ void vtkBlockLODSurfaceRepresentation::OnRenderEnd()
   {
     known->second = 0.5 * (known->second + overhead);
   }
-  if (!drawn.Learn || drawn.Triangles <= 0)
+  if (drawn.Triangles <= 0)
   {
     return;
   }
   mediso::FrameWork work;
   work.Method = mediso::FrameMethod::Triangles;
   work.Primitives = static_cast<std::uint64_t>(drawn.Triangles);
+  work.BuildElements = static_cast<std::uint64_t>(drawn.Uploaded);
   const int* size = this->ObservedRenderer->GetSize();
   work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
     static_cast<std::uint64_t>(std::max(0, size[1]));

@@ -45,7 +45,8 @@
  * representation feeds with the frames it draws in this process: each
  * frame's renderer time, with the triangles every Block LOD display drew in
  * it together, the view's pixels and whether any was translucent (a frame
- * that drew new data, i.e. uploaded it, is not learnt from). A display's
+ * that drew new data reports those triangles as uploaded, one-off work the
+ * model keeps apart from the drawing). A display's
  * candidate is predicted with the other Block LOD displays' last triangles
  * added, the frame it will share. Before any frame the model's prior is
  * conservative (a software renderer), so the first interactive level errs on
@@ -211,9 +212,10 @@ protected:
   unsigned long RendererEndObserver = 0;
   vtkWeakPointer<vtkRenderer> ObservedRenderer;
   vtkWeakPointer<vtkRenderWindow> ObservedWindow;
-  // The data drawn by the last frame, so that its first frame (uploads) is
-  // not learnt from.
+  // The full data and the LOD drawn last, so that a frame that draws either
+  // anew reports its upload.
   vtkMTimeType DrawnDataTime = 0;
+  vtkMTimeType DrawnLODTime = 0;
   int InteractiveLevel = -1;
   double InteractiveTriangles = 0.0;
   bool LastRenderUsedLOD = false;

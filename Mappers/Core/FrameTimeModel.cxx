@@ -32,6 +32,11 @@ constexpr int CauchyRounds = 4;
 // rounds (a frame fitted exactly would otherwise take all the weight).
 constexpr double MedianFloor = 0.02;
 
+// Frames with one-off work kept per method: each level's first frame, a
+// handful per drag; enough to follow a change of load, few enough to refit
+// at every frame.
+constexpr std::size_t OneOffHistoryLength = 16;
+
 using Vector3 = std::array<double, 3>;
 using Matrix3 = std::array<Vector3, 3>;
 
@@ -99,7 +104,65 @@ double Finite(double value, double fallback)
 {
   return std::isfinite(value) ? value : fallback;
 }
+
+double Dot(const Vector3& a, const Vector3& b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+// A frame's counts in the drawing's columns, and the coefficients as a vector.
+Vector3 DrawingCounts(const FrameWork& work)
+{
+  return { 1.0, static_cast<double>(work.Primitives), static_cast<double>(work.Pixels) };
+}
+Vector3 AsVector(const FrameTimeModel::Coefficients& c)
+{
+  return { c.Seconds, c.PerPrimitive, c.PerPixel };
+}
+FrameTimeModel::Coefficients AsCoefficients(const Vector3& x)
+{
+  FrameTimeModel::Coefficients c;
+  c.Seconds = x[0];
+  c.PerPrimitive = x[1];
+  c.PerPixel = x[2];
+  return c;
+}
+
+// The same for one-off work.
+Vector3 OneOffCounts(const FrameWork& work)
+{
+  return { static_cast<double>(work.Programs), static_cast<double>(work.BuildElements),
+    std::isfinite(work.ExtractSeconds) ? std::max(0.0, work.ExtractSeconds) : 0.0 };
+}
+Vector3 AsVector(const FrameTimeModel::OneOffCoefficients& c)
+{
+  return { c.PerProgram, c.PerElement, c.ExtractScale };
+}
+FrameTimeModel::OneOffCoefficients AsOneOffCoefficients(const Vector3& x)
+{
+  FrameTimeModel::OneOffCoefficients c;
+  c.PerProgram = x[0];
+  c.PerElement = x[1];
+  c.ExtractScale = x[2];
+  return c;
+}
 } // namespace
+
+bool FrameWork::HasOneOff() const
+{
+  return this->BuildElements > 0 || this->Programs > 0 ||
+    (std::isfinite(this->ExtractSeconds) && this->ExtractSeconds > 0.0);
+}
+
+double FrameTimeModel::OneOffCoefficients::Evaluate(const FrameWork& work) const
+{
+  const double seconds = Dot(AsVector(*this), OneOffCounts(work));
+  if (!(seconds > 0.0))
+  {
+    return 0.0;
+  }
+  return std::isfinite(seconds) ? seconds : std::numeric_limits<double>::max();
+}
 
 double FrameTimeModel::Coefficients::Evaluate(const FrameWork& work) const
 {
@@ -166,6 +229,27 @@ FrameTimeModel::Coefficients FrameTimeModel::Prior(FrameMethod method, bool tran
   return prior;
 }
 
+FrameTimeModel::OneOffCoefficients FrameTimeModel::OneOffPrior(FrameMethod method)
+{
+  // A software renderer's, of the right order rather than exact: the first
+  // frame at a new level is predicted from it, and that frame's time then
+  // scales it. A program is a compile and link of the isosurface shaders
+  // (tens of milliseconds on llvmpipe); a GPU level's cell costs its share of
+  // the coarse copy, the upload and the build passes; a triangle its
+  // extraction's output and its upload. The estimator's seconds are taken
+  // as they are.
+  OneOffCoefficients prior;
+  prior.PerProgram = 0.03;
+  prior.PerElement = method == FrameMethod::CellRasterisation ? 3e-8 : 1e-7;
+  prior.ExtractScale = 1.0;
+  return prior;
+}
+
+std::size_t FrameTimeModel::MethodKey(FrameMethod method)
+{
+  return method == FrameMethod::CellRasterisation ? 0 : 1;
+}
+
 std::size_t FrameTimeModel::Key(FrameMethod method, bool translucent)
 {
   const std::size_t m = method == FrameMethod::CellRasterisation ? 0 : 1;
@@ -180,13 +264,61 @@ void FrameTimeModel::Observe(const FrameWork& work, double seconds)
     return;
   }
   Pair& pair = this->Pairs[Key(work.Method, work.Translucent)];
-  pair.Samples.push_back(
-    { static_cast<double>(work.Primitives), static_cast<double>(work.Pixels), seconds });
+  if (work.HasOneOff())
+  {
+    // Kept apart from the drawing frames. A pair without a drawing frame yet
+    // learns from this one too (else its next frame would again be predicted
+    // from the prior): the frame less its predicted one-off work (the
+    // estimator's seconds, or a rate learnt from other levels, are nearer
+    // this machine than an unseen pair's prior), but never less than half its
+    // share in proportion to the two predictions (one-off work predicted too
+    // long must not leave the drawing nothing).
+    if (pair.Samples.empty())
+    {
+      const double drawing = this->PredictDrawing(work);
+      const double oneOff = this->PredictOneOff(work);
+      const double share = drawing + oneOff > 0.0 ? drawing / (drawing + oneOff) : 1.0;
+      pair.Samples.push_back(
+        { DrawingCounts(work), std::max(seconds - oneOff, 0.5 * share * seconds) });
+      this->Refit(work.Method, work.Translucent);
+    }
+    OneOffFit& fit = this->OneOffs[MethodKey(work.Method)];
+    fit.Samples.push_back({ work, seconds });
+    while (fit.Samples.size() > OneOffHistoryLength)
+    {
+      fit.Samples.pop_front();
+    }
+    this->RefitOneOff(work.Method);
+    return;
+  }
+  pair.Samples.push_back({ DrawingCounts(work), seconds });
   while (pair.Samples.size() > HistoryLength)
   {
     pair.Samples.pop_front();
   }
   this->Refit(work.Method, work.Translucent);
+  // The one-off frames' residuals are measured against the drawing fit.
+  if (!this->OneOffs[MethodKey(work.Method)].Samples.empty())
+  {
+    this->RefitOneOff(work.Method);
+  }
+}
+
+void FrameTimeModel::RefitOneOff(FrameMethod method)
+{
+  // What each one-off frame took beyond its drawing's prediction, by the
+  // drawing fit as it stands now; a frame faster than its drawing's
+  // prediction says its one-off work was free (the fit's coefficients are
+  // non-negative).
+  OneOffFit& fit = this->OneOffs[MethodKey(method)];
+  std::deque<Sample> residuals;
+  for (const OneOffSample& s : fit.Samples)
+  {
+    residuals.push_back({ OneOffCounts(s.Work), s.Seconds - this->PredictDrawing(s.Work) });
+  }
+  const Vector3 prior = AsVector(OneOffPrior(method));
+  double scale = 1.0;
+  fit.Fitted = AsOneOffCoefficients(Solve(residuals, prior, prior, scale));
 }
 
 void FrameTimeModel::Refit(FrameMethod method, bool translucent)
@@ -195,8 +327,8 @@ void FrameTimeModel::Refit(FrameMethod method, bool translucent)
   double scale = 1.0;
   // Anchored to the prior's shape; the scale found is the frames' ratio to
   // the prior, what a pair without frames borrows (Anchor()).
-  const Coefficients prior = Prior(method, translucent);
-  pair.Fitted = Solve(pair.Samples, prior, prior, scale);
+  const Vector3 prior = AsVector(Prior(method, translucent));
+  pair.Fitted = AsCoefficients(Solve(pair.Samples, prior, prior, scale));
   pair.PriorScale = scale;
 }
 
@@ -241,8 +373,8 @@ FrameTimeModel::Coefficients FrameTimeModel::Anchor(FrameMethod method, bool tra
   return prior;
 }
 
-FrameTimeModel::Coefficients FrameTimeModel::Solve(const std::deque<Sample>& samples,
-  const Coefficients& prior, const Coefficients& anchor, double& priorScale)
+FrameTimeModel::Vector3 FrameTimeModel::Solve(const std::deque<Sample>& samples,
+  const Vector3& prior, const Vector3& anchor, double& priorScale)
 {
   // Rows in relative terms: frame i asks (a, b, c) . (1, P, X) / p_i = t_i /
   // p_i, p_i the prior's seconds for its work, weighted by recency. Dividing by
@@ -259,14 +391,11 @@ FrameTimeModel::Coefficients FrameTimeModel::Solve(const std::deque<Sample>& sam
   for (std::size_t k = n; k-- > 0;)
   {
     const Sample& s = samples[k];
-    const double p =
-      std::max(prior.Seconds + prior.PerPrimitive * s.Primitives + prior.PerPixel * s.Pixels,
-        MinimumSeconds);
+    const double p = std::max(Dot(prior, s.Counts), MinimumSeconds);
     recency[k] = w;
-    row[k] = { 1.0 / p, s.Primitives / p, s.Pixels / p };
+    row[k] = { s.Counts[0] / p, s.Counts[1] / p, s.Counts[2] / p };
     target[k] = s.Seconds / p;
-    anchored[k] =
-      (anchor.Seconds + anchor.PerPrimitive * s.Primitives + anchor.PerPixel * s.Pixels) / p;
+    anchored[k] = Dot(anchor, s.Counts) / p;
     w *= RecencyDecay;
   }
 
@@ -280,7 +409,7 @@ FrameTimeModel::Coefficients FrameTimeModel::Solve(const std::deque<Sample>& sam
   // rounds weigh those by how well they agree. With fewer than three frames
   // no frame can be outvoted: the plain fit.
   std::vector<double> weight = recency;
-  Coefficients fitted = anchor;
+  Vector3 fitted = anchor;
   priorScale = 1.0;
   const int rounds = n >= 3 ? 1 + MedianRounds + CauchyRounds : 1;
   for (int round = 0; round < rounds; ++round)
@@ -293,9 +422,7 @@ FrameTimeModel::Coefficients FrameTimeModel::Solve(const std::deque<Sample>& sam
     for (std::size_t k = 0; k < n; ++k)
     {
       const Sample& s = samples[k];
-      const double predicted = std::max(
-        fitted.Seconds + fitted.PerPrimitive * s.Primitives + fitted.PerPixel * s.Pixels,
-        MinimumSeconds);
+      const double predicted = std::max(Dot(fitted, s.Counts), MinimumSeconds);
       // The residual in the rows' units (seconds / p_k) over the frame's
       // fitted time in those units: the frame's relative error.
       const double r = (s.Seconds - predicted) / predicted;
@@ -313,9 +440,9 @@ FrameTimeModel::Coefficients FrameTimeModel::Solve(const std::deque<Sample>& sam
   return fitted;
 }
 
-FrameTimeModel::Coefficients FrameTimeModel::SolveWeighted(const std::vector<Vector3>& row,
+FrameTimeModel::Vector3 FrameTimeModel::SolveWeighted(const std::vector<Vector3>& row,
   const std::vector<double>& target, const std::vector<double>& anchored,
-  const std::vector<double>& weight, const Coefficients& anchor, double& priorScale)
+  const std::vector<double>& weight, const Vector3& anchor, double& priorScale)
 {
   const std::size_t n = row.size();
   double totalWeight = 0.0;
@@ -351,8 +478,8 @@ FrameTimeModel::Coefficients FrameTimeModel::SolveWeighted(const std::vector<Vec
   }
   const double anchorScale = den > 0.0 ? Finite(num / den, 1.0) : 1.0;
   priorScale = anchorScale;
-  const Vector3 priorPhi = { anchorScale * anchor.Seconds * scale[0],
-    anchorScale * anchor.PerPrimitive * scale[1], anchorScale * anchor.PerPixel * scale[2] };
+  const Vector3 priorPhi = { anchorScale * anchor[0] * scale[0], anchorScale * anchor[1] * scale[1],
+    anchorScale * anchor[2] * scale[2] };
 
   // Normal equations of the scaled problem with the ridge towards the prior.
   const double ridge = PriorWeight * totalWeight;
@@ -420,20 +547,59 @@ FrameTimeModel::Coefficients FrameTimeModel::SolveWeighted(const std::vector<Vec
     }
   }
 
-  Coefficients fitted;
-  fitted.Seconds = Finite(best[0] / scale[0], anchor.Seconds);
-  fitted.PerPrimitive = Finite(best[1] / scale[1], anchor.PerPrimitive);
-  fitted.PerPixel = Finite(best[2] / scale[2], anchor.PerPixel);
+  Vector3 fitted;
+  for (int j = 0; j < 3; ++j)
+  {
+    fitted[j] = Finite(best[j] / scale[j], anchor[j]);
+  }
   return fitted;
 }
 
 double FrameTimeModel::Predict(const FrameWork& work) const
+{
+  const double seconds = this->PredictDrawing(work) + this->PredictOneOff(work);
+  return std::isfinite(seconds) ? seconds : std::numeric_limits<double>::max();
+}
+
+double FrameTimeModel::PredictDrawing(const FrameWork& work) const
 {
   if (work.Method != FrameMethod::CellRasterisation && work.Method != FrameMethod::Triangles)
   {
     return Prior(FrameMethod::CellRasterisation, true).Evaluate(work);
   }
   return this->Fit(work.Method, work.Translucent).Evaluate(work);
+}
+
+double FrameTimeModel::PredictOneOff(const FrameWork& work) const
+{
+  if (!work.HasOneOff())
+  {
+    return 0.0;
+  }
+  if (work.Method != FrameMethod::CellRasterisation && work.Method != FrameMethod::Triangles)
+  {
+    return OneOffPrior(FrameMethod::Triangles).Evaluate(work);
+  }
+  return this->FitOneOff(work.Method).Evaluate(work);
+}
+
+std::size_t FrameTimeModel::OneOffCount(FrameMethod method) const
+{
+  if (method != FrameMethod::CellRasterisation && method != FrameMethod::Triangles)
+  {
+    return 0;
+  }
+  return this->OneOffs[MethodKey(method)].Samples.size();
+}
+
+FrameTimeModel::OneOffCoefficients FrameTimeModel::FitOneOff(FrameMethod method) const
+{
+  if (method != FrameMethod::CellRasterisation && method != FrameMethod::Triangles)
+  {
+    return OneOffPrior(FrameMethod::Triangles);
+  }
+  const OneOffFit& fit = this->OneOffs[MethodKey(method)];
+  return fit.Samples.empty() ? OneOffPrior(method) : fit.Fitted;
 }
 
 bool FrameTimeModel::HasObservations(FrameMethod method, bool translucent) const
@@ -460,9 +626,31 @@ void FrameTimeModel::Reset()
     pair.Fitted = Coefficients();
     pair.PriorScale = 1.0;
   }
+  for (OneOffFit& fit : this->OneOffs)
+  {
+    fit.Samples.clear();
+    fit.Fitted = OneOffCoefficients();
+  }
 }
 
 std::size_t FrameTimeModel::Choose(
+  const std::vector<Candidate>& candidates, double budgetSeconds) const
+{
+  if (candidates.empty())
+  {
+    return 0;
+  }
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+  {
+    if (this->PredictDrawing(candidates[i].Work) <= budgetSeconds)
+    {
+      return i;
+    }
+  }
+  return candidates.size() - 1;
+}
+
+std::size_t FrameTimeModel::ChooseWholeFrame(
   const std::vector<Candidate>& candidates, double budgetSeconds) const
 {
   if (candidates.empty())

@@ -59,13 +59,41 @@
  * predicts, so a host's first interactive frame errs on the coarse side; a
  * GPU's first observed frame scales it down at once.
  *
+ * One-off work (issue 30: the misses of the frames a host chose were the
+ * frames that switch level). The first frame at a level pays for making it
+ * before it draws: a GPU volume level's pyramid (the coarse copy, its upload
+ * and the build passes), a Block LOD level's extraction and the upload of its
+ * triangles, the programs a new variant compiles. A host says so in the
+ * frame's work (BuildElements, Programs, ExtractSeconds) both when it asks
+ * for a prediction and when it reports the frame, and the model predicts the
+ * whole frame: the drawing, as above, plus
+ *
+ *     seconds = p * Programs + e * BuildElements + x * ExtractSeconds
+ *
+ * per method (a GPU level's cells and a level's triangles are elements of a
+ * different cost), x the ratio of the estimator's seconds to this machine's.
+ * A frame with one-off work is kept apart from the drawing frames: what it
+ * took beyond the drawing fit's prediction for it (recomputed at each refit,
+ * so a drawing fit that learns the new level corrects it) is fitted for
+ * (p, e, x) the same way as the drawing (the same robust, recency-weighted,
+ * non-negative fit anchored to OneOffPrior()). Its first frame at a pair
+ * with no drawing frame yet teaches the drawing as well: the frame is split
+ * between the two in proportion to their predictions, so the next frame is
+ * not predicted from the bare prior again.
+ *
+ * Choose() picks on the drawing alone: the level a drag can hold, whose
+ * one-off work is paid once (choosing on the whole frame would keep a drag on
+ * whatever level is already made, and never reach the finer one). A host
+ * whose every candidate has to be made anyway (an isovalue's first answer)
+ * uses ChooseWholeFrame().
+ *
  * Limits: a frame's time also depends on what the counts do not say (overdraw,
  * the depth complexity of translucent layers, caches, other load on the
  * machine); the recency weighting follows slow changes, not frame-to-frame
- * noise. Frames that include one-off work (shader compilation, uploads, a
- * pyramid rebuild after an isovalue change) should not be observed, or they
- * inflate the fit until they age out. A GPU frame must be timed to its end
- * (a finish or a query), else the CPU time of issuing it is what is learnt.
+ * noise. One-off work a host does not report (a driver's own caches) inflates
+ * the drawing fit until the robust fit outvotes it. A GPU frame must be timed
+ * to its end (a finish or a query), else the CPU time of issuing it is what is
+ * learnt.
  *
  * Bad input never yields NaN or a negative time: non-finite or negative seconds
  * are not observed, zero work predicts the fixed cost a, and Choose() on an
@@ -97,6 +125,17 @@ struct FrameWork
   std::uint64_t Primitives = 0; ///< active cell-isovalue pairs drawn, or triangles
   std::uint64_t Pixels = 0;     ///< pixels shaded: viewport pixels / (sample distance)^2
   bool Translucent = false;
+
+  // One-off work, done before the frame draws (0 when it only draws what is made):
+  /// Elements the frame makes: the cells of the GPU volume levels whose pyramids it builds
+  /// (CellRasterisation), or the triangles it extracts and uploads (Triangles).
+  std::uint64_t BuildElements = 0;
+  /// Programs (and their buffers) the frame sets up: a level, distance or look not drawn before.
+  std::uint32_t Programs = 0;
+  /// The extraction estimator's seconds for the surfaces the frame extracts (where known).
+  double ExtractSeconds = 0.0;
+  /// Whether the frame does any one-off work.
+  bool HasOneOff() const;
 };
 
 class FrameTimeModel
@@ -126,12 +165,35 @@ public:
   /// the fit is anchored to.
   static Coefficients Prior(FrameMethod method, bool translucent);
 
-  /// A measured frame (seconds of rendering it), folded into the fit for its
-  /// method and translucency.
+  /// The three coefficients of a method's one-off work: seconds = PerProgram *
+  /// Programs + PerElement * BuildElements + ExtractScale * ExtractSeconds.
+  struct OneOffCoefficients
+  {
+    double PerProgram = 0.0;
+    double PerElement = 0.0;
+    double ExtractScale = 0.0;
+    double Evaluate(const FrameWork& work) const;
+  };
+  /// The one-off coefficients used before a method's first frame with one-off
+  /// work, and the shape their fit is anchored to.
+  static OneOffCoefficients OneOffPrior(FrameMethod method);
+
+  /// A measured frame (seconds of rendering it, its one-off work included),
+  /// folded into the fit for its method and translucency, or, when it did
+  /// one-off work, into its method's one-off fit.
   void Observe(const FrameWork& work, double seconds);
-  /// Predicted seconds for a frame (before any frame of its method and
-  /// translucency: its prior, scaled as another pair's frames scale theirs).
+  /// Predicted seconds for a frame, its one-off work included (before any
+  /// frame of its method and translucency: its prior, scaled as another
+  /// pair's frames scale theirs).
   double Predict(const FrameWork& work) const;
+  /// The frame's drawing alone (what the same frame costs once its level is made).
+  double PredictDrawing(const FrameWork& work) const;
+  /// The frame's one-off work alone (0 when it has none).
+  double PredictOneOff(const FrameWork& work) const;
+  /// Frames with one-off work currently kept for a method.
+  std::size_t OneOffCount(FrameMethod method) const;
+  /// The fitted one-off coefficients of a method (before any such frame: the prior).
+  OneOffCoefficients FitOneOff(FrameMethod method) const;
   bool HasObservations(FrameMethod method, bool translucent) const;
   /// Frames currently kept for a pair (at most HistoryLength).
   std::size_t ObservationCount(FrameMethod method, bool translucent) const;
@@ -147,15 +209,21 @@ public:
     float SampleDistance = 1.0f;
     FrameWork Work;
   };
-  /// Index of the first candidate (callers order them finest first) predicted
-  /// within budgetSeconds, else the last (coarsest).
+  /// Index of the first candidate (callers order them finest first) whose
+  /// drawing is predicted within budgetSeconds, else the last (coarsest): the
+  /// level a drag holds, its one-off work paid on its first frame.
   std::size_t Choose(const std::vector<Candidate>& candidates, double budgetSeconds) const;
+  /// The same on each candidate's whole frame, its one-off work included: for
+  /// a frame whose candidates all have to be made (an isovalue's first answer).
+  std::size_t ChooseWholeFrame(
+    const std::vector<Candidate>& candidates, double budgetSeconds) const;
 
 private:
+  using Vector3 = std::array<double, 3>;
+  // A frame's three counts (the columns its coefficients multiply) and seconds.
   struct Sample
   {
-    double Primitives = 0.0;
-    double Pixels = 0.0;
+    Vector3 Counts = { { 0.0, 0.0, 0.0 } };
     double Seconds = 0.0;
   };
   struct Pair
@@ -164,19 +232,36 @@ private:
     Coefficients Fitted;
     double PriorScale = 1.0; // the frames' least-squares ratio to the prior
   };
+  // A frame with one-off work: its whole work (its drawing is predicted by
+  // its pair's fit at each refit) and seconds.
+  struct OneOffSample
+  {
+    FrameWork Work;
+    double Seconds = 0.0;
+  };
+  struct OneOffFit
+  {
+    std::deque<OneOffSample> Samples; // oldest first
+    OneOffCoefficients Fitted;
+  };
   static std::size_t Key(FrameMethod method, bool translucent);
+  static std::size_t MethodKey(FrameMethod method);
   // A pair's prediction before any of its frames: its prior, scaled as the
   // same method drawn the other way scales its frames, else as the other
   // method's do, else the prior.
   Coefficients Anchor(FrameMethod method, bool translucent) const;
   void Refit(FrameMethod method, bool translucent);
-  static Coefficients Solve(const std::deque<Sample>& samples, const Coefficients& prior,
-    const Coefficients& anchor, double& priorScale);
-  static Coefficients SolveWeighted(const std::vector<std::array<double, 3>>& row,
-    const std::vector<double>& target, const std::vector<double>& anchored,
-    const std::vector<double>& weight, const Coefficients& anchor, double& priorScale);
+  void RefitOneOff(FrameMethod method);
+  // The robust, recency-weighted, non-negative fit of x in counts . x =
+  // seconds, anchored to `anchor` scaled to the frames, relative to `prior`.
+  static Vector3 Solve(const std::deque<Sample>& samples, const Vector3& prior,
+    const Vector3& anchor, double& priorScale);
+  static Vector3 SolveWeighted(const std::vector<Vector3>& row, const std::vector<double>& target,
+    const std::vector<double>& anchored, const std::vector<double>& weight, const Vector3& anchor,
+    double& priorScale);
 
   std::array<Pair, 4> Pairs;
+  std::array<OneOffFit, 2> OneOffs;
 };
 
 } // namespace mediso

@@ -820,8 +820,12 @@ int main(int argc, char* argv[])
             hp->SetInteractiveTriangleLevels(
               opt.InteractiveLevels.find("triangles") != std::string::npos);
             scene.Window->SetDesiredUpdateRate(1000.0);
-            std::vector<double> frameTimes, distances, predicted, measured, errors, levels;
+            std::vector<double> frameTimes, distances, predicted, measured, errors, levels, paths,
+              oneOff;
             int within = 0;
+            // Frames that made something before drawing (a level's build or
+            // extraction, a program), and how many of them were within 25%.
+            int oneOffFrames = 0, oneOffWithin = 0;
             int triangleFrames = 0;
             int volumeLevelFrames = 0;
             for (int f = 0; f < opt.Frames; ++f)
@@ -830,18 +834,27 @@ int main(int argc, char* argv[])
               frameTimes.push_back(scene.Frame());
               distances.push_back(hp->GetLastSampleDistance());
               levels.push_back(hp->GetLastLevel());
+              paths.push_back(static_cast<double>(hp->GetLastRenderPath()));
               triangleFrames +=
                 hp->GetLastRenderPath() == vtkHistoPyramidIsoMapper::FallbackPath ? 1 : 0;
               volumeLevelFrames +=
                 hp->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath && hp->GetLastLevel() < 3
                 ? 1
                 : 0;
-              predicted.push_back(hp->GetLastPredictedSeconds());
+              // The whole frame's prediction: its drawing and its one-off work.
+              predicted.push_back(
+                hp->GetLastPredictedSeconds() + hp->GetLastPredictedOneOffSeconds());
+              oneOff.push_back(hp->GetLastPredictedOneOffSeconds());
               measured.push_back(hp->GetLastMeasuredSeconds());
               const double error =
                 std::abs(predicted.back() - measured.back()) / std::max(measured.back(), 1e-9);
               errors.push_back(error);
               within += error <= 0.25 ? 1 : 0;
+              if (oneOff.back() > 0.0)
+              {
+                ++oneOffFrames;
+                oneOffWithin += error <= 0.25 ? 1 : 0;
+              }
             }
             scene.Window->SetDesiredUpdateRate(0.0001);
             const double stillAfter = scene.Frame();
@@ -869,6 +882,18 @@ int main(int argc, char* argv[])
               .Add("error_median", Summarise(errors).Median)
               .Add("within_25", static_cast<double>(within) / std::max(1, opt.Frames))
               .Add("still_after_s", stillAfter)
+              // Per frame, for classifying the model's misses (issue 30): the
+              // frame's wall time, the mapper's prediction and its own timing,
+              // level, sample distance and path (GetLastRenderPath()).
+              .Add("frame_s", frameTimes)
+              .Add("frame_predicted_s", predicted)
+              .Add("frame_measured_s", measured)
+              .Add("frame_level", levels)
+              .Add("frame_distance", distances)
+              .Add("frame_path", paths)
+              .Add("frame_predicted_one_off_s", oneOff)
+              .Add("one_off_frames", static_cast<double>(oneOffFrames))
+              .Add("one_off_within_25", static_cast<double>(oneOffWithin))
               .Add("still_after_distance", hp->GetLastSampleDistance())
               .Print();
             std::printf("%s %s interactive (budget %g s): median %.4f s against still %.4f s, "

@@ -64,6 +64,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -253,8 +254,7 @@ public:
     }
     this->CPU.SetVolume(description);
     this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
-    std::fill(std::begin(this->GPUBuildTimes), std::end(this->GPUBuildTimes), -1.0);
-    std::fill(std::begin(this->GPUBuildsSeen), std::end(this->GPUBuildsSeen), 0);
+    this->Warm.clear(); // another volume: other pyramids, other programs
     this->Viewpoint.ResetCamera();
     return true;
   }
@@ -672,8 +672,15 @@ public:
       values.push_back(s.Value);
     }
     this->LastBuildMs = 0.0;
+    // The frame's one-off work for the frame-time model (Finish()): the
+    // estimator's seconds of what it extracts (0 for cached surfaces), the
+    // cells of the pyramids it builds.
+    this->FrameExtractSeconds = 0.0;
+    this->FrameBuildCells = 0;
     if (this->CPUPath)
     {
+      this->FrameExtractSeconds = this->ExtractSeconds(
+        this->RequestedLevel >= 0 ? this->RequestedLevel : this->MemoryLevel());
       if (!this->UpdateCPUSurfaces())
       {
         return false;
@@ -688,6 +695,7 @@ public:
       const auto builds = [this]()
       { return this->Scene->GetStats().PyramidBuilds + this->Scene->GetStats().CoarseBuilds; };
       const std::uint64_t before = builds();
+      const IsosurfaceSceneStats statsBefore = this->Scene->GetStats();
       this->Scene->SetSurfaces(this->Frame.Surfaces);
       this->Frame.Level = this->StreamedGPULevel();
       std::string error;
@@ -701,7 +709,15 @@ public:
       if (builds() != before)
       {
         this->LastBuildMs = emscripten_get_now() - start;
-        this->ObserveGPUBuild(this->GPULevel, this->LastBuildMs / 1000.0);
+        const IsosurfaceSceneStats& after = this->Scene->GetStats();
+        if (after.PyramidBuilds != statsBefore.PyramidBuilds)
+        {
+          this->FrameBuildCells += this->LevelCells(NumberOfLevels - 1);
+        }
+        if (after.CoarseBuilds != statsBefore.CoarseBuilds)
+        {
+          this->FrameBuildCells += this->LevelCells(this->Frame.Level);
+        }
       }
     }
     Camera& camera = this->Viewpoint.GetCamera();
@@ -764,20 +780,36 @@ public:
     return true;
   }
 
-  /// Waits for the GPU to finish (a one-pixel read-back): for timings. A
-  /// frame that built nothing (GPU path: no pyramid build; CPU path: no
-  /// surface extracted or uploaded) is then given to the frame-time model
-  /// with its time to here (one-off work would inflate the fit).
+  /// Waits for the GPU to finish (a one-pixel read-back): for timings. The
+  /// frame is then given to the frame-time model with its time to here and
+  /// the one-off work it did (GPU path: the pyramids it built; CPU path: the
+  /// estimator's seconds of its extraction and the triangles it uploaded;
+  /// either: the program of a level, distance and look not drawn before),
+  /// which the model keeps apart from the drawing.
   void Finish()
   {
     emscripten_webgl_make_context_current(this->Context);
     unsigned char pixel[4];
     this->GL->F().ReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, pixel);
     const double seconds = (emscripten_get_now() - this->FrameStart) / 1000.0;
-    const bool oneOff = this->CPUPath ? this->MeshesUploaded : this->LastBuildMs > 0.0;
-    if (this->FrameDrawn && !oneOff)
+    if (this->FrameDrawn)
     {
-      this->Times.Observe(this->DrawnWork(this->DrawnSampleDistance), seconds);
+      FrameWork work = this->DrawnWork(this->DrawnSampleDistance);
+      const int level = this->CPUPath ? this->CPULevel : this->Stats.Level;
+      if (this->CPUPath)
+      {
+        work.ExtractSeconds = this->MeshesUploaded ? this->FrameExtractSeconds : 0.0;
+        work.BuildElements = this->MeshesUploaded ? work.Primitives : 0;
+      }
+      else
+      {
+        work.BuildElements = this->FrameBuildCells;
+      }
+      work.Programs = this->Warm.insert(this->WarmKey(level, this->DrawnSampleDistance, work))
+                        .second
+        ? 1
+        : 0;
+      this->Times.Observe(work, seconds);
     }
     this->FrameDrawn = false;
   }
@@ -800,7 +832,6 @@ public:
   val ChooseFrame(double budgetSeconds, bool interactive)
   {
     std::vector<FrameTimeModel::Candidate> candidates;
-    std::vector<double> extraSeconds;
     const int memoryLevel = this->CPUPath ? this->MemoryLevel() : NumberOfLevels - 1;
     if (this->CPUPath)
     {
@@ -808,20 +839,18 @@ public:
       {
         FrameTimeModel::Candidate c;
         c.Level = level;
-        double triangles = 0.0, seconds = 0.0;
+        double triangles = 0.0;
         for (const IsosurfaceLook& s : this->Frame.Surfaces)
         {
           triangles += this->CPU.Estimate(s.Value, level).Counts.Triangles;
-          seconds += std::max(0.0, this->CPU.EstimateSeconds(s.Value, level));
         }
         c.Work = this->Work(static_cast<std::uint64_t>(triangles), 1.0);
+        c.Work.ExtractSeconds = this->ExtractSeconds(level);
         candidates.push_back(c);
-        extraSeconds.push_back(seconds);
       }
       // A drag whose level 0 is over the budget: level 0 on fewer pixels (on software WebGL about
       // half of such a frame of a few thousand triangles is its pixels: shading, blending).
       const FrameTimeModel::Candidate levelZero = candidates.back();
-      const double levelZeroSeconds = extraSeconds.back();
       if (interactive)
       {
         for (double distance : { 1.5, 2.0, 3.0, 4.0, 6.0, 8.0 })
@@ -829,35 +858,39 @@ public:
           FrameTimeModel::Candidate c = levelZero;
           c.SampleDistance = static_cast<float>(distance);
           c.Work = this->Work(levelZero.Work.Primitives, distance);
+          c.Work.ExtractSeconds = levelZero.Work.ExtractSeconds;
           candidates.push_back(c);
-          extraSeconds.push_back(levelZeroSeconds);
         }
       }
     }
     else
     {
       this->AddGPUCandidates(candidates);
-      for (const FrameTimeModel::Candidate& c : candidates)
-      {
-        extraSeconds.push_back(this->GPUBuildSeconds(c.Level));
-      }
     }
-    std::size_t chosen = candidates.size() - 1;
-    for (std::size_t i = 0; i < candidates.size(); ++i)
+    // CPU path: the drawing and the extraction of the surfaces not cached, as before. GPU path:
+    // while the full volume's pyramid is built for these surfaces (a drag), the level a drag
+    // holds, on the drawing (a level's build is paid on its first frame); after an isovalue
+    // change, when every candidate's pyramid has to be built, on the whole frame, so that the
+    // first answer is a level whose build fits as well.
+    const bool wholeFrame = this->CPUPath || !this->FullLevelBuiltForSurfaces();
+    const std::size_t chosen = wholeFrame ? this->Times.ChooseWholeFrame(candidates, budgetSeconds)
+                                          : this->Times.Choose(candidates, budgetSeconds);
+    if (this->CPUPath)
     {
-      // Choose() on the drawing alone, with the extraction added per candidate.
-      if (this->Times.Predict(candidates[i].Work) + extraSeconds[i] <= budgetSeconds)
-      {
-        chosen = i;
-        break;
-      }
+      // Predicted with the rest of its one-off work: a level not shown uploads its triangles
+      // (after extracting those not cached), a level not drawn before sets up its buffers.
+      FrameWork& work = candidates[chosen].Work;
+      const int level = candidates[chosen].Level;
+      const bool shown = work.ExtractSeconds <= 0.0 && level == this->CPULevel;
+      work.BuildElements = shown ? 0 : work.Primitives;
+      work.Programs =
+        this->Warm.count(this->WarmKey(level, candidates[chosen].SampleDistance, work)) ? 0 : 1;
     }
     val out = val::object();
     out.set("level", candidates[chosen].Level);
     out.set("sampleDistance", candidates[chosen].SampleDistance);
-    out.set("predictedMs",
-      1000.0 * (this->Times.Predict(candidates[chosen].Work) + extraSeconds[chosen]));
-    out.set("fullMs", 1000.0 * (this->Times.Predict(candidates[0].Work) + extraSeconds[0]));
+    out.set("predictedMs", 1000.0 * this->Times.Predict(candidates[chosen].Work));
+    out.set("fullMs", 1000.0 * this->Times.Predict(candidates[0].Work));
     out.set("memoryLevel", memoryLevel);
     return out;
   }
@@ -955,44 +988,20 @@ private:
     this->SlotTriangles.assign(this->SlotValues.size(), std::numeric_limits<double>::quiet_NaN());
   }
 
-  // An isovalue change's build on the GPU path: a level's pyramid is built for the new values
-  // before its first frame, on a software WebGL2 a cost of seconds for the full volume, which a
-  // change's first answer must count. Each level's last build (not its first: that one also
-  // samples and uploads the level's volume) is kept; GPUBuildSeconds() is 0 while the full
-  // volume is built for the surfaces drawn (a drag: its frames keep choosing on their drawing
-  // alone) or the level is, else that level's last build, else the full volume's scaled by the
-  // level's samples (1 / stride^3), else 0 (nothing built yet: the first frame is not coarse).
-  void ObserveGPUBuild(int level, double seconds)
-  {
-    if (level >= 0 && level < NumberOfLevels)
-    {
-      if (this->GPUBuildsSeen[level]++ > 0 || level == NumberOfLevels - 1)
-      {
-        this->GPUBuildTimes[level] = seconds;
-      }
-    }
-  }
-
-  double GPUBuildSeconds(int level) const
+  // The current surfaces' values, as the scene keeps a level's built values.
+  std::vector<double> SurfaceValues() const
   {
     std::vector<double> values;
     for (const IsosurfaceLook& s : this->Frame.Surfaces)
     {
       values.push_back(s.Value);
     }
-    const int full = NumberOfLevels - 1;
-    if (!this->Scene || values.empty() || this->Scene->GetBuiltValues(full) == values ||
-      this->Scene->GetBuiltValues(level) == values)
-    {
-      return 0.0;
-    }
-    if (this->GPUBuildTimes[level] >= 0.0)
-    {
-      return this->GPUBuildTimes[level];
-    }
-    const double stride = LevelStride(level);
-    return this->GPUBuildTimes[full] >= 0.0 ? this->GPUBuildTimes[full] / (stride * stride * stride)
-                                            : 0.0;
+    return values;
+  }
+
+  bool FullLevelBuiltForSurfaces() const
+  {
+    return this->Scene && this->Scene->GetBuiltValues(NumberOfLevels - 1) == this->SurfaceValues();
   }
 
   // The GPU path's candidates, finest first: the full volume at each sample distance, then the
@@ -1003,9 +1012,11 @@ private:
   void AddGPUCandidates(std::vector<FrameTimeModel::Candidate>& candidates) const
   {
     const std::uint64_t full = this->Scene ? this->Scene->GetActivePairs() : 0;
+    const std::vector<double> values = this->SurfaceValues();
     for (int level : { NumberOfLevels - 1, 2, 1, 0 })
     {
       const std::uint64_t built = this->Scene ? this->Scene->GetActivePairs(level) : 0;
+      const bool builtNow = this->Scene && this->Scene->GetBuiltValues(level) == values;
       const std::uint64_t pairs =
         built > 0 ? built : IsosurfaceScene::EstimateActivePairs(full, level);
       for (double distance : { 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0 })
@@ -1014,6 +1025,8 @@ private:
         c.Level = level;
         c.SampleDistance = static_cast<float>(distance);
         c.Work = this->Work(pairs, distance);
+        c.Work.BuildElements = builtNow ? 0 : this->LevelCells(level);
+        c.Work.Programs = this->Warm.count(this->WarmKey(level, distance, c.Work)) ? 0 : 1;
         candidates.push_back(c);
       }
     }
@@ -1031,6 +1044,39 @@ private:
     work.Translucent = std::any_of(this->Frame.Surfaces.begin(), this->Frame.Surfaces.end(),
       [](const IsosurfaceLook& s) { return s.Opacity < 1.0f; });
     return work;
+  }
+
+  // The estimator's seconds of extracting the current surfaces at a CPU level (0 when cached).
+  double ExtractSeconds(int level)
+  {
+    double seconds = 0.0;
+    for (const IsosurfaceLook& s : this->Frame.Surfaces)
+    {
+      seconds += std::max(0.0, this->CPU.EstimateSeconds(s.Value, level));
+    }
+    return seconds;
+  }
+
+  // Cells of a GPU volume level (every stride-th point and the last of each axis): what its
+  // pyramid's build covers.
+  std::uint64_t LevelCells(int level) const
+  {
+    const int* dims = this->Viewpoint.GetPlacement().Dimensions;
+    const int stride = 1 << (NumberOfLevels - 1 - level);
+    std::uint64_t cells = 1;
+    for (int a = 0; a < 3; ++a)
+    {
+      cells *= static_cast<std::uint64_t>(std::max(0, (dims[a] - 1 + stride - 1) / stride));
+    }
+    return cells;
+  }
+
+  // Warm's key: a path, level, sample distance and translucency drawn before (their programs
+  // and buffers made).
+  static std::array<int, 4> WarmKey(int level, double sampleDistance, const FrameWork& work)
+  {
+    return { static_cast<int>(work.Method), level,
+      static_cast<int>(std::lround(100.0 * sampleDistance)), work.Translucent ? 1 : 0 };
   }
 
   // The last frame's work, as drawn.
@@ -1330,11 +1376,13 @@ private:
   double LastBuildMs = 0.0, LastFrameMs = 0.0;
   double SampleDistance = 1.0, DrawnSampleDistance = 1.0;
   int GPULevel = NumberOfLevels - 1; // the GPU path's volume level (SetGPULevel)
-  double GPUBuildTimes[NumberOfLevels] = { -1.0, -1.0, -1.0, -1.0 }; // ObserveGPUBuild
-  int GPUBuildsSeen[NumberOfLevels] = { 0, 0, 0, 0 };
   FrameTimeModel Times; // this client's frames: the time each level or sample distance takes
   double FrameStart = 0.0;
   bool FrameDrawn = false; // a frame was drawn since the last Finish
+  // The one-off work of the frame being drawn (Finish() reports it), and what was drawn before.
+  double FrameExtractSeconds = 0.0;
+  std::uint64_t FrameBuildCells = 0;
+  std::set<std::array<int, 4>> Warm;
   bool MeshesUploaded = false; // the last frame made or uploaded a CPU path surface
   glcore::Name Sampled, SampledColor, SampledDepth; // a sampled frame's framebuffer
   int SampledSize[2] = { 0, 0 };
