@@ -240,8 +240,9 @@ public:
     std::copy(placement.Spacing, placement.Spacing + 3, description.Spacing);
     description.Stamp = ++this->VolumeStamp;
     this->Described = description;
+    this->SceneVolumeStale = true;
     std::string error;
-    if (!this->Scene->SetVolume(description, error))
+    if (!this->CPUPath && !this->UpdateSceneVolume(error))
     {
       this->LastError = error;
       return false;
@@ -513,11 +514,11 @@ public:
   /// the CPU path chooses its levels again.
   void EndStreaming()
   {
-    // The GPU path's texture was uploaded from the empty buffer: a new stamp uploads the values.
+    // A texture the GPU path uploaded from the empty buffer: a new stamp uploads the values.
     this->Described.Stamp = ++this->VolumeStamp;
-    emscripten_webgl_make_context_current(this->Context);
+    this->SceneVolumeStale = true;
     std::string error;
-    if (!this->Scene->SetVolume(this->Described, error))
+    if (!this->CPUPath && !this->UpdateSceneVolume(error))
     {
       this->LastError = error;
     }
@@ -604,6 +605,12 @@ public:
       values.push_back(s.Value);
     }
     this->LastBuildMs = 0.0;
+    std::string sceneError;
+    if (!this->CPUPath && !this->UpdateSceneVolume(sceneError))
+    {
+      this->LastError = sceneError;
+      return false;
+    }
     if (this->CPUPath)
     {
       if (!this->UpdateCPUSurfaces())
@@ -1034,6 +1041,27 @@ private:
   // The CPU path: the surfaces unit makes or finds each surface at the
   // level requested, or the estimator's within the budget (a guide here:
   // level 0 when nothing fits, said in the error); uploaded when it changed.
+  /**
+   * The GPU scene takes the volume SetVolume described when the GPU path first needs it (its
+   * frame, or SetVolume on the GPU path), not while the CPU path draws: that upload is the bulk
+   * of SetVolume on a software renderer, and a streamed volume's empty buffer (docs/web.md,
+   * Streaming) then never goes up before its values have arrived.
+   */
+  bool UpdateSceneVolume(std::string& error)
+  {
+    if (!this->SceneVolumeStale)
+    {
+      return true;
+    }
+    emscripten_webgl_make_context_current(this->Context);
+    if (!this->Scene->SetVolume(this->Described, error))
+    {
+      return false;
+    }
+    this->SceneVolumeStale = false;
+    return true;
+  }
+
   bool UpdateCPUSurfaces()
   {
     // Streaming: the surfaces named coarse come from the coarse volume, the others from the
@@ -1182,6 +1210,7 @@ private:
 #endif
   const void* CoarseData = nullptr;
   VolumeDescription Described; // the volume as SetVolume described it (EndStreaming uploads it again)
+  bool SceneVolumeStale = false; // the GPU scene has not taken Described yet (UpdateSceneVolume)
   BrickGrid Bricks;
   std::vector<double> CoarseValues;
   std::vector<double> SlotValues;
