@@ -72,8 +72,9 @@ export async function startViewer(canvas, probe, moduleLoaded = () => {}) {
     [canvas.width, canvas.height] = backingStore(canvas.getBoundingClientRect());
   }
   const launched = inWorker && RemoteViewer.launch(canvas,
-    { threads: withThreads() && navigator.hardwareConcurrency > 1, budgetMs: Number(params.get("frameBudget")) || 0,
-      abort: params.get("abort") !== "0", slowExtractionMs: Number(params.get("slowExtraction")) || 0,
+    { threads: withThreads() && navigator.hardwareConcurrency > 1,
+      budgetMs: Number(params.get("frameBudget")) || 0, abort: params.get("abort") !== "0",
+      slowExtractionMs: Number(params.get("slowExtraction")) || 0,
       slowPass: Number(params.get("slowPass")) || 1,
       refineDelayMs: Number(params.get("refineDelay")) || 0 });
   state.remote = inWorker;
