@@ -127,9 +127,11 @@ export async function startStream(level) {
   state.stream = { level, manifest, type, dims, resident: new Uint8Array(count),
     pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, received: 0,
     total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), requested: [],
-    readyKey: "", error: "" };
+    readyKey: "", error: "", afterFirstFrame: true };
   state.received = 0;
-  fetchMore();
+  // The bricks are asked for once the first frame (level 0's) is drawn (afterEach): on a fast
+  // link they would otherwise come first, and their writing and the server's encoding would
+  // hold that frame (the page's start-up, docs/web.md).
 }
 
 // The next brick: one the current isovalues need first, else the next in order.
@@ -274,6 +276,10 @@ function fullNow() {
     drawnValues.every((v, i) => v === values[i]);
 }
 function afterEach() {
+  if (state.stream && state.stream.afterFirstFrame) {
+    state.stream.afterFirstFrame = false;
+    fetchMore();
+  }
   const stats = state.viewer.stats();
   const drawn = stats.surfaceValues || [];
   const full = state.stream ? state.stream.level : drawnLevel();
