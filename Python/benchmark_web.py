@@ -4,6 +4,7 @@
     python3 Python/benchmark_web.py [--inputs ct,ct512] [--sweep 10] [--size 800x600] [--out FILE.md]
     python3 Python/benchmark_web.py --interactive [--inputs phantom:256,ct] [--paths cpu,gpu] [--before main]
     python3 Python/benchmark_web.py --stream [--inputs ct,phantom:256] [--networks 30/40,loopback]
+    python3 Python/benchmark_web.py --startup [--inputs ct] [--networks 30/40,loopback]
 
 In one headless Chromium (Debian's, software WebGL2: SwiftShader), on the same volume and canvas
 size: the page's GPU path (the core on WebGL2), its CPU path (the BlockLOD core in WebAssembly at
@@ -32,6 +33,11 @@ it (level 0, then the bricks the surfaces need first), each in a fresh browser c
 Chromium, under each network (MBIT/LATENCY_MS through CDP's Network.emulateNetworkConditions, or
 loopback): the time to the first image, to the current surfaces at the full level, to the whole
 level, and the bytes on the wire.
+
+--startup (issue 31's first image): the streaming page's start-up request by request, in a fresh
+context under each network (Testing/Web/bench-startup.mjs): when each of the page's requests was
+sent and finished and its bytes on the wire, and the page's marks (its module loaded, the worker
+ready, the first image).
 """
 import argparse
 import json
@@ -84,6 +90,8 @@ def parse_args(argv):
     p.add_argument("--networks", default="30/40,loopback",
                    help="--stream: MBIT/LATENCY_MS or loopback, comma-separated")
     p.add_argument("--repeats", type=int, default=1, help="--stream: runs of each page")
+    p.add_argument("--startup", action="store_true",
+                   help="the streaming page's start-up, request by request (issue 31's first image)")
     return p.parse_args(argv)
 
 
@@ -304,14 +312,7 @@ def main_stream(args, argv):
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     load_before = load_average()
     t0 = time.perf_counter()
-    networks = []
-    for n in args.networks.split(","):
-        if n == "loopback":
-            networks.append({"name": "loopback"})
-        else:
-            mbps, latency = n.split("/")
-            networks.append({"name": "%s Mbit/s, %s ms" % (mbps, latency), "mbps": float(mbps),
-                             "latencyMs": float(latency)})
+    networks = parse_networks(args.networks)
     lines = ["# The page streaming against the whole level (issue 31)", "",
              "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv), "",
              "| input | network | page | first image ms | surfaces at full level ms | whole level ms | bytes |",
@@ -349,8 +350,64 @@ def main_stream(args, argv):
     return 0
 
 
+def main_startup(args, argv, networks):
+    """The streaming page's requests and marks up to its first image (bench-startup.mjs)."""
+    lines = ["# The page's start-up (issue 31's first image)", "",
+             "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv),
+             "- Started %s; load average %s; Chromium headless, SwiftShader; CPU path in the worker; "
+             "canvas %s; each run in a fresh context; ms from navigation" % (
+                 time.strftime("%Y-%m-%d %H:%M:%S"), load_average(), args.size)]
+    for name in args.inputs.split(","):
+        data = volume_path(name) if not name.startswith("phantom:") else name
+        work = os.path.join(args.work, "startup-" + name.replace(":", "-"))
+        os.makedirs(work, exist_ok=True)
+        server, url = start_server(ROOT, args, data)
+        try:
+            config_file = os.path.join(work, "config.json")
+            out_file = os.path.join(work, "result.json")
+            with open(config_file, "w") as f:
+                json.dump({"url": url, "size": [int(v) for v in args.size.split("x")],
+                           "networks": networks, "repeats": args.repeats}, f)
+            progress("%s: start-up, %s" % (name, args.networks))
+            subprocess.run(["node", os.path.join(WEB, "bench-startup.mjs"), config_file, out_file],
+                           check=True, cwd=WEB, timeout=3600)
+            with open(out_file) as f:
+                runs = json.load(f)["runs"]
+        finally:
+            server.kill()
+        for run in runs:
+            marks = ", ".join("%s %.0f" % (m["name"][len("mediso:"):], m["at"]) for m in run["marks"])
+            lines += ["", "## %s, %s: first image %d ms (%s)" % (name, run["network"], run["firstMs"], marks),
+                      "", "| request | sent | response | end | bytes | encoding |", "|---|---:|---:|---:|---:|---|"]
+            for r in sorted(run["requests"], key=lambda r: r["sentMs"]):
+                if "ids=" in r["url"] or r["sentMs"] > run["firstMs"]:
+                    continue  # the bricks, and what came after the first image
+                lines.append("| %s | %s | %s | %s | %d | %s |" % (
+                    r["url"].split("&token")[0], r["sentMs"], r["responseMs"], r["endMs"], r["bytes"],
+                    r.get("encoding") or ""))
+    write_report(lines, args.out)
+    return 0
+
+
+def parse_networks(text):
+    """MBIT/LATENCY_MS or loopback, comma-separated, as bench-stream.mjs and bench-startup.mjs take them."""
+    networks = []
+    for n in text.split(","):
+        if n == "loopback":
+            networks.append({"name": "loopback"})
+        else:
+            mbps, latency = n.split("/")
+            networks.append({"name": "%s Mbit/s, %s ms" % (mbps, latency), "mbps": float(mbps),
+                             "latencyMs": float(latency)})
+    return networks
+
+
 def main(argv):
     args = parse_args(argv)
+    if args.startup:
+        if args.inputs == "ct,ct512":
+            args.inputs = "ct"
+        return main_startup(args, argv, parse_networks(args.networks))
     if args.stream:
         if args.inputs == "ct,ct512":
             args.inputs = "ct,phantom:256"

@@ -17,8 +17,8 @@ worker (Python/serve_jobs.py runs the queue), so that the event loop keeps servi
 meanwhile.
 
 The aiohttp shape: the app's state is one ServerState under one key (STATE), the handlers are
-module functions that read it, the page's files are a static route, and the startup and cleanup
-of the job runner are the app's signals.
+module functions that read it, the page's files are served by name and gzip'd (serve_static.py),
+and the startup and cleanup of the job runner are the app's signals.
 """
 import argparse
 import asyncio
@@ -47,6 +47,7 @@ from serve_jobs import (FORMATS, RESULT_GRACE_S, RESULTS_PER_SESSION, Operations
                         Session, StartFailed, log)
 from serve_messages import LEVEL_STRIDES, BadRequest, parse_message  # noqa: E402
 import serve_upload  # noqa: E402  (a local volume uploaded once: POST /api/upload)
+from serve_static import StaticFiles  # noqa: E402  (the page's files, gzip'd)
 
 MAX_FRAME = 1024 * 1024        # above this aiohttp closes the socket (1009, message too big)
 MAX_SESSIONS = 64              # WebSockets open at once
@@ -217,9 +218,11 @@ class ServerState:
     opened: int = 0                                # WebSockets opened so far (session numbers)
     encoding: dict = field(default_factory=dict)  # (dataset, level) -> future of its bytes
     fingerprints: dict = field(default_factory=dict)  # dataset -> future of its digest
+    files: Optional[StaticFiles] = None  # the page's files (page_files), gzip'd once each
 
     def __post_init__(self):
         self.by_id = {d.ident: d for d in self.datasets}
+        self.files = self.files or page_files(self.wasm)
 
 
 # aiohttp 3.9 keys app state with web.AppKey (typed); Debian 12's aiohttp 3.8 has no AppKey and
@@ -244,15 +247,13 @@ async def authenticate(request, handler):
 
 
 async def index(request):
-    return web.FileResponse(os.path.join(STATIC, "index.html"))
+    return await request.app[STATE].files.respond(request, os.path.join(STATIC, "index.html"))
 
 
-async def wasm(request):
-    name = request.match_info["name"]
-    path = os.path.join(request.app[STATE].wasm, name)
-    if not os.path.isfile(path):
-        raise web.HTTPNotFound(text="%s is not built: run Scripts/build-web.sh\n" % name)
-    return web.FileResponse(path)
+def page_files(wasm):
+    """The page's files: the WebAssembly build's (its own folder) first, then Web/static's."""
+    return StaticFiles([(wasm, WASM_FILES), (STATIC, None)], not_modified,
+                       missing=lambda name: "%s is not built: run Scripts/build-web.sh\n" % name)
 
 
 async def list_datasets(request):
@@ -372,6 +373,21 @@ async def handle(state, session, text):
         await session.send({"id": e.ident, "error": str(e)})
 
 
+async def warm_up(state, prepare_bricks):
+    """What a first page waits for, made in the background at the server's start (docs/web.md,
+    "The page's start-up"): the page's files gzip'd, and for each dataset its fingerprint (the
+    validators), level 0 encoded and the full level's brick manifest (what streaming asks for
+    first). The handlers await the same futures, so a request that comes sooner waits for them."""
+    state.files.warm()
+    loop = asyncio.get_running_loop()
+    for d in state.datasets:
+        if (d.ident, 0) not in state.encoding:
+            state.encoding[(d.ident, 0)] = loop.run_in_executor(None, d.encode, 0)
+        if d.ident not in state.fingerprints:
+            state.fingerprints[d.ident] = loop.run_in_executor(None, d.fingerprint)
+        prepare_bricks(d, len(LEVEL_STRIDES) - 1)
+
+
 async def start_jobs(app):
     operations = app[STATE].operations
     operations.task = asyncio.get_running_loop().create_task(operations.run())
@@ -385,22 +401,22 @@ def make_app(args, datasets, operations):
     app = web.Application(middlewares=[authenticate], client_max_size=64 * 1024)
     app[STATE] = ServerState(args.token, args.wasm, datasets, operations)
     app.router.add_get("/", index)
-    # The WebAssembly build first (its own folder), then every file of Web/static (aiohttp's
-    # static route: names resolved inside the folder only, content types from the suffix).
-    app.router.add_get("/static/{name:%s}" % "|".join(n.replace(".", r"\.") for n in WASM_FILES),
-                       wasm)
-    app.router.add_static("/static", STATIC)
+    # The WebAssembly build's files and those of Web/static, by name only (no path is resolved),
+    # gzip'd where the browser takes it (serve_static.py), content types from the suffix.
+    app.router.add_get("/static/{name}", app[STATE].files.handler)
     app.router.add_get("/api/datasets", list_datasets)
     app.router.add_get("/api/volume/{ident}", volume)
-    app.router.add_get("/api/bricks/{ident}", serve_bricks.handler(
+    bricks = serve_bricks.handler(
         lambda request: request.app[STATE].by_id.get(request.match_info["ident"]),
-        not_modified, VOLUME_CACHE_CONTROL))
+        not_modified, VOLUME_CACHE_CONTROL)
+    app.router.add_get("/api/bricks/{ident}", bricks)
     app.router.add_get("/api/result/{rid}", result)
     app.router.add_get("/api/status", status)
     app.router.add_get("/api/ws", websocket)
     # A local volume the page read itself, uploaded once for the operations (serve_upload.py).
     app.router.add_post("/api/upload", serve_upload.handler(STATE, Dataset))
     app.on_startup.append(start_jobs)
+    app.on_startup.append(lambda app: warm_up(app[STATE], bricks.prepare))
     app.on_cleanup.append(stop_jobs)
     return app
 

@@ -131,14 +131,18 @@ def handler(find, not_modified, cache_control):
     manifests = {}  # (dataset id, level) -> future of the manifest
     fingerprints = {}  # dataset id -> future of its fingerprint
 
+    def prepared(d, k):
+        """The future of level k's manifest of dataset d (made once, off the event loop)."""
+        key = (d.ident, k)
+        if key not in manifests:
+            manifests[key] = asyncio.get_running_loop().run_in_executor(None, manifest, d, k)
+        return manifests[key]
+
     async def bricks(request):
         d = find(request)
         k = requested_level(request, d)
         loop = asyncio.get_running_loop()
-        key = (d.ident, k)
-        if key not in manifests:  # once per level, off the event loop
-            manifests[key] = loop.run_in_executor(None, manifest, d, k)
-        m = await asyncio.shield(manifests[key])
+        m = await asyncio.shield(prepared(d, k))
         if "ids" not in request.query:
             return web.json_response(m, headers={"Cache-Control": "no-store"})
         ids = parse_ids(request.query["ids"], len(m["ranges"]))
@@ -154,4 +158,5 @@ def handler(find, not_modified, cache_control):
             "Content-Encoding": "gzip", "Content-Type": "application/octet-stream",
             "X-Mediso-Type": d.type, "X-Mediso-Bricks": ",".join(map(str, ids))}))
 
+    bricks.prepare = prepared  # the server's start makes the manifest a first page asks for
     return bricks

@@ -28,7 +28,7 @@ import { linkedView, readLink, scheduleLink } from "./link.js";
 import { setupOperations } from "./operations.js";
 import { VIEWS, applyNamedView, drawMarker, markerLabels, sceneView, setDataset, withWorld }
   from "./orientation.js";
-import { applyPath, drawnLevel, requestPath } from "./path.js";
+import { applyPath, drawnLevel, prefetchPath, requestPath } from "./path.js";
 import { drawHistogram, histogramInfo, setupHistogram } from "./histogram.js";
 import { serverDataset, setupLocalFiles } from "./local.js";
 import { setupPresets } from "./presets.js";
@@ -52,14 +52,24 @@ async function start() {
   }
   $("app").hidden = false;
   const canvas = $("view");
-  if (!(await startViewer(canvas, probe))) {
-    throw unsupported("WebGL2 is here but cannot run the GPU path: " + state.viewer.error());
-  }
-  $("renderer").textContent = state.rendererNote;
   if (params.get("budget")) {
     $("budget").value = params.get("budget");
   }
-  const list = await requestJSON("/api/datasets");
+  // The page's start-up (docs/web.md): the datasets, this thread's module and the worker's are
+  // asked for at once; once the dataset and the module's facts are known, the first requests of
+  // the stream the path will choose (level 0, the bricks' manifest), while the worker starts.
+  const datasets = requestJSON("/api/datasets");
+  datasets.catch(() => {}); // awaited below
+  const prefetch = () => datasets.then((list) => {
+    const d = list.datasets[0];
+    prefetchPath(d, readLink(location.hash, d.range, state.facts.maximumIsovalues).path ||
+      state.requestedPath);
+  }).catch(() => {});
+  if (!(await startViewer(canvas, probe, prefetch))) {
+    throw unsupported("WebGL2 is here but cannot run the GPU path: " + state.viewer.error());
+  }
+  $("renderer").textContent = state.rendererNote;
+  const list = await datasets;
   state.dataset = list.datasets[0];
   const d = state.dataset;
   showDataset(d);
@@ -95,6 +105,12 @@ async function start() {
   setupSurfaceList();
   if (link.surfaces) {
     replaceSurfaces(link.surfaces, true);
+  }
+  // With the worker, the first frame is asked for now: the worker draws it while this thread
+  // sets up the panel, slices and histogram below (in this same task, so that every afterFrame
+  // call is there before its answer comes). On this thread, at the end.
+  if (state.remote) {
+    renderNow();
   }
   // Choosing the value: the CT presets, the histogram and the slice views, redrawn after a frame
   // whose surfaces or volume level changed.
@@ -139,8 +155,11 @@ async function start() {
     drawMarker($("marker"), state.viewer.getView());
     scheduleLink();
   });
-  renderNow();
+  if (!state.remote) {
+    renderNow();
+  }
   await drawn(); // ready after the first frame (the worker's answer)
+  performance.mark("mediso:ready");
   // The "On the server" panel (Web/static/operations.js) is given what it needs here.
   setupOperations({
     get dataset() { return state.dataset; }, // a local file's once it is opened

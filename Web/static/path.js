@@ -6,7 +6,7 @@
 import { showPathNote } from "./readout.js";
 import { $, state } from "./state.js";
 import { loadVolume } from "./volume.js";
-import { canStream, startStream, stopStream } from "./stream.js";
+import { canStream, prefetchStream, startStream, stopStream } from "./stream.js";
 import { renderNow } from "./viewer.js";
 
 // The CPU path keeps the volume within 1 / CPU_VOLUME_SHARE of the budget: its surfaces and
@@ -66,6 +66,19 @@ function choosePath(requested, info, dataset, budgetMB) {
       why: "auto: the GPU path would need a coarser volume (" + gpu.why + ")" };
   }
   return { path: "gpu", level: gpu, why: "auto: WebGL2 on " + state.unmaskedRenderer };
+}
+
+/**
+ * The page's start-up (app.js, docs/web.md): where the page will stream `dataset` (the path and
+ * level applyPath will choose, the path asked for being `requested`), its first requests are
+ * sent now, before the viewer is ready, and applyPath's stream takes their answers.
+ */
+export function prefetchPath(dataset, requested) {
+  const budgetMB = Number($("budget").value) || 1024;
+  const choice = choosePath(requested, null, dataset, budgetMB);
+  if (canStream(choice.path, choice.level.level)) {
+    prefetchStream(dataset, choice.level.level);
+  }
 }
 
 /** Sets the path and fetches the volume again only if the path needs another level of it. */

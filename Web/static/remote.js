@@ -20,25 +20,37 @@ export function offscreenWebGL2() {
 
 export class RemoteViewer {
   /**
-   * Starts the worker on `canvas` (its control handed over for good) with the module `M` of
-   * this thread (the camera, the CPU model's count); `threads`: the worker loads the threaded
-   * module; `budgetMs`: the frame budget (0: the worker's); `abort`: false to let a running
-   * refinement run to its end; `slowExtractionMs`, `slowPass`, `refineDelayMs`: test hooks (render-worker.js). Resolves to the viewer, or rejects.
+   * Starts the worker on `canvas` (its control handed over for good: size it first); it loads
+   * its module at once, while this thread loads its own (the page's start-up, docs/web.md).
+   * `threads`: the worker loads the threaded module; `budgetMs`: the frame budget (0: the
+   * worker's); `abort`: false to let a running refinement run to its end; `slowExtractionMs`,
+   * `slowPass`, `refineDelayMs`: test hooks (render-worker.js). Returns {worker, ready}, ready a
+   * promise of the worker's "ready" message, for start().
    */
-  static async start(canvas, M, { threads, budgetMs, abort, slowExtractionMs, slowPass, refineDelayMs }, onFrame) {
+  static launch(canvas, { threads, budgetMs, abort, slowExtractionMs, slowPass, refineDelayMs }) {
     const worker = new Worker("static/render-worker.js");
     const offscreen = canvas.transferControlToOffscreen();
-    const viewer = new RemoteViewer(worker, M, onFrame);
     const base = new URL("static/", location.href).href;
-    const ready = await new Promise((resolve, reject) => {
-      viewer.onReady = resolve;
+    const ready = new Promise((resolve, reject) => {
+      worker.onmessage = (e) => e.data.op === "ready" && resolve(e.data);
       worker.onerror = (e) => reject(new Error("the render worker failed: " + (e.message || "no reason given")));
-      worker.postMessage({ op: "init", canvas: offscreen, base, threads, budgetMs, abort, slowExtractionMs,
-        slowPass, refineDelayMs },
-        [offscreen]);
     });
-    viewer.readyState = ready;
-    viewer.generation = ready.generation || null;
+    ready.catch(() => {}); // start() awaits it
+    worker.postMessage({ op: "init", canvas: offscreen, base, threads, budgetMs, abort, slowExtractionMs,
+      slowPass, refineDelayMs },
+      [offscreen]);
+    return { worker, ready };
+  }
+
+  /**
+   * The viewer of a launched worker (launch()) once it is ready, with the module `M` of this
+   * thread (the camera, the CPU model's count). Resolves to the viewer, or rejects.
+   */
+  static async start({ worker, ready }, M, onFrame) {
+    const answer = await ready;
+    const viewer = new RemoteViewer(worker, M, onFrame);
+    viewer.readyState = answer;
+    viewer.generation = answer.generation || null;
     return viewer;
   }
 
@@ -63,9 +75,7 @@ export class RemoteViewer {
   }
 
   receive(m) {
-    if (m.op === "ready") {
-      this.onReady(m);
-    } else if (m.op === "answer") {
+    if (m.op === "answer") {
       const resolve = this.answers.get(m.id);
       this.answers.delete(m.id);
       if (resolve) {

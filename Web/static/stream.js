@@ -16,7 +16,8 @@ import { drawnLevel } from "./path.js";
 import { updateReadout } from "./readout.js";
 import { params, state } from "./state.js";
 import { afterFrame, beforeFrame, renderNow } from "./viewer.js";
-import { fetchLevel, loadVolume, request, requestJSON, typedValues, unshuffle } from "./volume.js";
+import { fetchLevel, levelURL, loadVolume, mallocZeros, prefetch, request, requestJSON, typedValues,
+  unshuffle } from "./volume.js";
 
 // Requests in flight at once (a browser opens 6 connections to a host over HTTP/1.1). Each asks
 // for one brick: its URL is then the same at every load, so the browser keeps it and a reload
@@ -32,6 +33,20 @@ export function canStream(path, level) {
   return (path === "cpu" || path === "gpu") && state.remote && level > 0 &&
     params.get("stream") !== "0" &&
     !(state.dataset && state.dataset.local); // a local file is in the page already
+}
+
+// The URL of the manifest of level `level`'s bricks.
+function manifestURL(d, level) {
+  return "/api/bricks/" + d.id + "?level=" + level;
+}
+
+/**
+ * What startStream(level) asks for first (the manifest and level 0), sent now (the page's
+ * start-up, path.js: while the modules load); startStream takes the answers.
+ */
+export function prefetchStream(d, level) {
+  prefetch(manifestURL(d, level));
+  prefetch(levelURL(d, 0), "no-cache");
 }
 
 /** Stops a stream under way (a new level or path replaces the volume). */
@@ -85,7 +100,7 @@ function ready(s, v) {
 export async function startStream(level) {
   const d = state.dataset;
   state.stream = null;
-  const manifest = await requestJSON("/api/bricks/" + d.id + "?level=" + level);
+  const manifest = await requestJSON(manifestURL(d, level));
   if (manifest.ranges.length < 2) {
     await loadVolume(level); // one brick: nothing comes sooner by streaming it
     return;
@@ -99,9 +114,7 @@ export async function startStream(level) {
   if (pointerBefore) {
     M._free(pointerBefore);
   }
-  const bytes = type.bytes * dims[0] * dims[1] * dims[2];
-  state.volumePointer = M._malloc(bytes);
-  M.HEAPU8.fill(0, state.volumePointer, state.volumePointer + bytes);
+  state.volumePointer = mallocZeros(M, type.bytes * dims[0] * dims[1] * dims[2]);
   // The page's own copy (slices, histogram) is level 0 until the full level has arrived.
   state.values = coarse.values;
   state.grid = { dims: coarse.dims, spacing: coarse.spacing, origin: coarse.origin };
@@ -122,9 +135,11 @@ export async function startStream(level) {
   state.stream = { level, path: state.path, manifest, type, dims, resident: new Uint8Array(count),
     pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, received: 0,
     total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), requested: [],
-    readyKey: "", error: "" };
+    readyKey: "", error: "", afterFirstFrame: true };
   state.received = 0;
-  fetchMore();
+  // The bricks are asked for once the first frame (level 0's) is drawn (afterEach): on a fast
+  // link they would otherwise come first, and their writing and the server's encoding would
+  // hold that frame (the page's start-up, docs/web.md).
 }
 
 // The next brick: one the current isovalues need first, else the next in order.
@@ -269,6 +284,10 @@ function fullNow() {
     drawnValues.every((v, i) => v === values[i]);
 }
 function afterEach() {
+  if (state.stream && state.stream.afterFirstFrame) {
+    state.stream.afterFirstFrame = false;
+    fetchMore();
+  }
   const stats = state.viewer.stats();
   const drawn = stats.surfaceValues || [];
   const full = state.stream ? state.stream.level : drawnLevel();

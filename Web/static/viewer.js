@@ -10,11 +10,17 @@ import { RemoteViewer, offscreenWebGL2 } from "./remote.js";
 import { updateReadout } from "./readout.js";
 import { params, state } from "./state.js";
 
-// The module: with threads where the page is cross-origin isolated (the server sends the
-// headers), else on one thread. Where the viewer runs in a worker (remote.js), this thread's
-// module only keeps the camera and counts: one thread; the worker loads the threaded one.
+// Threads where the page is cross-origin isolated (the server sends the headers) and not
+// declined (?threads=0).
+function withThreads() {
+  return window.crossOriginIsolated && params.get("threads") !== "0";
+}
+
+// The module: with threads where withThreads(), else on one thread. Where the viewer runs in a
+// worker (remote.js), this thread's module only keeps the camera and counts: one thread; the
+// worker loads the threaded one.
 async function loadModule(inWorker) {
-  const threads = window.crossOriginIsolated && params.get("threads") !== "0";
+  const threads = withThreads();
   const name = threads && !inWorker ? "mediso-mt" : "mediso";
   await new Promise((resolve, reject) => {
     const script = Object.assign(document.createElement("script"), { src: "static/" + name + ".js" });
@@ -50,27 +56,38 @@ function readFacts(M) {
 
 /**
  * Loads the module and makes its viewer on `canvas` (sized by the size=WIDTHxHEIGHT parameter
- * when given). `probe` is a WebGL2 context of the page's, which names the renderer.
+ * when given). `probe` is a WebGL2 context of the page's, which names the renderer. With the
+ * viewer in a worker, the worker loads its module while this thread loads its own (the page's
+ * start-up, docs/web.md); `moduleLoaded` is called once this thread's module and state.facts
+ * are there, before the worker is waited for.
  */
-export async function startViewer(canvas, probe) {
+export async function startViewer(canvas, probe, moduleLoaded = () => {}) {
   // The viewer in a worker where the browser can draw WebGL2 there (?worker=0: on this thread).
   const inWorker = params.get("worker") !== "0" && offscreenWebGL2();
-  state.module = await loadModule(inWorker);
-  state.facts = readFacts(state.module);
+  // The canvas's size first: once handed to the worker, it is sized there.
   if (params.get("size")) { // WIDTHxHEIGHT (tests, benchmarks): a fixed backing store
     [canvas.width, canvas.height] = params.get("size").split("x").map(Number);
     canvas.classList.add("fixed");
   } else {
     [canvas.width, canvas.height] = backingStore(canvas.getBoundingClientRect());
   }
+  const launched = inWorker && RemoteViewer.launch(canvas,
+    { threads: withThreads() && navigator.hardwareConcurrency > 1,
+      budgetMs: Number(params.get("frameBudget")) || 0, abort: params.get("abort") !== "0",
+      slowExtractionMs: Number(params.get("slowExtraction")) || 0,
+      slowPass: Number(params.get("slowPass")) || 1,
+      refineDelayMs: Number(params.get("refineDelay")) || 0 });
+  state.remote = inWorker;
+  const debug = probe.getExtension("WEBGL_debug_renderer_info");
+  state.unmaskedRenderer = debug ? probe.getParameter(debug.UNMASKED_RENDERER_WEBGL) : "";
+  state.software = /SwiftShader|llvmpipe|softpipe|Software/i.test(state.unmaskedRenderer);
+  state.module = await loadModule(inWorker);
+  state.facts = readFacts(state.module);
+  performance.mark("mediso:module");
+  moduleLoaded();
   if (inWorker) {
-    state.viewer = await RemoteViewer.start(canvas, state.module,
-      { threads: state.threads > 1, budgetMs: Number(params.get("frameBudget")) || 0,
-        abort: params.get("abort") !== "0", slowExtractionMs: Number(params.get("slowExtraction")) || 0,
-        slowPass: Number(params.get("slowPass")) || 1,
-        refineDelayMs: Number(params.get("refineDelay")) || 0 },
-      frameAnswered);
-    state.remote = true;
+    state.viewer = await RemoteViewer.start(launched, state.module, frameAnswered);
+    performance.mark("mediso:worker");
     state.rendererNote = "Drawn in a worker (OffscreenCanvas): turning, typing and the panel do " +
       "not wait for an extraction or a frame.";
   } else {
@@ -93,10 +110,10 @@ export async function startViewer(canvas, probe) {
   if (params.get("gpuBudgetMB")) {
     state.viewer.setGPUBudget(1e6 * (Number(params.get("gpuBudgetMB")) || 0));
   }
-  const debug = probe.getExtension("WEBGL_debug_renderer_info");
-  state.unmaskedRenderer = debug ? probe.getParameter(debug.UNMASKED_RENDERER_WEBGL)
-                                 : state.viewer.info().renderer;
-  state.software = /SwiftShader|llvmpipe|softpipe|Software/i.test(state.unmaskedRenderer);
+  if (!debug) { // the renderer as the module's context names it
+    state.unmaskedRenderer = state.viewer.info().renderer;
+    state.software = /SwiftShader|llvmpipe|softpipe|Software/i.test(state.unmaskedRenderer);
+  }
   return true;
 }
 

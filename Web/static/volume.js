@@ -25,6 +25,23 @@ function transferred(url) {
   return last && last.transferSize > 0 ? last.transferSize : null;
 }
 
+// Requests sent before the page needs their answers (prefetch), by cache mode and URL: the
+// request() that needs one takes its answer from here instead of asking again.
+const early = new Map();
+
+/**
+ * Sends a request of the page's now, for a request() of the same URL and `cache` later (the
+ * page's start-up: level 0 and the bricks' manifest while the modules load, docs/web.md).
+ */
+export function prefetch(url, cache = "no-store") {
+  const key = cache + " " + url;
+  if (!early.has(key)) {
+    const answer = fetch(withToken(url), { cache });
+    answer.catch(() => {}); // said by the request() that takes it
+    early.set(key, answer);
+  }
+}
+
 /**
  * Every request of the page's own goes through here, so that the bytes are counted. `cache`:
  * "no-store" (the default: never kept) or "no-cache" (the volume: kept by the browser and
@@ -33,7 +50,10 @@ function transferred(url) {
 export async function request(url, cache = "no-store") {
   const full = withToken(url);
   state.bytesSent += full.length + 64; // the request line and the few headers a browser adds
-  const response = await fetch(full, { cache });
+  const key = cache + " " + url;
+  const sent = early.get(key);
+  early.delete(key);
+  const response = await (sent || fetch(full, { cache }));
   if (!response.ok) {
     throw new Error(url + ": " + response.status + " " + (await response.text()));
   }
@@ -89,8 +109,7 @@ function typedValues(bytes, typeName) {
  * origin, bytes (un-shuffled), values (a typed array over them)}.
  */
 export async function fetchLevel(level) {
-  const d = state.dataset;
-  const { response, body } = await request("/api/volume/" + d.id + "?level=" + level, "no-cache");
+  const { response, body } = await request(levelURL(state.dataset, level), "no-cache");
   const typeName = response.headers.get("X-Mediso-Type");
   const type = state.facts.scalarTypes.get(typeName);
   if (!type) {
@@ -101,6 +120,26 @@ export async function fetchLevel(level) {
   const origin = response.headers.get("X-Mediso-Origin").split(",").map(Number);
   const bytes = unshuffle(new Uint8Array(body), type.bytes);
   return { type, dims, spacing, origin, bytes, values: typedValues(bytes, typeName) };
+}
+
+/**
+ * `length` bytes of zeros in module `M`'s memory (malloc'd: the caller frees them). The part of
+ * them the heap has just grown by is zero already (WebAssembly's new pages) and is not written
+ * again: a streamed level's buffer (stream.js) would otherwise be hundreds of MB of zeros
+ * written before the first frame (the page's start-up, docs/web.md).
+ */
+export function mallocZeros(M, length) {
+  const end = M.HEAPU8.length; // the memory's size before the malloc
+  const at = M._malloc(length);
+  if (at && at < end) {
+    M.HEAPU8.fill(0, at, Math.min(end, at + length));
+  }
+  return at;
+}
+
+/** The URL of level `level` of dataset `d` (kept by the browser: request it with "no-cache"). */
+export function levelURL(d, level) {
+  return "/api/volume/" + d.id + "?level=" + level;
 }
 
 /** Byte-shuffled values of `size` bytes back in order, and their typed view (stream.js). */

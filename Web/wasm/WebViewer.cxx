@@ -246,8 +246,9 @@ public:
     std::copy(placement.Spacing, placement.Spacing + 3, description.Spacing);
     description.Stamp = ++this->VolumeStamp;
     this->Described = description;
+    this->SceneVolumeStale = true;
     std::string error;
-    if (!this->Scene->SetVolume(description, error))
+    if (!this->CPUPath && !this->UpdateSceneVolume(error))
     {
       this->LastError = error;
       return false;
@@ -572,10 +573,9 @@ public:
   {
     emscripten_webgl_make_context_current(this->Context);
     std::string error;
-    // The GPU path's texture has every brick (RegionArrived); where the scene did not stream (the
-    // CPU path), it was uploaded from the empty buffer: a new stamp uploads the values.
     if (this->Scene->IsStreaming())
     {
+      // The GPU path's texture has every brick (RegionArrived).
       if (!this->Scene->EndStreaming(error))
       {
         this->LastError = error;
@@ -583,8 +583,11 @@ public:
     }
     else
     {
+      // A texture uploaded from the buffer before its bricks (a path switched mid-stream) is
+      // stale: a new stamp uploads the values, now on the GPU path, else when it first draws.
       this->Described.Stamp = ++this->VolumeStamp;
-      if (!this->Scene->SetVolume(this->Described, error))
+      this->SceneVolumeStale = true;
+      if (!this->CPUPath && !this->UpdateSceneVolume(error))
       {
         this->LastError = error;
       }
@@ -677,6 +680,12 @@ public:
     // cells of the pyramids it builds.
     this->FrameExtractSeconds = 0.0;
     this->FrameBuildCells = 0;
+    std::string sceneError;
+    if (!this->CPUPath && !this->UpdateSceneVolume(sceneError))
+    {
+      this->LastError = sceneError;
+      return false;
+    }
     if (this->CPUPath)
     {
       this->FrameExtractSeconds = this->ExtractSeconds(
@@ -1254,6 +1263,27 @@ private:
   // The CPU path: the surfaces unit makes or finds each surface at the
   // level requested, or the estimator's within the budget (a guide here:
   // level 0 when nothing fits, said in the error); uploaded when it changed.
+  /**
+   * The GPU scene takes the volume SetVolume described when the GPU path first needs it (its
+   * frame, or SetVolume on the GPU path), not while the CPU path draws: that upload is the bulk
+   * of SetVolume on a software renderer, and a streamed volume's empty buffer (docs/web.md,
+   * Streaming) then never goes up before its values have arrived.
+   */
+  bool UpdateSceneVolume(std::string& error)
+  {
+    if (!this->SceneVolumeStale)
+    {
+      return true;
+    }
+    emscripten_webgl_make_context_current(this->Context);
+    if (!this->Scene->SetVolume(this->Described, error))
+    {
+      return false;
+    }
+    this->SceneVolumeStale = false;
+    return true;
+  }
+
   bool UpdateCPUSurfaces()
   {
     // Streaming: the surfaces named coarse come from the coarse volume, the others from the
@@ -1406,6 +1436,7 @@ private:
 #endif
   const void* CoarseData = nullptr;
   VolumeDescription Described; // the volume as SetVolume described it (EndStreaming uploads it again)
+  bool SceneVolumeStale = false; // the GPU scene has not taken Described yet (UpdateSceneVolume)
   BrickGrid Bricks;
   std::vector<double> CoarseValues;
   int StreamLevel = 0; // the GPU scene's coarse level the coarse volume is (streaming)
