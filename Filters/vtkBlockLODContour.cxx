@@ -2,6 +2,7 @@
 #include "vtkBlockLODContour.h"
 
 #include "BlockLODSurfaces.h"
+#include "LargeBuffers.h"
 #include "ProcessMemory.h"
 
 #include "vtkAOSDataArrayTemplate.h"
@@ -50,11 +51,6 @@
 #include <string>
 #include <type_traits>
 #include <vector>
-
-#if defined(__linux__)
-#include <sys/mman.h>
-#include <unistd.h>
-#endif
 
 vtkStandardNewMacro(vtkBlockLODContour);
 
@@ -207,195 +203,19 @@ void SharedTriangleOffsets::Release(void* pointer)
   }
 }
 
-// Large output arrays in mappings of their own, on transparent huge pages
-// where the system allows them for memory that asks (Linux's
-// /sys/kernel/mm/transparent_hugepage/enabled set to `madvise` or `always`).
-// Every new surface is fresh memory while the cache has room, and the kernel
-// maps and zeroes it a page at a time as it is first written: with 4 KB pages
-// a noisy MRI's 54 MB surface takes about 13,000 faults, a third of a warm
-// change. In 2 MB pages the same surface takes 27 and the zeroing is left.
-// Only an array's whole 2 MB pages are asked for (madvise), so that a surface
-// holds no more memory than its values need. The mapping's length is kept
-// here, by address, for Release (vtkBuffer's free function gets the address
-// only) and for SpareBuffers, which resizes these with mremap, not realloc.
-// Elsewhere, or when a mapping fails, arrays are malloc'ed by vtkBuffer.
-class LargeBuffers
+// An array of `values` values in `memory` from mediso::LargeBuffers (the
+// process's), which the array gives back there when it lets it go: arrays of
+// 32 MiB and more, which glibc would map afresh for every surface and unmap
+// when freed, reuse the pages of those released before them (LargeBuffers.h).
+// Anything that grows such an array copies it out first (vtkBuffer does so
+// for memory with a free function of its own).
+template <typename ArrayT>
+void AdoptLargeBuffer(ArrayT* array, void* memory, vtkIdType values)
 {
-public:
-  // Arrays below this many bytes are not worth a mapping of their own.
-  static constexpr std::size_t MinimumBytes = std::size_t(2) << 20;
-
-  // Fresh memory for `bytes`, or null (the caller then allocates as usual).
-  static void* Allocate(std::size_t bytes)
-  {
-#if defined(__linux__)
-    if (bytes < MinimumBytes)
-    {
-      return nullptr;
-    }
-    const std::size_t length = PageRounded(bytes);
-    void* memory = MapAligned(length);
-    if (!memory)
-    {
-      return nullptr;
-    }
-    AskForHugePages(memory, length);
-    LargeBuffers& all = Instance();
-    std::lock_guard<std::mutex> lock(all.Mutex);
-    all.Lengths[memory] = length;
-    return memory;
-#else
-    (void)bytes;
-    return nullptr;
-#endif
-  }
-
-  // The bytes a buffer of this class can hold; 0 for memory it did not map.
-  static std::size_t Capacity(void* memory)
-  {
-    LargeBuffers& all = Instance();
-    std::lock_guard<std::mutex> lock(all.Mutex);
-    auto found = all.Lengths.find(memory);
-    return found == all.Lengths.end() ? 0 : found->second;
-  }
-
-  // `memory` (of this class) grown or shrunk to hold `bytes`, its pages kept
-  // (moved, not copied, when it cannot grow where it is); null when that
-  // failed, and `memory` is then unchanged.
-  static void* Resize(void* memory, std::size_t bytes)
-  {
-#if defined(__linux__)
-    const std::size_t length = PageRounded(std::max<std::size_t>(bytes, 1));
-    const std::size_t old = Capacity(memory);
-    if (old == 0)
-    {
-      return nullptr;
-    }
-    if (length == old)
-    {
-      return memory;
-    }
-    void* moved = nullptr;
-    if (length < old || mremap(memory, old, length, 0) != MAP_FAILED)
-    {
-      if (length < old)
-      {
-        munmap(static_cast<char*>(memory) + length, old - length);
-      }
-      moved = memory;
-    }
-    else if (void* target = MapAligned(length))
-    {
-      // Onto a huge-page boundary, so that the moved huge pages stay whole.
-      moved = mremap(memory, old, length, MREMAP_MAYMOVE | MREMAP_FIXED, target);
-      if (moved == MAP_FAILED)
-      {
-        munmap(target, length);
-        return nullptr;
-      }
-    }
-    else
-    {
-      return nullptr;
-    }
-    AskForHugePages(moved, length);
-    LargeBuffers& all = Instance();
-    std::lock_guard<std::mutex> lock(all.Mutex);
-    all.Lengths.erase(memory);
-    all.Lengths[moved] = length;
-    return moved;
-#else
-    (void)memory;
-    (void)bytes;
-    return nullptr;
-#endif
-  }
-
-  // The free function of the arrays that hold these buffers.
-  static void Release(void* memory)
-  {
-    LargeBuffers& all = Instance();
-    std::size_t length = 0;
-    {
-      std::lock_guard<std::mutex> lock(all.Mutex);
-      auto found = all.Lengths.find(memory);
-      if (found == all.Lengths.end())
-      {
-        return;
-      }
-      length = found->second;
-      all.Lengths.erase(found);
-    }
-#if defined(__linux__)
-    munmap(memory, length);
-#endif
-  }
-
-  // An array of `values` values in `memory` (of this class), which the array
-  // releases when it lets it go.
-  template <typename ArrayT>
-  static void Adopt(ArrayT* array, void* memory, vtkIdType values)
-  {
-    using ValueT = typename ArrayT::ValueType;
-    array->SetArray(static_cast<ValueT*>(memory), values, 0, ArrayT::VTK_DATA_ARRAY_USER_DEFINED);
-    array->SetArrayFreeFunction(&LargeBuffers::Release);
-  }
-
-private:
-  static constexpr std::size_t HugePage = std::size_t(2) << 20;
-
-  // Never destroyed: arrays that outlive static destruction still release.
-  static LargeBuffers& Instance()
-  {
-    static LargeBuffers* const all = new LargeBuffers;
-    return *all;
-  }
-
-#if defined(__linux__)
-  static std::size_t PageRounded(std::size_t bytes)
-  {
-    const std::size_t page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
-    return (bytes + page - 1) / page * page;
-  }
-
-  // `length` bytes of fresh memory starting on a huge-page boundary, or null.
-  static void* MapAligned(std::size_t length)
-  {
-    const std::size_t span = length + HugePage;
-    void* region = mmap(nullptr, span, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (region == MAP_FAILED)
-    {
-      return nullptr;
-    }
-    char* begin = static_cast<char*>(region);
-    const std::uintptr_t address = reinterpret_cast<std::uintptr_t>(begin);
-    char* aligned = begin + (HugePage - address % HugePage) % HugePage;
-    if (aligned > begin)
-    {
-      munmap(begin, static_cast<std::size_t>(aligned - begin));
-    }
-    char* end = begin + span;
-    if (aligned + length < end)
-    {
-      munmap(aligned + length, static_cast<std::size_t>(end - (aligned + length)));
-    }
-    return aligned;
-  }
-
-  // Only the whole huge pages: the last partial one stays in small pages.
-  static void AskForHugePages(void* memory, std::size_t length)
-  {
-    const std::size_t whole = length / HugePage * HugePage;
-    if (whole > 0)
-    {
-      madvise(memory, whole, MADV_HUGEPAGE); // a hint: refused, the pages stay small
-    }
-  }
-#endif
-
-  std::mutex Mutex;
-  std::map<void*, std::size_t> Lengths;
-};
+  using ValueT = typename ArrayT::ValueType;
+  array->SetArray(static_cast<ValueT*>(memory), values, 0, ArrayT::VTK_DATA_ARRAY_USER_DEFINED);
+  array->SetArrayFreeFunction(&mediso::LargeBuffers::ReleaseToProcess);
+}
 
 // Memory of the surfaces the cache drops during one update, for the update's
 // new surfaces (SurfaceMaker::Recycle in BlockLODSurfaces.h). A fresh output
@@ -421,7 +241,7 @@ public:
     {
       if (b.Large)
       {
-        LargeBuffers::Release(b.Pointer);
+        mediso::LargeBuffers::Process().Release(b.Pointer);
       }
       else
       {
@@ -460,7 +280,7 @@ public:
 
   // Gives `array` `tuples` tuples, in a spare buffer when one is big enough
   // (or, the largest, at least half as big: realloc and mremap keep its pages
-  // and add the rest), else in fresh memory (LargeBuffers for a large array);
+  // and add the rest), else in new memory (LargeBuffers for a large array);
   // the values are left unset, as SetNumberOfTuples leaves them.
   template <typename ArrayT>
   void Size(ArrayT* array, vtkIdType tuples)
@@ -489,10 +309,10 @@ public:
       const Buffer spare = this->Buffers[best];
       if (spare.Large)
       {
-        if (void* memory = LargeBuffers::Resize(spare.Pointer, bytes))
+        if (void* memory = mediso::LargeBuffers::Process().Resize(spare.Pointer, bytes))
         {
           this->Buffers.erase(this->Buffers.begin() + static_cast<std::ptrdiff_t>(best));
-          LargeBuffers::Adopt(array, memory, values);
+          AdoptLargeBuffer(array, memory, values);
           return;
         }
       }
@@ -503,9 +323,9 @@ public:
         return;
       }
     }
-    if (void* memory = LargeBuffers::Allocate(bytes))
+    if (void* memory = mediso::LargeBuffers::Process().Allocate(bytes))
     {
-      LargeBuffers::Adopt(array, memory, values);
+      AdoptLargeBuffer(array, memory, values);
       return;
     }
     array->SetNumberOfTuples(tuples);
@@ -542,7 +362,7 @@ private:
     const vtkIdType size = typed->GetSize();
     if (memory && size > 0)
     {
-      const std::size_t mapped = LargeBuffers::Capacity(memory);
+      const std::size_t mapped = mediso::LargeBuffers::Process().Capacity(memory);
       typed->SetArray(memory, size, 1); // the array no longer frees it
       this->Buffers.push_back(mapped > 0
           ? Buffer{ memory, mapped, true }
