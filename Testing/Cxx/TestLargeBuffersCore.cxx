@@ -5,6 +5,7 @@
 // bytes and their age are bounded; memory it did not allocate is ignored.
 #include "LargeBuffers.h"
 
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -90,7 +91,8 @@ int main()
 
   // A request with no kept mapping at least half its size is mapped afresh.
   void* c = buffers.Allocate(5 * MB);
-  Check(c != nullptr && buffers.GetNumberOfSpares() == 1, "nothing half as big kept: a new mapping");
+  Check(
+    c != nullptr && buffers.GetNumberOfSpares() == 1, "nothing half as big kept: a new mapping");
   buffers.Release(c);
   Check(buffers.GetNumberOfSpares() == 2, "two kept");
 
@@ -128,6 +130,7 @@ int main()
   Check(mediso::LargeBuffers::Process().Allocate(16 * MB) == nullptr,
     "the process's instance leaves arrays below 32 MiB to malloc");
 
-  std::printf("%s\n", failures == 0 ? "LargeBuffers: all checks passed" : "LargeBuffers: checks failed");
+  std::printf(
+    "%s\n", failures == 0 ? "LargeBuffers: all checks passed" : "LargeBuffers: checks failed");
   return failures == 0 ? 0 : 1;
 }
