@@ -2,6 +2,7 @@
 #include "vtkBlockLODContour.h"
 
 #include "BlockLODSurfaces.h"
+#include "LargeBuffers.h"
 #include "ProcessMemory.h"
 
 #include "vtkAOSDataArrayTemplate.h"
@@ -40,6 +41,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <map>
@@ -201,6 +203,20 @@ void SharedTriangleOffsets::Release(void* pointer)
   }
 }
 
+// An array of `values` values in `memory` from mediso::LargeBuffers (the
+// process's), which the array gives back there when it lets it go: arrays of
+// 32 MiB and more, which glibc would map afresh for every surface and unmap
+// when freed, reuse the pages of those released before them (LargeBuffers.h).
+// Anything that grows such an array copies it out first (vtkBuffer does so
+// for memory with a free function of its own).
+template <typename ArrayT>
+void AdoptLargeBuffer(ArrayT* array, void* memory, vtkIdType values)
+{
+  using ValueT = typename ArrayT::ValueType;
+  array->SetArray(static_cast<ValueT*>(memory), values, 0, ArrayT::VTK_DATA_ARRAY_USER_DEFINED);
+  array->SetArrayFreeFunction(&mediso::LargeBuffers::ReleaseToProcess);
+}
+
 // Memory of the surfaces the cache drops during one update, for the update's
 // new surfaces (SurfaceMaker::Recycle in BlockLODSurfaces.h). A fresh output
 // buffer costs a page fault and a page the kernel zeroes per 4 KB: on a noisy
@@ -223,7 +239,14 @@ public:
   {
     for (const Buffer& b : this->Buffers)
     {
-      free(b.Pointer);
+      if (b.Large)
+      {
+        mediso::LargeBuffers::Process().Release(b.Pointer);
+      }
+      else
+      {
+        free(b.Pointer);
+      }
     }
   }
 
@@ -256,8 +279,9 @@ public:
   }
 
   // Gives `array` `tuples` tuples, in a spare buffer when one is big enough
-  // (or, the largest, at least half as big: realloc keeps its pages and adds
-  // the rest); the values are left unset, as SetNumberOfTuples leaves them.
+  // (or, the largest, at least half as big: realloc and mremap keep its pages
+  // and add the rest), else in new memory (LargeBuffers for a large array);
+  // the values are left unset, as SetNumberOfTuples leaves them.
   template <typename ArrayT>
   void Size(ArrayT* array, vtkIdType tuples)
   {
@@ -282,12 +306,27 @@ public:
     const std::size_t best = fitting != none ? fitting : largest;
     if (values > 0 && best != none)
     {
-      if (void* memory = realloc(this->Buffers[best].Pointer, bytes))
+      const Buffer spare = this->Buffers[best];
+      if (spare.Large)
+      {
+        if (void* memory = mediso::LargeBuffers::Process().Resize(spare.Pointer, bytes))
+        {
+          this->Buffers.erase(this->Buffers.begin() + static_cast<std::ptrdiff_t>(best));
+          AdoptLargeBuffer(array, memory, values);
+          return;
+        }
+      }
+      else if (void* memory = realloc(spare.Pointer, bytes))
       {
         this->Buffers.erase(this->Buffers.begin() + static_cast<std::ptrdiff_t>(best));
         array->SetArray(static_cast<ValueT*>(memory), values, 0, ArrayT::VTK_DATA_ARRAY_FREE);
         return;
       }
+    }
+    if (void* memory = mediso::LargeBuffers::Process().Allocate(bytes))
+    {
+      AdoptLargeBuffer(array, memory, values);
+      return;
     }
     array->SetNumberOfTuples(tuples);
   }
@@ -297,6 +336,7 @@ private:
   {
     void* Pointer;
     std::size_t Bytes;
+    bool Large; // from LargeBuffers, else from malloc
   };
 
   void TakeArray(vtkAbstractArray* array)
@@ -307,8 +347,9 @@ private:
     }
   }
 
-  // The arrays of the filter's surfaces are allocated by vtkBuffer with malloc
-  // (or by Size() above): their memory may be realloc'ed and freed here.
+  // The arrays of the filter's surfaces are allocated by vtkBuffer with malloc,
+  // or by LargeBuffers (Size() above): their memory may be resized and freed
+  // here, each kind by its own functions.
   template <typename ValueT>
   bool TakeAs(vtkAbstractArray* array)
   {
@@ -321,8 +362,11 @@ private:
     const vtkIdType size = typed->GetSize();
     if (memory && size > 0)
     {
+      const std::size_t mapped = mediso::LargeBuffers::Process().Capacity(memory);
       typed->SetArray(memory, size, 1); // the array no longer frees it
-      this->Buffers.push_back(Buffer{ memory, static_cast<std::size_t>(size) * sizeof(ValueT) });
+      this->Buffers.push_back(mapped > 0
+          ? Buffer{ memory, mapped, true }
+          : Buffer{ memory, static_cast<std::size_t>(size) * sizeof(ValueT), false });
     }
     return true;
   }
