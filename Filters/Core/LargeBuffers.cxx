@@ -173,6 +173,8 @@ void LargeBuffers::Release(void* memory)
   {
     munmap(s.Memory, s.Length);
   }
+#else
+  (void)length;
 #endif
 }
 
