@@ -3,14 +3,17 @@
 // not wait for the whole level. It fetches the server's level 0 (1/512 of the points) and draws
 // every surface from it at once, then fetches the full level's bricks (/api/bricks, the cores'
 // BrickGrid bricks; the brick size is the server's manifest's) a few requests at a time, the
-// bricks the current isovalues need first (one a request, kept by the browser), writes each into the full level's buffer (allocated
-// once, in this thread's module and in the worker's, where WebViewer.writeBrick completes the
-// BlockLOD ranges of what arrived) and draws each surface at the full level as soon as every
-// brick it needs is there. What goes up is the list of bricks; every point comes once.
+// bricks the current isovalues need first (one a request, kept by the browser), decodes each
+// (decodeBrick: the server's predictor undone), writes it into the full level's buffer
+// (allocated once, in this thread's module and in the worker's, where WebViewer.writeBrick
+// completes the BlockLOD ranges of what arrived) and draws each surface at the full level as soon
+// as every brick it needs is there. What goes up is the isovalues (the need query) and the list
+// of bricks; every point comes once.
 //
-// A brick needs: the bricks whose range (over the points its cells and gradients read, the
-// manifest's) holds the isovalue (min < v <= max) and their neighbours (whose points those
-// cells and gradients read).
+// An isovalue needs the bricks holding the points that the cells and gradients of the core's
+// blocks crossing it read: the server answers which (askExact); until it has, the page takes a
+// superset from the manifest's brick ranges (the bricks whose range holds the value, min < v <=
+// max, and all their neighbours).
 
 import { drawnLevel } from "./path.js";
 import { updateReadout } from "./readout.js";
@@ -38,18 +41,27 @@ function currentValues() {
   return state.surfaces.filter((s) => !s.hidden && s.opacity > 0).map((s) => s.value);
 }
 
-// The bricks isovalue `v` needs (a Set of ids), kept per value.
+// The bricks isovalue `v` needs (a Set of ids): the server's exact set once it has answered the
+// need query (askExact), until then a superset: every brick whose range holds v, then their
+// neighbours (whose points the cells and gradients at a brick's faces read).
 function needed(s, v) {
+  return s.exact.get(v) || superset(s, v);
+}
+
+function superset(s, v) {
   if (s.need.has(v)) {
     return s.need.get(v);
   }
   const m = s.manifest;
   const [nx, ny, nz] = m.bricks;
-  const ids = new Set();
+  const holding = [];
   m.ranges.forEach((range, id) => {
-    if (!range || !(range[0] < v && v <= range[1])) {
-      return;
+    if (range && range[0] < v && v <= range[1]) {
+      holding.push(id);
     }
+  });
+  const ids = new Set(holding); // the bricks that hold v first, in the order of requests
+  for (const id of holding) {
     const bx = id % nx, by = Math.floor(id / nx) % ny, bz = Math.floor(id / (nx * ny));
     for (let z = Math.max(0, bz - 1); z <= Math.min(nz - 1, bz + 1); ++z) {
       for (let y = Math.max(0, by - 1); y <= Math.min(ny - 1, by + 1); ++y) {
@@ -58,9 +70,44 @@ function needed(s, v) {
         }
       }
     }
-  });
+  }
   s.need.set(v, ids);
   return ids;
+}
+
+// Asks the server which bricks the current isovalues need exactly (the bricks holding the points
+// that the core's blocks crossing each value read: far fewer than the neighbours of every brick
+// that holds it); the answer also moves those bricks to the front of the server's encoding.
+function askExact(s) {
+  const values = currentValues().filter((v) => !s.exact.has(v) && !s.asked.has(v));
+  if (!values.length) {
+    return;
+  }
+  values.forEach((v) => s.asked.add(v));
+  requestJSON("/api/bricks/" + state.dataset.id + "?level=" + s.level + "&need=" + values.join(","))
+    .then((answer) => {
+      values.forEach((v, i) => s.exact.set(v, new Set(answer.need[i])));
+      if (state.stream === s) {
+        redrawIfReady(s);
+      }
+    })
+    .catch((error) => {
+      // The supersets stay: the surfaces come later, never wrong.
+      values.forEach((v) => s.asked.delete(v));
+      console.error("streaming: the bricks the isovalues need: " + error.message);
+    });
+}
+
+// A surface whose bricks have all arrived is drawn again, at the full level: one frame for
+// everything that arrived since the last (completions are coalesced, not drawn brick by brick).
+function redrawIfReady(s) {
+  const key = currentValues().map((v) => ready(s, v)).join();
+  if (key !== s.readyKey) {
+    s.readyKey = key;
+    renderNow();
+    return true;
+  }
+  return false;
 }
 
 function ready(s, v) {
@@ -113,10 +160,21 @@ export async function startStream(level) {
   const count = manifest.ranges.length;
   state.stream = { level, manifest, type, dims, resident: new Uint8Array(count),
     pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, received: 0,
-    total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), requested: [],
-    readyKey: "", error: "" };
+    total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), exact: new Map(),
+    asked: new Set(), requested: [], readyKey: "", error: "", started: false };
   state.received = 0;
-  fetchMore();
+  // The bricks are asked for from the first frame on, when the first surfaces are known (so
+  // that the first requests are bricks they need); a timer in case no frame comes.
+  const s = state.stream;
+  setTimeout(() => begin(s), 100);
+}
+
+function begin(s) {
+  if (s && state.stream === s && !s.started) {
+    s.started = true;
+    askExact(s);
+    fetchMore();
+  }
 }
 
 // The next brick: one the current isovalues need first, else the next in order.
@@ -151,15 +209,20 @@ function fetchMore() {
   }
 }
 
-// A brick's owned points (x fastest) into this thread's copy of the full level.
-function writeHere(s, id, brick) {
+// The points brick `id` owns: [x0, x1) x [y0, y1) x [z0, z1).
+function ownedBox(s, id) {
   const [nx, ny] = s.manifest.bricks;
-  const B = s.manifest.brick, size = s.type.bytes;
+  const B = s.manifest.brick;
   const [dx, dy, dz] = s.dims;
   const bx = id % nx, by = Math.floor(id / nx) % ny, bz = Math.floor(id / (nx * ny));
-  const x0 = bx * B, x1 = Math.min(dx, x0 + B);
-  const y0 = by * B, y1 = Math.min(dy, y0 + B);
-  const z0 = bz * B, z1 = Math.min(dz, z0 + B);
+  return [bx * B, Math.min(dx, bx * B + B), by * B, Math.min(dy, by * B + B), bz * B, Math.min(dz, bz * B + B)];
+}
+
+// A brick's owned points (x fastest) into this thread's copy of the full level.
+function writeHere(s, id, brick) {
+  const [x0, x1, y0, y1, z0, z1] = ownedBox(s, id);
+  const size = s.type.bytes;
+  const [dx, dy] = s.dims;
   const row = (x1 - x0) * size;
   const heap = state.module.HEAPU8;
   let from = 0;
@@ -170,18 +233,66 @@ function writeHere(s, id, brick) {
   }
 }
 
+const UNSIGNED = { 1: Uint8Array, 2: Uint16Array, 4: Uint32Array };
+const SIGNED = { 1: Int8Array, 2: Int16Array, 4: Int32Array };
+
+/**
+ * One brick as the server encoded it (serve_bricks.py): byte-shuffled, and for integer values the
+ * zigzag'd residuals of `predictor` ("xyz": differences along x, then y, then z; "x": along x;
+ * "none") in the type's width. Gives its owned points' bytes (x fastest) in a buffer of their own.
+ * Running sums undo the differences (in any order: they commute); a typed array's store wraps
+ * as the server's differences did.
+ */
+export function decodeBrick(encoded, size, predictor, box) {
+  const raw = size === 1 ? encoded.slice() : unshuffle(encoded, size);
+  if (predictor === "none") {
+    return raw;
+  }
+  const n = raw.length / size;
+  const u = new UNSIGNED[size](raw.buffer, raw.byteOffset, n);
+  const d = new SIGNED[size](raw.buffer, raw.byteOffset, n);
+  for (let i = 0; i < n; ++i) {
+    const z = u[i];
+    d[i] = (z >>> 1) ^ -(z & 1);
+  }
+  const [x0, x1, y0, y1, z0, z1] = box;
+  const nx = x1 - x0, ny = y1 - y0, nz = z1 - z0;
+  for (let r = 0; r < n; r += nx) {
+    let sum = 0;
+    for (let i = r; i < r + nx; ++i) {
+      sum += d[i];
+      d[i] = sum;
+    }
+  }
+  if (predictor === "xyz") {
+    const plane = nx * ny;
+    for (let z = 0; z < nz; ++z) {
+      for (let i = z * plane + nx; i < (z + 1) * plane; ++i) {
+        d[i] += d[i - nx];
+      }
+    }
+    for (let i = plane; i < n; ++i) {
+      d[i] += d[i - plane];
+    }
+  }
+  return raw;
+}
+
 async function fetchBatch(s, ids) {
-  const { body } = await request("/api/bricks/" + state.dataset.id + "?level=" + s.level +
+  const { response, body } = await request("/api/bricks/" + state.dataset.id + "?level=" + s.level +
     "&ids=" + ids.join(","), "no-cache");
   if (state.stream !== s) {
     return; // another volume since
   }
-  const joined = unshuffle(new Uint8Array(body), s.type.bytes);
+  const predictor = response.headers.get("X-Mediso-Predictor") || "none";
+  const encoded = new Uint8Array(body);
   const list = [];
   let offset = 0;
   for (const id of ids) {
-    const brick = joined.slice(offset, offset + s.manifest.bytes[id]);
-    offset += brick.length;
+    const length = s.manifest.bytes[id];
+    const brick = decodeBrick(encoded.subarray(offset, offset + length), s.type.bytes, predictor,
+      ownedBox(s, id));
+    offset += length;
     writeHere(s, id, brick);
     s.resident[id] = 1;
     s.received += brick.length;
@@ -194,12 +305,7 @@ async function fetchBatch(s, ids) {
     finish(s);
     return;
   }
-  // A surface whose bricks have all arrived is drawn again, at the full level.
-  const key = currentValues().map((v) => ready(s, v)).join();
-  if (key !== s.readyKey) {
-    s.readyKey = key;
-    renderNow();
-  } else {
+  if (!redrawIfReady(s)) {
     updateReadout();
   }
   fetchMore();
@@ -246,6 +352,11 @@ export function setupStream() {
 function beforeEach() {
   const s = state.stream;
   if (s) {
+    if (!s.started) {
+      begin(s);
+    } else {
+      askExact(s);
+    }
     state.viewer.setCoarseValues(currentValues().filter((v) => !ready(s, v)));
   }
 }
@@ -294,7 +405,10 @@ export function streamNote() {
     (state.stream.error ? "; not received: " + state.stream.error : "");
 }
 
-/** For tests: the bricks asked for so far ([{ids, values}]), and the bricks values need. */
+/**
+ * For tests: the bricks asked for so far ([{ids, values}]), the bricks values need, whether that
+ * is the server's exact answer, and the size of the superset the manifest's ranges give.
+ */
 export function streamInfo(values = []) {
   const s = state.stream;
   if (!s) {
@@ -303,5 +417,6 @@ export function streamInfo(values = []) {
   return { level: s.level, brick: s.manifest.brick, bricks: [...s.manifest.bricks],
     requested: s.requested.map((r) => ({ ids: [...r.ids], values: [...r.values] })),
     resident: s.resident.reduce((a, b) => a + b, 0), error: s.error,
-    needed: values.map((v) => [...needed(s, v)]) };
+    needed: values.map((v) => [...needed(s, v)]), exact: values.map((v) => s.exact.has(v)),
+    superset: values.map((v) => superset(s, v).size) };
 }
