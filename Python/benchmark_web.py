@@ -3,7 +3,7 @@
 
     python3 Python/benchmark_web.py [--inputs ct,ct512] [--sweep 10] [--size 800x600] [--out FILE.md]
     python3 Python/benchmark_web.py --interactive [--inputs phantom:256,ct] [--paths cpu,gpu] [--before main]
-    python3 Python/benchmark_web.py --stream [--inputs ct,phantom:256] [--networks 30/40,loopback]
+    python3 Python/benchmark_web.py --stream [--inputs ct512,phantom:512:noise=40] [--networks 30/40,loopback]
 
 In one headless Chromium (Debian's, software WebGL2: SwiftShader), on the same volume and canvas
 size: the page's GPU path (the core on WebGL2), its CPU path (the BlockLOD core in WebAssembly at
@@ -26,7 +26,8 @@ and the drag. Inputs: phantom:N (the plugin's phantom) or ct.
 it (level 0, then the bricks the surfaces need first), each in a fresh browser context, in one
 Chromium, under each network (MBIT/LATENCY_MS through CDP's Network.emulateNetworkConditions, or
 loopback): the time to the first image, to the current surfaces at the full level, to the whole
-level, and the bytes on the wire.
+level, and the bytes on the wire. Inputs: ct, ct512, or any server spec phantom:N[:noise=HU]
+(the issue's: the 512-wide CT and phantom:512:noise=40, the default).
 """
 import argparse
 import json
@@ -280,8 +281,9 @@ def main_stream(args, argv):
                              "latencyMs": float(latency)})
     lines = ["# The page streaming against the whole level (issue 31)", "",
              "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv), "",
-             "| input | network | page | first image ms | surfaces at full level ms | whole level ms | bytes |",
-             "|---|---|---|---:|---:|---:|---:|"]
+             "| input | network | page | first image ms | surfaces at full level ms | whole level ms | bytes "
+             "| bytes at full level (level received) |",
+             "|---|---|---|---:|---:|---:|---:|---:|"]
     for name in args.inputs.split(","):
         data = volume_path(name) if not name.startswith("phantom:") else name
         work = os.path.join(args.work, "stream-" + name.replace(":", "-"))
@@ -301,12 +303,21 @@ def main_stream(args, argv):
         finally:
             server.kill()
         for network in networks:
+            whole = {}
             for mode in ("whole", "stream"):
                 rs = [r for r in runs if r["network"] == network["name"] and r["mode"] == mode]
                 med = lambda key: statistics.median(r[key] for r in rs)  # noqa: E731
-                lines.append("| %s | %s | %s | %.0f | %.0f | %.0f | %d |" % (
+                if mode == "whole":
+                    whole = {key: med(key) for key in ("wholeMs", "bytes")}
+                    ratios = ("", "", "")
+                else:  # against the whole level's page of the same run
+                    ratios = (" (%.2fx)" % (med("fullMs") / whole["wholeMs"]),
+                              " (%.2fx)" % (med("wholeMs") / whole["wholeMs"]),
+                              " (%.2fx)" % (med("bytes") / whole["bytes"]))
+                lines.append("| %s | %s | %s | %.0f | %.0f%s | %.0f%s | %d%s | %d (%.0f%%) |" % (
                     name, network["name"], "whole level (`?stream=0`)" if mode == "whole" else "**streaming**",
-                    med("firstMs"), med("fullMs"), med("wholeMs"), med("bytes")))
+                    med("firstMs"), med("fullMs"), ratios[0], med("wholeMs"), ratios[1], med("bytes"),
+                    ratios[2], med("bytesAtFull"), 100 * med("receivedAtFull")))
     lines[3:3] = ["- Started %s, %.0f s; load average %s before, %s after; medians of %d" % (
         started, time.perf_counter() - t0, load_before, load_average(), args.repeats),
         "- Machine: nproc %d (%s); Chromium headless, SwiftShader; CPU path in the worker; canvas %s" % (
@@ -319,7 +330,7 @@ def main(argv):
     args = parse_args(argv)
     if args.stream:
         if args.inputs == "ct,ct512":
-            args.inputs = "ct,phantom:256"
+            args.inputs = "ct512,phantom:512:noise=40"
         return main_stream(args, argv)
     if args.interactive:
         if args.inputs == "ct,ct512":
