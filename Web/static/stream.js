@@ -99,11 +99,13 @@ function askExact(s) {
 }
 
 // A surface whose bricks have all arrived is drawn again, at the full level: one frame for
-// everything that arrived since the last (completions are coalesced, not drawn brick by brick).
+// everything that arrived since the last (completions are coalesced, not drawn brick by brick),
+// and none where no surface has become ready (a change draws its own frame).
 function redrawIfReady(s) {
-  const key = currentValues().map((v) => ready(s, v)).join();
-  if (key !== s.readyKey) {
-    s.readyKey = key;
+  const key = currentValues().filter((v) => ready(s, v)).join();
+  const before = s.readyKey;
+  s.readyKey = key;
+  if (key && key !== before) {
     renderNow();
     return true;
   }
