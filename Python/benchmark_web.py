@@ -72,6 +72,9 @@ def parse_args(argv):
     p.add_argument("--networks", default="30/40,loopback",
                    help="--stream: MBIT/LATENCY_MS or loopback, comma-separated")
     p.add_argument("--repeats", type=int, default=1, help="--stream: runs of each page")
+    p.add_argument("--warm", action="store_true",
+                   help="--stream: before the pages, have the server encode the whole level and "
+                        "every brick once (both are kept), so that neither page waits for it")
     return p.parse_args(argv)
 
 
@@ -267,6 +270,21 @@ def main_interactive(args, argv):
     return 0
 
 
+def warm(url):
+    """The server's encodings made before the pages: level 3 of /api/volume and each brick of
+    /api/bricks (serve.py keeps both), as a server that has served the volume once has them."""
+    import urllib.request
+    base, _, query = url.partition("/?")
+    get = lambda path: urllib.request.urlopen(base + path + ("&" if "?" in path else "?") + query,  # noqa: E731
+                                              timeout=3600).read()
+    ident = json.loads(get("/api/datasets"))["datasets"][0]["id"]
+    get("/api/volume/%s?level=3" % ident)
+    count = len(json.loads(get("/api/bricks/%s?level=3" % ident))["ranges"])
+    for brick in range(count):
+        get("/api/bricks/%s?level=3&ids=%d" % (ident, brick))
+    progress("warm: level 3 and its %d bricks encoded" % count)
+
+
 def main_stream(args, argv):
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     load_before = load_average()
@@ -290,6 +308,8 @@ def main_stream(args, argv):
         os.makedirs(work, exist_ok=True)
         server, url = start_server(ROOT, args, data)
         try:
+            if args.warm:
+                warm(url)
             config_file = os.path.join(work, "config.json")
             out_file = os.path.join(work, "result.json")
             with open(config_file, "w") as f:
@@ -318,8 +338,10 @@ def main_stream(args, argv):
                     name, network["name"], "whole level (`?stream=0`)" if mode == "whole" else "**streaming**",
                     med("firstMs"), med("fullMs"), ratios[0], med("wholeMs"), ratios[1], med("bytes"),
                     ratios[2], med("bytesAtFull"), 100 * med("receivedAtFull")))
-    lines[3:3] = ["- Started %s, %.0f s; load average %s before, %s after; medians of %d" % (
-        started, time.perf_counter() - t0, load_before, load_average(), args.repeats),
+    lines[3:3] = ["- Started %s, %.0f s; load average %s before, %s after; medians of %d; %s" % (
+        started, time.perf_counter() - t0, load_before, load_average(), args.repeats,
+        "warm server (--warm: the level and the bricks encoded before the pages)" if args.warm
+        else "cold server (each page's first request of the level or a brick has it encoded)"),
         "- Machine: nproc %d (%s); Chromium headless, SwiftShader; CPU path in the worker; canvas %s" % (
         os.cpu_count() or 0, cpu_model(), args.size)]
     write_report(lines, args.out)
