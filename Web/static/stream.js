@@ -100,16 +100,31 @@ function askExact(s) {
 
 // A surface whose bricks have all arrived is drawn again, at the full level: one frame for
 // everything that arrived since the last (completions are coalesced, not drawn brick by brick),
-// and none where no surface has become ready (a change draws its own frame).
+// and none where no surface has become ready (a change draws its own frame). Where the other
+// surfaces lack no more bricks than one round of requests brings, the frame waits for them: a
+// frame at the full level costs seconds on a software renderer, and the surfaces of a CT (skin
+// and bone) need nearly the same bricks.
 function redrawIfReady(s) {
-  const key = currentValues().filter((v) => ready(s, v)).join();
-  const before = s.readyKey;
-  s.readyKey = key;
-  if (key && key !== before) {
-    renderNow();
-    return true;
+  const values = currentValues();
+  const key = values.filter((v) => ready(s, v)).join();
+  if (!key || key === s.readyKey) {
+    s.readyKey = key;
+    return false;
   }
-  return false;
+  const missing = new Set();
+  for (const v of values) {
+    for (const id of needed(s, v)) {
+      if (!s.resident[id]) {
+        missing.add(id);
+      }
+    }
+  }
+  if (missing.size && missing.size <= IN_FLIGHT && !s.error) {
+    return false; // the last of them redraws (a brick that failed: no waiting)
+  }
+  s.readyKey = key;
+  renderNow();
+  return true;
 }
 
 function ready(s, v) {
