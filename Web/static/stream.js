@@ -218,7 +218,6 @@ function fetchMore() {
     fetchBatch(s, batch).catch((error) => {
       // Said in the readout; the surfaces that need the brick stay at level 0.
       s.error = "brick " + batch.join(", ") + ": " + error.message;
-      --s.inFlight;
       console.error("streaming: " + s.error);
       updateReadout();
       fetchMore();
@@ -261,16 +260,34 @@ const SIGNED = { 1: Int8Array, 2: Int16Array, 4: Int32Array };
  * as the server's differences did.
  */
 export function decodeBrick(encoded, size, predictor, box) {
-  const raw = size === 1 ? encoded.slice() : unshuffle(encoded, size);
-  if (predictor === "none") {
-    return raw;
-  }
-  const n = raw.length / size;
-  const u = new UNSIGNED[size](raw.buffer, raw.byteOffset, n);
-  const d = new SIGNED[size](raw.buffer, raw.byteOffset, n);
-  for (let i = 0; i < n; ++i) {
-    const z = u[i];
-    d[i] = (z >>> 1) ^ -(z & 1);
+  const n = encoded.length / size;
+  let raw, d;
+  if (size === 2) {
+    // The common case (int16, uint16) in one pass: the two byte planes joined and unzigzag'd.
+    d = new Int16Array(n);
+    raw = new Uint8Array(d.buffer);
+    const lo = encoded.subarray(0, n), hi = encoded.subarray(n);
+    if (predictor === "none") {
+      for (let i = 0; i < n; ++i) {
+        d[i] = lo[i] | (hi[i] << 8);
+      }
+      return raw;
+    }
+    for (let i = 0; i < n; ++i) {
+      const z = lo[i] | (hi[i] << 8);
+      d[i] = (z >>> 1) ^ -(z & 1);
+    }
+  } else {
+    raw = size === 1 ? encoded.slice() : unshuffle(encoded, size);
+    if (predictor === "none") {
+      return raw;
+    }
+    const u = new UNSIGNED[size](raw.buffer, raw.byteOffset, n);
+    d = new SIGNED[size](raw.buffer, raw.byteOffset, n);
+    for (let i = 0; i < n; ++i) {
+      const z = u[i];
+      d[i] = (z >>> 1) ^ -(z & 1);
+    }
   }
   const [x0, x1, y0, y1, z0, z1] = box;
   const nx = x1 - x0, ny = y1 - y0, nz = z1 - z0;
@@ -296,11 +313,19 @@ export function decodeBrick(encoded, size, predictor, box) {
 }
 
 async function fetchBatch(s, ids) {
-  const { response, body } = await request("/api/bricks/" + state.dataset.id + "?level=" + s.level +
-    "&ids=" + ids.join(","), "no-cache");
+  let response, body;
+  try {
+    ({ response, body } = await request("/api/bricks/" + state.dataset.id + "?level=" + s.level +
+      "&ids=" + ids.join(","), "no-cache"));
+  } finally {
+    --s.inFlight;
+  }
   if (state.stream !== s) {
     return; // another volume since
   }
+  // The next request goes out before this one is decoded: the link stays busy while the main
+  // thread works (on a loaded machine its decoding was what the requests waited for).
+  fetchMore();
   const predictor = response.headers.get("X-Mediso-Predictor") || "none";
   const encoded = new Uint8Array(body);
   const list = [];
@@ -316,16 +341,14 @@ async function fetchBatch(s, ids) {
     list.push({ id, bytes: brick.buffer });
   }
   state.viewer.writeBricks(list);
-  --s.inFlight;
   state.received = s.received / s.total;
-  if (!s.pending.size && !s.inFlight) {
+  if (!s.pending.size && !s.inFlight) { // (every other answer was handled when it came)
     finish(s);
     return;
   }
   if (!redrawIfReady(s)) {
     updateReadout();
   }
-  fetchMore();
 }
 
 // The last stream's manifest and type (brickRanges, after the end).
