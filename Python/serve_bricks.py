@@ -278,7 +278,8 @@ class Encoder:
     def first(self, ids):
         """Bricks `ids` go to the front of the background's queue."""
         front = set(ids)
-        self.queue = [b for b in self.queue if b not in front] + [b for b in ids[::-1] if b not in self.bodies]
+        self.queue = ([b for b in self.queue if b not in front] +
+                      [b for b in ids[::-1] if b not in self.bodies])
 
     async def ahead(self):
         while self.queue:

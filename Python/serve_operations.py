@@ -5,10 +5,11 @@
 
 SOURCE is a volume file (MetaImage, VTK XML image, NIfTI .nii/.nii.gz), a DICOM series folder,
 or phantom:N[:noise=HU][:seed=K] (the plugin's MedicalPhantom, N^3 points, with its seeded noise
-of standard deviation HU, 0 by default, and seed K, 1 by default: phantom_spec()). Python/serve.py starts this program as its
-worker (Python/serve_jobs.py). It opens the volumes (open_sources(), each announced first with an
-"opening" line, so that the server can name the file whose reader ended the process; the readers'
-errors are captured and said in one "fatal" line); at the server's start, --export also writes
+of standard deviation HU, 0 by default, and seed K, 1 by default: phantom_spec()).
+Python/serve.py starts this program as its worker (Python/serve_jobs.py). It opens the volumes
+(open_sources(), each announced first with an "opening" line, so that the server can name the
+file whose reader ended the process; the readers' errors are captured and said in one "fatal"
+line); at the server's start, --export also writes
 their values as DIR/dN.npy and describes them in the "ready" line, so that no reader ever runs in
 the server. Then one JSON line per job on stdin, JSON lines back on stdout (progress, then done,
 error or cancelled); SIGUSR1 cancels the job that runs. A job extracts the page's surface with

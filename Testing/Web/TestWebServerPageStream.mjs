@@ -65,7 +65,8 @@ function exactNeed(values, v) {
         if (!(lo < v && v <= hi)) {
           continue;
         }
-        const ends = [bx, by, bz].map((b) => [...new Set([Math.max(0, 8 * b - 1) >> 6, Math.min(N - 1, 8 * b + 9) >> 6])]);
+        const ends = [bx, by, bz].map((b) =>
+          [...new Set([Math.max(0, 8 * b - 1) >> 6, Math.min(N - 1, 8 * b + 9) >> 6])]);
         for (const z of ends[2]) {
           for (const y of ends[1]) {
             for (const x of ends[0]) {

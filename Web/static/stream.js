@@ -231,7 +231,8 @@ function ownedBox(s, id) {
   const B = s.manifest.brick;
   const [dx, dy, dz] = s.dims;
   const bx = id % nx, by = Math.floor(id / nx) % ny, bz = Math.floor(id / (nx * ny));
-  return [bx * B, Math.min(dx, bx * B + B), by * B, Math.min(dy, by * B + B), bz * B, Math.min(dz, bz * B + B)];
+  return [bx * B, Math.min(dx, bx * B + B), by * B, Math.min(dy, by * B + B),
+    bz * B, Math.min(dz, bz * B + B)];
 }
 
 // A brick's owned points (x fastest) into this thread's copy of the full level.
