@@ -3,7 +3,7 @@
 
     python3 Python/benchmark_web.py [--inputs ct,ct512] [--sweep 10] [--size 800x600] [--out FILE.md]
     python3 Python/benchmark_web.py --interactive [--inputs phantom:256,ct] [--paths cpu,gpu] [--before main]
-    python3 Python/benchmark_web.py --stream [--inputs ct,phantom:256] [--networks 30/40,loopback]
+    python3 Python/benchmark_web.py --stream [--inputs ct512,phantom:512:noise=40] [--networks 30/40,loopback] [--warm]
     python3 Python/benchmark_web.py --startup [--inputs ct] [--networks 30/40,loopback]
 
 In one headless Chromium (Debian's, software WebGL2: SwiftShader), on the same volume and canvas
@@ -32,7 +32,8 @@ drag's --moves (a longer drag for slow frames); --before none runs this page onl
 it (level 0, then the bricks the surfaces need first), each in a fresh browser context, in one
 Chromium, under each network (MBIT/LATENCY_MS through CDP's Network.emulateNetworkConditions, or
 loopback): the time to the first image, to the current surfaces at the full level, to the whole
-level, and the bytes on the wire.
+level, and the bytes on the wire. Inputs: ct, ct512, or any server spec phantom:N[:noise=HU]
+(the issue's: the 512-wide CT and phantom:512:noise=40, the default).
 
 --startup (issue 31's first image): the streaming page's start-up request by request, in a fresh
 context under each network (Testing/Web/bench-startup.mjs): when each of the page's requests was
@@ -92,6 +93,9 @@ def parse_args(argv):
     p.add_argument("--repeats", type=int, default=1, help="--stream: runs of each page")
     p.add_argument("--startup", action="store_true",
                    help="the streaming page's start-up, request by request (issue 31's first image)")
+    p.add_argument("--warm", action="store_true",
+                   help="--stream: before the pages, have the server encode the whole level and "
+                        "every brick once (both are kept), so that neither page waits for it")
     return p.parse_args(argv)
 
 
@@ -308,6 +312,21 @@ def main_interactive(args, argv):
     return 0
 
 
+def warm(url):
+    """The server's encodings made before the pages: level 3 of /api/volume and each brick of
+    /api/bricks (serve.py keeps both), as a server that has served the volume once has them."""
+    import urllib.request
+    base, _, query = url.partition("/?")
+    get = lambda path: urllib.request.urlopen(base + path + ("&" if "?" in path else "?") + query,  # noqa: E731
+                                              timeout=3600).read()
+    ident = json.loads(get("/api/datasets"))["datasets"][0]["id"]
+    get("/api/volume/%s?level=3" % ident)
+    count = len(json.loads(get("/api/bricks/%s?level=3" % ident))["ranges"])
+    for brick in range(count):
+        get("/api/bricks/%s?level=3&ids=%d" % (ident, brick))
+    progress("warm: level 3 and its %d bricks encoded" % count)
+
+
 def main_stream(args, argv):
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     load_before = load_average()
@@ -315,14 +334,17 @@ def main_stream(args, argv):
     networks = parse_networks(args.networks)
     lines = ["# The page streaming against the whole level (issue 31)", "",
              "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv), "",
-             "| input | network | page | first image ms | surfaces at full level ms | whole level ms | bytes |",
-             "|---|---|---|---:|---:|---:|---:|"]
+             "| input | network | page | first image ms | surfaces at full level ms | whole level ms | bytes "
+             "| bytes at full level (level received) |",
+             "|---|---|---|---:|---:|---:|---:|---:|"]
     for name in args.inputs.split(","):
         data = volume_path(name) if not name.startswith("phantom:") else name
         work = os.path.join(args.work, "stream-" + name.replace(":", "-"))
         os.makedirs(work, exist_ok=True)
         server, url = start_server(ROOT, args, data)
         try:
+            if args.warm:
+                warm(url)
             config_file = os.path.join(work, "config.json")
             out_file = os.path.join(work, "result.json")
             with open(config_file, "w") as f:
@@ -336,14 +358,25 @@ def main_stream(args, argv):
         finally:
             server.kill()
         for network in networks:
+            whole = {}
             for mode in ("whole", "stream"):
                 rs = [r for r in runs if r["network"] == network["name"] and r["mode"] == mode]
                 med = lambda key: statistics.median(r[key] for r in rs)  # noqa: E731
-                lines.append("| %s | %s | %s | %.0f | %.0f | %.0f | %d |" % (
+                if mode == "whole":
+                    whole = {key: med(key) for key in ("wholeMs", "bytes")}
+                    ratios = ("", "", "")
+                else:  # against the whole level's page of the same run
+                    ratios = (" (%.2fx)" % (med("fullMs") / whole["wholeMs"]),
+                              " (%.2fx)" % (med("wholeMs") / whole["wholeMs"]),
+                              " (%.2fx)" % (med("bytes") / whole["bytes"]))
+                lines.append("| %s | %s | %s | %.0f | %.0f%s | %.0f%s | %d%s | %d (%.0f%%) |" % (
                     name, network["name"], "whole level (`?stream=0`)" if mode == "whole" else "**streaming**",
-                    med("firstMs"), med("fullMs"), med("wholeMs"), med("bytes")))
-    lines[3:3] = ["- Started %s, %.0f s; load average %s before, %s after; medians of %d" % (
-        started, time.perf_counter() - t0, load_before, load_average(), args.repeats),
+                    med("firstMs"), med("fullMs"), ratios[0], med("wholeMs"), ratios[1], med("bytes"),
+                    ratios[2], med("bytesAtFull"), 100 * med("receivedAtFull")))
+    lines[3:3] = ["- Started %s, %.0f s; load average %s before, %s after; medians of %d; %s" % (
+        started, time.perf_counter() - t0, load_before, load_average(), args.repeats,
+        "warm server (--warm: the level and the bricks encoded before the pages)" if args.warm
+        else "cold server (each page's first request of the level or a brick has it encoded)"),
         "- Machine: nproc %d (%s); Chromium headless, SwiftShader; CPU path in the worker; canvas %s" % (
         os.cpu_count() or 0, cpu_model(), args.size)]
     write_report(lines, args.out)
@@ -410,7 +443,7 @@ def main(argv):
         return main_startup(args, argv, parse_networks(args.networks))
     if args.stream:
         if args.inputs == "ct,ct512":
-            args.inputs = "ct,phantom:256"
+            args.inputs = "ct512,phantom:512:noise=40"
         return main_stream(args, argv)
     if args.interactive:
         if args.inputs == "ct,ct512":

@@ -106,7 +106,7 @@ def parse_args(argv):
     p = ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--data", action="append", default=[],
                    help="a volume file (MetaImage, VTK XML image, NIfTI .nii/.nii.gz), a DICOM "
-                        "series folder, or phantom:N (repeat for several)")
+                        "series folder, or phantom:N[:noise=HU][:seed=K] (repeat for several)")
     p.add_argument("--port", type=_port, default=8765)
     p.add_argument("--host", default="127.0.0.1",
                    help="address to listen on (default 127.0.0.1: this machine only)")

@@ -4,10 +4,12 @@
         [--export DIR] SOURCE [SOURCE ...]
 
 SOURCE is a volume file (MetaImage, VTK XML image, NIfTI .nii/.nii.gz), a DICOM series folder,
-or phantom:N (the plugin's MedicalPhantom, N^3 points). Python/serve.py starts this program as its
-worker (Python/serve_jobs.py). It opens the volumes (open_sources(), each announced first with an
-"opening" line, so that the server can name the file whose reader ended the process; the readers'
-errors are captured and said in one "fatal" line); at the server's start, --export also writes
+or phantom:N[:noise=HU][:seed=K] (the plugin's MedicalPhantom, N^3 points, with its seeded noise
+of standard deviation HU, 0 by default, and seed K, 1 by default: phantom_spec()).
+Python/serve.py starts this program as its worker (Python/serve_jobs.py). It opens the volumes
+(open_sources(), each announced first with an "opening" line, so that the server can name the
+file whose reader ended the process; the readers' errors are captured and said in one "fatal"
+line); at the server's start, --export also writes
 their values as DIR/dN.npy and describes them in the "ready" line, so that no reader ever runs in
 the server. Then one JSON line per job on stdin, JSON lines back on stdout (progress, then done,
 error or cancelled); SIGUSR1 cancels the job that runs. A job extracts the page's surface with
@@ -66,6 +68,41 @@ def _producer(image, name):
     return producer
 
 
+def phantom_spec(spec):
+    """(N, noise, seed) of phantom:N[:noise=HU][:seed=K]: the plugin's MedicalPhantom at N^3
+    points (2-1024) with NoiseStandardDeviation HU (0-10000, its range; 0: none, the default)
+    and Seed K (1 by default), e.g. phantom:512:noise=40 for the issues' noisy phantom.
+    Raises ValueError with a message for the user."""
+    size, *options = spec[len(PHANTOM):].split(":")
+    try:
+        n = int(size)
+    except ValueError:
+        n = 0
+    if not 2 <= n <= 1024:
+        raise ValueError("%s: the phantom's size is an integer 2-1024" % spec)
+    noise, seed = 0.0, 1
+    for option in options:
+        key, _, value = option.partition("=")
+        try:
+            if key == "noise":
+                noise = float(value)
+                if not 0 <= noise <= 10000:  # rejects NaN too
+                    raise ValueError
+            elif key == "seed":
+                seed = int(value)
+                if not -2 ** 31 <= seed < 2 ** 31:
+                    raise ValueError
+            else:
+                raise KeyError
+        except KeyError:
+            raise ValueError("%s: a phantom's options are noise=HU and seed=N (%r is neither)"
+                             % (spec, option))
+        except ValueError:
+            raise ValueError("%s: noise is a number of HU from 0 to 10000, seed an integer (%r)"
+                             % (spec, option))
+    return n, noise, seed
+
+
 def open_reader(spec, ns):
     """A ParaView source for SOURCE, its display name and a note on the reader used.
 
@@ -75,14 +112,11 @@ def open_reader(spec, ns):
     """
     import paraview.simple as simple
     if spec.startswith(PHANTOM):
-        try:
-            n = int(spec[len(PHANTOM):])
-        except ValueError:
-            n = 0
-        if not 2 <= n <= 1024:
-            raise ValueError("%s: the phantom's size is an integer 2-1024" % spec)
-        phantom = ns["MedicalPhantom"](Dimensions=[n, n, n], Spacing=[PHANTOM_EXTENT_MM / n] * 3)
-        return phantom, "MedicalPhantom %d^3" % n, "the plugin's MedicalPhantom"
+        n, noise, seed = phantom_spec(spec)
+        phantom = ns["MedicalPhantom"](Dimensions=[n, n, n], Spacing=[PHANTOM_EXTENT_MM / n] * 3,
+                                       NoiseStandardDeviation=noise, Seed=seed)
+        name = "MedicalPhantom %d^3" % n + (", noise %g HU (seed %d)" % (noise, seed) if noise else "")
+        return phantom, name, "the plugin's MedicalPhantom"
     path = os.path.abspath(spec)
     name = os.path.basename(os.path.normpath(path))
     if os.path.isdir(path):

@@ -97,6 +97,8 @@ with open(os.path.join(folder, "notes.txt"), "w") as f:
     f.write("not DICOM\n")
 refused(["--data", folder], 1, "serve: %s: a folder, but it holds no DICOM files" % folder)
 refused(["--data", "phantom:1"], 1, "serve: phantom:1: the phantom's size is an integer 2-1024")
+refused(["--data", "phantom:8:noise=x"], 1,
+        "serve: phantom:8:noise=x: noise is a number of HU from 0 to 10000, seed an integer ('noise=x')")
 
 # A reader that segfaults: the worker dies, the server names the file and the signal.
 crash = os.path.join(work, "segfaulting-reader.mha")

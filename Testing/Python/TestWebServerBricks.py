@@ -3,13 +3,19 @@
 On the phantom at 77^3 points (bricks of 64: 2 per axis, the last ones partial) and at level 2
 (39^3): the manifest states the brick size, the bricks per axis, each brick's owned bytes and its
 range over its read points (owned, + 1 on the + side, the apron on each side) equal to a brute
-force here; the bricks, fetched in batches in an order that is not the volume's, put back
-together, are the level's values exactly, every point sent once; their bytes on the wire, with
-level 0's, are at most 1.05x the whole level's from /api/volume (1.10x at level 3, where
-13 of the 77 points per axis are a partial brick); bad requests get 400, a wrong
-token 403. On the head CT (when Python/fetch_data.py has fetched it), the bricks and level 0 are at
-most 1.05x its whole level on the wire (the phantom, a smooth synthetic volume that gzip shrinks
-19-fold whole, costs more in bricks: docs/web.md, Streaming). The ranges against the C++ core's ComputeBrickRanges are checked in Chromium
+force here; the bricks, fetched in batches in an order that is not the volume's and decoded here
+(each brick byte-shuffled on its own, its integer values the zigzag'd residuals of the predictor
+the answer names, undone by running sums), put back together, are the level's values exactly,
+every point sent once; their bytes on the wire, with level 0's, are at most 1.05x the whole
+level's from /api/volume (1.10x at level 3, where 13 of the 77 points per axis are a partial
+brick); a need query answers, for each isovalue, exactly the bricks holding the points that the
+core's blocks crossing it read (a brute force over the blocks here), a subset of the page's
+superset (the bricks whose range holds it and their neighbours); bad requests get 400, a wrong
+token 403. The same server opens phantom:77:noise=40 (serve_operations.phantom_spec): its
+values are the noiseless phantom's plus noise of about 40 HU, and its bricks decode to them. On
+the head CT (when Python/fetch_data.py has fetched it), the bricks and level 0 are at most 1.05x
+its whole level on the wire. The ranges against the C++ core's ComputeBrickRanges, and the
+surfaces drawn from the needed bricks against the dense ones, are checked in Chromium
 (TestWebServerPageStream), where the module is.
 """
 import asyncio
@@ -23,7 +29,66 @@ import numpy  # noqa: E402
 
 N = 77
 checks = webserver.Checks()
-server = webserver.Server(["phantom:%d" % N])
+NOISE = 40
+server = webserver.Server(["phantom:%d" % N, "phantom:%d:noise=%d" % (N, NOISE)])
+PREDICTORS = ("xyz", "x", "none")
+
+
+def decode_bricks(body, dtype, boxes, predictor):
+    """The owned points of each brick of a /api/bricks answer ((z, y, x) shapes `boxes`, in the
+    order asked): gunzip, then per brick unshuffle, unzigzag and running sums in the type's width."""
+    import gzip
+    raw = gzip.decompress(body)
+    size = dtype.itemsize
+    unsigned = numpy.dtype("u%d" % size)
+    out, offset = [], 0
+    for shape in boxes:
+        count = shape[0] * shape[1] * shape[2]
+        planes = numpy.frombuffer(raw, numpy.uint8, count * size, offset).reshape(size, count)
+        offset += count * size
+        values = numpy.ascontiguousarray(planes.T).view(unsigned).reshape(shape)
+        if predictor != "none" and dtype.kind != "f":
+            values = (values >> 1) ^ (-(values & 1).astype(dtype)).view(unsigned)
+            for axis in {"xyz": (0, 1, 2), "x": (2,)}[predictor]:
+                values = numpy.cumsum(values, axis=axis, dtype=unsigned)
+        out.append(values.view(dtype))
+    return out, offset == len(raw)
+
+
+def brute_need(values, brick, v):
+    """The bricks isovalue v needs: for every block of 8 cells whose points [8b, 8b + 8] hold it
+    (min < v <= max), the bricks of the points 8b - 1 .. 8b + 9 its cells and gradients read."""
+    n = values.shape
+    blocks = [max(1, (m - 1 + 7) // 8) for m in n]
+    counts = [(m + brick - 1) // brick for m in n[::-1]]
+    out = set()
+    for bz in range(blocks[0]):
+        for by in range(blocks[1]):
+            for bx in range(blocks[2]):
+                box = values[8 * bz:8 * bz + 9, 8 * by:8 * by + 9, 8 * bx:8 * bx + 9]
+                if not box.min() < v <= box.max():
+                    continue
+                ends = [sorted({max(0, 8 * b - 1) // brick, min(m - 1, 8 * b + 9) // brick})
+                        for b, m in ((bx, n[2]), (by, n[1]), (bz, n[0]))]
+                for z in ends[2]:
+                    for y in ends[1]:
+                        for x in ends[0]:
+                            out.add(x + counts[0] * (y + counts[1] * z))
+    return sorted(out)
+
+
+def superset(ranges, counts, v):
+    """The page's superset before the server answers: the bricks whose range holds v and their
+    neighbours."""
+    out = set()
+    for i, (lo, hi) in enumerate(ranges):
+        if lo < v <= hi:
+            b = (i % counts[0], (i // counts[0]) % counts[1], i // (counts[0] * counts[1]))
+            for z in range(max(0, b[2] - 1), min(counts[2], b[2] + 2)):
+                for y in range(max(0, b[1] - 1), min(counts[1], b[1] + 2)):
+                    for x in range(max(0, b[0] - 1), min(counts[0], b[0] + 2)):
+                        out.add(x + counts[0] * (y + counts[1] * z))
+    return out
 
 
 def brute_ranges(values, brick, apron):
@@ -73,23 +138,23 @@ async def main():
                 url = "/api/bricks/%s?level=%d&ids=%s" % (d["id"], k, ",".join(map(str, batch)))
                 async with http.get(server.url(url)) as r:
                     body = await r.read()
-                    checks(r.status == 200 and r.headers["X-Mediso-Bricks"] == ",".join(map(str, batch)),
-                           "level %d: bricks %s answered" % (k, batch))
+                    predictor = r.headers.get("X-Mediso-Predictor")
+                    checks(r.status == 200 and r.headers["X-Mediso-Bricks"] == ",".join(map(str, batch))
+                           and predictor in PREDICTORS,
+                           "level %d: bricks %s answered (predictor %s)" % (k, batch, predictor))
                 wire += len(body)
-                import gzip
-                raw = gzip.decompress(body)
-                joined = numpy.frombuffer(raw, numpy.uint8).reshape(dtype.itemsize, -1).T
-                joined = numpy.ascontiguousarray(joined).view(dtype).ravel()
-                offset = 0
+                boxes = []
                 for brick in batch:
-                    size = m["bytes"][brick] // dtype.itemsize
                     bx = brick % counts[0]
                     by = (brick // counts[0]) % counts[1]
                     bz = brick // (counts[0] * counts[1])
-                    box = rebuilt[bz * b:(bz + 1) * b, by * b:(by + 1) * b, bx * b:(bx + 1) * b]
-                    box[...] = joined[offset:offset + size].reshape(box.shape)
-                    offset += size
-                checks(offset == joined.size, "level %d: a batch holds its bricks and nothing else" % k)
+                    boxes.append((slice(bz * b, (bz + 1) * b), slice(by * b, (by + 1) * b),
+                                  slice(bx * b, (bx + 1) * b)))
+                decoded, whole_body = decode_bricks(body, dtype, [rebuilt[box].shape for box in boxes],
+                                                    predictor)
+                for box, brick_values in zip(boxes, decoded):
+                    rebuilt[box] = brick_values
+                checks(whole_body, "level %d: a batch holds its bricks and nothing else" % k)
             checks(numpy.array_equal(rebuilt, values),
                    "level %d: the bricks put together are the level's values" % k)
             async with http.get(server.url("/api/volume/%s?level=0" % d["id"])) as r:
@@ -101,7 +166,23 @@ async def main():
                    "level %d: the bricks (%d bytes) and level 0 (%d) are at most %.2fx the whole "
                    "level (%d: %.3fx)" % (k, wire, level0, bound, len(whole),
                                           (wire + level0) / len(whole)))
+            for v in (-500.0, 0.0, 400.0, float(values.max())):
+                url = "/api/bricks/%s?level=%d&need=%r" % (d["id"], k, v)
+                async with http.get(server.url(url)) as r:
+                    need = (await r.json())["need"][0]
+                exact = brute_need(values, b, v)
+                checks(need == exact and set(need) <= superset(m["ranges"], counts, v),
+                       "level %d, isovalue %g: the server's need (%d bricks) is the blocks' brute "
+                       "force (%d) and within the superset (%d)" % (
+                           k, v, len(need), len(exact), len(superset(m["ranges"], counts, v))))
+        url = "/api/bricks/%s?level=3&need=-500,400" % d["id"]
+        async with http.get(server.url(url)) as r:
+            both = (await r.json())["need"]
+        checks(len(both) == 2, "a need query answers each isovalue in order")
+        await noisy_phantom(http)
         for query, status in (("level=4", 400), ("level=x", 400), ("level=3&ids=", 400),
+                              ("level=3&need=", 400), ("level=3&need=a", 400),
+                              ("level=3&need=nan", 400), ("level=3&need=" + ",".join(["1"] * 17), 400),
                               ("level=3&ids=1,1", 400), ("level=3&ids=-1", 400),
                               ("level=3&ids=27", 400), ("level=3&ids=a", 400)):
             async with http.get(server.url("/api/bricks/%s?%s" % (d["id"], query))) as r:
@@ -110,6 +191,30 @@ async def main():
             checks(r.status == 404, "an unknown dataset: 404 (%d)" % r.status)
         async with http.get(server.url("/api/bricks/%s?level=3&ids=0" % d["id"], token="wrong")) as r:
             checks(r.status == 403, "without the token: 403 (%d)" % r.status)
+
+
+async def noisy_phantom(http):
+    """phantom:N:noise=40: the noiseless phantom's values plus seeded noise of about 40 HU (the
+    two as the server sends them), and its bricks decode to its values."""
+    async with http.get(server.url("/api/datasets")) as r:
+        clean, noisy = (await r.json())["datasets"][:2]
+    levels = []
+    for d in (clean, noisy):
+        async with http.get(server.url("/api/volume/%s?level=3" % d["id"])) as r:
+            body = await r.read()
+        levels.append(webserver.decode(body, numpy.dtype(d["type"]), N * N * N).reshape(N, N, N))
+    difference = levels[1].astype(numpy.float64) - levels[0]
+    checks("noise 40 HU" in noisy["name"] and 35 < difference.std() < 45 and abs(difference.mean()) < 2,
+           "phantom:%d:noise=%d (%s): the noiseless values plus noise of std %.1f HU, mean %.2f"
+           % (N, NOISE, noisy["name"], difference.std(), difference.mean()))
+    url = "/api/bricks/%s?level=3&ids=0,7" % noisy["id"]
+    async with http.get(server.url(url)) as r:
+        body = await r.read()
+        predictor = r.headers.get("X-Mediso-Predictor")
+    (first, last), _ = decode_bricks(body, levels[1].dtype, [(64, 64, 64), (13, 13, 13)], predictor)
+    checks(numpy.array_equal(first, levels[1][:64, :64, :64]) and
+           numpy.array_equal(last, levels[1][64:, 64:, 64:]),
+           "the noisy phantom's bricks 0 and 7 decode to its values (predictor %s)" % predictor)
 
 
 async def ct_bytes(ct):

@@ -1,10 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Streaming (issue 31; docs/web.md, Streaming), in Chromium (SwiftShader), CPU path in the worker,
 // the network throttled through CDP (Network.emulateNetworkConditions) so that there is a "while",
-// on a volume the test writes (two blobs, one whose surface needs every brick, one a corner's):
+// on a volume the test writes (two blobs, one in the middle, one in a corner):
 // - the first image comes from level 0 (every surface at level 0, said in the readout), and at
 //   every frame each surface's triangles are the dense ones at its level: level 0's from a page
 //   that fetched level 0 whole, level 3's from a page that fetched level 3 whole (?stream=0);
+// - the bricks the surface at FIRST needs, as the server answers the need query, are those its
+//   blocks read (a brute force here over the values written: 14, the 8 middle ones among them),
+//   where the manifest's ranges alone gave all 64 (the bricks that hold the value, and every
+//   neighbour);
 // - an isovalue changed mid-stream (to the corner's blob) is drawn at once, and the next bricks
 //   asked for are the ones it needs, while others are still to come;
 // - whenFull() resolves with every surface at level 3 (before the whole level has come, where
@@ -19,8 +23,9 @@ import { Checks, countWire, launchBrowser, niftiBytes, openPage, startServer } f
 
 const checks = new Checks();
 // Two blobs in a 256^3 int16 NIfTI (bricks of 64: 4 per axis): a large one in the middle, whose
-// surface at FIRST needs every brick, and a small one in a corner, whose surface at SMALL needs
-// the far corner's 8 bricks (the last in the volume's order); a little deterministic noise.
+// surface at FIRST (radius 50, points 78-178 along each axis) lies in the middle 8 bricks, and a
+// small one in a corner, whose surface at SMALL needs the far corner's bricks (the last in the
+// volume's order); a little deterministic noise.
 const N = 256, FIRST = 500, SMALL = 1500;
 function writeVolume(file) {
   const values = new Int16Array(N * N * N);
@@ -36,10 +41,47 @@ function writeVolume(file) {
     }
   }
   writeFileSync(file, niftiBytes([N, N, N], [1, 1, 1], [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]], values));
+  return values;
+}
+
+// The bricks (64 points a side) isovalue v needs, by brute force: for every block of 8 cells whose
+// points [8b, 8b + 8] hold v (min < v <= max), the bricks of the points 8b - 1 .. 8b + 9 its
+// cells and gradients read.
+function exactNeed(values, v) {
+  const blocks = Math.ceil((N - 1) / 8), out = new Set();
+  for (let bz = 0; bz < blocks; ++bz) {
+    for (let by = 0; by < blocks; ++by) {
+      for (let bx = 0; bx < blocks; ++bx) {
+        let lo = Infinity, hi = -Infinity;
+        for (let k = 8 * bz; k <= Math.min(N - 1, 8 * bz + 8); ++k) {
+          for (let j = 8 * by; j <= Math.min(N - 1, 8 * by + 8); ++j) {
+            for (let i = 8 * bx; i <= Math.min(N - 1, 8 * bx + 8); ++i) {
+              const x = values[(k * N + j) * N + i];
+              lo = Math.min(lo, x);
+              hi = Math.max(hi, x);
+            }
+          }
+        }
+        if (!(lo < v && v <= hi)) {
+          continue;
+        }
+        const ends = [bx, by, bz].map((b) =>
+          [...new Set([Math.max(0, 8 * b - 1) >> 6, Math.min(N - 1, 8 * b + 9) >> 6])]);
+        for (const z of ends[2]) {
+          for (const y of ends[1]) {
+            for (const x of ends[0]) {
+              out.add((z * 4 + y) * 4 + x);
+            }
+          }
+        }
+      }
+    }
+  }
+  return [...out].sort((a, b) => a - b);
 }
 const folder = mkdtempSync(path.join(tmpdir(), "mediso-stream-"));
 const nifti = path.join(folder, "blobs.nii");
-writeVolume(nifti);
+const written = writeVolume(nifti);
 const server = await startServer([nifti]);
 const browser = await launchBrowser();
 const surface = (value) => ({ value, color: [1, 1, 1], opacity: 1 });
@@ -58,13 +100,29 @@ async function open(query, throttle) {
   return { page, wire };
 }
 
-// The streaming page, at 8 Mbit/s and 40 ms, one surface.
-const { page, wire } = await open("&path=cpu#iso=" + FIRST + ",ffffff,1", 8);
+// The streaming page, at 5 Mbit/s and 40 ms (the predicted bricks are 0.76x the level: slower than the
+// 8 Mbit/s of before, so that the change below still comes mid-stream), one surface.
+const { page, wire } = await open("&path=cpu#iso=" + FIRST + ",ffffff,1", 5);
 const first = await page.evaluate(() => window.mediso.stats());
 checks.check(first.levels.length === 1 && first.levels[0] === 0 && first.received < 1,
   "the first image: the surface at level 0 (" + first.levels + "), " + (100 * first.received).toFixed(0) + "% received");
 checks.check(/level 0 is the coarse one/.test(await page.locator("#readout").textContent()),
   "the readout says the coarse level and the fraction received");
+
+// The server's need for FIRST: exactly the bricks its blocks read (the middle 8, and the corner
+// blob's: 500 is inside it too), far fewer than the superset's 64.
+await page.waitForFunction((v) => { const i = window.mediso.streamInfo([v]); return !i || i.exact[0]; },
+  FIRST, { timeout: 60000, polling: 20 });
+{
+  const i = await page.evaluate((v) => window.mediso.streamInfo([v]), FIRST);
+  const expected = exactNeed(written, FIRST);
+  if (checks.check(i !== null, "the stream was under way when the server's need came")) {
+    checks.check(i.needed[0].slice().sort((a, b) => a - b).join() === expected.join() &&
+      [21, 22, 25, 26, 37, 38, 41, 42].every((id) => expected.includes(id)) && i.superset[0] === 64,
+      "the surface at " + FIRST + " needs the " + expected.length + " bricks its blocks read, the middle 8 " +
+      "among them (" + i.needed[0] + "), where the manifest's ranges alone gave " + i.superset[0]);
+  }
+}
 
 // Mid-stream: a change to the small blob is drawn at once, its bricks first.
 const pick = SMALL;

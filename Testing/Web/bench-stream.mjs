@@ -5,7 +5,8 @@
 // each network condition (CDP Network.emulateNetworkConditions; "loopback": none): the time from
 // navigation to the first image (window.mediso.ready), to the current surfaces at the full level
 // (whenFull()), to the whole level received (stats().received === 1), and the bytes on the wire
-// (CDP loadingFinished).
+// (CDP loadingFinished), in all and when the surfaces were at the full level, with the fraction of
+// the level received then.
 //   node bench-stream.mjs CONFIG.json OUT.json
 // CONFIG: {url, size: [w, h], networks: [{name, mbps, latencyMs} | {name: "loopback"}], repeats}
 import { launch } from "./page.mjs";
@@ -37,10 +38,12 @@ for (let repeat = 0; repeat < (config.repeats || 1); ++repeat) {
       const firstMs = Date.now() - start;
       const full = await page.evaluate(() => window.mediso.whenFull());
       const fullMs = Date.now() - start;
+      const bytesAtFull = bytes;
       await page.waitForFunction(() => window.mediso.stats().received === 1, null, { timeout: 600000, polling: 50 });
       const wholeMs = Date.now() - start;
       await page.waitForTimeout(200);
-      runs.push({ network: network.name, mode, firstMs, fullMs, wholeMs, bytes, levels: full.levels,
+      runs.push({ network: network.name, mode, firstMs, fullMs, wholeMs, bytes, bytesAtFull,
+        receivedAtFull: full.received, levels: full.levels,
         surfaces: (await page.evaluate(() => window.mediso.getSurfaces())).map((s) => s.value) });
       console.log(JSON.stringify(runs[runs.length - 1]));
       await context.close();

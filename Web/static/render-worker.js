@@ -369,6 +369,11 @@ self.onmessage = async (event) => {
         viewer.writeBrick(brick.id, at);
         M._free(at);
       }
+      // A frame asked for before these bricks is drawn now: where bricks come faster than they
+      // are written (loopback), its timer's turn came only after the last of them.
+      if (scheduled) {
+        pump();
+      }
     } else if (m.op === "streamEnd") {
       viewer.endStreaming();
       streaming = false;
