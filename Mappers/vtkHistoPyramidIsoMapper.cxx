@@ -750,11 +750,13 @@ mediso::FrameTimeModel::Candidate vtkHistoPyramidIsoMapper::ChooseInteractiveLev
   // last, level 0's triangles, is the coarsest but not always the cheapest:
   // translucent triangles are sorted on the CPU every frame, where level 0's
   // GPU frame of a large volume costs little more than its few primitives.
-  if (impl.Model.Predict(candidates[chosen].Work) > budget)
+  // On the drawing, as Choose(): a level's one-off work is paid once.
+  if (impl.Model.PredictDrawing(candidates[chosen].Work) > budget)
   {
     for (std::size_t i = 0; i < candidates.size(); ++i)
     {
-      if (impl.Model.Predict(candidates[i].Work) < impl.Model.Predict(candidates[chosen].Work))
+      if (impl.Model.PredictDrawing(candidates[i].Work) <
+        impl.Model.PredictDrawing(candidates[chosen].Work))
       {
         chosen = i;
       }
