@@ -145,6 +145,26 @@ public:
   bool IsBricked() const;
   ///@}
 
+  ///@{
+  /**
+   * The brick pool (on by default): a volume kept as bricks holds its
+   * resident bricks as the slots of one 3D texture within the texture limit
+   * and the budget (each slot a power of two a side, 16 points or more,
+   * holding a brick with its apron), with an indirection per slot (the
+   * brick's place in the volume and the cells it owns) and one pyramid over
+   * the pool, built once per isovalue change and drawn in one pass. With the
+   * pool, bricks are at most half the texture limit a side (PoolBrickPoints())
+   * so that the pool has room for several. Where the pool cannot hold the
+   * active bricks within the limit and the budget, they are drawn as their
+   * own pyramids, as with the pool off. A change takes effect at the next
+   * SetVolume().
+   */
+  void SetBrickPool(bool on);
+  bool GetBrickPool() const;
+  /// The brick edge with the pool: ChooseBrickPoints() under half the texture limit.
+  static int PoolBrickPoints(ScalarType type, int maxTextureSize, std::uint64_t budget);
+  ///@}
+
   /**
    * The brick edge (points, a multiple of 8) for a volume of `type` under a
    * texture limit and a budget: the largest 2^k - 8 (so that a brick's

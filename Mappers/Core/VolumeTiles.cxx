@@ -171,6 +171,95 @@ void VolumeTiles::Clear()
   this->FloatRanges.clear();
 }
 
+namespace
+{
+template<typename R>
+R NoLow()
+{
+  return std::numeric_limits<R>::has_infinity ? std::numeric_limits<R>::infinity()
+                                              : std::numeric_limits<R>::max();
+}
+template<typename R>
+R NoHigh()
+{
+  return std::numeric_limits<R>::has_infinity ? -std::numeric_limits<R>::infinity()
+                                              : std::numeric_limits<R>::lowest();
+}
+
+template<typename R>
+void EmptyRanges(std::vector<R>& ranges, std::size_t tiles)
+{
+  ranges.resize(2 * tiles);
+  for (std::size_t t = 0; t < tiles; ++t)
+  {
+    ranges[2 * t] = NoLow<R>();
+    ranges[2 * t + 1] = NoHigh<R>();
+  }
+}
+
+// Tiles [origin, origin + count) of `to` (tile counts `toTiles`) from `from`
+// (tile counts `fromTiles`; empty where it has none).
+template<typename R>
+void PlaceRanges(std::vector<R>& to, const PyramidLayout::Int3& toTiles, const std::vector<R>* from,
+  const PyramidLayout::Int3& fromTiles, const int origin[3], const int count[3])
+{
+  for (int z = 0; z < count[2] && origin[2] + z < toTiles[2]; ++z)
+    for (int y = 0; y < count[1] && origin[1] + y < toTiles[1]; ++y)
+      for (int x = 0; x < count[0] && origin[0] + x < toTiles[0]; ++x)
+      {
+        const std::size_t t =
+          (static_cast<std::size_t>(origin[2] + z) * toTiles[1] + origin[1] + y) * toTiles[0] +
+          origin[0] + x;
+        const bool inside = from && x < fromTiles[0] && y < fromTiles[1] && z < fromTiles[2];
+        const std::size_t f =
+          inside ? (static_cast<std::size_t>(z) * fromTiles[1] + y) * fromTiles[0] + x : 0;
+        to[2 * t] = inside ? (*from)[2 * f] : NoLow<R>();
+        to[2 * t + 1] = inside ? (*from)[2 * f + 1] : NoHigh<R>();
+      }
+}
+} // namespace
+
+void VolumeTiles::Reset(ScalarType type, const PyramidLayout& layout)
+{
+  this->Clear();
+  this->Layout = layout;
+  const auto tiles = layout.TileCounts();
+  const std::size_t n = static_cast<std::size_t>(tiles[0]) * tiles[1] * tiles[2];
+  switch (ValueKindOf(type))
+  {
+    case ValueKind::Signed:
+      EmptyRanges(this->IntRanges, n);
+      break;
+    case ValueKind::Unsigned:
+      EmptyRanges(this->UIntRanges, n);
+      break;
+    case ValueKind::Float:
+      EmptyRanges(this->FloatRanges, n);
+      break;
+  }
+}
+
+void VolumeTiles::Place(const VolumeTiles* part, const int origin[3], const int count[3])
+{
+  const auto tiles = this->Layout.TileCounts();
+  const auto partTiles = part ? part->Layout.TileCounts() : PyramidLayout::Int3{ { 0, 0, 0 } };
+  if (!this->IntRanges.empty())
+  {
+    PlaceRanges(
+      this->IntRanges, tiles, part ? &part->IntRanges : nullptr, partTiles, origin, count);
+  }
+  if (!this->UIntRanges.empty())
+  {
+    PlaceRanges(
+      this->UIntRanges, tiles, part ? &part->UIntRanges : nullptr, partTiles, origin, count);
+  }
+  if (!this->FloatRanges.empty())
+  {
+    PlaceRanges(
+      this->FloatRanges, tiles, part ? &part->FloatRanges : nullptr, partTiles, origin, count);
+  }
+}
+
 std::uint64_t VolumeTiles::GetNumberOfTiles() const
 {
   return (this->IntRanges.size() + this->UIntRanges.size() + this->FloatRanges.size()) / 2;

@@ -71,6 +71,18 @@ public:
 
   void Clear();
 
+  ///@{
+  /**
+   * A brick pool's tiles (HistoPyramidGL::AllocatePool()): Reset() makes
+   * every tile of `layout` empty for data of `type`; Place() gives the tiles
+   * [origin, origin + count) per axis the ranges of `part` (a brick's tiles,
+   * computed on its own points, whose tile 0 is tile `origin` here), or
+   * empties them where `part` is null or has fewer.
+   */
+  void Reset(ScalarType type, const PyramidLayout& layout);
+  void Place(const VolumeTiles* part, const int origin[3], const int count[3]);
+  ///@}
+
   /// Tiles of the last Compute() (0 after Clear()).
   std::uint64_t GetNumberOfTiles() const;
 
