@@ -40,15 +40,18 @@
  * uploads nothing but computes every brick's value range; Update() finds
  * the bricks the isovalues cross, uploads those not resident (each with the
  * apron its cells and gradients read, least recently used ones evicted to
- * stay within the budget) and builds a pyramid over each that counts only
- * the cells the brick owns; Render() draws those pyramids as pieces, each
- * placed at its brick, nearest brick first (farthest first for translucent
- * surfaces). Every cell is counted by exactly one brick, so the primitives
- * are the one-texture count exactly. Where the active bricks alone exceed
- * the budget, Update() fails with that reason (GetStats().OverBudget), and
- * the host falls back as for any other reason. Bricks read the host's values
- * when they become active: Data must stay valid while it is the scene's
- * volume (every host passes it to SetVolume() before each Update()).
+ * stay within the budget) into the slots of one pool texture and builds one
+ * pyramid over the pool that counts only the cells each slot's brick owns;
+ * Render() draws it in one pass, its slots walked in the bricks' visibility
+ * order (nearest brick first, farthest first for translucent surfaces), each
+ * cell placed at its brick through the slot table (SetBrickPool()). Where
+ * the pool cannot hold the active bricks, each is its own texture and
+ * pyramid, drawn as pieces in that order. Every cell is counted by exactly
+ * one brick, so the primitives are the one-texture count exactly. Where the active bricks alone
+ * exceed the budget, Update() fails with that reason (GetStats().OverBudget), and the host falls
+ * back as for any other reason. Bricks read the host's values when they become active: Data must
+ * stay valid while it is the scene's volume (every host passes it to SetVolume() before each
+ * Update()).
  *
  * The context of SetContext() (or one sharing its objects) must be current
  * in every call that touches GL: SetVolume(), Update(), Render(),
