@@ -96,18 +96,20 @@ vec4 walkEye;                // the eye in the texture's cell space (see startWa
 // translucent surfaces; mediso::IsosurfaceScene chooses it): entry i of
 // slotOrder (texel (i % 64, i / 64)) is the first primitive of the i-th
 // slot drawn and that slot, the entries' first primitives increasing. A
-// primitive finds its entry by a binary search (a constant bound, so that
-// the loop unrolls), then walks its slot's subtree of the pyramid from the
-// slot's node (the slot's side is a power of two, so the slot is one node
-// of level slotShift), with the eye moved into the slot, so that the cells
-// come out in the same order as from the brick's own pyramid.
+// primitive finds its entry by a binary search whose first step,
+// MEDISO_SLOT_SEARCH, is the power of two from half the pool's slots up (a
+// constant: the loop unrolls to log2 of the slots' steps), then walks its
+// slot's subtree of the pyramid from the slot's node (the slot's side is a
+// power of two, so the slot is one node of level slotShift), with the eye
+// moved into the slot, so that the cells come out in the same order as from
+// the brick's own pyramid.
 uniform usampler2D slotOrder;
 uniform int slotOrderCount;
 
 void startWalk(inout uint index, out ivec3 node)
 {
   int found = 0;
-  for (int step = 1024; step > 0; step >>= 1) // up to 2048 slots (HistoPyramidGL::MaximumSlots)
+  for (int step = MEDISO_SLOT_SEARCH; step > 0; step >>= 1)
   {
     int probe = found + step;
     if (probe < slotOrderCount && texelFetch(slotOrder, ivec2(probe & 63, probe >> 6), 0).x <= index)

@@ -292,6 +292,16 @@ HistoPyramidWalk HistoPyramidGL::GetWalk() const
     walk.Defines = "#define MEDISO_CHILD_MASKS 1\n";
   }
   walk.Defines += impl.Declarations();
+  if (impl.Pool)
+  {
+    // The binary search over the frame's slots (startWalk()): its first step.
+    int search = 1;
+    while (2 * search < impl.SlotCount())
+    {
+      search *= 2;
+    }
+    walk.Defines += "#define MEDISO_SLOT_SEARCH " + std::to_string(search) + "\n";
+  }
   std::ostringstream levels, descent;
   for (int l = 1; l + 1 < numLevels; ++l)
   {

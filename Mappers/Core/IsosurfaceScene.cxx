@@ -617,7 +617,6 @@ bool IsosurfaceScene::Internals::UpdatePool(const std::vector<std::int64_t>& act
     }
     this->ReleasePool();
     this->Pool.reset(new HistoPyramidGL(this->GL));
-    this->Pool->ShareProgramsWith(*this->Pyramid);
     const int cells[3] = { this->Volume.Dims[0] - 1, this->Volume.Dims[1] - 1,
       this->Volume.Dims[2] - 1 };
     std::string why;
@@ -626,6 +625,7 @@ bool IsosurfaceScene::Internals::UpdatePool(const std::vector<std::int64_t>& act
       this->ReleasePool(); // a context that cannot make it: the bricks' own pyramids
       return false;
     }
+    this->Pool->ShareProgramsWith(*this->Pyramid); // after the allocation, which starts afresh
     const std::size_t count = static_cast<std::size_t>(slots[0]) * slots[1] * slots[2];
     this->PoolBrick.assign(count, -1);
     this->PoolOwns.assign(count, 0);
