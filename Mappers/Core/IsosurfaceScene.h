@@ -47,11 +47,12 @@
  * cell placed at its brick through the slot table (SetBrickPool()). Where
  * the pool cannot hold the active bricks, each is its own texture and
  * pyramid, drawn as pieces in that order. Every cell is counted by exactly
- * one brick, so the primitives are the one-texture count exactly. Where the active bricks alone
- * exceed the budget, Update() fails with that reason (GetStats().OverBudget), and the host falls
- * back as for any other reason. Bricks read the host's values when they become active: Data must
- * stay valid while it is the scene's volume (every host passes it to SetVolume() before each
- * Update()).
+ * one brick, so the primitives are the one-texture count exactly. Where the
+ * active bricks alone exceed the budget, Update() fails with that reason
+ * (GetStats().OverBudget), and the host falls back as for any other reason.
+ * Bricks read the host's values when they become active: Data must stay
+ * valid while it is the scene's volume (every host passes it to SetVolume()
+ * before each Update()).
  *
  * The context of SetContext() (or one sharing its objects) must be current
  * in every call that touches GL: SetVolume(), Update(), Render(),
