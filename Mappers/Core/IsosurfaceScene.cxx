@@ -606,11 +606,17 @@ bool IsosurfaceScene::Internals::UpdatePool(const std::vector<std::int64_t>& act
   }
   if (!this->Pool || static_cast<std::size_t>(this->Pool->GetNumberOfSlots()) < active.size())
   {
-    // A pool for twice as many where that fits, so that a growing set of
-    // bricks does not make a new pool (and upload every brick again) each time.
-    const std::size_t slotsNow = this->Pool ? this->PoolBrick.size() : 0;
+    // Room for the next power of two of bricks where that fits: a growing set
+    // of bricks then seldom makes a new pool (and uploads every brick again),
+    // and the pyramid, whose levels are padded to powers of two, is no larger
+    // than for the active bricks alone.
+    std::size_t room = 1;
+    while (room < active.size())
+    {
+      room *= 2;
+    }
     int slots[3];
-    if (!this->ChoosePoolSlots(std::max(active.size(), 2 * slotsNow), side, slots) &&
+    if (!this->ChoosePoolSlots(room, side, slots) &&
       !this->ChoosePoolSlots(active.size(), side, slots))
     {
       return false;
