@@ -604,6 +604,18 @@ bool IsosurfaceScene::Internals::UpdatePool(const std::vector<std::int64_t>& act
   {
     side *= 2;
   }
+  // A slot is a cube: where the volume is thinner than a brick on an axis (a
+  // 4x4x2100 volume's bricks are 4x4x251 points), its bricks would fill a
+  // sliver of their slots. The pool then is not worth its memory; the bricks'
+  // own textures fit them.
+  {
+    int extent[6], points[3];
+    this->BrickTexture(0, extent, points); // the first brick is a whole one where any is
+    if (8.0 * points[0] * points[1] * points[2] < static_cast<double>(side) * side * side)
+    {
+      return false;
+    }
+  }
   if (!this->Pool || static_cast<std::size_t>(this->Pool->GetNumberOfSlots()) < active.size())
   {
     // Room for the next power of two of bricks where that fits: a growing set
