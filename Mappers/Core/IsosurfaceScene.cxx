@@ -369,11 +369,6 @@ bool IsosurfaceScene::GetBrickPool() const
   return this->Impl->UsePool;
 }
 
-int IsosurfaceScene::PoolBrickPoints(ScalarType type, int maxTextureSize, std::uint64_t budget)
-{
-  return ChooseBrickPoints(type, maxTextureSize / 2, budget);
-}
-
 int IsosurfaceScene::ChooseBrickPoints(ScalarType type, int maxTextureSize, std::uint64_t budget)
 {
   for (int k = 8; k > 4; --k)
@@ -396,9 +391,7 @@ int IsosurfaceScene::ChooseBrickPoints(ScalarType type, int maxTextureSize, std:
 bool IsosurfaceScene::Internals::AdoptBricks(
   const VolumeDescription& volume, const std::string& why, std::string& error)
 {
-  const int edge = this->UsePool
-    ? PoolBrickPoints(volume.Type, this->TextureLimit(), this->GetBudget())
-    : ChooseBrickPoints(volume.Type, this->TextureLimit(), this->GetBudget());
+  const int edge = ChooseBrickPoints(volume.Type, this->TextureLimit(), this->GetBudget());
   if (edge + 1 + 2 * BrickApron > this->TextureLimit())
   {
     error = why + ", and a brick of " + std::to_string(edge) + " points does not fit either";

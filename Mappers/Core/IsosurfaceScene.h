@@ -156,17 +156,15 @@ public:
    * and the budget (each slot a power of two a side, 16 points or more,
    * holding a brick with its apron), with an indirection per slot (the
    * brick's place in the volume and the cells it owns) and one pyramid over
-   * the pool, built once per isovalue change and drawn in one pass. With the
-   * pool, bricks are at most half the texture limit a side (PoolBrickPoints())
-   * so that the pool has room for several. Where the pool cannot hold the
-   * active bricks within the limit and the budget, they are drawn as their
-   * own pyramids, as with the pool off. A change takes effect at the next
-   * SetVolume().
+   * the pool, built once per isovalue change and drawn in one pass. The
+   * bricks are those of ChooseBrickPoints(), pool or not. Where the pool
+   * cannot hold the active bricks within the limit and the budget (a forced
+   * limit near the brick's size leaves room for few slots), they are drawn
+   * as their own pyramids, as with the pool off. A change takes effect at
+   * the next SetVolume().
    */
   void SetBrickPool(bool on);
   bool GetBrickPool() const;
-  /// The brick edge with the pool: ChooseBrickPoints() under half the texture limit.
-  static int PoolBrickPoints(ScalarType type, int maxTextureSize, std::uint64_t budget);
   ///@}
 
   /**

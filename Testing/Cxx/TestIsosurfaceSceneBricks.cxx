@@ -285,29 +285,30 @@ int main(int argc, char* argv[])
     { "bone, sample distance 2", { bone }, 200, 30, false, {}, 2.0f },
   };
   RunCases(gl, target, phantom, dims, cases, "int16");
-  // The same without the pool: bricks as large as the limit allows (24 points), each its own
-  // pyramid.
+  // The same with the pool off: each brick its own pyramid as well.
   {
     Bricking off;
     off.Pool = false;
     RunCases(gl, target, phantom, dims, { cases[1], cases[2] }, "int16, no pool", off);
   }
-  // The pool holding every active brick: 27 bricks of 56 points in 64-point slots of a pool
-  // within a texture limit of 128.
+  // The pool holding every active brick: 27 bricks of 56 points (a 24 MB budget allows no
+  // larger) in 64-point slots of a pool within a texture limit of 128.
   const int large[3] = { 150, 130, 120 };
   const std::vector<std::int16_t> largePhantom = pyramid_checks::MakePhantom(large, 40.0, 11);
   {
     Bricking pool;
     pool.Limit = 128;
-    pool.Budget = 32u << 20;
+    pool.Budget = 24u << 20;
     pool.PoolHolds = true;
     RunCases(gl, target, largePhantom, large, cases, "int16 pool", pool);
   }
   // Sizes whose last brick on an axis owns one plane of points and no cell (48 = 2 x 24).
   {
     const int edge[3] = { 49, 25, 49 };
-    RunCases(
-      gl, target, pyramid_checks::MakePhantom(edge, 40.0, 3), edge, { cases[1] }, "int16 49x25x49");
+    Bricking held; // 4 active bricks of 24: the pool's 4 slots of 32 under the limit hold them
+    held.PoolHolds = true;
+    RunCases(gl, target, pyramid_checks::MakePhantom(edge, 40.0, 3), edge, { cases[1] },
+      "int16 49x25x49", held);
   }
 
   // Float data with NaN values: cells with a NaN corner count nothing, in bricks too.
@@ -320,7 +321,7 @@ int main(int argc, char* argv[])
     RunCases(gl, target, values, dims, { cases[1] }, "float with NaN");
     Bricking pool;
     pool.Limit = 128;
-    pool.Budget = 32u << 20;
+    pool.Budget = 24u << 20;
     pool.PoolHolds = true;
     std::vector<float> largeValues(largePhantom.begin(), largePhantom.end());
     for (std::size_t i = 0; i < largeValues.size(); i += 37)
@@ -397,6 +398,7 @@ int main(int argc, char* argv[])
         IsosurfaceScene alone(nullptr);
         alone.SetContext(gl);
         alone.SetMaxTextureSize(128);
+        alone.SetGPUMemoryBudget(24u << 20); // bricks of 56 points
         alone.SetSurfaces({ Look(iso, 1, 1, 1, 1) });
         Check(alone.SetVolume(largeVolume, error) && alone.Update(error) &&
             alone.GetStats().PoolSlots > 0,
