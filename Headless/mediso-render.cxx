@@ -99,6 +99,8 @@ Context:
                         (default: half the device's memory where OpenGL tells it,
                         GL_NVX_gpu_memory_info or GL_ATI_meminfo, else 1 GiB);
                         MB are 10^6 bytes, as in ParaView; a volume over it is kept as bricks
+  --no-brick-pool       keep each resident brick as its own texture and pyramid
+                        (default: the bricks in one pool texture with one pyramid)
 MEDISO_EGL_PLATFORM=surfaceless|device|default picks the EGL display.
 )";
 
@@ -126,6 +128,7 @@ struct Options
   bool ES = true;
   int MaxTextureSize = 0;      // 0: the context's
   std::uint64_t GPUBudget = 0; // bytes; 0: the scene's default
+  bool BrickPool = true;
 };
 
 struct UsageError
@@ -367,6 +370,10 @@ Options Parse(int argc, char* argv[])
       }
       opt.ES = api == "es";
     }
+    else if (arg == "--no-brick-pool")
+    {
+      opt.BrickPool = false;
+    }
     else if (arg == "--max-texture-size")
     {
       const double n = Number(value("--max-texture-size"), "--max-texture-size");
@@ -472,6 +479,7 @@ public:
     this->Scene.SetContext(this->GL);
     this->Scene.SetMaxTextureSize(options.MaxTextureSize);
     this->Scene.SetGPUMemoryBudget(options.GPUBudget);
+    this->Scene.SetBrickPool(options.BrickPool);
   }
 
   ~HeadlessView()
@@ -775,8 +783,10 @@ int Run(int argc, char* argv[])
            << ", \"sample_distance\": " << stats.SampleDistance << ", \"bricks\": " << stats.Bricks
            << ", \"brick_points\": " << stats.BrickPoints
            << ", \"active_bricks\": " << stats.ActiveBricks
-           << ", \"resident_bricks\": " << stats.ResidentBricks << ", \"gpu_budget_mb\": "
-           << scene.Scene.GetGPUMemoryBudget() / 1e6 << "}";
+           << ", \"resident_bricks\": " << stats.ResidentBricks
+           << ", \"pool_slots\": " << stats.PoolSlots
+           << ", \"brick_pyramid_builds\": " << stats.BrickPyramidBuilds
+           << ", \"gpu_budget_mb\": " << scene.Scene.GetGPUMemoryBudget() / 1e6 << "}";
       std::printf("%s\n", json.str().c_str());
     }
   }

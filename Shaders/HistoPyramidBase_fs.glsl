@@ -21,6 +21,7 @@ void main()
   if (all(lessThan(cell, cellDimensions)))
   {
     VALUE_TYPE v[8];
+    selectSlot(slotOfCell(cell));
     fetchCorners(cell, v);
     count = bitCount8(cellMask(cell, v));
   }

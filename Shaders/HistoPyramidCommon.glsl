@@ -25,6 +25,64 @@ uniform ivec3 cellDimensions;      // real cells per axis (points - 1)
 uniform ivec3 ownedCellsFirst;     // the cells that count: [first, end) per axis (every cell,
 uniform ivec3 ownedCellsEnd;       // or those a brick owns: its apron is read, never counted)
 
+// A brick pool (MEDISO_BRICK_POOL; IsosurfaceScene's bricks in one texture):
+// the volume texture is a grid of slots, each 2^slotShift points a side,
+// each holding one brick's points (with the apron its cells and gradients
+// read) from the slot's point 0, or nothing. The slot table (the
+// indirection, one row per slot: x + slotsPerAxis.x (y + slotsPerAxis.y z))
+// holds, slot-local, the cells its brick owns, [first, end) (empty for an
+// empty slot or an inactive brick's), the brick's cells (its points - 1) and
+// where the slot's point 0 lies in the volume. Every shader selects the slot
+// of the cells it works on (selectSlot()); without a pool the one "slot" is
+// the whole volume, and the same code reads as before.
+#ifdef MEDISO_BRICK_POOL
+uniform usampler2D slotTable; // columns: (owned first, placement.x), (owned end, placement.y),
+                              // (brick cells, placement.z)
+uniform int slotShift;
+uniform ivec3 slotsPerAxis;
+#endif
+
+ivec3 slotOrigin;     // the slot's point 0 in the texture
+ivec3 slotCells;      // the brick's cells: its reads clamp to [slotOrigin, slotOrigin + slotCells]
+ivec3 slotOwnedFirst; // the cells that count, slot-local
+ivec3 slotOwnedEnd;
+ivec3 slotPlacement;  // the volume's point at the slot's point 0
+
+// The slot (per axis) of texture cell c.
+ivec3 slotOfCell(ivec3 c)
+{
+#ifdef MEDISO_BRICK_POOL
+  return c >> slotShift;
+#else
+  return ivec3(0);
+#endif
+}
+
+void selectSlot(ivec3 slot)
+{
+#ifdef MEDISO_BRICK_POOL
+  int row = slot.x + slotsPerAxis.x * (slot.y + slotsPerAxis.y * slot.z);
+  ivec4 a = ivec4(texelFetch(slotTable, ivec2(0, row), 0));
+  ivec4 b = ivec4(texelFetch(slotTable, ivec2(1, row), 0));
+  ivec4 e = ivec4(texelFetch(slotTable, ivec2(2, row), 0));
+  slotOrigin = slot << slotShift;
+  slotOwnedFirst = a.xyz;
+  slotOwnedEnd = b.xyz;
+  slotCells = e.xyz;
+  slotPlacement = ivec3(a.w, b.w, e.w);
+  if (any(greaterThanEqual(slot, slotsPerAxis))) // the pyramid's padding: no slot, no cell
+  {
+    slotOwnedEnd = slotOwnedFirst;
+  }
+#else
+  slotOrigin = ivec3(0);
+  slotCells = cellDimensions;
+  slotOwnedFirst = ownedCellsFirst;
+  slotOwnedEnd = ownedCellsEnd;
+  slotPlacement = ivec3(0);
+#endif
+}
+
 // The volume is stored 4 points to a texel along x: texel (i, j, k) holds
 // points (4 i + c, j, k) in component c, and the last texel of a row repeats
 // the row's last point where the points run out (HistoPyramidGL's
@@ -32,11 +90,11 @@ uniform ivec3 ownedCellsEnd;       // or those a brick owns: its apron is read, 
 // whole rows of points (a level-1 node's, a packed texel of level 1's) then
 // need a fetch per 4 points instead of one per point.
 
-// Points 4 texelX .. 4 texelX + 3 of row (y, z) (y, z inside the volume);
+// Points 4 texelX .. 4 texelX + 3 of row (y, z) (y, z inside the slot);
 // past the row's end every one is the row's last point, as a clamp gives.
 VALUE_VEC4 pointQuad(int texelX, int y, int z)
 {
-  int last = cellDimensions.x >> 2; // the row's last texel
+  int last = (slotOrigin.x + slotCells.x) >> 2; // the row's last texel (slots start at a texel)
   VALUE_VEC4 quad = texelFetch(volume, ivec3(min(texelX, last), y, z), 0);
   return texelX <= last ? quad : quad.wwww;
 }
@@ -81,12 +139,14 @@ uint bitCount8(int mask)
   return bitCount8(uvec4(uint(mask), 0u, 0u, 0u)).x;
 }
 
-// Crossing mask of cell c (0 outside the owned cells, which lie in the real
-// cell grid, and, for float data, for a cell with a NaN corner), from its
-// corner values v[0..7], corner (dx, dy, dz) at index dx + 2 dy + 4 dz.
+// Crossing mask of cell c (0 outside the selected slot's owned cells, which
+// lie in the real cell grid, and, for float data, for a cell with a NaN
+// corner), from its corner values v[0..7], corner (dx, dy, dz) at index
+// dx + 2 dy + 4 dz.
 int cellMask(ivec3 c, VALUE_TYPE v[8])
 {
-  if (any(lessThan(c, ownedCellsFirst)) || any(greaterThanEqual(c, ownedCellsEnd)))
+  ivec3 local = c - slotOrigin;
+  if (any(lessThan(local, slotOwnedFirst)) || any(greaterThanEqual(local, slotOwnedEnd)))
   {
     return 0;
   }

@@ -74,6 +74,7 @@ void main()
 {
   ivec3 texel = packedTexel(ivec2(gl_FragCoord.xy), shifts);
   ivec3 base = ivec3(4 * texel.xy, texel.z * factor.z);
+  selectSlot(slotOfCell(base)); // a texel's 4 nodes lie in one slot (slots are 16 cells or more)
   VALUE_TYPE points[75]; // point base + (x, y, z) at x + 5 y + 25 z
   for (int r = 0; r < 15; ++r) // row r: points base + (0..4, r % 5, r / 5)
   {

@@ -88,13 +88,56 @@ flat out float vNearDepth;   // NDC depth of the footprint
 
 int vIsovalue;               // the isovalue this primitive draws (-1: none)
 vec3 cornerGradients[8];
+vec4 walkEye;                // the eye in the texture's cell space (see startWalk())
+
+#ifdef MEDISO_BRICK_POOL
+// A brick pool (see HistoPyramidCommon.glsl) is drawn slot by slot, in the
+// frame's order of its bricks (nearest first, farthest first for
+// translucent surfaces; mediso::IsosurfaceScene chooses it): entry i of
+// slotOrder (texel (i % 64, i / 64)) is the first primitive of the i-th
+// slot drawn and that slot, the entries' first primitives increasing. A
+// primitive finds its entry by a binary search whose first step,
+// MEDISO_SLOT_SEARCH, is the power of two from half the pool's slots up (a
+// constant: the loop unrolls to log2 of the slots' steps), then walks its
+// slot's subtree of the pyramid from the slot's node (the slot's side is a
+// power of two, so the slot is one node of level slotShift), with the eye
+// moved into the slot, so that the cells come out in the same order as from
+// the brick's own pyramid.
+uniform usampler2D slotOrder;
+uniform int slotOrderCount;
+
+void startWalk(inout uint index, out ivec3 node)
+{
+  int found = 0;
+  for (int step = MEDISO_SLOT_SEARCH; step > 0; step >>= 1)
+  {
+    int probe = found + step;
+    if (probe < slotOrderCount && texelFetch(slotOrder, ivec2(probe & 63, probe >> 6), 0).x <= index)
+    {
+      found = probe;
+    }
+  }
+  uvec4 entry = texelFetch(slotOrder, ivec2(found & 63, found >> 6), 0);
+  index -= entry.x;
+  node = ivec3(entry.yzw);
+  selectSlot(node);
+  walkEye = vec4(eyeIndex.xyz - vec3(slotPlacement - slotOrigin) * eyeIndex.w, eyeIndex.w);
+}
+#else
+void startWalk(inout uint index, out ivec3 node)
+{
+  node = ivec3(0);
+  selectSlot(node);
+  walkEye = eyeIndex;
+}
+#endif
 
 // Children of a node in visiting order: bit a of the returned mask flips
 // axis a, so that child (order ^ mask) is the order-th one visited.
 int orderMask(ivec3 node, ivec3 factor, vec3 childSpan)
 {
   vec3 split = (2.0 * vec3(node) + 1.0) * childSpan;
-  bvec3 plusSide = greaterThanEqual(eyeIndex.xyz - split * eyeIndex.w, vec3(0.0));
+  bvec3 plusSide = greaterThanEqual(walkEye.xyz - split * walkEye.w, vec3(0.0));
   int mask = (factor.x == 2 && plusSide.x ? 1 : 0) | (factor.y == 2 && plusSide.y ? 2 : 0) |
     (factor.z == 2 && plusSide.z ? 4 : 0);
   if (backToFront == 1)
@@ -199,10 +242,11 @@ void descendToMasks(usampler2D lower, ivec3 factor, ivec3 shifts, vec3 childSpan
 // upper one; those 12 of the 24 neighbours are fetched (4 per axis), the
 // other 12 and the 8 corners cost no fetch (20 fetches fewer per vertex).
 // Points beyond the volume clamp to its border as in the node's block, so
-// the difference is one-sided there.
+// the difference is one-sided there (beyond the slot's brick in a pool: its
+// border is the volume's wherever a read reaches it).
 float outside(ivec3 p)
 {
-  return float(pointValue(clamp(p, ivec3(0), cellDimensions)));
+  return float(pointValue(clamp(p, slotOrigin, slotOrigin + slotCells)));
 }
 
 // The 4 values of a line of the neighbourhood from the node's 3 on it, for
@@ -224,9 +268,10 @@ vec4 shiftLine(bool upper, float n0, float n1, float n2)
     vec3 outer = vec3(q[1 + DY + 4 * (1 + DZ)][3 * DX], q[3 * DY + 4 * (1 + DZ)][1 + DX],   \
       q[1 + DY + 4 * 3 * DZ][1 + DX]);                                                     \
     vec3 sgn = vec3(DX == 0 ? 1.0 : -1.0, DY == 0 ? 1.0 : -1.0, DZ == 0 ? 1.0 : -1.0);       \
-    vec3 span = vec3(1.0) + vec3(DX == 0 ? corner.x > 0 : corner.x < cellDimensions.x,     \
-                               DY == 0 ? corner.y > 0 : corner.y < cellDimensions.y,       \
-                               DZ == 0 ? corner.z > 0 : corner.z < cellDimensions.z);      \
+    ivec3 top = slotOrigin + slotCells;                                                    \
+    vec3 span = vec3(1.0) + vec3(DX == 0 ? corner.x > slotOrigin.x : corner.x < top.x,     \
+                               DY == 0 ? corner.y > slotOrigin.y : corner.y < top.y,       \
+                               DZ == 0 ? corner.z > slotOrigin.z : corner.z < top.z);      \
     cornerGradients[I] = sgn * (inside - outer) / span;                                       \
   }
 
@@ -472,7 +517,8 @@ bool cellClippedAway(ivec3 c)
 void main()
 {
   uint index = uint(MEDISO_PRIMITIVE);
-  ivec3 node = ivec3(0);
+  ivec3 node;
+  startWalk(index, node);
 #ifdef MEDISO_CHILD_MASKS
   int nodeBits = 0; // the level-1 node's child mask, from its last step down
 #endif
@@ -491,8 +537,8 @@ void main()
   bool secondHalf = (first.x & 2) != 0;
   for (int r = 0; r < 9; ++r) // row r: points first + (0..2, r % 3, r / 3)
   {
-    int y = min(first.y + r % 3, cellDimensions.y);
-    int z = min(first.z + r / 3, cellDimensions.z);
+    int y = min(first.y + r % 3, slotOrigin.y + slotCells.y);
+    int z = min(first.z + r / 3, slotOrigin.z + slotCells.z);
     VALUE_VEC4 a = pointQuad(texelX, y, z);
     VALUE_VEC4 b = pointQuad(texelX + 1, y, z);
     p[3 * r] = secondHalf ? a.z : a.x;
@@ -533,7 +579,9 @@ void main()
   int c = pickChild(countsLow, countsHigh, orderMask(node, firstFactor, vec3(1.0)), index);
   ivec3 cell = first + ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
   int mask = c < 4 ? masksLow[c & 3] : masksHigh[c & 3];
-  vCellMask = ivec4(cell, mask);
+  // Where the cell lies in the volume (a pool's slot holds its brick elsewhere).
+  ivec3 placed = cell - slotOrigin + slotPlacement;
+  vCellMask = ivec4(placed, mask);
   // The index-th crossing isovalue, in increasing threshold order.
   vIsovalue = -1;
   int rank = int(index);
@@ -548,13 +596,13 @@ void main()
     vIsovalue = -1;
   }
 #ifdef MEDISO_CULL_CELLS
-  if (vIsovalue >= 0 && cellOffScreen(cell))
+  if (vIsovalue >= 0 && cellOffScreen(placed))
   {
     vIsovalue = -1;
   }
 #endif
 #ifdef MEDISO_CLIP_PLANES
-  if (vIsovalue >= 0 && cellClippedAway(cell))
+  if (vIsovalue >= 0 && cellClippedAway(placed))
   {
     vIsovalue = -1;
   }
@@ -585,7 +633,7 @@ void main()
 #else
     surfaceBox(vLow, vHigh, vLook.w, boxLo, boxHi);
 #endif
-    footprint(cell, boxLo, boxHi);
+    footprint(placed, boxLo, boxHi);
   }
   else
   {

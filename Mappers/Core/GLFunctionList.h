@@ -45,7 +45,7 @@
   X(GetProgramInfoLog) X(GetProgramiv) X(GetShaderInfoLog) X(GetShaderiv) X(GetString)              \
   X(GetStringi) X(GetUniformLocation) X(IsEnabled) X(LinkProgram) X(PixelStorei) X(ReadBuffer)      \
   X(ReadPixels) X(RenderbufferStorage) X(ShaderSource) X(TexImage2D) X(TexImage3D)                  \
-  X(TexSubImage3D)                                                                                 \
+  X(TexSubImage2D) X(TexSubImage3D)                                                               \
   X(TexParameteri) X(Uniform1f) X(Uniform1fv) X(Uniform1i) X(Uniform1iv) X(Uniform1uiv)            \
   X(Uniform2f) X(Uniform2i) X(Uniform3fv) X(Uniform3i) X(Uniform4f) X(Uniform4fv)                   \
   X(UniformMatrix3fv) X(UniformMatrix4fv) X(UseProgram) X(VertexAttribPointer) X(Viewport)

@@ -77,6 +77,21 @@ struct HistoPyramidGL::Internals
   // Per level-1 tile, the least and greatest value its cells read.
   VolumeTiles Tiles;
 
+  // A brick pool (AllocatePool()): slots of 2^SlotShift points a side, the
+  // slot table (one row of 3 RGBA32UI texels per slot, as the shaders read
+  // it, and its CPU copy), each slot's brick tiles, the last build's counts
+  // per slot, and the frame's order of the slots (64 entries to a row).
+  bool Pool = false;
+  int SlotShift = 0;
+  int SlotsPerAxis[3] = { 0, 0, 0 };
+  int DrawnCells[3] = { 0, 0, 0 };
+  Name SlotTable;
+  std::vector<std::array<GLuint, 12>> SlotRows;
+  std::vector<VolumeTiles> SlotTiles;
+  std::vector<std::uint32_t> SlotTotals;
+  Name SlotOrder;
+  int SlotOrderCount = 0;
+
   // The stored levels (index = level; 0 is empty), each a 2D atlas.
   std::vector<Name> Levels;
   bool Built = false;
@@ -99,8 +114,16 @@ struct HistoPyramidGL::Internals
   std::string Declarations() const;
   /// The hook that puts HistoPyramidCommon.glsl in a shader.
   Hooks CommonHooks() const;
-  /// The uniforms of HistoPyramidCommon.glsl on the bound program; the volume is on `volumeUnit`.
-  void SetCommonUniforms(Program& program, const IsoThresholds& t, int volumeUnit) const;
+  /// The uniforms of HistoPyramidCommon.glsl on the bound program; the volume is on
+  /// `volumeUnit`, a pool's slot table is bound to `tableUnit`.
+  void SetCommonUniforms(
+    Program& program, const IsoThresholds& t, int volumeUnit, int tableUnit) const;
+  /// A pool slot's row of the table sent to the GPU, and its tiles placed or emptied.
+  void UpdateSlot(int slot);
+  int SlotCount() const
+  {
+    return this->SlotsPerAxis[0] * this->SlotsPerAxis[1] * this->SlotsPerAxis[2];
+  }
 
   bool Target(GLuint texture, int width, int height, std::string& error);
   Program* Pass(
@@ -119,7 +142,8 @@ std::array<int, 3> HistoPyramidGL::Internals::Shifts(int level) const
 
 std::string HistoPyramidGL::Internals::Declarations() const
 {
-  return ValueKindDefines(ValueKindOf(this->Type));
+  return ValueKindDefines(ValueKindOf(this->Type)) +
+    (this->Pool ? "#define MEDISO_BRICK_POOL 1\n" : "");
 }
 
 Hooks HistoPyramidGL::Internals::CommonHooks() const
@@ -128,9 +152,16 @@ Hooks HistoPyramidGL::Internals::CommonHooks() const
 }
 
 void HistoPyramidGL::Internals::SetCommonUniforms(
-  Program& program, const IsoThresholds& t, int volumeUnit) const
+  Program& program, const IsoThresholds& t, int volumeUnit, int tableUnit) const
 {
   program.Set("volume", volumeUnit);
+  if (this->Pool)
+  {
+    BindTextureUnit(*this->GL, tableUnit, GL_TEXTURE_2D, this->SlotTable.Get());
+    program.Set("slotTable", tableUnit);
+    program.Set("slotShift", this->SlotShift);
+    program.Set3i("slotsPerAxis", this->SlotsPerAxis);
+  }
   program.Set("numberOfThresholds", t.Count);
   const int cells[3] = { this->Points[0] - 1, this->Points[1] - 1, this->Points[2] - 1 };
   program.Set3i("cellDimensions", cells);
@@ -176,6 +207,15 @@ void HistoPyramidGL::Internals::ReleaseAll()
     this->Programs->Clear();
   }
   this->Tiles.Clear();
+  this->Pool = false;
+  this->SlotShift = 0;
+  std::fill(this->SlotsPerAxis, this->SlotsPerAxis + 3, 0);
+  this->SlotTable.Reset();
+  this->SlotOrder.Reset();
+  this->SlotOrderCount = 0;
+  this->SlotRows.clear();
+  this->SlotTiles.clear();
+  this->SlotTotals.clear();
   this->Points[0] = this->Points[1] = this->Points[2] = 0;
   this->Layout = PyramidLayout();
   this->TilesDrawn = 0;
@@ -252,14 +292,25 @@ HistoPyramidWalk HistoPyramidGL::GetWalk() const
     walk.Defines = "#define MEDISO_CHILD_MASKS 1\n";
   }
   walk.Defines += impl.Declarations();
+  if (impl.Pool)
+  {
+    // The binary search over the frame's slots (startWalk()): its first step.
+    int search = 1;
+    while (2 * search < impl.SlotCount())
+    {
+      search *= 2;
+    }
+    walk.Defines += "#define MEDISO_SLOT_SEARCH " + std::to_string(search) + "\n";
+  }
   std::ostringstream levels, descent;
   for (int l = 1; l + 1 < numLevels; ++l)
   {
     levels << "uniform usampler2D level" << l << ";\n";
   }
   // One step down per level, with the level's constants: with one isovalue
-  // the last step reads level 1's child masks with the counts.
-  for (int l = numLevels - 1; l >= 2; --l)
+  // the last step reads level 1's child masks with the counts. A pool's walk
+  // starts at its slot's node (startWalk() in HistoPyramidIso_vs.glsl).
+  for (int l = impl.Pool ? impl.SlotShift : numLevels - 1; l >= 2; --l)
   {
     const int c = l - 1;
     const auto factor = layout.Factor(l);
@@ -274,7 +325,7 @@ HistoPyramidWalk HistoPyramidGL::GetWalk() const
   walk.Hooks = impl.CommonHooks();
   walk.Hooks.emplace_back("HistoPyramidLevels", levels.str());
   walk.Hooks.emplace_back("HistoPyramidDescent", descent.str());
-  walk.TextureUnits = numLevels - 1;
+  walk.TextureUnits = numLevels - 1 + (impl.Pool ? 2 : 0);
   return walk;
 }
 
@@ -284,13 +335,20 @@ void HistoPyramidGL::BindWalk(Program& program, int firstUnit) const
   const GLApi& gl = *impl.GL;
   const PyramidLayout& layout = impl.Layout;
   BindTextureUnit(gl, firstUnit, GL_TEXTURE_3D, impl.Volume.Get());
-  impl.SetCommonUniforms(program, impl.Current, firstUnit);
-  for (int l = 1; l + 1 < layout.GetNumberOfLevels(); ++l)
+  const int numLevels = layout.GetNumberOfLevels();
+  impl.SetCommonUniforms(program, impl.Current, firstUnit, firstUnit + numLevels - 1);
+  for (int l = 1; l + 1 < numLevels; ++l)
   {
     BindTextureUnit(gl, firstUnit + l, GL_TEXTURE_2D, impl.Levels[l].Get());
     program.Set(("level" + std::to_string(l)).c_str(), firstUnit + l);
   }
   program.Set3i("firstFactor", layout.Factor(1).data());
+  if (impl.Pool)
+  {
+    BindTextureUnit(gl, firstUnit + numLevels, GL_TEXTURE_2D, impl.SlotOrder.Get());
+    program.Set("slotOrder", firstUnit + numLevels);
+    program.Set("slotOrderCount", impl.SlotOrderCount);
+  }
 }
 
 std::uint64_t HistoPyramidGL::GetNumberOfTiles() const
@@ -486,7 +544,7 @@ void HistoPyramidGL::EmptyTiles()
   Internals& impl = *this->Impl;
   if (impl.Volume)
   {
-    impl.Tiles.Empty(impl.Type, impl.Layout);
+    impl.Tiles.Reset(impl.Type, impl.Layout);
   }
   impl.Built = false;
   impl.Total = 0;
@@ -733,7 +791,7 @@ bool HistoPyramidGL::Build(const std::vector<double>& isovalues, std::string& er
     {
       first->Use();
       BindTextureUnit(gl, 0, GL_TEXTURE_3D, impl.Volume.Get());
-      impl.SetCommonUniforms(*first, thresholds, 0);
+      impl.SetCommonUniforms(*first, thresholds, 0, 1);
       const auto factor = layout.Factor(1);
       const auto shifts = impl.Shifts(1);
       first->Set3i("factor", factor.data());
@@ -797,7 +855,314 @@ bool HistoPyramidGL::Build(const std::vector<double>& isovalues, std::string& er
   impl.ChildMasks = childMasks;
   impl.TilesDrawn = tilesDrawn;
   impl.Built = true;
+  if (impl.Pool)
+  {
+    // Each slot's count: its node of level SlotShift (a few texels read back).
+    std::vector<std::uint32_t> counts;
+    int size[3];
+    if (!this->ReadLevel(impl.SlotShift, counts, size, false, error))
+    {
+      impl.Built = false;
+      return false;
+    }
+    const int* n = impl.SlotsPerAxis;
+    impl.SlotTotals.assign(static_cast<std::size_t>(impl.SlotCount()), 0u);
+    for (int z = 0; z < n[2]; ++z)
+      for (int y = 0; y < n[1]; ++y)
+        for (int x = 0; x < n[0]; ++x)
+        {
+          impl.SlotTotals[static_cast<std::size_t>(x + n[0] * (y + n[1] * z))] =
+            counts[(static_cast<std::size_t>(z) * size[1] + y) * size[0] + x];
+        }
+    impl.SlotOrderCount = 0;
+  }
   return true;
+}
+
+//------------------------------------------------------------------------------
+bool HistoPyramidGL::AllocatePool(ScalarType type, int slotPoints, const int slots[3],
+  const int drawnCells[3], const GLParallelFor& parallel, std::string& error)
+{
+  Internals& impl = *this->Impl;
+  const GLApi& gl = *impl.GL;
+  const GLApi::Functions& f = gl.F();
+  const int shift = Log2(slotPoints);
+  if (slotPoints < 16 || (1 << shift) != slotPoints || slots[0] < 1 || slots[1] < 1 ||
+    slots[2] < 1 || static_cast<long long>(slots[0]) * slots[1] * slots[2] > MaximumSlots)
+  {
+    error = "a brick pool takes slots of 16 or more points a side, a power of two, and 1 to " +
+      std::to_string(MaximumSlots) + " slots";
+    return false;
+  }
+  const int points[3] = { slots[0] * slotPoints, slots[1] * slotPoints, slots[2] * slotPoints };
+  const int cells[3] = { points[0] - 1, points[1] - 1, points[2] - 1 };
+  const PyramidLayout layout(cells);
+  const int width = PackedVolumeWidth(points[0]);
+  std::string limit;
+  if (std::max({ width, points[1], points[2] }) > gl.GetMax3DTextureSize())
+  {
+    limit = "GL_MAX_3D_TEXTURE_SIZE";
+  }
+  for (int l = 1; l < layout.GetNumberOfLevels(); ++l)
+  {
+    const auto atlas = layout.AtlasSize(l);
+    limit = std::max(atlas[0], atlas[1]) > gl.GetMaxTextureSize() ? "GL_MAX_TEXTURE_SIZE" : limit;
+  }
+  if (!limit.empty())
+  {
+    error = "a brick pool of " + std::to_string(slots[0]) + "x" + std::to_string(slots[1]) + "x" +
+      std::to_string(slots[2]) + " slots exceeds " + limit;
+    return false;
+  }
+  const VolumeFormat format = VolumeFormatOf(type);
+  const int count = slots[0] * slots[1] * slots[2];
+  ScopedGLState saved(gl, 1);
+  gl.TakeErrors();
+  impl.ReleaseAll();
+  impl.Volume = Name(gl, NameKind::Texture);
+  BindTextureUnit(gl, 0, GL_TEXTURE_3D, impl.Volume.Get());
+  SetNearest(gl, GL_TEXTURE_3D);
+  f.TexImage3D(GL_TEXTURE_3D, 0, static_cast<GLint>(format.InternalFormat), width, points[1],
+    points[2], 0, format.Format, format.Type, nullptr);
+  // The table: every slot empty (owns no cell).
+  impl.SlotRows.assign(static_cast<std::size_t>(count), std::array<GLuint, 12>{});
+  impl.SlotTable = Name(gl, NameKind::Texture);
+  BindTextureUnit(gl, 0, GL_TEXTURE_2D, impl.SlotTable.Get());
+  SetNearest(gl, GL_TEXTURE_2D);
+  f.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  f.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  f.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32UI, 3, count, 0, GL_RGBA_INTEGER, GL_UNSIGNED_INT,
+    impl.SlotRows.data());
+  impl.SlotOrder = Name(gl, NameKind::Texture);
+  const std::string errors = gl.TakeErrors();
+  if (!errors.empty())
+  {
+    error = "cannot allocate a brick pool of " + std::to_string(points[0]) + "x" +
+      std::to_string(points[1]) + "x" + std::to_string(points[2]) + " points: " + errors;
+    impl.ReleaseAll();
+    return false;
+  }
+  impl.Pool = true;
+  impl.SlotShift = shift;
+  std::copy(slots, slots + 3, impl.SlotsPerAxis);
+  std::copy(drawnCells, drawnCells + 3, impl.DrawnCells);
+  impl.SlotTiles.assign(static_cast<std::size_t>(count), VolumeTiles());
+  impl.SlotTotals.assign(static_cast<std::size_t>(count), 0u);
+  impl.Type = type;
+  impl.Layout = layout;
+  impl.Parallel = SerialIfEmpty(parallel);
+  impl.Tiles.Reset(type, layout);
+  std::copy(points, points + 3, impl.Points);
+  std::fill(impl.OwnedFirst, impl.OwnedFirst + 3, 0);
+  std::fill(impl.OwnedEnd, impl.OwnedEnd + 3, 0);
+  return true;
+}
+
+bool HistoPyramidGL::UploadSlot(
+  int slot, const void* values, const int points[3], const int placement[3], std::string& error)
+{
+  Internals& impl = *this->Impl;
+  const GLApi& gl = *impl.GL;
+  const GLApi::Functions& f = gl.F();
+  const int side = 1 << impl.SlotShift;
+  if (!impl.Pool || slot < 0 || slot >= impl.SlotCount() || !values ||
+    std::min({ points[0], points[1], points[2] }) < 2 ||
+    std::max({ points[0], points[1], points[2] }) > side)
+  {
+    error = "a brick of " + std::to_string(points[0]) + "x" + std::to_string(points[1]) + "x" +
+      std::to_string(points[2]) + " points does not fit slot " + std::to_string(slot) +
+      " of the brick pool";
+    return false;
+  }
+  const std::int64_t numPoints = static_cast<std::int64_t>(points[0]) * points[1] * points[2];
+  const VolumeFormat format = VolumeFormatOf(impl.Type);
+  std::vector<float> converted;
+  std::vector<unsigned char> packed;
+  const void* data = values;
+  try
+  {
+    if (impl.Type == ScalarType::Float64)
+    {
+      converted.resize(static_cast<std::size_t>(numPoints));
+      const double* d = static_cast<const double*>(values);
+      for (std::int64_t i = 0; i < numPoints; ++i)
+      {
+        converted[static_cast<std::size_t>(i)] = static_cast<float>(d[i]);
+      }
+      data = converted.data();
+    }
+    if (points[0] % 4 != 0)
+    {
+      packed = PackVolumeRows(data, points, format.BytesPerValue, impl.Parallel);
+    }
+  }
+  catch (const std::bad_alloc&)
+  {
+    error = "memory ran out while copying a brick for the GPU upload";
+    return false;
+  }
+  const int* n = impl.SlotsPerAxis;
+  const int s[3] = { slot % n[0], (slot / n[0]) % n[1], slot / (n[0] * n[1]) };
+  ScopedGLState saved(gl, 1);
+  gl.TakeErrors();
+  BindTextureUnit(gl, 0, GL_TEXTURE_3D, impl.Volume.Get());
+  f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  f.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  f.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
+  f.TexSubImage3D(GL_TEXTURE_3D, 0, s[0] * side / 4, s[1] * side, s[2] * side,
+    PackedVolumeWidth(points[0]), points[1], points[2], format.Format, format.Type,
+    packed.empty() ? data : packed.data());
+  const std::string errors = gl.TakeErrors();
+  if (!errors.empty())
+  {
+    error = "cannot upload a brick into the brick pool: " + errors;
+    return false;
+  }
+  const int cells[3] = { points[0] - 1, points[1] - 1, points[2] - 1 };
+  impl.SlotTiles[static_cast<std::size_t>(slot)].Compute(
+    impl.Type == ScalarType::Float64 ? ScalarType::Float32 : impl.Type, data, points,
+    PyramidLayout(cells), impl.Parallel);
+  std::array<GLuint, 12>& row = impl.SlotRows[static_cast<std::size_t>(slot)];
+  for (int a = 0; a < 3; ++a)
+  {
+    row[a] = row[4 + a] = 0; // owns nothing until SetSlotCells()
+    row[8 + a] = static_cast<GLuint>(cells[a]);
+    row[4 * a + 3] = static_cast<GLuint>(placement[a]);
+  }
+  impl.UpdateSlot(slot);
+  return true;
+}
+
+void HistoPyramidGL::SetSlotCells(int slot, const int first[3], const int end[3])
+{
+  Internals& impl = *this->Impl;
+  if (!impl.Pool || slot < 0 || slot >= impl.SlotCount())
+  {
+    return;
+  }
+  std::array<GLuint, 12>& row = impl.SlotRows[static_cast<std::size_t>(slot)];
+  bool empty = false;
+  for (int a = 0; a < 3; ++a)
+  {
+    const int last = static_cast<int>(row[8 + a]);
+    const int lo = std::max(0, std::min(first[a], last));
+    const int hi = std::max(lo, std::min(end[a], last));
+    empty = empty || lo == hi;
+    row[a] = static_cast<GLuint>(lo);
+    row[4 + a] = static_cast<GLuint>(hi);
+  }
+  if (empty)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      row[a] = row[4 + a] = 0;
+    }
+  }
+  impl.UpdateSlot(slot);
+}
+
+void HistoPyramidGL::Internals::UpdateSlot(int slot)
+{
+  const GLApi& gl = *this->GL;
+  const GLApi::Functions& f = gl.F();
+  const std::array<GLuint, 12>& row = this->SlotRows[static_cast<std::size_t>(slot)];
+  {
+    ScopedGLState saved(gl, 1);
+    BindTextureUnit(gl, 0, GL_TEXTURE_2D, this->SlotTable.Get());
+    f.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    f.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    f.TexSubImage2D(GL_TEXTURE_2D, 0, 0, slot, 3, 1, GL_RGBA_INTEGER, GL_UNSIGNED_INT, row.data());
+  }
+  // Its tiles: the brick's where it owns cells, else none drawn.
+  const int side = 1 << this->SlotShift;
+  const int* n = this->SlotsPerAxis;
+  const int s[3] = { slot % n[0], (slot / n[0]) % n[1], slot / (n[0] * n[1]) };
+  const int cellsPerTile[3] = { 4 * PyramidLayout::TileTexels, 4 * PyramidLayout::TileTexels, 2 };
+  int origin[3], count[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    origin[a] = s[a] * side / cellsPerTile[a];
+    count[a] = side / cellsPerTile[a];
+  }
+  const bool owns = row[4] > row[0];
+  this->Tiles.Place(
+    owns ? &this->SlotTiles[static_cast<std::size_t>(slot)] : nullptr, origin, count);
+  this->Built = false;
+  this->Total = 0;
+}
+
+void HistoPyramidGL::SetSlotOrder(const std::vector<int>& slots)
+{
+  Internals& impl = *this->Impl;
+  if (!impl.Pool || !impl.Built)
+  {
+    return;
+  }
+  const GLApi& gl = *impl.GL;
+  const GLApi::Functions& f = gl.F();
+  // Entries (first primitive, slot x, y, z) of the slots with primitives, in
+  // the order given, then any such slot not given (every primitive must
+  // find its slot).
+  std::vector<GLuint> entries;
+  std::vector<char> listed(impl.SlotTotals.size(), 0);
+  GLuint first = 0;
+  const int* n = impl.SlotsPerAxis;
+  auto add = [&](int slot)
+  {
+    if (slot < 0 || slot >= impl.SlotCount() || listed[static_cast<std::size_t>(slot)] ||
+      impl.SlotTotals[static_cast<std::size_t>(slot)] == 0)
+    {
+      return;
+    }
+    listed[static_cast<std::size_t>(slot)] = 1;
+    entries.insert(entries.end(),
+      { first, static_cast<GLuint>(slot % n[0]), static_cast<GLuint>((slot / n[0]) % n[1]),
+        static_cast<GLuint>(slot / (n[0] * n[1])) });
+    first += impl.SlotTotals[static_cast<std::size_t>(slot)];
+  };
+  for (const int slot : slots)
+  {
+    add(slot);
+  }
+  for (int slot = 0; slot < impl.SlotCount(); ++slot)
+  {
+    add(slot);
+  }
+  impl.SlotOrderCount = static_cast<int>(entries.size() / 4);
+  const int rows = std::max(1, (impl.SlotOrderCount + 63) / 64);
+  entries.resize(static_cast<std::size_t>(4 * 64 * rows), 0u);
+  ScopedGLState saved(gl, 1);
+  BindTextureUnit(gl, 0, GL_TEXTURE_2D, impl.SlotOrder.Get());
+  SetNearest(gl, GL_TEXTURE_2D);
+  f.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  f.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  f.TexImage2D(
+    GL_TEXTURE_2D, 0, GL_RGBA32UI, 64, rows, 0, GL_RGBA_INTEGER, GL_UNSIGNED_INT, entries.data());
+}
+
+bool HistoPyramidGL::IsPool() const
+{
+  return this->Impl->Pool;
+}
+
+int HistoPyramidGL::GetNumberOfSlots() const
+{
+  return this->Impl->Pool ? this->Impl->SlotCount() : 0;
+}
+
+const std::vector<std::uint32_t>& HistoPyramidGL::GetSlotTotals() const
+{
+  return this->Impl->SlotTotals;
+}
+
+std::array<int, 3> HistoPyramidGL::GetDrawnCells() const
+{
+  const Internals& impl = *this->Impl;
+  if (impl.Pool)
+  {
+    return { { impl.DrawnCells[0], impl.DrawnCells[1], impl.DrawnCells[2] } };
+  }
+  return impl.Layout.GetCells();
 }
 
 //------------------------------------------------------------------------------
@@ -817,7 +1182,7 @@ bool HistoPyramidGL::ReadLevel(
   std::copy(s.begin(), s.end(), size);
   counts.assign(static_cast<std::size_t>(s[0]) * s[1] * s[2], 0u);
 
-  ScopedGLState saved(gl, 1);
+  ScopedGLState saved(gl, 2);
   gl.TakeErrors();
   SetCountingPassState(gl);
   f.PixelStorei(GL_PACK_ALIGNMENT, 4);
@@ -852,7 +1217,7 @@ bool HistoPyramidGL::ReadLevel(
     }
     base->Use();
     BindTextureUnit(gl, 0, GL_TEXTURE_3D, impl.Volume.Get());
-    impl.SetCommonUniforms(*base, impl.Current, 0);
+    impl.SetCommonUniforms(*base, impl.Current, 0, 1);
     const int shifts[3] = { Log2(s[0]), Log2(s[1]), Log2(columns) };
     base->Set3i("shifts", shifts);
     impl.DrawFullScreen();

@@ -140,6 +140,47 @@ public:
    */
   void SetOwnedCells(const int first[3], const int end[3]);
 
+  ///@{
+  /**
+   * A brick pool: the volume texture as a grid of `slots` slots of
+   * `slotPoints` points a side (a power of two, 16 or more), each holding
+   * one brick of a larger volume or nothing, and one pyramid over all of
+   * them (IsosurfaceScene's bricks, HistoPyramidCommon.glsl). A slot's side
+   * being a power of two makes it one node of level log2(slotPoints), which
+   * Build() reads back as the slot's count (GetSlotTotals()), and from which
+   * the walk descends into the slot.
+   *
+   * AllocatePool() replaces the volume by an empty pool (every slot counts
+   * nothing) whose primitives are placed in a volume of `drawnCells`
+   * cells. UploadSlot() puts a brick's `points` (each at most slotPoints;
+   * its values x fastest) into a slot with glTexSubImage3D, the slot's
+   * point 0 being the volume's point `placement`; it keeps counting nothing
+   * until SetSlotCells() says which of its cells count (slot-local
+   * [first, end); first == end: none, as for a resident brick the
+   * isovalues do not cross). SetSlotOrder() gives the frame's order of the
+   * slots to draw (their bricks' visibility order), after Build(). Each
+   * invalidates the pyramid where the counts change. False, with the reason,
+   * where the pool exceeds the context's limits or a GL call fails.
+   */
+  static constexpr int MaximumSlots = 2048;
+  bool AllocatePool(ScalarType type, int slotPoints, const int slots[3], const int drawnCells[3],
+    const GLParallelFor& parallel, std::string& error);
+  bool UploadSlot(
+    int slot, const void* values, const int points[3], const int placement[3], std::string& error);
+  void SetSlotCells(int slot, const int first[3], const int end[3]);
+  void SetSlotOrder(const std::vector<int>& slots);
+  bool IsPool() const;
+  int GetNumberOfSlots() const;
+  /// Per slot, the primitives the last Build() counted in it.
+  const std::vector<std::uint32_t>& GetSlotTotals() const;
+  ///@}
+
+  /**
+   * The cells of the index space the walk places primitives in: the
+   * layout's, or a pool's volume (AllocatePool()).
+   */
+  std::array<int, 3> GetDrawnCells() const;
+
   /**
    * Compile the build passes' programs once for several pyramids of one
    * context (the bricks of one volume): this pyramid uses `other`'s program

@@ -144,6 +144,13 @@ struct IsosurfaceSceneStats
   std::uint64_t BrickUploads = 0;
   bool OverBudget = false;
   ///@}
+  ///@{
+  /// The brick pool (IsosurfaceScene::SetBrickPool()): its slots (0: none, the bricks drawn as
+  /// their own pyramids), and the pyramids the last build of a bricked volume built (1 with the
+  /// pool, one per active brick without).
+  std::uint64_t PoolSlots = 0;
+  std::uint64_t BrickPyramidBuilds = 0;
+  ///@}
 };
 
 } // namespace mediso

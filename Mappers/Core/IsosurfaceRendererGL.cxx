@@ -249,7 +249,7 @@ std::string ChooseVariant(
 
   // The footprint (points where they provably cover every cell) and the
   // first-hit pass (opaque frames with points).
-  const auto& cells = pyramid.GetLayout().GetCells();
+  const auto cells = pyramid.GetDrawnCells(); // a brick pool's: the volume's
   std::copy(cells.begin(), cells.end(), v.Cells);
   v.Points = frame.AllowPointFootprint &&
     PointsCoverCells(v.IndexToView, v.Projection, v.Cells, frame.NearPlane, frame.Parallel,

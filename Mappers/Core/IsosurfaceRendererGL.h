@@ -61,9 +61,13 @@
  * The still frame (distance 1) does not touch the reduced target. Where
  * the target cannot be made, the frame is drawn at every pixel instead.
  *
- * A volume kept as bricks (IsosurfaceScene over a texture limit or a GPU
- * budget) is drawn as pieces: one pyramid per brick, each over its own
- * sub-volume and counting only the cells the brick owns, placed by its
+ * A volume kept as bricks in a pool (IsosurfaceScene's default) is one
+ * pyramid and is drawn as a whole volume: its walk places each cell in the
+ * volume (HistoPyramidGL::GetDrawnCells() gives the box the footprint and
+ * culling tests use). Bricks the pool cannot hold (IsosurfaceScene over a
+ * texture limit or a GPU budget) are drawn as pieces: one pyramid per
+ * brick, each over its own sub-volume and counting only the cells the
+ * brick owns, placed by its
  * offset in the volume's cell-index space. Each piece is drawn as above
  * with the frame moved into the piece's index space (its matrices and
  * clipping planes shifted by the offset), in the order given (the scene

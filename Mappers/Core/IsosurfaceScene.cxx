@@ -133,6 +133,19 @@ struct IsosurfaceScene::Internals
   std::unordered_map<std::int64_t, std::unique_ptr<HistoPyramidGL>> Bricks;
   std::vector<std::int64_t> Active;
 
+  // The brick pool (SetBrickPool()): the resident bricks in the slots of one
+  // texture with one pyramid (PoolBrick: the brick in each slot, -1 for
+  // none; PoolOwns: whether the slot's cells count in the current build),
+  // least recently used slots given to new bricks (PoolResidency counts
+  // slots, one "byte" each). PoolDrawn: the last build used the pool.
+  bool UsePool = true;
+  std::unique_ptr<HistoPyramidGL> Pool;
+  std::vector<std::int64_t> PoolBrick;
+  std::vector<char> PoolOwns;
+  std::unordered_map<std::int64_t, int> PoolSlot;
+  BrickResidency PoolResidency;
+  bool PoolDrawn = false;
+
   int TextureLimit() const
   {
     const int context = this->GL ? this->GL->GetMax3DTextureSize() : 0;
@@ -164,7 +177,21 @@ struct IsosurfaceScene::Internals
     this->BrickTexture(brick, extent, points);
     return HistoPyramidGL::EstimateGPUMemoryBytes(this->Volume.Type, points);
   }
-  void ReleaseBricks()
+  void ReleasePool()
+  {
+    if (this->Pool)
+    {
+      this->Pool->Release();
+    }
+    this->Pool.reset();
+    this->PoolBrick.clear();
+    this->PoolOwns.clear();
+    this->PoolSlot.clear();
+    this->PoolResidency.Clear();
+    this->PoolDrawn = false;
+    this->Stats.PoolSlots = 0;
+  }
+  void ReleaseBrickPyramids()
   {
     for (auto& brick : this->Bricks)
     {
@@ -172,6 +199,11 @@ struct IsosurfaceScene::Internals
     }
     this->Bricks.clear();
     this->Residency.Clear();
+  }
+  void ReleaseBricks()
+  {
+    this->ReleasePool();
+    this->ReleaseBrickPyramids();
     this->Active.clear();
     this->Bricked = false;
     this->Grid = BrickGrid();
@@ -182,6 +214,10 @@ struct IsosurfaceScene::Internals
   }
   bool AdoptBricks(const VolumeDescription& volume, const std::string& why, std::string& error);
   bool UpdateBricks(const std::vector<double>& values, std::string& error);
+  bool UpdatePool(const std::vector<std::int64_t>& active, const std::vector<double>& values,
+    bool& held, std::string& error);
+  bool ChoosePoolSlots(std::size_t count, int side, int slots[3]) const;
+  std::vector<std::int64_t> VisibilityOrder(const IsosurfaceFrame& frame) const;
   std::vector<IsosurfacePiece> Pieces(const IsosurfaceFrame& frame) const;
 };
 
@@ -200,6 +236,7 @@ void IsosurfaceScene::SetContext(std::shared_ptr<const GLApi> gl)
   impl.Pyramid.reset(impl.GL ? new HistoPyramidGL(impl.GL) : nullptr);
   impl.Renderer.reset(impl.GL ? new IsosurfaceRendererGL(impl.GL) : nullptr);
   impl.Bricks.clear(); // Release()d in their own context before, as the doc asks
+  impl.Pool.reset();
   impl.ReleaseBricks();
   impl.HasVolume = false;
   impl.BuiltValues.clear();
@@ -336,6 +373,20 @@ bool IsosurfaceScene::IsBricked() const
   return this->Impl->HasVolume && this->Impl->Bricked;
 }
 
+void IsosurfaceScene::SetBrickPool(bool on)
+{
+  if (on != this->Impl->UsePool)
+  {
+    this->Impl->UsePool = on;
+    this->Impl->HasVolume = false; // decided again at the next SetVolume()
+  }
+}
+
+bool IsosurfaceScene::GetBrickPool() const
+{
+  return this->Impl->UsePool;
+}
+
 int IsosurfaceScene::ChooseBrickPoints(ScalarType type, int maxTextureSize, std::uint64_t budget)
 {
   for (int k = 8; k > 4; --k)
@@ -405,6 +456,7 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
 {
   IsosurfaceSceneStats& stats = this->Stats;
   this->Active.clear(); // until every active brick is built
+  this->PoolDrawn = false;
   const std::vector<std::int64_t> active = ActiveBricks(this->Ranges, values);
   std::uint64_t need = 0;
   for (const std::int64_t brick : active)
@@ -420,6 +472,22 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
       " bricks that the isovalues cross need " + Megabytes(need) +
       " of GPU memory, over the budget of " + Megabytes(this->GetBudget());
     return false;
+  }
+  stats.BrickPyramidBuilds = 0;
+  if (this->UsePool)
+  {
+    bool held = false;
+    const bool built = this->UpdatePool(active, values, held, error);
+    if (held)
+    {
+      if (built)
+      {
+        this->Active = active;
+      }
+      return built;
+    }
+    // The pool cannot hold them within the limit and the budget: the bricks' own pyramids.
+    this->ReleasePool();
   }
   // Bricks in use first become the most recent, so that only others make room.
   for (const std::int64_t brick : active)
@@ -492,8 +560,199 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
     }
     stats.BuildTilesDrawn += pyramid.GetLastTilesDrawn();
     stats.BuildTiles += pyramid.GetNumberOfTiles();
+    ++stats.BrickPyramidBuilds;
   }
   this->Active = active;
+  return true;
+}
+
+// The slots per axis of a pool for `count` bricks of `side` points a side
+// within the texture limit, HistoPyramidGL::MaximumSlots and the budget: the
+// fewest bytes among the boxes of the fewest slots. False where none holds them.
+bool IsosurfaceScene::Internals::ChoosePoolSlots(std::size_t count, int side, int slots[3]) const
+{
+  const int limit = this->TextureLimit();
+  const int most[3] = { 4 * limit / side, limit / side, limit / side }; // 4 points to a texel in x
+  std::uint64_t best = ~std::uint64_t(0);
+  long long fewest = -1;
+  for (int z = 1; z <= most[2]; ++z)
+  {
+    for (int y = 1; y <= most[1]; ++y)
+    {
+      const long long plane = static_cast<long long>(y) * z;
+      const long long x = (static_cast<long long>(count) + plane - 1) / plane;
+      if (x < 1 || x > most[0] || x * plane > HistoPyramidGL::MaximumSlots)
+      {
+        continue;
+      }
+      const int points[3] = { static_cast<int>(x) * side, y * side, z * side };
+      const std::uint64_t bytes = HistoPyramidGL::EstimateGPUMemoryBytes(this->Volume.Type, points);
+      if (bytes > this->GetBudget() || (fewest >= 0 && x * plane > fewest) ||
+        (x * plane == fewest && bytes >= best))
+      {
+        continue;
+      }
+      fewest = x * plane;
+      best = bytes;
+      slots[0] = static_cast<int>(x);
+      slots[1] = y;
+      slots[2] = z;
+    }
+  }
+  return fewest > 0;
+}
+
+// The active bricks in the pool and the pool's pyramid built over them.
+// `held` false (and nothing changed but the pool let go) where the pool
+// cannot hold them; else the result is the build's.
+bool IsosurfaceScene::Internals::UpdatePool(const std::vector<std::int64_t>& active,
+  const std::vector<double>& values, bool& held, std::string& error)
+{
+  IsosurfaceSceneStats& stats = this->Stats;
+  held = false;
+  int side = 16;
+  while (side < this->Grid.GetBrickPoints() + 1 + 2 * BrickApron)
+  {
+    side *= 2;
+  }
+  // A slot is a cube: where the volume is thinner than a brick on an axis (a
+  // 4x4x2100 volume's bricks are 4x4x251 points), its bricks would fill a
+  // sliver of their slots. The pool then is not worth its memory; the bricks'
+  // own textures fit them.
+  {
+    int extent[6], points[3];
+    this->BrickTexture(0, extent, points); // the first brick is a whole one where any is
+    if (8.0 * points[0] * points[1] * points[2] < static_cast<double>(side) * side * side)
+    {
+      return false;
+    }
+  }
+  if (!this->Pool || static_cast<std::size_t>(this->Pool->GetNumberOfSlots()) < active.size())
+  {
+    // Room for the next power of two of bricks where that fits: a growing set
+    // of bricks then seldom makes a new pool (and uploads every brick again),
+    // and the pyramid, whose levels are padded to powers of two, is no larger
+    // than for the active bricks alone.
+    std::size_t room = 1;
+    while (room < active.size())
+    {
+      room *= 2;
+    }
+    int slots[3];
+    if (!this->ChoosePoolSlots(room, side, slots) &&
+      !this->ChoosePoolSlots(active.size(), side, slots))
+    {
+      return false;
+    }
+    this->ReleasePool();
+    this->Pool.reset(new HistoPyramidGL(this->GL));
+    const int cells[3] = { this->Volume.Dims[0] - 1, this->Volume.Dims[1] - 1,
+      this->Volume.Dims[2] - 1 };
+    std::string why;
+    if (!this->Pool->AllocatePool(this->Volume.Type, side, slots, cells, this->Parallel, why))
+    {
+      this->ReleasePool(); // a context that cannot make it: the bricks' own pyramids
+      return false;
+    }
+    this->Pool->ShareProgramsWith(*this->Pyramid); // after the allocation, which starts afresh
+    const std::size_t count = static_cast<std::size_t>(slots[0]) * slots[1] * slots[2];
+    this->PoolBrick.assign(count, -1);
+    this->PoolOwns.assign(count, 0);
+    this->PoolResidency.SetBudget(count);
+    stats.PoolSlots = count;
+  }
+  held = true;
+  this->ReleaseBrickPyramids(); // the pool holds the bricks now
+  stats.ResidentBricks = 0;
+  // Bricks in use first become the most recent, so that only others give up their slots.
+  for (const std::int64_t brick : active)
+  {
+    this->PoolResidency.Touch(brick);
+  }
+  const int bytesPerValue = ScalarTypeSize(this->Volume.Type);
+  std::vector<unsigned char> values3d;
+  for (const std::int64_t brick : active)
+  {
+    if (this->PoolResidency.IsResident(brick))
+    {
+      continue;
+    }
+    std::vector<std::int64_t> evicted;
+    this->PoolResidency.MakeResident(brick, 1, evicted);
+    for (const std::int64_t gone : evicted)
+    {
+      const auto found = this->PoolSlot.find(gone);
+      if (found != this->PoolSlot.end())
+      {
+        this->PoolBrick[static_cast<std::size_t>(found->second)] = -1;
+        this->PoolSlot.erase(found);
+      }
+    }
+    const auto free = std::find(this->PoolBrick.begin(), this->PoolBrick.end(), -1);
+    const int slot = static_cast<int>(free - this->PoolBrick.begin());
+    int extent[6], points[3];
+    this->BrickTexture(brick, extent, points);
+    try
+    {
+      values3d.resize(BrickGrid::ExtentPoints(extent) * bytesPerValue);
+    }
+    catch (const std::bad_alloc&)
+    {
+      this->PoolResidency.Evict(brick);
+      error = "memory ran out while copying a brick for the GPU upload";
+      return false;
+    }
+    CopyBrick(this->Grid, brick, extent, this->Volume.Data, bytesPerValue, values3d.data());
+    const int placement[3] = { extent[0], extent[2], extent[4] };
+    if (free == this->PoolBrick.end() ||
+      !this->Pool->UploadSlot(slot, values3d.data(), points, placement, error))
+    {
+      this->PoolResidency.Evict(brick);
+      error = error.empty() ? "the brick pool has no free slot" : error;
+      return false;
+    }
+    this->PoolBrick[static_cast<std::size_t>(slot)] = brick;
+    this->PoolOwns[static_cast<std::size_t>(slot)] = 0; // UploadSlot() leaves it owning nothing
+    this->PoolSlot[brick] = slot;
+    ++stats.BrickUploads;
+  }
+  // Each slot's cells count where its brick is active: the cells the brick owns.
+  std::vector<char> isActive(this->PoolBrick.size(), 0);
+  for (const std::int64_t brick : active)
+  {
+    isActive[static_cast<std::size_t>(this->PoolSlot.at(brick))] = 1;
+  }
+  for (std::size_t slot = 0; slot < this->PoolBrick.size(); ++slot)
+  {
+    if (isActive[slot] == this->PoolOwns[slot])
+    {
+      continue;
+    }
+    int first[3] = { 0, 0, 0 }, end[3] = { 0, 0, 0 };
+    if (isActive[slot])
+    {
+      int extent[6], points[3], owned[6];
+      const std::int64_t brick = this->PoolBrick[slot];
+      this->BrickTexture(brick, extent, points);
+      this->Grid.OwnedPoints(brick, owned);
+      for (int a = 0; a < 3; ++a)
+      {
+        first[a] = owned[2 * a] - extent[2 * a];
+        end[a] = owned[2 * a + 1] - extent[2 * a] + 1;
+      }
+    }
+    this->Pool->SetSlotCells(static_cast<int>(slot), first, end);
+    this->PoolOwns[slot] = isActive[slot];
+  }
+  stats.ResidentBricks = this->PoolResidency.GetNumberOfResidentBricks();
+  if (!this->Pool->Build(values, error))
+  {
+    return false;
+  }
+  stats.BuildTilesDrawn = this->Pool->GetLastTilesDrawn();
+  stats.BuildTiles = this->Pool->GetNumberOfTiles();
+  stats.BrickPyramidBuilds = 1;
+  this->PoolDrawn = true;
   return true;
 }
 
@@ -503,7 +762,8 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
 // away from the eye's, so a brick in front of another is nearer on every
 // axis and strictly on one: nearest first, or farthest first for
 // translucent surfaces.
-std::vector<IsosurfacePiece> IsosurfaceScene::Internals::Pieces(const IsosurfaceFrame& frame) const
+std::vector<std::int64_t> IsosurfaceScene::Internals::VisibilityOrder(
+  const IsosurfaceFrame& frame) const
 {
   int eyeBrick[3] = { 0, 0, 0 };
   matrix4::Matrix viewToIndex;
@@ -528,11 +788,6 @@ std::vector<IsosurfacePiece> IsosurfaceScene::Internals::Pieces(const Isosurface
   std::vector<std::pair<int, std::int64_t>> order;
   for (const std::int64_t brick : this->Active)
   {
-    const auto found = this->Bricks.find(brick);
-    if (found == this->Bricks.end() || found->second->GetTotal() == 0)
-    {
-      continue;
-    }
     int index[3];
     this->Grid.BrickIndex(brick, index);
     const int steps = std::abs(index[0] - eyeBrick[0]) + std::abs(index[1] - eyeBrick[1]) +
@@ -540,13 +795,29 @@ std::vector<IsosurfacePiece> IsosurfaceScene::Internals::Pieces(const Isosurface
     order.emplace_back(translucent ? -steps : steps, brick);
   }
   std::sort(order.begin(), order.end());
-  std::vector<IsosurfacePiece> pieces;
+  std::vector<std::int64_t> bricks;
   for (const auto& entry : order)
   {
+    bricks.push_back(entry.second);
+  }
+  return bricks;
+}
+
+// The built bricks with something to draw, as pieces in visibility order.
+std::vector<IsosurfacePiece> IsosurfaceScene::Internals::Pieces(const IsosurfaceFrame& frame) const
+{
+  std::vector<IsosurfacePiece> pieces;
+  for (const std::int64_t brick : this->VisibilityOrder(frame))
+  {
+    const auto found = this->Bricks.find(brick);
+    if (found == this->Bricks.end() || found->second->GetTotal() == 0)
+    {
+      continue;
+    }
     IsosurfacePiece piece;
-    piece.Pyramid = this->Bricks.at(entry.second).get();
+    piece.Pyramid = found->second.get();
     int extent[6], points[3];
-    this->BrickTexture(entry.second, extent, points);
+    this->BrickTexture(brick, extent, points);
     piece.Offset[0] = extent[0];
     piece.Offset[1] = extent[2];
     piece.Offset[2] = extent[4];
@@ -977,10 +1248,25 @@ bool IsosurfaceScene::Render(const IsosurfaceFrame& frame, std::string& error)
     }
   }
   IsosurfaceFrameStats frameStats;
-  // A bricked volume's full level is drawn brick by brick; its coarse levels are one texture each.
-  const bool rendered = impl.Bricked && frame.Level == FullLevel
-    ? impl.Renderer->Render(impl.Pieces(frame), drawn, frameStats, error)
-    : impl.Renderer->Render(*pyramid, drawn, frameStats, error);
+  // A bricked volume's full level is drawn from the pool, its slots in the
+  // bricks' visibility order, or brick by brick; its coarse levels are one texture each.
+  bool rendered = false;
+  if (impl.Bricked && frame.Level == FullLevel && impl.PoolDrawn)
+  {
+    std::vector<int> slots;
+    for (const std::int64_t brick : impl.VisibilityOrder(frame))
+    {
+      slots.push_back(impl.PoolSlot.at(brick));
+    }
+    impl.Pool->SetSlotOrder(slots);
+    rendered = impl.Renderer->Render(*impl.Pool, drawn, frameStats, error);
+  }
+  else
+  {
+    rendered = impl.Bricked && frame.Level == FullLevel
+      ? impl.Renderer->Render(impl.Pieces(frame), drawn, frameStats, error)
+      : impl.Renderer->Render(*pyramid, drawn, frameStats, error);
+  }
   if (!rendered)
   {
     return false;
@@ -1005,6 +1291,10 @@ std::uint64_t IsosurfaceScene::GetActivePairs() const
   if (impl.BuiltValues.empty())
   {
     return 0;
+  }
+  if (impl.Bricked && impl.PoolDrawn)
+  {
+    return impl.Pool->GetTotal();
   }
   if (impl.Bricked)
   {
@@ -1085,6 +1375,7 @@ std::uint64_t IsosurfaceScene::GetGPUMemoryBytes() const
   {
     bytes += brick.second->GetGPUMemoryBytes();
   }
+  bytes += impl.Pool ? impl.Pool->GetGPUMemoryBytes() : 0;
   return bytes;
 }
 

@@ -40,15 +40,19 @@
  * uploads nothing but computes every brick's value range; Update() finds
  * the bricks the isovalues cross, uploads those not resident (each with the
  * apron its cells and gradients read, least recently used ones evicted to
- * stay within the budget) and builds a pyramid over each that counts only
- * the cells the brick owns; Render() draws those pyramids as pieces, each
- * placed at its brick, nearest brick first (farthest first for translucent
- * surfaces). Every cell is counted by exactly one brick, so the primitives
- * are the one-texture count exactly. Where the active bricks alone exceed
- * the budget, Update() fails with that reason (GetStats().OverBudget), and
- * the host falls back as for any other reason. Bricks read the host's values
- * when they become active: Data must stay valid while it is the scene's
- * volume (every host passes it to SetVolume() before each Update()).
+ * stay within the budget) into the slots of one pool texture and builds one
+ * pyramid over the pool that counts only the cells each slot's brick owns;
+ * Render() draws it in one pass, its slots walked in the bricks' visibility
+ * order (nearest brick first, farthest first for translucent surfaces), each
+ * cell placed at its brick through the slot table (SetBrickPool()). Where
+ * the pool cannot hold the active bricks, each is its own texture and
+ * pyramid, drawn as pieces in that order. Every cell is counted by exactly
+ * one brick, so the primitives are the one-texture count exactly. Where the
+ * active bricks alone exceed the budget, Update() fails with that reason
+ * (GetStats().OverBudget), and the host falls back as for any other reason.
+ * Bricks read the host's values when they become active: Data must stay
+ * valid while it is the scene's volume (every host passes it to SetVolume()
+ * before each Update()).
  *
  * The context of SetContext() (or one sharing its objects) must be current
  * in every call that touches GL: SetVolume(), Update(), Render(),
@@ -143,6 +147,24 @@ public:
   static constexpr std::uint64_t DefaultGPUMemoryBudget = std::uint64_t(1) << 30;
   /// Whether the current volume is kept as bricks.
   bool IsBricked() const;
+  ///@}
+
+  ///@{
+  /**
+   * The brick pool (on by default): a volume kept as bricks holds its
+   * resident bricks as the slots of one 3D texture within the texture limit
+   * and the budget (each slot a power of two a side, 16 points or more,
+   * holding a brick with its apron), with an indirection per slot (the
+   * brick's place in the volume and the cells it owns) and one pyramid over
+   * the pool, built once per isovalue change and drawn in one pass. The
+   * bricks are those of ChooseBrickPoints(), pool or not. Where the pool
+   * cannot hold the active bricks within the limit and the budget (a forced
+   * limit near the brick's size leaves room for few slots), they are drawn
+   * as their own pyramids, as with the pool off. A change takes effect at
+   * the next SetVolume().
+   */
+  void SetBrickPool(bool on);
+  bool GetBrickPool() const;
   ///@}
 
   /**

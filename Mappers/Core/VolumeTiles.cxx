@@ -239,42 +239,12 @@ void VolumeTiles::Compute(ScalarType type, const void* data, const int points[3]
   this->Layout = layout;
 }
 
-void VolumeTiles::Empty(ScalarType type, const PyramidLayout& layout)
-{
-  this->Clear();
-  const auto tiles = layout.TileCounts();
-  const std::size_t values = 2 * static_cast<std::size_t>(tiles[0]) * tiles[1] * tiles[2];
-  const auto fill = [values](auto& ranges)
-  {
-    using R = typename std::decay_t<decltype(ranges)>::value_type;
-    ranges.resize(values);
-    for (std::size_t i = 0; i < values; i += 2)
-    {
-      ranges[i] = EmptyLow<R>();
-      ranges[i + 1] = EmptyHigh<R>();
-    }
-  };
-  switch (ValueKindOf(type))
-  {
-    case ValueKind::Signed:
-      fill(this->IntRanges);
-      break;
-    case ValueKind::Unsigned:
-      fill(this->UIntRanges);
-      break;
-    case ValueKind::Float:
-      fill(this->FloatRanges);
-      break;
-  }
-  this->Layout = layout;
-}
-
 void VolumeTiles::ComputeRegion(ScalarType type, const void* data, const int points[3],
   const int first[3], const int last[3], const PointsArrived& arrived)
 {
   if (this->GetNumberOfTiles() == 0)
   {
-    return; // no layout: Compute() or Empty() first
+    return; // no layout: Compute() or Reset() first
   }
   // Values of their own type: double ones become the float they are on the GPU, one by one.
   VisitScalarType(type,
@@ -303,6 +273,83 @@ void VolumeTiles::Clear()
   this->IntRanges.clear();
   this->UIntRanges.clear();
   this->FloatRanges.clear();
+}
+
+namespace
+{
+
+template<typename R>
+void EmptyRanges(std::vector<R>& ranges, std::size_t tiles)
+{
+  ranges.resize(2 * tiles);
+  for (std::size_t t = 0; t < tiles; ++t)
+  {
+    ranges[2 * t] = EmptyLow<R>();
+    ranges[2 * t + 1] = EmptyHigh<R>();
+  }
+}
+
+// Tiles [origin, origin + count) of `to` (tile counts `toTiles`) from `from`
+// (tile counts `fromTiles`; empty where it has none).
+template<typename R>
+void PlaceRanges(std::vector<R>& to, const PyramidLayout::Int3& toTiles, const std::vector<R>* from,
+  const PyramidLayout::Int3& fromTiles, const int origin[3], const int count[3])
+{
+  for (int z = 0; z < count[2] && origin[2] + z < toTiles[2]; ++z)
+    for (int y = 0; y < count[1] && origin[1] + y < toTiles[1]; ++y)
+      for (int x = 0; x < count[0] && origin[0] + x < toTiles[0]; ++x)
+      {
+        const std::size_t t =
+          (static_cast<std::size_t>(origin[2] + z) * toTiles[1] + origin[1] + y) * toTiles[0] +
+          origin[0] + x;
+        const bool inside = from && x < fromTiles[0] && y < fromTiles[1] && z < fromTiles[2];
+        const std::size_t f =
+          inside ? (static_cast<std::size_t>(z) * fromTiles[1] + y) * fromTiles[0] + x : 0;
+        to[2 * t] = inside ? (*from)[2 * f] : EmptyLow<R>();
+        to[2 * t + 1] = inside ? (*from)[2 * f + 1] : EmptyHigh<R>();
+      }
+}
+} // namespace
+
+void VolumeTiles::Reset(ScalarType type, const PyramidLayout& layout)
+{
+  this->Clear();
+  this->Layout = layout;
+  const auto tiles = layout.TileCounts();
+  const std::size_t n = static_cast<std::size_t>(tiles[0]) * tiles[1] * tiles[2];
+  switch (ValueKindOf(type))
+  {
+    case ValueKind::Signed:
+      EmptyRanges(this->IntRanges, n);
+      break;
+    case ValueKind::Unsigned:
+      EmptyRanges(this->UIntRanges, n);
+      break;
+    case ValueKind::Float:
+      EmptyRanges(this->FloatRanges, n);
+      break;
+  }
+}
+
+void VolumeTiles::Place(const VolumeTiles* part, const int origin[3], const int count[3])
+{
+  const auto tiles = this->Layout.TileCounts();
+  const auto partTiles = part ? part->Layout.TileCounts() : PyramidLayout::Int3{ { 0, 0, 0 } };
+  if (!this->IntRanges.empty())
+  {
+    PlaceRanges(
+      this->IntRanges, tiles, part ? &part->IntRanges : nullptr, partTiles, origin, count);
+  }
+  if (!this->UIntRanges.empty())
+  {
+    PlaceRanges(
+      this->UIntRanges, tiles, part ? &part->UIntRanges : nullptr, partTiles, origin, count);
+  }
+  if (!this->FloatRanges.empty())
+  {
+    PlaceRanges(
+      this->FloatRanges, tiles, part ? &part->FloatRanges : nullptr, partTiles, origin, count);
+  }
 }
 
 std::uint64_t VolumeTiles::GetNumberOfTiles() const

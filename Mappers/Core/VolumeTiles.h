@@ -77,19 +77,27 @@ public:
 
   ///@{
   /**
-   * A volume whose values arrive region by region (a streamed one): Empty()
-   * gives every tile of `layout` an empty range, so that a build draws no
-   * tile; ComputeRegion() gives the tiles whose points meet [first, last]
+   * Tiles whose values arrive later: Reset() makes every tile of `layout`
+   * empty for data of `type`, so that a build draws no tile.
+   *
+   * A volume whose values arrive region by region (a streamed one):
+   * ComputeRegion() gives the tiles whose points meet [first, last]
    * (inclusive, per axis) their range again from `data` (of the volume's
    * own type: Float64 values are taken as the floats they become), each where
    * `arrived` says every point its cells read holds its value, and leaves
    * the others empty. A tile's cells then count exactly the dense volume's
    * once its points have arrived, and nothing before (not the values of
    * points still to come).
+   *
+   * A brick pool's tiles (HistoPyramidGL::AllocatePool()): Place() gives the
+   * tiles [origin, origin + count) per axis the ranges of `part` (a brick's
+   * tiles, computed on its own points, whose tile 0 is tile `origin` here),
+   * or empties them where `part` is null or has fewer.
    */
-  void Empty(ScalarType type, const PyramidLayout& layout);
+  void Reset(ScalarType type, const PyramidLayout& layout);
   void ComputeRegion(ScalarType type, const void* data, const int points[3], const int first[3],
     const int last[3], const PointsArrived& arrived);
+  void Place(const VolumeTiles* part, const int origin[3], const int count[3]);
   ///@}
 
   /// Tiles of the last Compute() (0 after Clear()).

@@ -9,7 +9,11 @@
 // clipping plane, a parallel view, a sample distance of 2); float data with NaN values counts the
 // same; isovalue changes evict least recently used bricks within the budget and still count
 // exactly; active bricks over the budget fail with that reason; the limits set back to the defaults
-// give one texture again. Exit 125 (skip) where no such context can be made.
+// give one texture again. The brick pool (IsosurfaceScene::SetBrickPool(), on by default) is
+// checked the same way on a phantom whose active bricks it holds (one pyramid built per isovalue
+// change for all of them, one pass drawn), with slots reused across isovalue changes within a
+// budget; where it cannot hold them (a limit of 32) and with the pool off, the bricks' own
+// pyramids. Exit 125 (skip) where no such context can be made.
 #include "GLApi.h"
 #include "GLApiFunctions.h"
 #include "HeadlessTestUtilities.h"
@@ -167,9 +171,20 @@ struct Case
   float SampleDistance;
 };
 
+// How the bricked scene is set: its texture limit and budget, the pool on or off, and whether
+// the pool then holds the active bricks (else each brick is its own pyramid).
+struct Bricking
+{
+  int Limit = 32;
+  std::uint64_t Budget = 3u << 20;
+  bool Pool = true;
+  bool PoolHolds = false;
+};
+
 template<typename T>
 void RunCases(const std::shared_ptr<const GLApi>& gl, Target& target, const std::vector<T>& values,
-  const int dims[3], const std::vector<Case>& cases, const std::string& prefix)
+  const int dims[3], const std::vector<Case>& cases, const std::string& prefix,
+  const Bricking& how = Bricking())
 {
   VolumeDescription volume;
   volume.Type = ScalarTypeOf<T>();
@@ -180,13 +195,14 @@ void RunCases(const std::shared_ptr<const GLApi>& gl, Target& target, const std:
   IsosurfaceScene dense(nullptr), bricked(nullptr);
   dense.SetContext(gl);
   bricked.SetContext(gl);
-  bricked.SetMaxTextureSize(32);
-  bricked.SetGPUMemoryBudget(3u << 20);
+  bricked.SetMaxTextureSize(how.Limit);
+  bricked.SetGPUMemoryBudget(how.Budget);
+  bricked.SetBrickPool(how.Pool);
   std::string error;
   Check(
     dense.SetVolume(volume, error) && !dense.IsBricked(), prefix + ": one texture (" + error + ")");
   Check(bricked.SetVolume(volume, error) && bricked.IsBricked(),
-    prefix + ": over a texture limit of 32, bricks (" + error + ")");
+    prefix + ": over a texture limit of " + std::to_string(how.Limit) + ", bricks (" + error + ")");
   for (const Case& c : cases)
   {
     const std::string name = prefix + " " + c.Name;
@@ -212,12 +228,24 @@ void RunCases(const std::shared_ptr<const GLApi>& gl, Target& target, const std:
     const std::uint64_t expected = BruteForceCount(values, dims, isos);
     const IsosurfaceSceneStats& s = bricked.GetStats();
     std::printf("%s: %llu primitives (brute force %llu), %llu of %llu bricks of %d active, "
-                "%llu resident, %llu GPU bytes\n",
+                "%llu resident, %llu GPU bytes, %llu pool slots, %llu pyramids built\n",
       name.c_str(), static_cast<unsigned long long>(bricked.GetActivePairs()),
       static_cast<unsigned long long>(expected), static_cast<unsigned long long>(s.ActiveBricks),
       static_cast<unsigned long long>(s.Bricks), s.BrickPoints,
       static_cast<unsigned long long>(s.ResidentBricks),
-      static_cast<unsigned long long>(bricked.GetGPUMemoryBytes()));
+      static_cast<unsigned long long>(bricked.GetGPUMemoryBytes()),
+      static_cast<unsigned long long>(s.PoolSlots),
+      static_cast<unsigned long long>(s.BrickPyramidBuilds));
+    if (how.Pool && how.PoolHolds)
+    {
+      Check(s.PoolSlots >= s.ActiveBricks && s.BrickPyramidBuilds == 1,
+        name + ": the pool holds the active bricks, one pyramid built over them");
+    }
+    else
+    {
+      Check(s.PoolSlots == 0 && s.BrickPyramidBuilds == s.ActiveBricks,
+        name + ": each active brick its own pyramid");
+    }
     Check(dense.GetActivePairs() == expected, name + ": one texture counts the brute-force cells");
     Check(bricked.GetActivePairs() == expected, name + ": bricks count exactly the same cells");
     Check(c.Clip.empty() ? s.Primitives == expected : s.Primitives <= expected,
@@ -257,11 +285,30 @@ int main(int argc, char* argv[])
     { "bone, sample distance 2", { bone }, 200, 30, false, {}, 2.0f },
   };
   RunCases(gl, target, phantom, dims, cases, "int16");
+  // The same with the pool off: each brick its own pyramid as well.
+  {
+    Bricking off;
+    off.Pool = false;
+    RunCases(gl, target, phantom, dims, { cases[1], cases[2] }, "int16, no pool", off);
+  }
+  // The pool holding every active brick: 27 bricks of 56 points (a 24 MB budget allows no
+  // larger) in 64-point slots of a pool within a texture limit of 128.
+  const int large[3] = { 150, 130, 120 };
+  const std::vector<std::int16_t> largePhantom = pyramid_checks::MakePhantom(large, 40.0, 11);
+  {
+    Bricking pool;
+    pool.Limit = 128;
+    pool.Budget = 24u << 20;
+    pool.PoolHolds = true;
+    RunCases(gl, target, largePhantom, large, cases, "int16 pool", pool);
+  }
   // Sizes whose last brick on an axis owns one plane of points and no cell (48 = 2 x 24).
   {
     const int edge[3] = { 49, 25, 49 };
-    RunCases(
-      gl, target, pyramid_checks::MakePhantom(edge, 40.0, 3), edge, { cases[1] }, "int16 49x25x49");
+    Bricking held; // 4 active bricks of 24: the pool's 4 slots of 32 under the limit hold them
+    held.PoolHolds = true;
+    RunCases(gl, target, pyramid_checks::MakePhantom(edge, 40.0, 3), edge, { cases[1] },
+      "int16 49x25x49", held);
   }
 
   // Float data with NaN values: cells with a NaN corner count nothing, in bricks too.
@@ -272,6 +319,16 @@ int main(int argc, char* argv[])
       values[i] = std::nanf("");
     }
     RunCases(gl, target, values, dims, { cases[1] }, "float with NaN");
+    Bricking pool;
+    pool.Limit = 128;
+    pool.Budget = 24u << 20;
+    pool.PoolHolds = true;
+    std::vector<float> largeValues(largePhantom.begin(), largePhantom.end());
+    for (std::size_t i = 0; i < largeValues.size(); i += 37)
+    {
+      largeValues[i] = std::nanf("");
+    }
+    RunCases(gl, target, largeValues, large, { cases[1] }, "float with NaN, pool", pool);
   }
 
   // Isovalue changes within a budget that holds the bricks of one change but
@@ -321,6 +378,80 @@ int main(int argc, char* argv[])
     }
     const IsosurfaceSceneStats& s = scene.GetStats();
     Check(uploads > s.ResidentBricks, "budget: bricks were evicted and uploaded again");
+
+    // The pool within a budget that holds the slots of one change but not of all: the least
+    // recently used inactive bricks give up their slots to new ones, the pool stays. A ramp
+    // along x, so that each isovalue crosses one column of 3x3 bricks of 56 points.
+    {
+      std::vector<std::int16_t> ramp(static_cast<std::size_t>(large[0]) * large[1] * large[2]);
+      for (std::size_t i = 0; i < ramp.size(); ++i)
+      {
+        ramp[i] = static_cast<std::int16_t>(i % static_cast<std::size_t>(large[0]));
+      }
+      VolumeDescription largeVolume = volume;
+      largeVolume.Data = ramp.data();
+      std::copy(large, large + 3, largeVolume.Dims);
+      const std::vector<double> isos = { 30.5, 85.5, 130.5, 30.5, 85.5, 130.5 };
+      std::uint64_t most = 0;
+      for (const double iso : isos)
+      {
+        IsosurfaceScene alone(nullptr);
+        alone.SetContext(gl);
+        alone.SetMaxTextureSize(128);
+        alone.SetGPUMemoryBudget(24u << 20); // bricks of 56 points
+        alone.SetSurfaces({ Look(iso, 1, 1, 1, 1) });
+        Check(alone.SetVolume(largeVolume, error) && alone.Update(error) &&
+            alone.GetStats().PoolSlots > 0,
+          "pool budget: alone, in a pool (" + error + ")");
+        most = std::max(most, alone.GetGPUMemoryBytes());
+        alone.Release();
+      }
+      IsosurfaceScene pooled(nullptr);
+      pooled.SetContext(gl);
+      pooled.SetMaxTextureSize(128);
+      pooled.SetGPUMemoryBudget(most);
+      Check(pooled.SetVolume(largeVolume, error) && pooled.IsBricked(),
+        "pool budget: bricks (" + error + ")");
+      std::uint64_t slots = 0, before = 0, reused = 0;
+      for (std::size_t i = 0; i < isos.size(); ++i)
+      {
+        pooled.SetSurfaces({ Look(isos[i], 1, 1, 1, 1) });
+        const bool updated = pooled.Update(error);
+        const IsosurfaceSceneStats& p = pooled.GetStats();
+        std::printf("pool budget, iso %g: %llu active, %llu resident in %llu slots, %llu uploads "
+                    "so far, %llu pyramids built, %llu GPU bytes\n",
+          isos[i], static_cast<unsigned long long>(p.ActiveBricks),
+          static_cast<unsigned long long>(p.ResidentBricks),
+          static_cast<unsigned long long>(p.PoolSlots),
+          static_cast<unsigned long long>(p.BrickUploads),
+          static_cast<unsigned long long>(p.BrickPyramidBuilds),
+          static_cast<unsigned long long>(pooled.GetGPUMemoryBytes()));
+        const std::string name = "pool budget, iso " + std::to_string(isos[i]);
+        Check(updated && p.PoolSlots > 0 && p.BrickPyramidBuilds == 1,
+          name + ": in the pool, one pyramid (" + error + ")");
+        Check(p.ActiveBricks == 9 &&
+            pooled.GetActivePairs() == BruteForceCount(ramp, large, { isos[i] }),
+          name + ": 9 bricks, exact count");
+        Check(
+          pooled.GetGPUMemoryBytes() <= pooled.GetGPUMemoryBudget(), name + ": within the budget");
+        if (i >= 1)
+        {
+          Check(p.PoolSlots == slots, name + ": the same pool, its slots reused");
+          reused += p.BrickUploads - before;
+        }
+        slots = p.PoolSlots;
+        before = p.BrickUploads;
+        // Drawn too: the frame's primitives are the count.
+        IsosurfaceFrame frame = View(large, 30.0 * static_cast<double>(i), 10, false);
+        std::string drawError;
+        Check(!target.Draw(pooled, frame, drawError).empty() &&
+            pooled.GetStats().Primitives == pooled.GetActivePairs(),
+          name + ": drawn (" + drawError + ")");
+      }
+      Check(reused > 0 && pooled.GetStats().ResidentBricks <= pooled.GetStats().PoolSlots,
+        "pool budget: evicted bricks' slots took other bricks");
+      pooled.Release();
+    }
 
     // Active bricks alone over the budget: the reason, and no volume drawn.
     scene.SetMaxTextureSize(32);
