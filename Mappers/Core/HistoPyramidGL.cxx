@@ -57,6 +57,24 @@ int Log2(int powerOfTwo)
   }
   return shift;
 }
+
+// Texels [offset, offset + texels) of a volume texture (x in texels of 4 values) from `data`,
+// rows packed: a streamed region or a brick pool's slot. False with GL's errors.
+bool UploadBox(const GLApi& gl, GLuint texture, const VolumeFormat& format, const int offset[3],
+  const int texels[3], const void* data, std::string& error)
+{
+  const GLApi::Functions& f = gl.F();
+  ScopedGLState saved(gl, 1);
+  gl.TakeErrors();
+  BindTextureUnit(gl, 0, GL_TEXTURE_3D, texture);
+  f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  f.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  f.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
+  f.TexSubImage3D(GL_TEXTURE_3D, 0, offset[0], offset[1], offset[2], texels[0], texels[1],
+    texels[2], format.Format, format.Type, data);
+  error = gl.TakeErrors();
+  return error.empty();
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -614,22 +632,11 @@ bool HistoPyramidGL::UploadRegion(const void* values, const int first[3], const 
     }
   }
   const GLApi& gl = *impl.GL;
-  const GLApi::Functions& f = gl.F();
+  const int offset[3] = { t0, lo[1], lo[2] };
+  if (!UploadBox(gl, impl.Volume.Get(), format, offset, texels, staging.data(), error))
   {
-    ScopedGLState saved(gl, 1);
-    gl.TakeErrors();
-    BindTextureUnit(gl, 0, GL_TEXTURE_3D, impl.Volume.Get());
-    f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    f.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    f.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
-    f.TexSubImage3D(GL_TEXTURE_3D, 0, t0, lo[1], lo[2], texels[0], texels[1], texels[2],
-      format.Format, format.Type, staging.data());
-    const std::string errors = gl.TakeErrors();
-    if (!errors.empty())
-    {
-      error = "cannot upload a region of the volume: " + errors;
-      return false;
-    }
+    error = "cannot upload a region of the volume: " + error;
+    return false;
   }
   impl.Tiles.ComputeRegion(impl.Type, values, impl.Points, lo, hi, arrived);
   impl.Built = false;
@@ -963,7 +970,6 @@ bool HistoPyramidGL::UploadSlot(
 {
   Internals& impl = *this->Impl;
   const GLApi& gl = *impl.GL;
-  const GLApi::Functions& f = gl.F();
   const int side = 1 << impl.SlotShift;
   if (!impl.Pool || slot < 0 || slot >= impl.SlotCount() || !values ||
     std::min({ points[0], points[1], points[2] }) < 2 ||
@@ -1002,20 +1008,13 @@ bool HistoPyramidGL::UploadSlot(
     return false;
   }
   const int* n = impl.SlotsPerAxis;
-  const int s[3] = { slot % n[0], (slot / n[0]) % n[1], slot / (n[0] * n[1]) };
-  ScopedGLState saved(gl, 1);
-  gl.TakeErrors();
-  BindTextureUnit(gl, 0, GL_TEXTURE_3D, impl.Volume.Get());
-  f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  f.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-  f.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
-  f.TexSubImage3D(GL_TEXTURE_3D, 0, s[0] * side / 4, s[1] * side, s[2] * side,
-    PackedVolumeWidth(points[0]), points[1], points[2], format.Format, format.Type,
-    packed.empty() ? data : packed.data());
-  const std::string errors = gl.TakeErrors();
-  if (!errors.empty())
+  const int offset[3] = { (slot % n[0]) * side / 4, ((slot / n[0]) % n[1]) * side,
+    (slot / (n[0] * n[1])) * side };
+  const int texels[3] = { PackedVolumeWidth(points[0]), points[1], points[2] };
+  if (!UploadBox(gl, impl.Volume.Get(), format, offset, texels,
+        packed.empty() ? data : packed.data(), error))
   {
-    error = "cannot upload a brick into the brick pool: " + errors;
+    error = "cannot upload a brick into the brick pool: " + error;
     return false;
   }
   const int cells[3] = { points[0] - 1, points[1] - 1, points[2] - 1 };
