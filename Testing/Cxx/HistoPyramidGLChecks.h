@@ -45,6 +45,35 @@ inline std::vector<std::int16_t> MakePhantom(const int dims[3], double noise, st
   return values;
 }
 
+// Cells crossed by each isovalue (min < iso <= max over the 8 corners, none NaN), summed.
+template <typename T>
+inline std::uint64_t BruteForceCount(
+  const std::vector<T>& v, const int n[3], const std::vector<double>& isos)
+{
+  std::uint64_t count = 0;
+  for (int z = 0; z + 1 < n[2]; ++z)
+    for (int y = 0; y + 1 < n[1]; ++y)
+      for (int x = 0; x + 1 < n[0]; ++x)
+      {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        bool nan = false;
+        for (int c = 0; c < 8; ++c)
+        {
+          const double value = static_cast<double>(
+            v[(static_cast<std::size_t>(z + (c >> 2)) * n[1] + y + ((c >> 1) & 1)) * n[0] + x +
+              (c & 1)]);
+          nan = nan || std::isnan(value);
+          lo = std::min(lo, value);
+          hi = std::max(hi, value);
+        }
+        for (const double iso : isos)
+        {
+          count += !nan && lo < iso && iso <= hi;
+        }
+      }
+  return count;
+}
+
 inline std::string Describe(const std::vector<double>& isovalues)
 {
   std::ostringstream os;

@@ -20,6 +20,7 @@
 #include "GLApi.h"
 #include "GLApiFunctions.h"
 #include "HeadlessTestUtilities.h"
+#include "HistoPyramidGLChecks.h" // BruteForceCount
 #include "IsosurfaceScene.h"
 #include "MedicalTestUtilities.h"
 #include "SceneView.h"
@@ -37,40 +38,12 @@
 namespace
 {
 using medical_test::Check;
+using pyramid_checks::BruteForceCount;
 using namespace mediso;
 
 constexpr int Width = 160;
 constexpr int Height = 120;
 constexpr int BrickEdge = 16;
-
-// Cells crossed by each isovalue (min < iso <= max over the 8 corners, none NaN), summed.
-template <typename T>
-std::uint64_t BruteForceCount(
-  const std::vector<T>& v, const int n[3], const std::vector<double>& isos)
-{
-  std::uint64_t count = 0;
-  for (int z = 0; z + 1 < n[2]; ++z)
-    for (int y = 0; y + 1 < n[1]; ++y)
-      for (int x = 0; x + 1 < n[0]; ++x)
-      {
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        bool nan = false;
-        for (int c = 0; c < 8; ++c)
-        {
-          const double value = static_cast<double>(
-            v[(static_cast<std::size_t>(z + (c >> 2)) * n[1] + y + ((c >> 1) & 1)) * n[0] + x +
-              (c & 1)]);
-          nan = nan || std::isnan(value);
-          lo = std::min(lo, value);
-          hi = std::max(hi, value);
-        }
-        for (const double iso : isos)
-        {
-          count += !nan && lo < iso && iso <= hi;
-        }
-      }
-  return count;
-}
 
 IsosurfaceFrame View(const int dims[3], double azimuth, double elevation)
 {
