@@ -16,10 +16,10 @@
 //   on the wire are at most 1.05x the whole level's;
 // - after the end, the manifest's brick ranges are the cores' ComputeBrickRanges over the level
 //   received, and a change sends nothing.
-import { mkdtempSync, rmSync, writeFileSync } from "node:fs";
+import { mkdtempSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
-import { Checks, countWire, launchBrowser, niftiBytes, openPage, startServer } from "./webserver-harness.mjs";
+import { Checks, countWire, launchBrowser, openPage, startServer, writeTwoBlobs } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 // Two blobs in a 256^3 int16 NIfTI (bricks of 64: 4 per axis): a large one in the middle, whose
@@ -27,22 +27,7 @@ const checks = new Checks();
 // small one in a corner, whose surface at SMALL needs the far corner's bricks (the last in the
 // volume's order); a little deterministic noise.
 const N = 256, FIRST = 500, SMALL = 1500;
-function writeVolume(file) {
-  const values = new Int16Array(N * N * N);
-  let seed = 2463534242;
-  for (let k = 0, id = 0; k < N; ++k) {
-    for (let j = 0; j < N; ++j) {
-      for (let i = 0; i < N; ++i, ++id) {
-        seed ^= seed << 13; seed ^= seed >>> 17; seed ^= seed << 5;
-        const big = 1000 - 10 * Math.hypot(i - 128, j - 128, k - 128);
-        const small = 2000 - 20 * Math.hypot(i - 226, j - 226, k - 226);
-        values[id] = Math.round(Math.max(0, big, small)) + ((seed >>> 0) % 4);
-      }
-    }
-  }
-  writeFileSync(file, niftiBytes([N, N, N], [1, 1, 1], [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]], values));
-  return values;
-}
+const writeVolume = (file) => writeTwoBlobs(file, N, 226, 4);
 
 // The bricks (64 points a side) isovalue v needs, by brute force: for every block of 8 cells whose
 // points [8b, 8b + 8] hold v (min < v <= max), the bricks of the points 8b - 1 .. 8b + 9 its

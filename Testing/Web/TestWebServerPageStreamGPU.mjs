@@ -7,16 +7,16 @@
 // - at every frame the primitives are exactly the CPU model's count at the level it was drawn at
 //   (0 while any current surface's bricks are missing, else 3), and every surface's level in
 //   stats() is that one;
-// - an isovalue changed mid-stream (to the corner's blob) is drawn at once, and the next bricks
-//   asked for are the ones it needs;
+// - an isovalue changed mid-stream (to the corner's blob) is drawn at once, and the bricks it
+//   needs (the server's exact need, within the ranges' superset) are asked for before any other;
 // - whenFull() resolves with the surface at level 3 and the full level's exact count before the
 //   whole level has come; received reaches 1; the bricks went into the texture as sub-regions
 //   (one whole upload: the empty buffer); the bytes of level 0 and the bricks are at most 1.05x
 //   the whole level's; after the end a change sends nothing.
-import { mkdtempSync, rmSync, writeFileSync } from "node:fs";
+import { mkdtempSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
-import { Checks, countWire, launchBrowser, niftiBytes, openPage, startServer } from "./webserver-harness.mjs";
+import { Checks, countWire, launchBrowser, openPage, startServer, writeTwoBlobs } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 // Two blobs in a 192^3 int16 NIfTI (bricks of 64: 3 per axis): a large one in the middle, whose
@@ -24,21 +24,7 @@ const checks = new Checks();
 // the far corner's 8 bricks (the last in the volume's order); deterministic noise (4 bits, so that
 // the level takes a while on the wire).
 const N = 192, FIRST = 500, SMALL = 1500;
-function writeVolume(file) {
-  const values = new Int16Array(N * N * N);
-  let seed = 2463534242;
-  for (let k = 0, id = 0; k < N; ++k) {
-    for (let j = 0; j < N; ++j) {
-      for (let i = 0; i < N; ++i, ++id) {
-        seed ^= seed << 13; seed ^= seed >>> 17; seed ^= seed << 5;
-        const big = 1000 - 10 * Math.hypot(i - 96, j - 96, k - 96);
-        const small = 2000 - 20 * Math.hypot(i - 168, j - 168, k - 168);
-        values[id] = Math.round(Math.max(0, big, small)) + ((seed >>> 0) % 16);
-      }
-    }
-  }
-  writeFileSync(file, niftiBytes([N, N, N], [1, 1, 1], [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]], values));
-}
+const writeVolume = (file) => writeTwoBlobs(file, N, 168, 16);
 const folder = mkdtempSync(path.join(tmpdir(), "mediso-stream-gpu-"));
 const nifti = path.join(folder, "blobs.nii");
 writeVolume(nifti);
@@ -115,17 +101,33 @@ if (checks.check(info !== null, "the stream was still under way after the change
   const owed = [...need].filter((id) => !before.has(id));
   checks.check(need.size < total && owed.length > 0, "the new isovalue needs some bricks not asked for yet, " +
     "and not all of them (" + owed.length + " of " + need.size + " of " + total + ")");
-  // The requests after the change, once as many as it owes have gone out (or the stream ended).
-  await page.waitForFunction(([v, n]) => {
+  // The server's exact need (the bricks the blocks crossing SMALL read) replaces the superset when
+  // it comes; the requests after the change, once those it owes have gone out (or the stream ended).
+  await page.waitForFunction((v) => { const i = window.mediso.streamInfo([v]); return !i || i.exact[0]; },
+    SMALL, { timeout: 60000, polling: 20 });
+  const exactInfo = await page.evaluate((v) => window.mediso.streamInfo(v), [SMALL]);
+  const exact = new Set(exactInfo ? exactInfo.needed[0] : []);
+  const owedExact = [...exact].filter((id) => !before.has(id));
+  await page.waitForFunction(([v, owedIds]) => {
     const i = window.mediso.streamInfo([v]);
-    return !i || i.requested.filter((r) => r.values.join() === String(v)).length >= n;
-  }, [SMALL, owed.length], { timeout: 300000 });
+    if (!i) {
+      return true;
+    }
+    const asked = new Set(i.requested.filter((r) => r.values.join() === String(v)).flatMap((r) => r.ids));
+    return owedIds.every((id) => asked.has(id));
+  }, [SMALL, owedExact], { timeout: 300000 });
   const later = await page.evaluate((v) => window.mediso.streamInfo(v), [SMALL]);
   const asked = later ? later.requested.filter((r) => r.values.join() === String(SMALL)).flatMap((r) => r.ids) : [];
   console.log("bricks: " + total + ", asked before the change " + before.size + ", " + SMALL + " needs " +
-    need.size + " (" + owed.length + " not yet asked); asked after: " + JSON.stringify(asked));
-  checks.check(asked.length >= owed.length && asked.slice(0, owed.length).every((id) => need.has(id)),
-    "after the change the next " + owed.length + " bricks asked for are those the new isovalue needs");
+    need.size + " by the ranges, " + exact.size + " by the server (" + owedExact.length +
+    " not yet asked); asked after: " + JSON.stringify(asked));
+  // Every brick it needs is asked for before any brick that it does not need by the ranges either.
+  const lastNeeded = Math.max(...owedExact.map((id) => asked.indexOf(id)));
+  const firstOther = asked.findIndex((id) => !need.has(id));
+  checks.check(exact.size > 0 && [...exact].every((id) => need.has(id)) && lastNeeded >= 0 &&
+    (firstOther < 0 || lastNeeded < firstOther),
+    "after the change the bricks the new isovalue needs (" + owedExact.length + " owed) are asked for " +
+    "before any other");
 }
 
 const full = await page.evaluate(() => window.mediso.whenFull());

@@ -4,7 +4,7 @@
 // ready, the bytes on the wire counted by Chrome's own network events (CDP), checks that print
 // ok/FAILED and end the test. Run through Testing/Scripts/web-test.sh (npm ci first).
 import { spawn } from "node:child_process";
-import { existsSync } from "node:fs";
+import { existsSync, writeFileSync } from "node:fs";
 import net from "node:net";
 import path from "node:path";
 import { fileURLToPath } from "node:url";
@@ -213,6 +213,30 @@ export const drawnCentroid = (page) => page.evaluate(() => {
   }
   return { n, x: n ? sx / n - view.width / 2 : 0, y: n ? view.height / 2 - sy / n : 0 };
 });
+
+/**
+ * The streaming tests' volume: n^3 int16 points of two blobs, a large one in the middle (1000 at
+ * its centre, falling 10 a point) and a small one near the far corner (2000 at `corner` along each
+ * axis, falling 20 a point), over 0, plus deterministic noise of `noise` levels (xorshift32); as a
+ * NIfTI file at `file` (1 mm, identity axes). Returns the values written, i fastest.
+ */
+export function writeTwoBlobs(file, n, corner, noise) {
+  const values = new Int16Array(n * n * n);
+  const middle = n / 2;
+  let seed = 2463534242;
+  for (let k = 0, id = 0; k < n; ++k) {
+    for (let j = 0; j < n; ++j) {
+      for (let i = 0; i < n; ++i, ++id) {
+        seed ^= seed << 13; seed ^= seed >>> 17; seed ^= seed << 5;
+        const big = 1000 - 10 * Math.hypot(i - middle, j - middle, k - middle);
+        const small = 2000 - 20 * Math.hypot(i - corner, j - corner, k - corner);
+        values[id] = Math.round(Math.max(0, big, small)) + ((seed >>> 0) % noise);
+      }
+    }
+  }
+  writeFileSync(file, niftiBytes([n, n, n], [1, 1, 1], [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]], values));
+  return values;
+}
 
 /**
  * The bytes of a NIfTI-1 file (.nii), in mm, with an sform of code 1 (scanner) and no qform:
