@@ -60,6 +60,8 @@ await page.fill("#op-hole", "20");
 await page.setChecked("#op-clip", false);
 await page.setChecked("#op-decimate", true);
 await page.fill("#op-reduction", "0.5");
+// A change is answered coarse first and refined: the surface's own count is its full level's.
+await page.evaluate(() => window.mediso.whenFull());
 const stats0 = await page.evaluate(() => window.mediso.stats());
 const sent0 = wire.frameBytesSent, received0 = wire.frameBytesReceived;
 await page.click("#op-run");
