@@ -302,15 +302,7 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
   std::vector<mediso::FrameTimeModel::Candidate> candidates;
   if (contour && still >= 0 && still < Levels)
   {
-    mediso::FrameWork work;
-    work.Method = mediso::FrameMethod::Triangles;
-    work.Translucent = this->Property->GetOpacity() < 1.0;
-    if (auto* view = vtkPVRenderView::SafeDownCast(this->GetView()))
-    {
-      const int* size = view->GetSize();
-      work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
-        static_cast<std::uint64_t>(std::max(0, size[1]));
-    }
+    mediso::FrameWork work = this->ViewFrameWork();
     std::array<double, Levels> others;
     others.fill(0.0);
     if (this->ObservedRenderer)
@@ -401,15 +393,7 @@ double* vtkBlockLODSurfaceRepresentation::GetPredictedStillSeconds()
     return this->PredictedStillSeconds;
   }
   const double* triangles = contour->GetCurrentEstimatedTriangles();
-  mediso::FrameWork work;
-  work.Method = mediso::FrameMethod::Triangles;
-  work.Translucent = this->Property->GetOpacity() < 1.0;
-  if (auto* view = vtkPVRenderView::SafeDownCast(this->GetView()))
-  {
-    const int* size = view->GetSize();
-    work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
-      static_cast<std::uint64_t>(std::max(0, size[1]));
-  }
+  mediso::FrameWork work = this->ViewFrameWork();
   std::lock_guard<std::mutex> lock(Frames().Mutex);
   const void* renderer = this->ObservedRenderer.GetPointer();
   work.Translucent = work.Translucent || (renderer && Frames().OthersTranslucent(renderer, this));
@@ -601,6 +585,21 @@ bool vtkBlockLODSurfaceRepresentation::RemoveFromView(vtkView* view)
     this->ObservedRenderer = nullptr;
   }
   return this->Superclass::RemoveFromView(view);
+}
+
+//------------------------------------------------------------------------------
+mediso::FrameWork vtkBlockLODSurfaceRepresentation::ViewFrameWork()
+{
+  mediso::FrameWork work;
+  work.Method = mediso::FrameMethod::Triangles;
+  work.Translucent = this->Property->GetOpacity() < 1.0;
+  if (auto* view = vtkPVRenderView::SafeDownCast(this->GetView()))
+  {
+    const int* size = view->GetSize();
+    work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
+      static_cast<std::uint64_t>(std::max(0, size[1]));
+  }
+  return work;
 }
 
 //------------------------------------------------------------------------------

@@ -75,6 +75,11 @@
 
 #include <array> // For std::array
 
+namespace mediso
+{
+struct FrameWork;
+}
+
 class vtkBlockLODContour;
 class vtkCompositeDataSet;
 class vtkRenderWindow;
@@ -224,6 +229,9 @@ protected:
   vtkSmartPointer<vtkCompositeDataSet> LevelPiece;
 
 private:
+  // A triangle frame of this display in its view: translucency and the view's pixels.
+  mediso::FrameWork ViewFrameWork();
+
   vtkBlockLODSurfaceRepresentation(const vtkBlockLODSurfaceRepresentation&) = delete;
   void operator=(const vtkBlockLODSurfaceRepresentation&) = delete;
 };
