@@ -13,7 +13,8 @@ when they are flushed, at the swap, so without the glFinish the renderer's own d
 in the window's time; with it, what is left of the window is the cost that does not depend on the
 data shown (the view's other renderers, the blit, the swap). The series: opaque and skin at 0.3,
 with the view's defaults (FXAA as ParaView sets it, depth peeling with 4 peels), with FXAA off,
-translucent with 1 peel, and the empty view. Not a test: it prints a table.
+translucent with 1 peel, translucent with depth peeling off (VTK's one blended pass), and the
+empty view. Not a test: it prints a table.
 """
 import argparse
 import os
@@ -101,19 +102,23 @@ def main():
         return [statistics.median(t[k] for t in times) for k in range(5)]
 
     rows = []
-    peels, fxaa = view.MaximumNumberOfPeels, view.UseFXAA
+    peels, fxaa, peeling = view.MaximumNumberOfPeels, view.UseFXAA, view.DepthPeeling
     for opacity in (1.0, 0.3):
         displays[0].Opacity = opacity
         scene = "opaque" if opacity == 1.0 else "skin 0.3 over bone"
-        settings = [("view's defaults (FXAA %d, %d peels)" % (fxaa, peels), fxaa, peels),
-                    ("FXAA off", 0, peels)]
+        settings = [("view's defaults (FXAA %d, %d peels)" % (fxaa, peels), fxaa, peels, peeling),
+                    ("FXAA off", 0, peels, peeling)]
         if opacity < 1.0:
-            settings.append(("FXAA off, 1 peel", 0, 1))
-        for name, use_fxaa, use_peels in settings:
-            view.UseFXAA, view.MaximumNumberOfPeels = use_fxaa, use_peels
+            settings.append(("FXAA off, 1 peel", 0, 1, peeling))
+            # VTK's renderer blends translucent props in one pass (weighted, order-independent
+            # blending) when depth peeling is off.
+            settings.append(("depth peeling off (one blended pass)", fxaa, peels, 0))
+            settings.append(("FXAA off, depth peeling off", 0, peels, 0))
+        for name, use_fxaa, use_peels, use_peeling in settings:
+            view.UseFXAA, view.MaximumNumberOfPeels, view.DepthPeeling = use_fxaa, use_peels, use_peeling
             rows.append((scene, name, series()))
             print(rows[-1], flush=True)
-        view.UseFXAA, view.MaximumNumberOfPeels = fxaa, peels
+        view.UseFXAA, view.MaximumNumberOfPeels, view.DepthPeeling = fxaa, peels, peeling
     for d in displays:
         d.Visibility = 0
     rows.append(("empty view", "view's defaults", series()))
