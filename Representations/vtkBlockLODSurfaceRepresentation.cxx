@@ -51,6 +51,14 @@ struct ProcessFrames
     double Start = 0.0;         // the render window's StartEvent
     double RendererStart = 0.0; // the view's renderer's StartEvent
     double RendererSeconds = -1.0;
+    // Translucent displays of the frame that ask to blend it in one pass, or
+    // to peel it (then it is peeled, as the still frame).
+    bool AskBlend = false;
+    bool AskPeel = false;
+    // The view's depth peeling was switched off for this frame (on again at
+    // the renderer's end); the model counts the frame as one pass.
+    bool Blended = false;
+    bool Started = false;
   };
   std::mutex Mutex;
   // Fitted to the view's renderer's time of each frame: the triangles' cost.
@@ -212,6 +220,19 @@ void vtkBlockLODSurfaceRepresentation::SetInteractiveTriangleBudget(double trian
 }
 
 //------------------------------------------------------------------------------
+void vtkBlockLODSurfaceRepresentation::SetInteractiveTranslucency(int mode)
+{
+  mode = std::min<int>(BLENDED, std::max<int>(PEELED, mode));
+  if (mode != this->InteractiveTranslucency)
+  {
+    this->InteractiveTranslucency = mode;
+    // The level is chosen for the frame this mode draws (a peeled frame costs
+    // more): chosen again by the next update's REQUEST_UPDATE_LOD.
+    this->MarkModified();
+  }
+}
+
+//------------------------------------------------------------------------------
 vtkBlockLODContour* vtkBlockLODSurfaceRepresentation::FindContour()
 {
   if (this->GetNumberOfInputPorts() < 1 || this->GetNumberOfInputConnections(0) != 1)
@@ -315,6 +336,9 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
       work.Translucent =
         work.Translucent || Frames().OthersTranslucent(this->ObservedRenderer.GetPointer(), this);
     }
+    // The model's translucent frames are peeled ones; a frame blended in one
+    // pass costs what an opaque frame does, plus a full-viewport resolve.
+    work.Translucent = work.Translucent && !this->BlendsInteractiveFrames();
     for (int level = still; level >= 0; --level)
     {
       const bool allowed =
@@ -487,6 +511,8 @@ int vtkBlockLODSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKe
     // one-off work the model keeps apart from the drawing).
     vtkDataObject* drawn =
       this->LastRenderUsedLOD ? lod : vtkPVView::GetDeliveredPiece(inInfo, this);
+    this->DrawsTranslucent =
+      drawn != nullptr && this->GetVisibility() && this->Property->GetOpacity() < 1.0;
     if (drawn && this->GetVisibility() && this->ObservedRenderer)
     {
       int level = -1;
@@ -511,6 +537,11 @@ int vtkBlockLODSurfaceRepresentation::ProcessViewRequest(vtkInformationRequestKe
       frame.Triangles += triangles;
       frame.Uploaded += newData ? triangles : 0.0;
       frame.Translucent = frame.Translucent || this->Property->GetOpacity() < 1.0;
+      if (this->DrawsTranslucent && this->LastRenderUsedLOD)
+      {
+        // Only interactive frames: a still frame is always the view's.
+        (this->InteractiveTranslucency == BLENDED ? frame.AskBlend : frame.AskPeel) = true;
+      }
       Frames().Drawn[this->ObservedRenderer.GetPointer()][this] = triangles;
       Frames().Translucent[this->ObservedRenderer.GetPointer()][this] =
         this->Property->GetOpacity() < 1.0;
@@ -663,7 +694,7 @@ void vtkBlockLODSurfaceRepresentation::OnRenderEnd()
   const int* size = this->ObservedRenderer->GetSize();
   work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
     static_cast<std::uint64_t>(std::max(0, size[1]));
-  work.Translucent = drawn.Translucent;
+  work.Translucent = drawn.Translucent && !drawn.Blended;
   Frames().Model.Observe(work, drawn.RendererSeconds);
 }
 
@@ -676,6 +707,29 @@ void vtkBlockLODSurfaceRepresentation::OnRendererStart()
     return;
   }
   auto frame = Frames().Pending.find(this->ObservedRenderer.GetPointer());
+  if (frame != Frames().Pending.end() && !frame->second.Started)
+  {
+    // The first display to hear of the frame switches the view's depth
+    // peeling off for it, when the frame's translucent displays ask for one
+    // blended pass; the renderer reads the setting in this render only.
+    frame->second.Started = true;
+    if (frame->second.AskBlend && !frame->second.AskPeel &&
+      this->ObservedRenderer->GetUseDepthPeeling())
+    {
+      this->ObservedRenderer->SetUseDepthPeeling(0);
+      frame->second.Blended = true;
+    }
+  }
+  // Every display says how it is drawn, after the switch above.
+  if (!this->DrawsTranslucent)
+  {
+    this->LastRenderTranslucency = OPAQUE_SURFACE;
+  }
+  else
+  {
+    this->LastRenderTranslucency =
+      this->ObservedRenderer->GetUseDepthPeeling() ? PEELED_SURFACE : BLENDED_SURFACE;
+  }
   if (frame != Frames().Pending.end() && frame->second.RendererStart == 0.0)
   {
     frame->second.RendererStart = Now();
@@ -697,6 +751,19 @@ void vtkBlockLODSurfaceRepresentation::OnRendererEnd()
   {
     frame->second.RendererSeconds = end - frame->second.RendererStart;
   }
+  if (frame != Frames().Pending.end() && frame->second.Blended &&
+    !this->ObservedRenderer->GetUseDepthPeeling())
+  {
+    // The view's setting back, before anything else renders.
+    this->ObservedRenderer->SetUseDepthPeeling(1);
+  }
+}
+
+//------------------------------------------------------------------------------
+bool vtkBlockLODSurfaceRepresentation::BlendsInteractiveFrames()
+{
+  return this->InteractiveTranslucency == BLENDED && this->ObservedRenderer &&
+    this->ObservedRenderer->GetUseDepthPeeling();
 }
 
 //------------------------------------------------------------------------------
@@ -730,6 +797,9 @@ void vtkBlockLODSurfaceRepresentation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "InteractiveFrameBudget: " << this->InteractiveFrameBudget << " s\n";
   os << indent << "PredictedInteractiveSeconds: " << this->PredictedInteractiveSeconds << "\n";
   os << indent << "InteractiveTriangleBudget: " << this->InteractiveTriangleBudget << "\n";
+  os << indent << "InteractiveTranslucency: "
+     << (this->InteractiveTranslucency == BLENDED ? "BLENDED" : "PEELED") << "\n";
+  os << indent << "LastRenderTranslucency: " << this->LastRenderTranslucency << "\n";
   os << indent << "InteractiveLevel: " << this->InteractiveLevel << "\n";
   os << indent << "InteractiveTriangles: " << this->InteractiveTriangles << "\n";
   os << indent << "LastRenderUsedLOD: " << this->LastRenderUsedLOD << "\n";

@@ -134,6 +134,49 @@ public:
   ///@}
 
   /**
+   * How interactive frames draw translucent surfaces. The still frame is the
+   * view's (ParaView's render view peels translucent geometry: up to
+   * MaximumNumberOfPeels full-viewport passes, most of a translucent frame's
+   * time on a software renderer whatever its triangles).
+   * - PEELED: as the still frame, with the view's depth peeling.
+   * - BLENDED: during the frames that draw the interactive geometry, the
+   *   view's renderer blends translucent geometry in one pass instead (VTK's
+   *   vtkOrderIndependentTranslucentPass, weighted blended order-independent
+   *   transparency, which vtkOpenGLRenderer uses when depth peeling is off):
+   *   no sorting and no peels, the layers weighted by depth rather than
+   *   composited exactly, which a coarse surface in motion hides. The view's
+   *   setting is switched off at the renderer's StartEvent and back at its
+   *   EndEvent, so it holds for that frame only, and for every translucent
+   *   prop of the view in it. A frame blends only when no translucent Block
+   *   LOD display in it asks for PEELED.
+   * The interactive level is chosen for the frame this mode draws. Default
+   * BLENDED.
+   */
+  enum InteractiveTranslucencyModes
+  {
+    PEELED = 0,
+    BLENDED = 1
+  };
+  void SetInteractiveTranslucency(int mode);
+  vtkGetMacro(InteractiveTranslucency, int);
+
+  /**
+   * How the last render on this process drew this display's surface:
+   * OPAQUE_SURFACE (opaque, hidden or not drawn), PEELED_SURFACE (translucent,
+   * with the view's depth peeling) or BLENDED_SURFACE (translucent, in one
+   * blended pass: an interactive frame with InteractiveTranslucency BLENDED,
+   * or a view without depth peeling). Read from the renderer when it starts
+   * the frame, on the rendering process.
+   */
+  enum SurfaceTranslucency
+  {
+    OPAQUE_SURFACE = 0,
+    PEELED_SURFACE = 1,
+    BLENDED_SURFACE = 2
+  };
+  vtkGetMacro(LastRenderTranslucency, int);
+
+  /**
    * The seconds the frame-time model predicted, when the level was chosen
    * (on this data process), for a frame drawing that level (0 when none was).
    */
@@ -206,7 +249,15 @@ protected:
   bool AddToView(vtkView* view) override;
   bool RemoveFromView(vtkView* view) override;
 
+  // Whether interactive frames that draw this display translucent are to be
+  // blended in one pass (InteractiveTranslucency BLENDED, a view that peels).
+  bool BlendsInteractiveFrames();
+
   bool InteractiveLevels = true;
+  int InteractiveTranslucency = BLENDED;
+  int LastRenderTranslucency = OPAQUE_SURFACE;
+  // Set by REQUEST_RENDER: the coming frame draws this display translucent.
+  bool DrawsTranslucent = false;
   double InteractiveFrameBudget = 0.1;
   double InteractiveTriangleBudget = 0.0;
   double PredictedInteractiveSeconds = 0.0;

@@ -1,6 +1,6 @@
 """What the Block LOD Surface display's tests share (pvpython).
 
-    info = frame_info(display)   # {"level": ..., "triangles": ..., "lod": ...}
+    info = frame_info(display)   # {"level": ..., "triangles": ..., "lod": ..., "translucency": ...}
 """
 from paraview.modules.vtkRemotingCore import vtkPVSession
 
@@ -8,7 +8,8 @@ from paraview.modules.vtkRemotingCore import vtkPVSession
 def frame_info(display):
     """What the rendering process's representation drew in the last render (builtin: this
     process; client/server with local rendering: the client): the interactive level, its
-    triangles, and whether the render used the LOD geometry (1) or the full level (0)."""
+    triangles, whether the render used the LOD geometry (1) or the full level (0), and how it
+    drew the surface (0 opaque, 1 translucent with depth peeling, 2 in one blended pass)."""
     sub = display.SMProxy.GetProperty("BlockLODInteractiveLevel").GetParent()
     previous = sub.GetLocation()
     sub.SetLocation(vtkPVSession.CLIENT)
@@ -19,4 +20,5 @@ def frame_info(display):
     value = lambda name: display.GetProperty(name)[0]  # noqa: E731
     return {"level": int(value("BlockLODInteractiveLevel")),
             "triangles": int(value("BlockLODInteractiveTriangles")),
-            "lod": int(value("BlockLODLastRenderUsedLOD"))}
+            "lod": int(value("BlockLODLastRenderUsedLOD")),
+            "translucency": int(value("BlockLODLastRenderTranslucency"))}
