@@ -40,7 +40,9 @@ With --interaction (under X, in this process, no children): ParaView rotation fr
 Contour's displays, skin (first isovalue) over bone (second) each from its own filter at level 3,
 skin opaque and then at opacity 0.3: still frames (Render) against interactive frames
 (InteractiveRender, as during a mouse drag), with the coarser Block LOD levels while interacting
-(the default) and with ParaView's own decimated LOD (BlockLODInteractiveLevels off), at the view's
+(the default; a translucent skin blended in one pass while interacting, its default, and with the
+view's depth peeling) and with ParaView's own decimated LOD (BlockLODInteractiveLevels off, depth
+peeling as ParaView draws it), at the view's
 default LODThreshold and the displays' default budgets; per frame median, the first interactive
 frame (which makes the LOD geometry) apart, the level and triangles each display drew, and the
 frame time its model predicted for that level when it was chosen.
@@ -1357,13 +1359,21 @@ def run_interaction(args):
             sub.UpdatePropertyInformation()
             return (int(d.GetProperty("BlockLODInteractiveLevel")[0]),
                     int(d.GetProperty("BlockLODInteractiveTriangles")[0]),
-                    float(d.GetProperty("BlockLODPredictedInteractiveSeconds")[0]))
+                    float(d.GetProperty("BlockLODPredictedInteractiveSeconds")[0]),
+                    int(d.GetProperty("BlockLODLastRenderTranslucency")[0]))
+
+        how = {0: "", 1: ", peeled", 2: ", blended"}  # BlockLODLastRenderTranslucency
 
         for opacity in (1.0, 0.3):
             displays[0].Opacity = opacity
-            for mode, levels in (("Block LOD levels", 1), ("ParaView decimation", 0)):
+            modes = [("Block LOD levels", 1, "One Blended Pass")]
+            if opacity < 1.0:
+                modes.append(("Block LOD levels, depth peeling", 1, "Depth Peeling"))
+            modes.append(("ParaView decimation", 0, "Depth Peeling"))
+            for mode, levels, translucency in modes:
                 for d in displays:
                     d.BlockLODInteractiveLevels = levels
+                    d.BlockLODInteractiveTranslucency = translucency
                 pvs.Render(view)
                 pvs.Render(view)
                 still, moving, rendered, still_rendered, windowed = [], [], [], [], []
@@ -1399,8 +1409,8 @@ def run_interaction(args):
                              fmt_s(statistics.median(still)), fmt_s(statistics.median(moving)),
                              "%.2f" % (statistics.median(moving) / statistics.median(still)),
                              fmt_s(first),
-                             " / ".join("L%d %d" % w[:2] if w[0] >= 0 else "decimated %d" % w[1]
-                                        for w in what),
+                             " / ".join(("L%d %d" % w[:2] if w[0] >= 0 else "decimated %d" % w[1])
+                                        + how.get(w[3], "") for w in what),
                              " / ".join(fmt_s(w[2]) if w[0] >= 0 else "-" for w in what),
                              "%s / %s" % (fmt_s(statistics.median(rendered)),
                                           fmt_s(statistics.median(windowed))),

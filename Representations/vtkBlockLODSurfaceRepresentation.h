@@ -58,9 +58,26 @@
  * client/server the level is chosen on the server, which renders no frame to
  * learn from when the client renders: there the prior decides.
  *
+ * Translucency while interacting: ParaView's render view peels translucent
+ * geometry (vtkDualDepthPeelingPass, up to the view's MaximumNumberOfPeels),
+ * full-viewport passes that on a software renderer are most of a translucent
+ * frame whatever its triangles, so a coarser level alone does not bring such
+ * a frame within the budget (docs/blocklod.md). A renderer whose depth
+ * peeling is off draws translucent geometry in one pass of weighted blended
+ * order-independent transparency (vtkOrderIndependentTranslucentPass), and
+ * it reads UseDepthPeeling at each render; so with InteractiveTranslucency
+ * BLENDED (the default) a frame that draws the interactive geometry of a
+ * translucent display switches it off at the view's renderer's StartEvent
+ * and on again at its EndEvent: that frame blends, every other frame (the
+ * still one) is the view's. The blended image is not the peeled one (layers
+ * weighted by depth instead of composited in order): close to it on a
+ * single-colour surface, and the camera is moving. The frame-time model
+ * counts such a frame as one pass (an opaque frame's pair).
+ *
  * What interactive frames draw is readable on the rendering process:
  * GetInteractiveLevel() (the level of the LOD geometry, -1 when it is not a
- * Block LOD level), GetInteractiveTriangles() and GetLastRenderUsedLOD().
+ * Block LOD level), GetInteractiveTriangles(), GetLastRenderUsedLOD() and
+ * GetLastRenderTranslucency() (opaque, peeled or blended).
  *
  * @sa vtkBlockLODContour vtkGeometryRepresentation vtkPVRenderView
  */
