@@ -786,6 +786,11 @@ void vtkBlockLODSurfaceRepresentation::SetVisibility(bool visible)
     std::lock_guard<std::mutex> lock(Frames().Mutex);
     Frames().Drawn[this->ObservedRenderer.GetPointer()].erase(this);
   }
+  if (!visible)
+  {
+    // A hidden display gets no REQUEST_RENDER: its frames draw nothing of it.
+    this->DrawsTranslucent = false;
+  }
   this->Superclass::SetVisibility(visible);
 }
 

@@ -12,6 +12,7 @@ LODThreshold at 0 (interactive renders always draw the LOD geometry) and its dep
   interactive images of the same camera differ (the blended one really is another drawing) but
   cover the same pixels and stay close in colour (a correct-looking surface, not an artefact);
 - the still image after all this equals the one before, pixel for pixel;
+- a hidden display says it drew nothing translucent;
 - a view without depth peeling: its still and interactive frames blend, and its setting stays
   off after an interactive frame.
 (How much time the blended pass saves: Python/benchmark_render_window.py and
@@ -138,6 +139,13 @@ info = blocklod_display.frame_info(skin)
 check(info["lod"] == 0 and info["translucency"] == PEELED, "the still frame after is peeled (%s)" % info)
 differ = int((before != after).any(axis=2).sum())
 check(differ == 0, "the still image after interaction equals the one before (%d pixels differ)" % differ)
+
+# A hidden display draws nothing: it says so (it hears the renderer's frames all the same).
+Hide(shown[0][0], view)
+still()
+interactive()
+check(blocklod_display.frame_info(skin)["translucency"] == 0, "a hidden skin says it drew nothing translucent")
+Show(shown[0][0], view)
 
 # A view that does not peel: nothing to switch; its frames blend, and it stays that way.
 view.DepthPeeling = 0
