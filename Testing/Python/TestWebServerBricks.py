@@ -12,8 +12,9 @@ brick); a need query answers, for each isovalue, exactly the bricks holding the 
 core's blocks crossing it read (a brute force over the blocks here), a subset of the page's
 superset (the bricks whose range holds it and their neighbours); a batch of bricks is their
 single answers joined (values, order, bytes no more); bad requests (a batch that repeats a brick,
-ids out of range, too many) get 400, a wrong token 403. The same server opens phantom:77:noise=40 (serve_operations.phantom_spec): its
-values are the noiseless phantom's plus noise of about 40 HU, and its bricks decode to them. On
+ids out of range or not integers) get 400, a wrong token 403. The same server opens
+phantom:77:noise=40 (serve_operations.phantom_spec): its values are the noiseless phantom's plus
+noise of about 40 HU, and its bricks decode to them. On
 the head CT (when Python/fetch_data.py has fetched it), the bricks and level 0 are at most 1.05x
 its whole level on the wire. The ranges against the C++ core's ComputeBrickRanges, and the
 surfaces drawn from the needed bricks against the dense ones, are checked in Chromium

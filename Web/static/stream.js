@@ -209,7 +209,7 @@ export async function startStream(level) {
   state.stream = { level, path: state.path, manifest, type, dims, resident: new Uint8Array(count),
     pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, received: 0,
     total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), exact: new Map(),
-    asked: new Set(), requested: [], readyKey: "", error: "", started: false, framed: false,
+    asked: new Set(), requested: [], arrived: [], readyKey: "", error: "", started: false, framed: false,
     batch: Math.max(1, Math.ceil(count / BATCHES)) };
   state.received = 0;
   // The bricks are asked for once the first frame (level 0's) is drawn (afterEach): on a fast
@@ -289,6 +289,7 @@ function fetchMore() {
       console.error("streaming: " + s.error);
       updateReadout();
       fetchMore();
+      handOver(s); // nothing waits for a surface that cannot come
     });
   }
 }
@@ -310,19 +311,53 @@ async function fetchBatch(s, ids) {
   if (body.byteLength !== length) {
     throw new Error(body.byteLength + " bytes where the bricks own " + length);
   }
-  // Decoded and written by the worker, before any frame asked for after this (messages keep
-  // their order): the bricks are resident for this thread's bookkeeping from now on.
-  state.viewer.writeBricks({ ids, body, predictor: response.headers.get("X-Mediso-Predictor") || "none" });
-  for (const id of ids) {
-    s.resident[id] = 1;
-    s.received += s.manifest.bytes[id];
+  s.arrived.push({ ids, body, predictor: response.headers.get("X-Mediso-Predictor") || "none" });
+  await handOver(s);
+}
+
+// Hands the batches that have arrived to the worker, which decodes and writes them before any
+// frame asked for after them (messages keep their order); the bricks are resident for this
+// thread's bookkeeping from then on. A batch that no current surface needs waits while a
+// surface still lacks bricks: on a fast link the bricks come faster than the worker writes them
+// (a first frame or an extraction holds it), and the others' batches queued before the frame
+// that a surface's last brick asks for would hold that frame. They go as soon as every current
+// surface has its bricks (after that frame's request), or a brick has failed.
+async function handOver(s) {
+  if (state.stream !== s) {
+    return;
   }
-  if (!s.pending.size && !s.inFlight) { // (every other answer was handled when it came)
-    await finish(s); // received is 1 once the page's copy is there too
+  const values = currentValues();
+  const needs = (id) => values.some((v) => needed(s, v).has(id));
+  const write = (batch) => {
+    state.viewer.writeBricks(batch);
+    for (const id of batch.ids) {
+      s.resident[id] = 1;
+      s.received += s.manifest.bytes[id];
+    }
+  };
+  const held = [];
+  for (const batch of s.arrived) {
+    if (batch.ids.some(needs)) {
+      write(batch);
+    } else {
+      held.push(batch);
+    }
+  }
+  s.arrived = held;
+  const drawn = redrawIfReady(s);
+  if (held.length && (s.error || values.every((v) => ready(s, v)))) {
+    held.forEach(write);
+    s.arrived = [];
+  }
+  if (!s.pending.size && !s.inFlight && !s.arrived.length) { // every brick is in the worker
+    if (!s.finishing) {
+      s.finishing = true;
+      await finish(s); // received is 1 once the page's copy is there too
+    }
     return;
   }
   state.received = s.received / s.total;
-  if (!redrawIfReady(s)) {
+  if (!drawn) {
     updateReadout();
   }
 }
@@ -389,6 +424,9 @@ function fullNow() {
 function afterEach() {
   if (state.stream && !state.stream.framed) {
     framed(state.stream);
+  }
+  if (state.stream && state.stream.arrived.length) {
+    handOver(state.stream); // a change since may need them, or need nothing more
   }
   const stats = state.viewer.stats();
   const drawn = stats.surfaceValues || [];
