@@ -13,8 +13,10 @@ point once.
   GET /api/bricks/<id>?level=k             the manifest (JSON)
   GET /api/bricks/<id>?level=k&ids=3,4,9    those bricks' owned points, each x fastest and
                                             encoded on its own (below), one after the other in
-                                            the order asked, gzip'd; kept by the browser and
-                                            revalidated (ETag) like /api/volume
+                                            the order asked, gzip'd (one gzip stream: the page
+                                            finds each brick by its owned bytes, the manifest's);
+                                            kept by the browser and revalidated (ETag) like
+                                            /api/volume
   GET /api/bricks/<id>?level=k&need=v,w     the bricks each isovalue needs (JSON), exactly:
                                             those holding the points that the cells and
                                             gradients of the core's blocks crossing it read
@@ -31,10 +33,19 @@ noise, and a smooth volume's values repeat patterns that gzip's level 6 finds, s
 chooses its encoding (ENCODINGS) on a sample of its bricks. Encoded bricks are kept (a brick is
 encoded once per server), encoded in the background from the manifest on, the bricks a page's
 isovalues need (its need query) first.
+
+A request names several bricks (the page asks for 10-30 batches, not one request a brick: each
+request costs the page a round of fetch, answer and hand-over). Its answer is made of the kept
+encodings without compressing anything again: each brick is kept as raw deflate blocks ended by a
+full flush (byte-aligned, no reference to earlier bytes), so the blocks of several bricks one
+after the other are one valid deflate stream; the answer puts gzip's header before them and an
+empty final block, the CRC-32 of the whole (each brick's kept CRC combined: crc32_combine) and
+its length after them.
 """
 import asyncio
 import gzip
 import math
+import struct
 import zlib
 
 from aiohttp import web
@@ -141,6 +152,71 @@ def gzipped(raw, encoding):
     return z.compress(raw) + z.flush()
 
 
+class Segment:
+    """One brick's encoding as kept: `blocks`, raw deflate blocks ended by a full flush (so that
+    segments put one after the other are one deflate stream), the CRC-32 and length of what they
+    inflate to."""
+    __slots__ = ("blocks", "crc", "length")
+
+    def __init__(self, raw, encoding):
+        _, level, strategy = ENCODINGS[encoding]
+        z = zlib.compressobj(level, zlib.DEFLATED, -zlib.MAX_WBITS, 9, strategy)
+        self.blocks = z.compress(raw) + z.flush(zlib.Z_FULL_FLUSH)
+        self.crc = zlib.crc32(raw)
+        self.length = len(raw)
+
+
+def _gf2_times(matrix, vector):
+    """A 32x32 matrix over GF(2) (its columns as ints) times a 32-bit vector."""
+    out, column = 0, 0
+    while vector:
+        if vector & 1:
+            out ^= matrix[column]
+        vector >>= 1
+        column += 1
+    return out
+
+
+_ZEROS = {}  # byte count -> the operator that appends that many zero bytes to a CRC register
+
+
+def _zeros_operator(count):
+    """The CRC-32 register's change by `count` zero bytes, as a matrix (kept: bricks have few
+    lengths). zlib's crc32_combine, which Python's zlib does not expose, computes the same."""
+    if count not in _ZEROS:
+        step = [0xEDB88320] + [1 << n for n in range(31)]  # one zero bit
+        for _ in range(3):  # one zero byte
+            step = [_gf2_times(step, c) for c in step]
+        result, n = None, count
+        while n:
+            if n & 1:
+                result = step if result is None else [_gf2_times(step, c) for c in result]
+            n >>= 1
+            if n:
+                step = [_gf2_times(step, c) for c in step]
+        _ZEROS[count] = result
+    return _ZEROS[count]
+
+
+def crc32_combine(crc1, crc2, length2):
+    """The CRC-32 of A + B from A's (`crc1`), B's (`crc2`) and B's length."""
+    return _gf2_times(_zeros_operator(length2), crc1) ^ crc2 if length2 else crc1
+
+
+_FINAL_BLOCK = zlib.compressobj(0, zlib.DEFLATED, -zlib.MAX_WBITS).flush()  # an empty last block
+
+
+def joined(segments):
+    """Segments (in the order asked) as one gzip stream: the header, their blocks, an empty final
+    block, the CRC-32 and length of the whole (RFC 1952). Nothing is compressed again."""
+    crc, length = 0, 0
+    for segment in segments:
+        crc = crc32_combine(crc, segment.crc, segment.length)
+        length += segment.length
+    return b"".join([b"\x1f\x8b\x08\x00\x00\x00\x00\x00\x00\xff"] + [s.blocks for s in segments] +
+                    [_FINAL_BLOCK, struct.pack("<II", crc, length & 0xFFFFFFFF)])
+
+
 def choose_encoding(values, counts):
     """The encoding (an ENCODINGS key) whose bricks are smallest on up to SAMPLE_BRICKS bricks
     spread over the level (floating-point values are not predicted)."""
@@ -152,13 +228,12 @@ def choose_encoding(values, counts):
     return min(names, key=lambda e: sizes[e])
 
 
-def encode(dataset, k, ids, encoding):
-    """Bricks `ids` of level k, each encoded on its own (encode_raw) with the predictor of
-    `encoding` (an ENCODINGS key), one after the other in the order asked, gzip'd."""
+def encode(dataset, k, brick, encoding):
+    """Brick `brick` of level k encoded (encode_raw) with the predictor of `encoding` (an
+    ENCODINGS key) and deflated as a Segment."""
     values = dataset.level(k)
     counts = brick_counts(values.shape)
-    predictor = ENCODINGS[encoding][0]
-    return gzipped(b"".join(encode_raw(owned(values, counts, b), predictor) for b in ids), encoding)
+    return Segment(encode_raw(owned(values, counts, brick), ENCODINGS[encoding][0]), encoding)
 
 
 def block_ranges(values):
@@ -251,7 +326,7 @@ def requested_level(request, d):
 
 
 class Encoder:
-    """A level's bricks encoded once each (one-brick bodies, as the page asks for them), kept for
+    """A level's bricks encoded once each (Segments, joined into any request's answer), kept for
     the server's life; ENCODE_AHEAD tasks encode them in the background, the bricks a need query
     named first, then the rest in id order, so that a page's next request finds its brick ready.
     The level's encoding is chosen first, off the event loop, once."""
@@ -261,14 +336,14 @@ class Encoder:
         loop = asyncio.get_running_loop()
         self.dataset, self.k = dataset, k
         self.encoding = loop.run_in_executor(None, lambda: choose_encoding(dataset.level(k), counts))
-        self.bodies = {}  # id -> task of its gzip'd body
+        self.bodies = {}  # id -> task of its Segment
         self.queue = list(range(counts[0] * counts[1] * counts[2]))[::-1]  # popped from the end
         self.tasks = [asyncio.ensure_future(self.ahead()) for _ in range(self.ENCODE_AHEAD)]
 
     async def encode(self, brick):
         encoding = await asyncio.shield(self.encoding)
         return await asyncio.get_running_loop().run_in_executor(
-            None, encode, self.dataset, self.k, [brick], encoding)
+            None, encode, self.dataset, self.k, brick, encoding)
 
     def body(self, brick):
         if brick not in self.bodies:
@@ -337,10 +412,8 @@ def handler(find, not_modified, cache_control):
                       "Cache-Control": cache_control}
         if not_modified(request, validators["ETag"], d.modified):
             return web.Response(status=304, headers=validators)
-        if len(ids) == 1:
-            body = await asyncio.shield(encoders[key].body(ids[0]))
-        else:
-            body = await loop.run_in_executor(None, encode, d, k, ids, encoding)
+        encoder = encoders[key]
+        body = joined(await asyncio.gather(*(asyncio.shield(encoder.body(b)) for b in ids)))
         return web.Response(body=body, headers=dict(validators, **{
             "Content-Encoding": "gzip", "Content-Type": "application/octet-stream",
             "X-Mediso-Type": d.type, "X-Mediso-Predictor": ENCODINGS[encoding][0],

@@ -10,9 +10,11 @@ every point sent once; their bytes on the wire, with level 0's, are at most 1.05
 level's from /api/volume (1.10x at level 3, where 13 of the 77 points per axis are a partial
 brick); a need query answers, for each isovalue, exactly the bricks holding the points that the
 core's blocks crossing it read (a brute force over the blocks here), a subset of the page's
-superset (the bricks whose range holds it and their neighbours); bad requests get 400, a wrong
-token 403. The same server opens phantom:77:noise=40 (serve_operations.phantom_spec): its
-values are the noiseless phantom's plus noise of about 40 HU, and its bricks decode to them. On
+superset (the bricks whose range holds it and their neighbours); a batch of bricks is their
+single answers joined (values, order, bytes no more); bad requests (a batch that repeats a brick,
+ids out of range or not integers) get 400, a wrong token 403. The same server opens
+phantom:77:noise=40 (serve_operations.phantom_spec): its values are the noiseless phantom's plus
+noise of about 40 HU, and its bricks decode to them. On
 the head CT (when Python/fetch_data.py has fetched it), the bricks and level 0 are at most 1.05x
 its whole level on the wire. The ranges against the C++ core's ComputeBrickRanges, and the
 surfaces drawn from the needed bricks against the dense ones, are checked in Chromium
@@ -180,6 +182,7 @@ async def main():
             both = (await r.json())["need"]
         checks(len(both) == 2, "a need query answers each isovalue in order")
         await noisy_phantom(http)
+        await batch_answers(http, d)
         for query, status in (("level=4", 400), ("level=x", 400), ("level=3&ids=", 400),
                               ("level=3&need=", 400), ("level=3&need=a", 400),
                               ("level=3&need=nan", 400), ("level=3&need=" + ",".join(["1"] * 17), 400),
@@ -187,10 +190,50 @@ async def main():
                               ("level=3&ids=27", 400), ("level=3&ids=a", 400)):
             async with http.get(server.url("/api/bricks/%s?%s" % (d["id"], query))) as r:
                 checks(r.status == status, "%s: %d (%d)" % (query, status, r.status))
+        # A batch: a brick repeated anywhere in it, an id past the last, a negative, empty or not
+        # whole one; refused whole, with a line saying what ids must be.
+        for ids in ("0,5,3,5", "3,0,3", "0,1,8", "2,-1", "1,,2", "0,1.5"):
+            async with http.get(server.url("/api/bricks/%s?level=3&ids=%s" % (d["id"], ids))) as r:
+                text = await r.text()
+                checks(r.status == 400 and text.startswith("ids:"),
+                       "ids=%s: 400 (%d, %s)" % (ids if len(ids) < 20 else ids[:17] + "...", r.status,
+                                                text.strip()))
         async with http.get(server.url("/api/bricks/nope?level=3")) as r:
             checks(r.status == 404, "an unknown dataset: 404 (%d)" % r.status)
         async with http.get(server.url("/api/bricks/%s?level=3&ids=0" % d["id"], token="wrong")) as r:
             checks(r.status == 403, "without the token: 403 (%d)" % r.status)
+
+
+async def batch_answers(http, d):
+    """A batch is its bricks' single answers put together: the same values in the order asked (one
+    gzip stream, its CRC checked by gzip.decompress), in no more bytes than the single answers
+    (the server joins its kept encodings; each single answer has a gzip header and trailer more),
+    the same bytes at every request (the browser's copy stays valid), and a batch of every brick
+    in any order decodes too."""
+    import gzip
+    base = "/api/bricks/%s?level=3&ids=" % d["id"]
+    singles = {}
+    for brick in range(8):
+        async with http.get(server.url(base + str(brick))) as r:
+            singles[brick] = await r.read()
+    order = [6, 1, 7, 0, 3]
+    bodies = []
+    for _ in range(2):
+        async with http.get(server.url(base + ",".join(map(str, order)))) as r:
+            bodies.append(await r.read())
+            checks(r.status == 200 and r.headers["X-Mediso-Bricks"] == ",".join(map(str, order)) and
+                   r.headers["Content-Encoding"] == "gzip", "a batch of 5 bricks answered")
+    joined = b"".join(gzip.decompress(singles[b]) for b in order)
+    checks(gzip.decompress(bodies[0]) == joined,
+           "a batch inflates to its bricks' single answers, one after the other in the order asked")
+    checks(len(bodies[0]) <= sum(len(singles[b]) for b in order) and bodies[0] == bodies[1],
+           "... in %d bytes (the single answers: %d), the same at every request"
+           % (len(bodies[0]), sum(len(singles[b]) for b in order)))
+    every = list(range(8))[::-1]
+    async with http.get(server.url(base + ",".join(map(str, every)))) as r:
+        body = await r.read()
+    checks(gzip.decompress(body) == b"".join(gzip.decompress(singles[b]) for b in every),
+           "a batch of every brick, last first, inflates to them all")
 
 
 async def noisy_phantom(http):

@@ -154,11 +154,21 @@ export class RemoteViewer {
     [bytes.buffer]);
     return uploaded;
   }
-  /** Bricks [{id, bytes (an ArrayBuffer of its owned points, transferred)}] for the worker's buffer. */
-  writeBricks(list) {
-    this.worker.postMessage({ op: "bricks", list }, list.map((b) => b.bytes));
+  /**
+   * A batch of bricks for the worker's buffer: `body` (an ArrayBuffer, transferred) holds bricks
+   * `ids` one after the other as the server encoded them (predictor `predictor`); the worker
+   * decodes and writes them (render-worker.js, writeBricks).
+   */
+  writeBricks({ ids, body, predictor }) {
+    this.worker.postMessage({ op: "bricks", ids, body, predictor }, [body]);
   }
-  endStream() { this.worker.postMessage({ op: "streamEnd" }); }
+  /** Streaming ends; resolves to the level's bytes as the worker holds them (an ArrayBuffer). */
+  endStream() {
+    const id = this.nextId++;
+    const bytes = new Promise((resolve) => this.answers.set(id, resolve));
+    this.worker.postMessage({ op: "streamEnd", id });
+    return bytes;
+  }
   setCoarseValues(values) { this.call("setCoarseValues", values); }
 
   setSurfaces(surfaces) {

@@ -11,8 +11,9 @@
 //   {op: "call", method, args, id?}                      a WebViewer call; with id, its answer
 //   {op: "volume", type, bytes, dims, spacing, origin}   the volume's values (transferred)
 //   {op: "mesh", points, triangles, color, opacity}      a surface the server made
-//   {op: "stream", type, dims, spacing, origin, brick, coarse}, {op: "bricks", list},
-//   {op: "streamEnd"}                                    streaming (stream.js, startStream here)
+//   {op: "stream", type, dims, spacing, origin, brick, coarse}, {op: "bricks", ids, body, predictor},
+//   {op: "streamEnd", id}                                streaming (stream.js, startStream here;
+//                                                        streamEnd answers the level's bytes)
 //   {op: "frame", id, surfaces, view, interactive, generation}  the frame wanted now
 // Messages out: {op: "ready", ok, error, info, generation}, {op: "answer", id, value},
 //   {op: "frame", id, stats, settled}, {op: "error", message}.
@@ -42,6 +43,7 @@ let skipped = 0;
 let volumeBytes = 0; // the pointer of the volume in this module's memory
 let streaming = false; // stream.js's bricks are arriving: each surface at level 0 or 3, no coarse first answer
 let coarseBytes = 0; // the pointer of the streamed level 0
+let streamGrid = null; // {dims, brick, size, length, scratch}: the streamed level (writeBricks)
 
 // The generation word (an Int32Array of one, shared with the page's main thread, which adds one
 // to it on every new set of isovalues and every drag frame before it sends the frame): a running
@@ -319,9 +321,46 @@ function startStream(m) {
     viewer.beginStreaming(m.brick) &&
     viewer.setCoarseVolume(m.type, coarseBytes, m.coarse.dims, m.coarse.spacing, m.coarse.origin);
   streaming = ok;
+  freeScratch();
+  streamGrid = { dims: m.dims, brick: m.brick, size, length, scratch: 0 };
   shownKey = "";
   refine = null;
   post({ op: "answer", id: m.id, value: ok ? "" : viewer.stats().error || "the volume cannot be streamed" });
+}
+
+// A batch of bricks as fetched by stream.js (one answer of /api/bricks: the bricks one after the
+// other, each as the server encoded it) decoded here, one at a time, into a scratch brick in the
+// module's memory and written into the volume (WebViewer.writeBrick): the page's main thread
+// does nothing per brick, and the bytes are copied once on their way into the volume.
+function writeBricks(m) {
+  if (!self.medisoBricks) {
+    importScripts("brick-decode.js");
+  }
+  const g = streamGrid;
+  const { decodeBrickInto, ownedBox } = self.medisoBricks;
+  if (!g.scratch) {
+    g.scratch = M._malloc(g.size * g.brick * g.brick * g.brick);
+  }
+  const body = new Uint8Array(m.body);
+  let offset = 0;
+  for (const id of m.ids) {
+    const box = ownedBox(g.dims, g.brick, id);
+    const length = g.size * (box[1] - box[0]) * (box[3] - box[2]) * (box[5] - box[4]);
+    // A view taken now: the memory may have grown (and been replaced) since the last brick.
+    decodeBrickInto(body.subarray(offset, offset + length), g.size, m.predictor, box,
+      new Uint8Array(M.HEAPU8.buffer, g.scratch, length));
+    offset += length;
+    if (!viewer.writeBrick(id, g.scratch)) {
+      throw new Error(viewer.stats().error || "brick " + id + " cannot be written");
+    }
+  }
+}
+
+function freeScratch() {
+  if (streamGrid && streamGrid.scratch) {
+    M._free(streamGrid.scratch);
+  }
+  streamGrid = null;
 }
 
 self.onmessage = async (event) => {
@@ -344,6 +383,7 @@ self.onmessage = async (event) => {
       }
     } else if (m.op === "volume") {
       streaming = false;
+      freeScratch();
       if (coarseBytes) {
         viewer.setCoarseVolume(0, 0, [], [], []);
         M._free(coarseBytes);
@@ -362,13 +402,7 @@ self.onmessage = async (event) => {
     } else if (m.op === "stream") {
       startStream(m);
     } else if (m.op === "bricks") {
-      for (const brick of m.list) {
-        const bytes = new Uint8Array(brick.bytes);
-        const at = M._malloc(bytes.length);
-        M.HEAPU8.set(bytes, at);
-        viewer.writeBrick(brick.id, at);
-        M._free(at);
-      }
+      writeBricks(m);
       // A frame asked for before these bricks is drawn now: where bricks come faster than they
       // are written (loopback), its timer's turn came only after the last of them.
       if (scheduled) {
@@ -377,10 +411,16 @@ self.onmessage = async (event) => {
     } else if (m.op === "streamEnd") {
       viewer.endStreaming();
       streaming = false;
+      const length = streamGrid ? streamGrid.length : 0;
+      freeScratch();
       if (coarseBytes) {
         M._free(coarseBytes);
         coarseBytes = 0;
       }
+      // The level as it arrived, for the page's own copy (its slices, histogram and CPU count),
+      // which the main thread no longer writes brick by brick: one copy, transferred.
+      const copy = M.HEAPU8.slice(volumeBytes, volumeBytes + length);
+      post({ op: "answer", id: m.id, value: copy.buffer }, [copy.buffer]);
     } else if (m.op === "mesh") {
       const points = M._malloc(m.points.byteLength);
       const triangles = M._malloc(m.triangles.byteLength);

@@ -2,13 +2,14 @@
 // Streaming (docs/web.md, Streaming): with the viewer in a worker (either path), the page does
 // not wait for the whole level. It fetches the server's level 0 (1/512 of the points) and draws
 // every surface from it at once, then fetches the full level's bricks (/api/bricks, the cores'
-// BrickGrid bricks; the brick size is the server's manifest's) a few requests at a time, the
-// bricks the current isovalues need first (one a request, kept by the browser), decodes each
-// (decodeBrick: the server's predictor undone), writes it into the full level's buffer
-// (allocated once, in this thread's module and in the worker's, where WebViewer.writeBrick
-// completes the BlockLOD ranges of what arrived) and draws each surface at the full level as soon
-// as every brick it needs is there. What goes up is the isovalues (the need query) and the list
-// of bricks; every point comes once.
+// BrickGrid bricks; the brick size is the server's manifest's) in batches of several bricks a
+// request, a few requests at a time, the bricks the current isovalues need first; each answer's
+// bytes go to the worker as they came (transferred), which decodes them (brick-decode.js: the
+// server's predictor undone) straight into the full level's buffer (WebViewer.writeBrick
+// completes the BlockLOD ranges of what arrived), and each surface is drawn at the full level as
+// soon as every brick it needs is there. This thread does nothing per brick; it gets the level
+// back from the worker at the end (its own copy: slices, histogram). What goes up is the
+// isovalues (the need query) and the list of bricks; every point comes once.
 //
 // An isovalue needs the bricks holding the points that the cells and gradients of the core's
 // blocks crossing it read: the server answers which (askExact); until it has, the page takes a
@@ -19,13 +20,17 @@ import { drawnLevel } from "./path.js";
 import { updateReadout } from "./readout.js";
 import { params, state } from "./state.js";
 import { afterFrame, beforeFrame, renderNow } from "./viewer.js";
-import { fetchLevel, levelURL, loadVolume, mallocZeros, prefetch, request, requestJSON, typedValues,
-  unshuffle } from "./volume.js";
+import { fetchLevel, levelURL, loadVolume, mallocZeros, prefetch, request, requestJSON,
+  typedValues } from "./volume.js";
 
-// Requests in flight at once (a browser opens 6 connections to a host over HTTP/1.1). Each asks
-// for one brick: its URL is then the same at every load, so the browser keeps it and a reload
-// revalidates it (304) instead of fetching it again.
+// Requests in flight at once (a browser opens 6 connections to a host over HTTP/1.1).
 const IN_FLIGHT = 6;
+// Requests a level's bricks are cut into, about: each request costs this thread a fetch, an
+// answer and a hand-over to the worker, and the server a round of its event loop (one brick a
+// request was 256-512 requests on a 512-wide volume). The batches are the same at every load
+// with the same isovalues (the first waits for the server's need: nextBatch), so their URLs are
+// too, and the browser keeps each answer as it keeps a level: a reload revalidates them (304).
+const BATCHES = 24;
 
 /**
  * Whether the page streams level `level` on `path` (?stream=0: the whole level at once). Both
@@ -108,13 +113,18 @@ function askExact(s) {
     .then((answer) => {
       values.forEach((v, i) => s.exact.set(v, new Set(answer.need[i])));
       if (state.stream === s) {
-        redrawIfReady(s);
+        if (s.started) {
+          redrawIfReady(s);
+        } else {
+          begin(s); // it waited for this answer
+        }
       }
     })
     .catch((error) => {
       // The supersets stay: the surfaces come later, never wrong.
       values.forEach((v) => s.asked.delete(v));
       console.error("streaming: the bricks the isovalues need: " + error.message);
+      begin(s);
     });
 }
 
@@ -139,7 +149,7 @@ function redrawIfReady(s) {
       }
     }
   }
-  if (missing.size && missing.size <= IN_FLIGHT && !s.error) {
+  if (missing.size && missing.size <= IN_FLIGHT * s.batch && !s.error) {
     return false; // the last of them redraws (a brick that failed: no waiting)
   }
   s.readyKey = key;
@@ -199,7 +209,8 @@ export async function startStream(level) {
   state.stream = { level, path: state.path, manifest, type, dims, resident: new Uint8Array(count),
     pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, received: 0,
     total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), exact: new Map(),
-    asked: new Set(), requested: [], readyKey: "", error: "", started: false };
+    asked: new Set(), requested: [], arrived: [], readyKey: "", error: "", started: false, framed: false,
+    batch: Math.max(1, Math.ceil(count / BATCHES)) };
   state.received = 0;
   // The bricks are asked for once the first frame (level 0's) is drawn (afterEach): on a fast
   // link they would otherwise come first, and their writing and the server's encoding would
@@ -207,30 +218,63 @@ export async function startStream(level) {
   // asked of the server before that frame (beforeEach), so that the first requests are theirs;
   // a timer in case no frame comes.
   const s = state.stream;
-  setTimeout(() => begin(s), 1000);
+  setTimeout(() => framed(s), 1000);
 }
 
-function begin(s) {
-  if (s && state.stream === s && !s.started) {
-    s.started = true;
-    askExact(s);
-    fetchMore();
+// The first frame is drawn (or a second has passed without one): the bricks may be asked for.
+function framed(s) {
+  if (s && state.stream === s) {
+    s.framed = true;
+    begin(s);
   }
 }
 
-// The next brick: one the current isovalues need first, else the next in order.
+// The bricks are asked for once the first frame is drawn and the server has said which bricks
+// the current isovalues need (one round trip, sent before that frame: it has mostly come by
+// then): the batches are then those of the exact sets, the same at every load (BATCHES). A need
+// query that fails (the supersets) or takes over 2 s more does not hold the bricks.
+function begin(s, late = false) {
+  if (!s || state.stream !== s || s.started || !s.framed) {
+    return;
+  }
+  askExact(s);
+  if (!late && currentValues().some((v) => s.asked.has(v) && !s.exact.has(v))) {
+    if (!s.needTimer) {
+      s.needTimer = setTimeout(() => begin(s, true), 2000);
+    }
+    return;
+  }
+  s.started = true;
+  fetchMore();
+}
+
+// The next batch: up to s.batch bricks the current isovalues need (those of the first value
+// first), else up to s.batch of the others in id order; a batch does not mix the two, so that
+// the last needed bricks do not wait for others.
 function nextBatch(s) {
+  const ids = [];
   for (const v of currentValues()) {
     for (const id of needed(s, v)) {
       if (s.pending.has(id)) {
         s.pending.delete(id);
-        return [id];
+        ids.push(id);
+        if (ids.length === s.batch) {
+          return ids;
+        }
       }
     }
   }
-  const id = s.pending.values().next().value;
-  s.pending.delete(id);
-  return [id];
+  if (ids.length) {
+    return ids;
+  }
+  for (const id of s.pending) {
+    if (ids.length === s.batch) {
+      break;
+    }
+    ids.push(id);
+  }
+  ids.forEach((id) => s.pending.delete(id));
+  return ids;
 }
 
 function fetchMore() {
@@ -241,100 +285,13 @@ function fetchMore() {
     ++s.inFlight;
     fetchBatch(s, batch).catch((error) => {
       // Said in the readout; the surfaces that need the brick stay at level 0.
-      s.error = "brick " + batch.join(", ") + ": " + error.message;
+      s.error = "bricks " + batch.join(", ") + ": " + error.message;
       console.error("streaming: " + s.error);
       updateReadout();
       fetchMore();
+      handOver(s); // nothing waits for a surface that cannot come
     });
   }
-}
-
-// The points brick `id` owns: [x0, x1) x [y0, y1) x [z0, z1).
-function ownedBox(s, id) {
-  const [nx, ny] = s.manifest.bricks;
-  const B = s.manifest.brick;
-  const [dx, dy, dz] = s.dims;
-  const bx = id % nx, by = Math.floor(id / nx) % ny, bz = Math.floor(id / (nx * ny));
-  return [bx * B, Math.min(dx, bx * B + B), by * B, Math.min(dy, by * B + B),
-    bz * B, Math.min(dz, bz * B + B)];
-}
-
-// A brick's owned points (x fastest) into this thread's copy of the full level.
-function writeHere(s, id, brick) {
-  const [x0, x1, y0, y1, z0, z1] = ownedBox(s, id);
-  const size = s.type.bytes;
-  const [dx, dy] = s.dims;
-  const row = (x1 - x0) * size;
-  const heap = state.module.HEAPU8;
-  let from = 0;
-  for (let z = z0; z < z1; ++z) {
-    for (let y = y0; y < y1; ++y, from += row) {
-      heap.set(brick.subarray(from, from + row), state.volumePointer + ((z * dy + y) * dx + x0) * size);
-    }
-  }
-}
-
-const UNSIGNED = { 1: Uint8Array, 2: Uint16Array, 4: Uint32Array };
-const SIGNED = { 1: Int8Array, 2: Int16Array, 4: Int32Array };
-
-/**
- * One brick as the server encoded it (serve_bricks.py): byte-shuffled, and for integer values the
- * zigzag'd residuals of `predictor` ("xyz": differences along x, then y, then z; "x": along x;
- * "none") in the type's width. Gives its owned points' bytes (x fastest) in a buffer of their own.
- * Running sums undo the differences (in any order: they commute); a typed array's store wraps
- * as the server's differences did.
- */
-export function decodeBrick(encoded, size, predictor, box) {
-  const n = encoded.length / size;
-  let raw, d;
-  if (size === 2) {
-    // The common case (int16, uint16) in one pass: the two byte planes joined and unzigzag'd.
-    d = new Int16Array(n);
-    raw = new Uint8Array(d.buffer);
-    const lo = encoded.subarray(0, n), hi = encoded.subarray(n);
-    if (predictor === "none") {
-      for (let i = 0; i < n; ++i) {
-        d[i] = lo[i] | (hi[i] << 8);
-      }
-      return raw;
-    }
-    for (let i = 0; i < n; ++i) {
-      const z = lo[i] | (hi[i] << 8);
-      d[i] = (z >>> 1) ^ -(z & 1);
-    }
-  } else {
-    raw = size === 1 ? encoded.slice() : unshuffle(encoded, size);
-    if (predictor === "none") {
-      return raw;
-    }
-    const u = new UNSIGNED[size](raw.buffer, raw.byteOffset, n);
-    d = new SIGNED[size](raw.buffer, raw.byteOffset, n);
-    for (let i = 0; i < n; ++i) {
-      const z = u[i];
-      d[i] = (z >>> 1) ^ -(z & 1);
-    }
-  }
-  const [x0, x1, y0, y1, z0, z1] = box;
-  const nx = x1 - x0, ny = y1 - y0, nz = z1 - z0;
-  for (let r = 0; r < n; r += nx) {
-    let sum = 0;
-    for (let i = r; i < r + nx; ++i) {
-      sum += d[i];
-      d[i] = sum;
-    }
-  }
-  if (predictor === "xyz") {
-    const plane = nx * ny;
-    for (let z = 0; z < nz; ++z) {
-      for (let i = z * plane + nx; i < (z + 1) * plane; ++i) {
-        d[i] += d[i - nx];
-      }
-    }
-    for (let i = plane; i < n; ++i) {
-      d[i] += d[i - plane];
-    }
-  }
-  return raw;
 }
 
 async function fetchBatch(s, ids) {
@@ -348,30 +305,59 @@ async function fetchBatch(s, ids) {
   if (state.stream !== s) {
     return; // another volume since
   }
-  // The next request goes out before this one is decoded: the link stays busy while the main
-  // thread works (on a loaded machine its decoding was what the requests waited for).
+  // The next request goes out before this answer is handed over: the link stays busy.
   fetchMore();
-  const predictor = response.headers.get("X-Mediso-Predictor") || "none";
-  const encoded = new Uint8Array(body);
-  const list = [];
-  let offset = 0;
-  for (const id of ids) {
-    const length = s.manifest.bytes[id];
-    const brick = decodeBrick(encoded.subarray(offset, offset + length), s.type.bytes, predictor,
-      ownedBox(s, id));
-    offset += length;
-    writeHere(s, id, brick);
-    s.resident[id] = 1;
-    s.received += brick.length;
-    list.push({ id, bytes: brick.buffer });
+  const length = ids.reduce((sum, id) => sum + s.manifest.bytes[id], 0);
+  if (body.byteLength !== length) {
+    throw new Error(body.byteLength + " bytes where the bricks own " + length);
   }
-  state.viewer.writeBricks(list);
-  state.received = s.received / s.total;
-  if (!s.pending.size && !s.inFlight) { // (every other answer was handled when it came)
-    finish(s);
+  s.arrived.push({ ids, body, predictor: response.headers.get("X-Mediso-Predictor") || "none" });
+  await handOver(s);
+}
+
+// Hands the batches that have arrived to the worker, which decodes and writes them before any
+// frame asked for after them (messages keep their order); the bricks are resident for this
+// thread's bookkeeping from then on. A batch that no current surface needs waits while a
+// surface still lacks bricks: on a fast link the bricks come faster than the worker writes them
+// (a first frame or an extraction holds it), and the others' batches queued before the frame
+// that a surface's last brick asks for would hold that frame. They go as soon as every current
+// surface has its bricks (after that frame's request), or a brick has failed.
+async function handOver(s) {
+  if (state.stream !== s) {
     return;
   }
-  if (!redrawIfReady(s)) {
+  const values = currentValues();
+  const needs = (id) => values.some((v) => needed(s, v).has(id));
+  const write = (batch) => {
+    state.viewer.writeBricks(batch);
+    for (const id of batch.ids) {
+      s.resident[id] = 1;
+      s.received += s.manifest.bytes[id];
+    }
+  };
+  const held = [];
+  for (const batch of s.arrived) {
+    if (batch.ids.some(needs)) {
+      write(batch);
+    } else {
+      held.push(batch);
+    }
+  }
+  s.arrived = held;
+  const drawn = redrawIfReady(s);
+  if (held.length && (s.error || values.every((v) => ready(s, v)))) {
+    held.forEach(write);
+    s.arrived = [];
+  }
+  if (!s.pending.size && !s.inFlight && !s.arrived.length) { // every brick is in the worker
+    if (!s.finishing) {
+      s.finishing = true;
+      await finish(s); // received is 1 once the page's copy is there too
+    }
+    return;
+  }
+  state.received = s.received / s.total;
+  if (!drawn) {
     updateReadout();
   }
 }
@@ -392,12 +378,15 @@ export function brickRanges() {
     s.dims, s.manifest.brick, s.manifest.apron) };
 }
 
-// Every brick is here: the viewer's buffer is the full level, the page's copy too.
-function finish(s) {
+// Every brick is here: the viewer's buffer is the full level; the worker hands it back for the
+// page's copy (this thread's module: the CPU count; the values: slices and histogram).
+async function finish(s) {
   lastStream = s;
-  state.viewer.endStream();
-  const bytes = state.module.HEAPU8.slice(state.volumePointer,
-    state.volumePointer + s.type.bytes * s.dims[0] * s.dims[1] * s.dims[2]);
+  const bytes = new Uint8Array(await state.viewer.endStream());
+  if (state.stream !== s) {
+    return; // another volume since
+  }
+  state.module.HEAPU8.set(bytes, state.volumePointer);
   state.values = typedValues(bytes, s.type.name);
   state.grid = { dims: s.dims, spacing: state.dataset.levels[s.level].spacing,
     origin: state.grid.origin };
@@ -433,8 +422,11 @@ function fullNow() {
     drawnValues.every((v, i) => v === values[i]);
 }
 function afterEach() {
-  if (state.stream && !state.stream.started) {
-    begin(state.stream);
+  if (state.stream && !state.stream.framed) {
+    framed(state.stream);
+  }
+  if (state.stream && state.stream.arrived.length) {
+    handOver(state.stream); // a change since may need them, or need nothing more
   }
   const stats = state.viewer.stats();
   const drawn = stats.surfaceValues || [];
