@@ -703,44 +703,52 @@ double ExtractionPlanBytes(std::int64_t blocks, std::int64_t activeBlocks, int l
     static_cast<double>(activeBlocks) * perActive;
 }
 
-template <typename T>
-bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
-  double isovalue, int level, ExtractionPlan& plan, const ParallelFor& parallel,
-  const std::function<bool()>& abort)
+namespace
+{
+// The plan's layout for a level (what every plan of it holds per active block).
+void SetPlanLayout(ExtractionPlan& plan, double isovalue, int level)
 {
   plan.Isovalue = isovalue;
   plan.Level = level;
   plan.WordsPerBlock = WordsPerBlock(level);
-  const int stride = LevelStride(level);
-  const std::int64_t numBlocks = ranges.GetNumberOfBlocks();
-
-  plan.ActiveBlocks.clear();
-  plan.ActiveIndex.assign(numBlocks, -1);
-  for (std::int64_t b = 0; b < numBlocks; ++b)
-  {
-    if (ranges.IsActive(b, isovalue))
-    {
-      plan.ActiveIndex[b] = static_cast<std::int32_t>(plan.ActiveBlocks.size());
-      plan.ActiveBlocks.push_back(static_cast<std::int32_t>(b));
-    }
-  }
-  const std::int64_t numActive = static_cast<std::int64_t>(plan.ActiveBlocks.size());
-  const int words = plan.WordsPerBlock;
-  const int cubesPerAxis = BlockCells / stride;
+  const int cubesPerAxis = BlockCells / LevelStride(level);
   plan.CubesPerBlock = cubesPerAxis * cubesPerAxis * cubesPerAxis;
   plan.CubeWordsPerBlock = CubeWordsPerBlock(level);
-  // Cases are read only where a cube's bit is set: no need to clear them.
-  plan.CubeCases.resize(numActive * plan.CubesPerBlock);
-  plan.CutCubes.assign(numActive * plan.CubeWordsPerBlock, 0);
-  plan.EdgeBits.assign(numActive * words, 0);
-  plan.EdgeRank.assign(numActive * words, 0);
-  plan.PointOffset.assign(numActive + 1, 0);
-  plan.TriangleOffset.assign(numActive + 1, 0);
+}
 
+// Sizes the per-active-block arrays for `numActive` blocks, those from
+// `first` on cleared (cases are read only where a cube's bit is set: not
+// cleared).
+void ResizePlan(ExtractionPlan& plan, std::int64_t first, std::int64_t numActive)
+{
+  const int words = plan.WordsPerBlock;
+  plan.CubeCases.resize(numActive * plan.CubesPerBlock);
+  plan.CutCubes.resize(first * plan.CubeWordsPerBlock);
+  plan.CutCubes.resize(numActive * plan.CubeWordsPerBlock, 0);
+  plan.EdgeBits.resize(first * words);
+  plan.EdgeBits.resize(numActive * words, 0);
+  plan.EdgeRank.resize(numActive * words);
+  plan.PointOffset.resize(first + 1);
+  plan.PointOffset.resize(numActive + 1, 0);
+  plan.TriangleOffset.resize(first + 1);
+  plan.TriangleOffset.resize(numActive + 1, 0);
+}
+
+// Pass 1 on the plan's active blocks [first, numActive): each block's counts
+// into PointOffset/TriangleOffset[a + 1], then the running sums from `first`
+// on. False (the plan incomplete) when `abort` stopped it.
+template <typename T>
+bool ClassifyActive(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
+  ExtractionPlan& plan, std::int64_t first, const ParallelFor& parallel,
+  const std::function<bool()>& abort)
+{
+  const std::int64_t numActive = static_cast<std::int64_t>(plan.ActiveBlocks.size());
+  const int words = plan.WordsPerBlock;
+  const int stride = LevelStride(plan.Level);
   const TriangleCounts counts(cases);
-  const AboveIsovalue<T> above(isovalue);
+  const AboveIsovalue<T> above(plan.Isovalue);
   std::atomic<bool> aborted(false);
-  parallel(0, numActive, [&](std::int64_t a0, std::int64_t a1) {
+  parallel(first, numActive, [&](std::int64_t a0, std::int64_t a1) {
     if (aborted || (abort && abort()))
     {
       aborted = true;
@@ -770,17 +778,103 @@ bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, Triangle
   {
     return false;
   }
-  for (std::int64_t a = 0; a < numActive; ++a)
+  for (std::int64_t a = first; a < numActive; ++a)
   {
     plan.PointOffset[a + 1] += plan.PointOffset[a];
     plan.TriangleOffset[a + 1] += plan.TriangleOffset[a];
   }
   return true;
 }
+} // namespace
+
+template <typename T>
+bool PlanExtraction(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
+  double isovalue, int level, ExtractionPlan& plan, const ParallelFor& parallel,
+  const std::function<bool()>& abort)
+{
+  SetPlanLayout(plan, isovalue, level);
+  const std::int64_t numBlocks = ranges.GetNumberOfBlocks();
+  plan.ActiveBlocks.clear();
+  plan.ActiveIndex.assign(numBlocks, -1);
+  for (std::int64_t b = 0; b < numBlocks; ++b)
+  {
+    if (ranges.IsActive(b, isovalue))
+    {
+      plan.ActiveIndex[b] = static_cast<std::int32_t>(plan.ActiveBlocks.size());
+      plan.ActiveBlocks.push_back(static_cast<std::int32_t>(b));
+    }
+  }
+  ResizePlan(plan, 0, static_cast<std::int64_t>(plan.ActiveBlocks.size()));
+  return ClassifyActive(volume, ranges, cases, plan, 0, parallel, abort);
+}
+
+void BeginPlan(const BlockRanges& ranges, double isovalue, int level, ExtractionPlan& plan)
+{
+  SetPlanLayout(plan, isovalue, level);
+  plan.ActiveBlocks.clear();
+  plan.ActiveIndex.assign(ranges.GetNumberOfBlocks(), -1);
+  ResizePlan(plan, 0, 0);
+}
+
+template <typename T>
+std::int64_t AppendToPlan(const Volume<T>& volume, const BlockRanges& ranges,
+  TriangleCaseTable cases, const std::vector<std::int32_t>& blocks, ExtractionPlan& plan,
+  const ParallelFor& parallel)
+{
+  const std::int64_t first = static_cast<std::int64_t>(plan.ActiveBlocks.size());
+  for (std::int32_t b : blocks)
+  {
+    if (plan.ActiveIndex[b] < 0 && ranges.IsActive(b, plan.Isovalue))
+    {
+      plan.ActiveIndex[b] = static_cast<std::int32_t>(plan.ActiveBlocks.size());
+      plan.ActiveBlocks.push_back(b);
+    }
+  }
+  ResizePlan(plan, first, static_cast<std::int64_t>(plan.ActiveBlocks.size()));
+  ClassifyActive(volume, ranges, cases, plan, first, parallel, {});
+  return first;
+}
+
+int PlanOwners(const BlockRanges& ranges, std::int64_t block, std::int64_t owners[7])
+{
+  const std::int64_t b[3] = { block % ranges.Blocks[0],
+    (block / ranges.Blocks[0]) % ranges.Blocks[1],
+    block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]) };
+  int n = 0;
+  for (int across = 1; across < 8; ++across)
+  {
+    bool exists = true;
+    std::int64_t o[3];
+    for (int d = 0; d < 3; ++d)
+    {
+      const bool along = (across >> d) & 1;
+      exists = exists && !(along && b[d] == ranges.Blocks[d] - 1);
+      o[d] = b[d] + (along ? 1 : 0);
+    }
+    if (exists)
+    {
+      owners[n++] = (o[2] * ranges.Blocks[1] + o[1]) * ranges.Blocks[0] + o[0];
+    }
+  }
+  return n;
+}
 
 template <typename T, typename IdType>
 void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
   const ExtractionPlan& plan, const SurfaceBuffers<IdType>& out, const ParallelFor& parallel)
+{
+  if (out.Ranges)
+  {
+    *out.Ranges = SurfaceRanges();
+  }
+  GenerateBlocks(
+    volume, ranges, cases, plan, nullptr, GeneratePoints | GenerateTriangles, out, parallel);
+}
+
+template <typename T, typename IdType>
+void GenerateBlocks(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
+  const ExtractionPlan& plan, const std::vector<std::int64_t>* list, int parts,
+  const SurfaceBuffers<IdType>& out, const ParallelFor& parallel)
 {
   const int stride = LevelStride(plan.Level);
   const int words = plan.WordsPerBlock;
@@ -843,7 +937,10 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
     }
     caseVertices[c] = v - v % 3;
   }
-  const std::int64_t numActive = static_cast<std::int64_t>(plan.ActiveBlocks.size());
+  const std::int64_t numActive = list ? static_cast<std::int64_t>(list->size())
+                                      : static_cast<std::int64_t>(plan.ActiveBlocks.size());
+  const bool writePoints = (parts & GeneratePoints) != 0;
+  const bool writeTriangles = (parts & GenerateTriangles) != 0;
 
   const std::int64_t sx = volume.Dims[0];
   const std::int64_t sxy = sx * volume.Dims[1];
@@ -854,17 +951,14 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
     return fullVolume ? c : volume.FullIndex(axis, c);
   };
   std::mutex rangesMutex;
-  if (out.Ranges)
-  {
-    *out.Ranges = SurfaceRanges();
-  }
   parallel(0, numActive, [&](std::int64_t a0, std::int64_t a1) {
     // Point id of each of the block's own cut edges, by bit: filled while the
     // points are written, so most triangle vertices are one load.
     std::vector<IdType> ownIds(static_cast<std::size_t>(words) * 64);
     SurfaceRanges written; // ranges of this range of blocks, merged at its end
-    for (std::int64_t a = a0; a < a1; ++a)
+    for (std::int64_t listed = a0; listed < a1; ++listed)
     {
+      const std::int64_t a = list ? (*list)[listed] : listed;
       const std::int64_t block = plan.ActiveBlocks[a];
       const BlockSamples s(ranges, block, stride);
       const int* n = s.Count;
@@ -877,6 +971,13 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
         for (std::uint64_t m = bits[w]; m; m &= m - 1)
         {
           const int bit = w * 64 + __builtin_ctzll(m);
+          if (!writePoints)
+          {
+            // Triangles only: the points were written before, in this order.
+            ownIds[bit] = static_cast<IdType>(out.FirstPointId + pid);
+            ++pid;
+            continue;
+          }
           const int packed = bitCoords[bit];
           const int axis = packed >> 12;
           // The edge's ends (an edge never starts at a block's last sample,
@@ -937,6 +1038,10 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
           ownIds[bit] = static_cast<IdType>(out.FirstPointId + pid);
           ++pid;
         }
+      }
+      if (!writeTriangles)
+      {
+        continue;
       }
 
       // The ids of the cut edges on the block's upper faces that a neighbour
@@ -1041,7 +1146,7 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
         }
       }
     }
-    if (out.Ranges)
+    if (out.Ranges && writePoints)
     {
       std::lock_guard<std::mutex> lock(rangesMutex);
       out.Ranges->Points.Merge(written.Points);
@@ -1119,6 +1224,14 @@ BlockSums CountBlocks(const Volume<T>& volume, const BlockRanges& ranges, Triang
   template void GenerateSurface<T, std::int64_t>(const Volume<T>&, const BlockRanges&,            \
     TriangleCaseTable, const ExtractionPlan&, const SurfaceBuffers<std::int64_t>&,                 \
     const ParallelFor&);                                                                           \
+  template std::int64_t AppendToPlan<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable,   \
+    const std::vector<std::int32_t>&, ExtractionPlan&, const ParallelFor&);                        \
+  template void GenerateBlocks<T, std::int32_t>(const Volume<T>&, const BlockRanges&,             \
+    TriangleCaseTable, const ExtractionPlan&, const std::vector<std::int64_t>*, int,              \
+    const SurfaceBuffers<std::int32_t>&, const ParallelFor&);                                      \
+  template void GenerateBlocks<T, std::int64_t>(const Volume<T>&, const BlockRanges&,             \
+    TriangleCaseTable, const ExtractionPlan&, const std::vector<std::int64_t>*, int,              \
+    const SurfaceBuffers<std::int64_t>&, const ParallelFor&);                                      \
   template BlockSums CountBlocks<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable,       \
     const std::vector<std::int32_t>&, double, int, int, const ParallelFor&)
 

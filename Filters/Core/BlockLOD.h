@@ -296,6 +296,50 @@ template <typename T, typename IdType>
 void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
   const ExtractionPlan& plan, const SurfaceBuffers<IdType>& out, const ParallelFor& parallel);
 
+/**
+ * @name A plan that grows (streaming)
+ * For a volume whose blocks become known a few at a time (BlockLODVolume's
+ * streaming), the two passes can run block by block, ahead of the frame that
+ * draws the surface. BeginPlan() makes an empty plan; AppendToPlan() runs
+ * pass 1 on blocks as they arrive and gives each active one its points and
+ * triangles after those already in the plan (ActiveBlocks is then in the
+ * order of arrival, not the volume's: GenerateSurface() needs no order);
+ * GenerateBlocks() runs pass 2 on some of the plan's blocks: a block's points
+ * (its owned cut edges) need only its own values, its triangles also the
+ * pass 1 of the blocks above it whose edges they use (PlanOwners()). The
+ * surface so made is the one Plan and Generate would make of the same
+ * blocks, its points and triangles in another order.
+ */
+///@{
+/// An empty plan of `level` for `isovalue` over a volume of `ranges`' blocks.
+void BeginPlan(const BlockRanges& ranges, double isovalue, int level, ExtractionPlan& plan);
+/// Pass 1 on those of `blocks` that are active for the plan's isovalue and not
+/// in it yet, appended to it; returns the active index of the first appended.
+template <typename T>
+std::int64_t AppendToPlan(const Volume<T>& volume, const BlockRanges& ranges,
+  TriangleCaseTable cases, const std::vector<std::int32_t>& blocks, ExtractionPlan& plan,
+  const ParallelFor& parallel);
+/// The blocks whose cut edges block `block`'s triangles may use (itself
+/// excluded: the up to 7 blocks above it along one, two or three axes), into
+/// `owners`; returns how many.
+int PlanOwners(const BlockRanges& ranges, std::int64_t block, std::int64_t owners[7]);
+/// What GenerateBlocks() writes of each block.
+enum GenerateParts
+{
+  GeneratePoints = 1,   ///< Points (and normals, scalars) of the block's owned cut edges.
+  GenerateTriangles = 2 ///< Its triangles (and block ids).
+};
+/// Pass 2 on the plan's active blocks `list` (active indices; every block
+/// when null), writing `parts` (GenerateParts, or'd) at the blocks' offsets;
+/// out.Ranges, when given, grows by what is written. A block's triangles read
+/// the plan of the blocks above it as it is now: a block not in it has no cut
+/// edge there.
+template <typename T, typename IdType>
+void GenerateBlocks(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
+  const ExtractionPlan& plan, const std::vector<std::int64_t>* list, int parts,
+  const SurfaceBuffers<IdType>& out, const ParallelFor& parallel);
+///@}
+
 /// Sums of point and triangle counts over a list of blocks, for exact counts
 /// and for the estimator's samples (BlockLODEstimator.h). With an auxiliary
 /// (coarser) level, the level's counts are split by whether the block's

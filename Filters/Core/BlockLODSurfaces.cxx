@@ -76,6 +76,19 @@ std::int64_t BlockLODSurfacesBase::RegionArrived(const int first[3], const int l
   return completed;
 }
 
+void BlockLODSurfacesBase::SetAheadIsovalues(const std::vector<double>& isovalues)
+{
+  std::vector<double> values;
+  for (double v : isovalues)
+  {
+    if (!this->IsCached(SurfaceKey{ v, NumberOfLevels - 1 }))
+    {
+      values.push_back(v);
+    }
+  }
+  this->Volume.SetAheadIsovalues(values);
+}
+
 void BlockLODSurfacesBase::EndStreaming()
 {
   this->Volume.EndStreaming();

@@ -24,7 +24,9 @@
  * -# **Generate.** Pass 2 for each planned isovalue into the host's own
  *    surface (SurfaceMaker: a vtkPolyData's arrays, or plain vectors), then
  *    cached per (isovalue, level) within the cache limit; a cached pair costs
- *    no extraction.
+ *    no extraction. While a volume streams, a level-3 surface extracted
+ *    ahead (SetAheadIsovalues; BlockLODVolume.h) is taken instead, when the
+ *    host can adopt its arrays (SurfaceMaker::Adopt).
  * -# **Record.** RecordCost() feeds the update's seconds, as the host timed
  *    them, to the cost model when the update extracted something and did no
  *    one-time work (block ranges, coarse copies).
@@ -124,7 +126,8 @@ struct SurfacesUpdate
   std::string Message; ///< OutOfMemory: what did not fit, and what binds.
 
   int Extractions = 0;      ///< Surfaces extracted.
-  int CacheHits = 0;        ///< Surfaces served from the cache.
+  int CacheHits = 0;        ///< Surfaces served from the cache (those taken ahead included).
+  int TakenAhead = 0;       ///< Surfaces extracted ahead while streaming, taken.
   SurfaceCounts Extracted;  ///< Cubes and triangles of the extracted surfaces.
   bool OneTimeWork = false; ///< Block ranges or a coarse copy were made for it.
 };
@@ -161,6 +164,10 @@ struct SurfaceMaker
   /// update's surfaces are made. With it the cache evicts before each new
   /// surface instead of after all of them: the same pairs go, earlier.
   std::function<void(Surface& evicted)> Recycle;
+  /// Optional: a new surface for `key` holding the arrays of a surface
+  /// extracted ahead (streaming), which the host may move into it; false
+  /// when it cannot. Without it the surfaces made ahead are not taken.
+  std::function<bool(const SurfaceKey& key, SurfaceArrays& arrays, Surface& surface)> Adopt;
 };
 
 /// Checks an update's hosts may give.
@@ -202,6 +209,11 @@ public:
   void BeginStreaming();
   std::int64_t RegionArrived(const int first[3], const int last[3]);
   void EndStreaming();
+  /// Streaming: the isovalues whose level-3 surfaces are extracted ahead as
+  /// regions arrive (BlockLODVolume::SetAheadIsovalues), but for those the
+  /// cache holds at level 3 already. Update() takes a surface so made instead
+  /// of extracting it, for a maker with Adopt.
+  void SetAheadIsovalues(const std::vector<double>& isovalues);
 
   /// The bytes of a surface in the host's layout; a change empties the cache.
   void SetLayout(const SurfaceLayout& layout);
@@ -291,6 +303,9 @@ protected:
 private:
   bool Generate(const std::vector<double>& values, int level, const SurfaceMaker<Surface>& maker,
     const UpdateHooks& hooks, SurfacesUpdate& update);
+  // Moves the surfaces extracted ahead of `values` into the cache (level 3).
+  void TakeAhead(
+    const std::vector<double>& values, const SurfaceMaker<Surface>& maker, SurfacesUpdate& update);
 
   SurfaceCache<Surface> Cache;
   std::vector<Surface> Surfaces;
@@ -311,6 +326,10 @@ SurfacesUpdate BlockLODSurfaces<Surface>::Update(const std::vector<double>& isov
     return update;
   }
   int level = this->ChooseLevel(isovalues, choice, update);
+  if (level == NumberOfLevels - 1)
+  {
+    this->TakeAhead(isovalues, maker, update);
+  }
   if (level >= 0 && this->PlanLevel(isovalues, choice, level, hooks, update))
   {
     update.Level = level;
@@ -326,6 +345,36 @@ SurfacesUpdate BlockLODSurfaces<Surface>::Update(const std::vector<double>& isov
   }
   this->End(update);
   return update;
+}
+
+//------------------------------------------------------------------------------
+template<typename Surface>
+void BlockLODSurfaces<Surface>::TakeAhead(
+  const std::vector<double>& values, const SurfaceMaker<Surface>& maker, SurfacesUpdate& update)
+{
+  if (!maker.Adopt || this->CacheLimit <= 0)
+  {
+    return;
+  }
+  for (double v : values)
+  {
+    const SurfaceKey key{ v, NumberOfLevels - 1 };
+    SurfaceArrays arrays;
+    if (this->Cache.Contains(key) || !this->Volume.TakeAhead(v, arrays))
+    {
+      continue;
+    }
+    SurfaceCounts counts;
+    counts.Points = static_cast<double>(arrays.Points.size() / 3);
+    counts.Triangles = static_cast<double>(arrays.Triangles.size() / 3);
+    Surface surface{};
+    if (maker.Adopt(key, arrays, surface))
+    {
+      this->Cache.Insert(
+        key, surface, maker.Bytes ? maker.Bytes(surface) : this->Layout.Bytes(counts));
+      ++update.TakenAhead;
+    }
+  }
 }
 
 //------------------------------------------------------------------------------

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <new>
 
 namespace mediso
 {
@@ -45,6 +46,11 @@ struct BlockLODVolume::Typed
   virtual void BlockRange(std::int64_t block, BlockRanges& ranges) = 0;
   // Forgets the coarse copies (the values they copied changed).
   virtual void ForgetCoarseCopies() = 0;
+  // Extraction ahead on the full volume (BlockLOD.h, AppendToPlan, GenerateBlocks).
+  virtual std::int64_t AppendAhead(
+    const std::vector<std::int32_t>& blocks, ExtractionPlan& plan) = 0;
+  virtual void GenerateAhead(const ExtractionPlan& plan, const std::vector<std::int64_t>& list,
+    int parts, const SurfaceBuffers<std::int32_t>& out) = 0;
   int CoarseCopies = 0; // made so far
 };
 
@@ -181,6 +187,18 @@ struct BlockLODVolume::TypedImpl : BlockLODVolume::Typed
     return c;
   }
 
+  std::int64_t AppendAhead(const std::vector<std::int32_t>& blocks, ExtractionPlan& plan) override
+  {
+    return AppendToPlan(this->Full, this->FullRanges, this->Cases, blocks, plan, this->Parallel);
+  }
+
+  void GenerateAhead(const ExtractionPlan& plan, const std::vector<std::int64_t>& list, int parts,
+    const SurfaceBuffers<std::int32_t>& out) override
+  {
+    GenerateBlocks(
+      this->Full, this->FullRanges, this->Cases, plan, &list, parts, out, this->Parallel);
+  }
+
   BlockSums CountFull(const std::vector<std::int32_t>& blocks, double isovalue, int level,
     int auxLevel) override
   {
@@ -246,6 +264,27 @@ BlockLODVolume::BlockLODVolume(TriangleCaseTable cases, ParallelFor parallel)
 {
 }
 
+// One isovalue's level-3 surface extracted ahead: its growing plan, its
+// arrays sized to the plan, and the active blocks whose triangles wait for a
+// block above them.
+struct BlockLODVolume::Ahead
+{
+  double Isovalue = 0;
+  bool Begun = false; // caught up over the blocks resident when it was named
+  ExtractionPlan Plan;
+  SurfaceArrays Arrays;
+  std::vector<std::int64_t> Waiting;
+
+  SurfaceBuffers<std::int32_t> Buffers()
+  {
+    SurfaceBuffers<std::int32_t> out;
+    out.Points = this->Arrays.Points.data();
+    out.Normals = this->Arrays.Normals.data();
+    out.Connectivity = this->Arrays.Triangles.data();
+    return out;
+  }
+};
+
 BlockLODVolume::~BlockLODVolume() = default;
 
 void BlockLODVolume::Reset()
@@ -255,6 +294,7 @@ void BlockLODVolume::Reset()
   this->ResidentBlocks.clear();
   this->NumberOfResidentBlocks = 0;
   this->Valid = false;
+  this->AheadSurfaces.clear();
   this->Impl.reset();
   this->ActiveLists.clear();
   this->Ranges = BlockRanges();
@@ -443,6 +483,7 @@ void BlockLODVolume::BeginStreaming()
   this->Ranges.ValueRange[0] = std::numeric_limits<double>::infinity();
   this->Ranges.ValueRange[1] = -std::numeric_limits<double>::infinity();
   this->ActiveLists.clear();
+  this->AheadSurfaces.clear();
   this->Impl->ForgetCoarseCopies();
 }
 
@@ -490,7 +531,7 @@ std::int64_t BlockLODVolume::RegionArrived(const int first[3], const int last[3]
     lo = std::max(0, b * BlockCells - 1) / BlockCells;
     hi = std::min(n - 1, b * BlockCells + BlockCells + 1) / BlockCells;
   };
-  std::int64_t completed = 0;
+  std::vector<std::int32_t> completed;
   for (int bz = b0[2]; bz <= b1[2]; ++bz)
   {
     for (int by = b0[1]; by <= b1[1]; ++by)
@@ -527,15 +568,130 @@ std::int64_t BlockLODVolume::RegionArrived(const int first[3], const int last[3]
         {
           this->Impl->BlockRange(block, this->Ranges);
           this->ResidentBlocks[block] = 1;
-          ++completed;
+          completed.push_back(static_cast<std::int32_t>(block));
         }
       }
     }
   }
-  this->NumberOfResidentBlocks += completed;
+  this->NumberOfResidentBlocks += static_cast<std::int64_t>(completed.size());
   this->ActiveLists.clear();
   this->Impl->ForgetCoarseCopies();
-  return completed;
+  this->AdvanceAhead(completed);
+  return static_cast<std::int64_t>(completed.size());
+}
+
+void BlockLODVolume::SetAheadIsovalues(const std::vector<double>& isovalues)
+{
+  auto named = [&isovalues](double v)
+  { return std::find(isovalues.begin(), isovalues.end(), v) != isovalues.end(); };
+  this->AheadSurfaces.erase(
+    std::remove_if(this->AheadSurfaces.begin(), this->AheadSurfaces.end(),
+      [&named](const std::unique_ptr<Ahead>& a) { return !named(a->Isovalue); }),
+    this->AheadSurfaces.end());
+  if (!this->Streaming)
+  {
+    return;
+  }
+  for (double v : isovalues)
+  {
+    const std::vector<double> held = this->GetAheadIsovalues();
+    if (std::isfinite(v) && std::find(held.begin(), held.end(), v) == held.end())
+    {
+      auto ahead = std::make_unique<Ahead>();
+      ahead->Isovalue = v;
+      this->AheadSurfaces.push_back(std::move(ahead));
+    }
+  }
+}
+
+std::vector<double> BlockLODVolume::GetAheadIsovalues() const
+{
+  std::vector<double> values;
+  for (const auto& a : this->AheadSurfaces)
+  {
+    values.push_back(a->Isovalue);
+  }
+  return values;
+}
+
+void BlockLODVolume::AdvanceAhead(const std::vector<std::int32_t>& completed)
+{
+  const int full = NumberOfLevels - 1;
+  for (auto it = this->AheadSurfaces.begin(); it != this->AheadSurfaces.end();)
+  {
+    Ahead& a = **it;
+    try
+    {
+      std::vector<std::int32_t> caughtUp;
+      const bool catchUp = !a.Begun;
+      if (catchUp)
+      {
+        // Named since the last region: every block resident so far, once.
+        BeginPlan(this->Ranges, a.Isovalue, full, a.Plan);
+        for (std::size_t b = 0; b < this->ResidentBlocks.size(); ++b)
+        {
+          if (this->ResidentBlocks[b])
+          {
+            caughtUp.push_back(static_cast<std::int32_t>(b));
+          }
+        }
+        a.Begun = true;
+      }
+      const std::int64_t first = this->Impl->AppendAhead(catchUp ? caughtUp : completed, a.Plan);
+      const std::int64_t end = static_cast<std::int64_t>(a.Plan.ActiveBlocks.size());
+      a.Arrays.Points.resize(3 * static_cast<std::size_t>(a.Plan.GetNumberOfPoints()));
+      a.Arrays.Normals.resize(a.Arrays.Points.size());
+      a.Arrays.Triangles.resize(3 * static_cast<std::size_t>(a.Plan.GetNumberOfTriangles()));
+      std::vector<std::int64_t> added;
+      for (std::int64_t i = first; i < end; ++i)
+      {
+        added.push_back(i);
+        a.Waiting.push_back(i);
+      }
+      this->Impl->GenerateAhead(a.Plan, added, GeneratePoints, a.Buffers());
+      // The triangles of the blocks whose blocks above are all resident now.
+      std::vector<std::int64_t> ready, waiting;
+      for (std::int64_t i : a.Waiting)
+      {
+        std::int64_t owners[7];
+        const int n = PlanOwners(this->Ranges, a.Plan.ActiveBlocks[i], owners);
+        bool settled = true;
+        for (int o = 0; o < n && settled; ++o)
+        {
+          settled = this->ResidentBlocks[owners[o]] != 0;
+        }
+        (settled ? ready : waiting).push_back(i);
+      }
+      this->Impl->GenerateAhead(a.Plan, ready, GenerateTriangles, a.Buffers());
+      a.Waiting.swap(waiting);
+      ++it;
+    }
+    catch (const std::bad_alloc&)
+    {
+      it = this->AheadSurfaces.erase(it); // ahead is an optimisation: the frame extracts it
+    }
+  }
+}
+
+bool BlockLODVolume::TakeAhead(double isovalue, SurfaceArrays& surface)
+{
+  for (auto it = this->AheadSurfaces.begin(); it != this->AheadSurfaces.end(); ++it)
+  {
+    Ahead& a = **it;
+    if (a.Isovalue != isovalue)
+    {
+      continue;
+    }
+    if (!a.Begun)
+    {
+      return false;
+    }
+    this->Impl->GenerateAhead(a.Plan, a.Waiting, GenerateTriangles, a.Buffers());
+    surface = std::move(a.Arrays);
+    this->AheadSurfaces.erase(it);
+    return true;
+  }
+  return false;
 }
 
 void BlockLODVolume::EndStreaming()
@@ -549,6 +705,11 @@ void BlockLODVolume::EndStreaming()
   this->ResidentBlocks.clear();
   this->ActiveLists.clear();
   this->Impl->ForgetCoarseCopies();
+  // The surfaces under way stay (every block is resident: complete once taken);
+  // those not begun would have nothing to catch up from.
+  this->AheadSurfaces.erase(std::remove_if(this->AheadSurfaces.begin(), this->AheadSurfaces.end(),
+                              [](const std::unique_ptr<Ahead>& a) { return !a->Begun; }),
+    this->AheadSurfaces.end());
 }
 
 std::int64_t BlockLODVolume::GetNumberOfResidentBlocks() const

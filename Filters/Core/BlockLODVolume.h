@@ -33,6 +33,19 @@
  * neighbours included); the coarse copies read every point, so a host draws
  * levels 0-2 of a streaming volume only after EndStreaming().
  *
+ * Extraction ahead (streaming): the level-3 surfaces of the isovalues a host
+ * names (SetAheadIsovalues) are made block by block while the values arrive,
+ * so that the frame that draws a surface once its last brick is in finds it
+ * nearly made. Each RegionArrived() runs pass 1 on the blocks it completed
+ * that are active for each named isovalue, appends them to that surface's
+ * growing plan (BlockLOD.h, AppendToPlan) and writes their points; a block's
+ * triangles are written once the blocks above it whose cut edges they use
+ * are resident too. TakeAhead() writes the triangles still waiting (as a
+ * Plan() would see the blocks above them now) and hands the arrays over: the
+ * same points, normals and triangles as Plan() and Generate() at that moment,
+ * in the order the blocks arrived. Nothing is copied at the end, and the
+ * work is the dense extraction's, moved to while the transfer runs.
+ *
  * The marching-cubes case table is data the host passes (BlockLOD.h,
  * TriangleCaseTable), and every pass runs through the host's ParallelFor.
  */
@@ -72,6 +85,14 @@ struct VolumeDescription
   bool IsPiece() const;
   bool operator==(const VolumeDescription& other) const;
   bool operator!=(const VolumeDescription& other) const { return !(*this == other); }
+};
+
+/// A level-3 surface extracted ahead (BlockLODVolume::TakeAhead): plain arrays.
+struct SurfaceArrays
+{
+  std::vector<float> Points;           ///< 3 per point.
+  std::vector<float> Normals;          ///< 3 per point.
+  std::vector<std::int32_t> Triangles; ///< 3 point ids per triangle.
 };
 
 /// Exact or estimated size of one (isovalue, level) surface, and the cubes
@@ -162,10 +183,26 @@ public:
   /// Blocks whose ranges are known (every block when not streaming).
   std::int64_t GetNumberOfResidentBlocks() const;
 
+  /// Streaming: the isovalues whose level-3 surfaces are extracted ahead (see
+  /// the file's description). One newly named catches up over the blocks
+  /// already resident at the next RegionArrived(); one no longer named is
+  /// forgotten. When not streaming only forgets (the surfaces made before
+  /// EndStreaming() stay until taken or forgotten).
+  void SetAheadIsovalues(const std::vector<double>& isovalues);
+  /// The isovalues with a surface under way ahead.
+  std::vector<double> GetAheadIsovalues() const;
+  /// Completes the surface extracted ahead for `isovalue` and moves it into
+  /// `surface`; false (nothing moved) when there is none under way, or it has
+  /// not caught up yet. The surface is then no longer held.
+  bool TakeAhead(double isovalue, SurfaceArrays& surface);
+
 private:
   struct Typed;
   template <typename T>
   struct TypedImpl;
+  struct Ahead;
+  // Extraction ahead on the blocks RegionArrived() just completed.
+  void AdvanceAhead(const std::vector<std::int32_t>& completed);
 
   TriangleCaseTable Cases;
   ParallelFor Parallel;
@@ -180,6 +217,7 @@ private:
   std::vector<std::uint8_t> ResidentRuns;
   std::vector<std::uint8_t> ResidentBlocks;
   std::int64_t NumberOfResidentBlocks = 0;
+  std::vector<std::unique_ptr<Ahead>> AheadSurfaces;
 };
 
 } // namespace mediso

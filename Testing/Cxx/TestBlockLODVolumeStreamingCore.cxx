@@ -15,6 +15,7 @@
 #include "BlockLODVolume.h"
 #include "FanCaseTable.h"
 #include "MedicalTestUtilities.h"
+#include "StreamingTestField.h"
 
 #include <algorithm>
 #include <cmath>
@@ -25,44 +26,7 @@
 namespace
 {
 using medical_test::Check;
-
-constexpr int Brick = 16; // points a side, a multiple of mediso::BlockCells
-
-struct Field
-{
-  int Dims[3] = { 77, 70, 45 };
-  std::vector<std::int16_t> Values;
-  Field()
-  {
-    this->Values.resize(static_cast<std::size_t>(this->Dims[0]) * this->Dims[1] * this->Dims[2]);
-    std::uint32_t state = 2463534242u;
-    std::size_t id = 0;
-    for (int k = 0; k < this->Dims[2]; ++k)
-      for (int j = 0; j < this->Dims[1]; ++j)
-        for (int i = 0; i < this->Dims[0]; ++i, ++id)
-        {
-          state ^= state << 13;
-          state ^= state >> 17;
-          state ^= state << 5;
-          const double r =
-            std::sqrt((i - 20.0) * (i - 20.0) + (j - 17.0) * (j - 17.0) + (k - 12.0) * (k - 12.0));
-          this->Values[id] = static_cast<std::int16_t>(100.0 * r + (state % 60));
-        }
-  }
-  std::size_t Index(int i, int j, int k) const
-  {
-    return (static_cast<std::size_t>(k) * this->Dims[1] + j) * this->Dims[0] + i;
-  }
-};
-
-mediso::VolumeDescription Describe(const Field& f, const std::int16_t* data)
-{
-  mediso::VolumeDescription d;
-  d.Type = mediso::ScalarType::Int16;
-  d.Data = data;
-  std::copy(f.Dims, f.Dims + 3, d.Dims);
-  return d;
-}
+using medical_test::StreamingField;
 
 struct Mesh
 {
@@ -85,25 +49,14 @@ Mesh Extract(mediso::BlockLODVolume& volume, double isovalue)
   volume.Generate(plan, out);
   return mesh;
 }
-
-// A brick's first and last point along each axis, with `apron` more on each
-// side and one more on the + side (what its cells and gradients read).
-void BrickBox(const Field& f, const int b[3], int apron, int first[3], int last[3])
-{
-  for (int a = 0; a < 3; ++a)
-  {
-    first[a] = std::max(0, b[a] * Brick - apron);
-    last[a] = std::min(f.Dims[a] - 1, (b[a] + 1) * Brick + apron);
-  }
-}
 } // namespace
 
 int main()
 {
-  const Field field;
+  const StreamingField field;
   const double isovalues[2] = { 650.0, 1400.0 };
   mediso::BlockLODVolume dense(medical_test::FanCases.Cases, mediso::SerialFor);
-  dense.SetVolume(Describe(field, field.Values.data()));
+  dense.SetVolume(field.Describe(field.Values.data()));
   std::vector<Mesh> expected;
   for (double v : isovalues)
   {
@@ -116,7 +69,7 @@ int main()
   // arrived ones.
   std::vector<std::int16_t> buffer(field.Values.size(), 30000);
   mediso::BlockLODVolume streamed(medical_test::FanCases.Cases, mediso::SerialFor);
-  streamed.SetVolume(Describe(field, buffer.data()));
+  streamed.SetVolume(field.Describe(buffer.data()));
   const int nowhere[3] = { 0, 0, 0 };
   Check(streamed.RegionArrived(nowhere, nowhere) == 0,
     "a region given when not streaming completes nothing");
@@ -131,61 +84,8 @@ int main()
   Check(streamed.RegionArrived(outsideFirst, outsideLast) == 0,
     "a region outside the volume completes nothing");
 
-  int bricks[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    bricks[a] = (field.Dims[a] + Brick - 1) / Brick;
-  }
-  const int count = bricks[0] * bricks[1] * bricks[2];
-  auto coords = [&](int id, int b[3]) {
-    b[0] = id % bricks[0];
-    b[1] = (id / bricks[0]) % bricks[1];
-    b[2] = id / (bricks[0] * bricks[1]);
-  };
-  // Each brick's range over its points with an apron of 1 (what the server's
-  // manifest states).
-  std::vector<double> lo(count), hi(count);
-  for (int id = 0; id < count; ++id)
-  {
-    int b[3], first[3], last[3];
-    coords(id, b);
-    BrickBox(field, b, 1, first, last);
-    lo[id] = 1e30;
-    hi[id] = -1e30;
-    for (int k = first[2]; k <= last[2]; ++k)
-      for (int j = first[1]; j <= last[1]; ++j)
-        for (int i = first[0]; i <= last[0]; ++i)
-        {
-          lo[id] = std::min<double>(lo[id], field.Values[field.Index(i, j, k)]);
-          hi[id] = std::max<double>(hi[id], field.Values[field.Index(i, j, k)]);
-        }
-  }
-  // The bricks an isovalue needs: the active ones and their 26 neighbours.
-  auto needed = [&](double v) {
-    std::vector<char> need(count, 0);
-    for (int id = 0; id < count; ++id)
-    {
-      if (!(lo[id] < v && v <= hi[id]))
-      {
-        continue;
-      }
-      int b[3];
-      coords(id, b);
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx)
-          {
-            const int n[3] = { b[0] + dx, b[1] + dy, b[2] + dz };
-            if (n[0] >= 0 && n[1] >= 0 && n[2] >= 0 && n[0] < bricks[0] && n[1] < bricks[1] &&
-              n[2] < bricks[2])
-            {
-              need[(n[2] * bricks[1] + n[1]) * bricks[0] + n[0]] = 1;
-            }
-          }
-    }
-    return need;
-  };
-  const std::vector<char> needs[2] = { needed(isovalues[0]), needed(isovalues[1]) };
+  const int count = field.Count();
+  const std::vector<char> needs[2] = { field.Needed(isovalues[0]), field.Needed(isovalues[1]) };
 
   // The bricks arrive in an order that is not the volume's (a stride through
   // the ids).
@@ -193,20 +93,8 @@ int main()
   int exactStages[2] = { 0, 0 };
   for (int n = 0; n < count; ++n)
   {
-    const int id = (n * 7) % count;
-    int b[3], first[3], last[3];
-    coords(id, b);
-    BrickBox(field, b, 0, first, last);
-    last[0] = std::min(field.Dims[0] - 1, (b[0] + 1) * Brick - 1);
-    last[1] = std::min(field.Dims[1] - 1, (b[1] + 1) * Brick - 1);
-    last[2] = std::min(field.Dims[2] - 1, (b[2] + 1) * Brick - 1);
-    for (int k = first[2]; k <= last[2]; ++k)
-      for (int j = first[1]; j <= last[1]; ++j)
-        for (int i = first[0]; i <= last[0]; ++i)
-        {
-          buffer[field.Index(i, j, k)] = field.Values[field.Index(i, j, k)];
-        }
-    streamed.RegionArrived(first, last);
+    const int id = field.Arriving(n);
+    field.Arrive(id, buffer, streamed);
     resident[id] = 1;
     for (int s = 0; s < 2; ++s)
     {

@@ -12,8 +12,9 @@
 // - an isovalue changed mid-stream (to the corner's blob) is drawn at once, and the next bricks
 //   asked for are the ones it needs, while others are still to come;
 // - whenFull() resolves with every surface at level 3 (before the whole level has come, where
-//   the surface needs fewer bricks), then received reaches 1; the bytes of level 0 and the bricks
-//   on the wire are at most 1.05x the whole level's;
+//   the surface needs fewer bricks), its surface made ahead as the bricks arrived (stats()'s
+//   takenAhead), then received reaches 1; the bytes of level 0 and the bricks on the wire are at
+//   most 1.05x the whole level's;
 // - after the end, the manifest's brick ranges are the cores' ComputeBrickRanges over the level
 //   received, and a change sends nothing.
 import { mkdtempSync, rmSync } from "node:fs";
@@ -136,6 +137,8 @@ const full = await page.evaluate(() => window.mediso.whenFull());
 checks.check(full.levels.join() === "3" && full.surfaceTriangles[0] > 0,
   "whenFull(): the surface at level 3 (" + full.levels + ") with " + (100 * full.received).toFixed(0) +
   "% of the level received");
+checks.check(full.takenAhead >= 1, "the surface at the full level was extracted ahead, as its bricks " +
+  "arrived, not at its frame (" + full.takenAhead + " taken)");
 await page.waitForFunction(() => window.mediso.stats().received === 1, null, { timeout: 300000 });
 checks.check((await page.evaluate(() => window.mediso.stats())).levels.join() === "3",
   "the whole level received, the surface still at level 3");

@@ -297,6 +297,9 @@ window.mediso = {
       return (drawn.surfaceTriangles || [])[(drawn.surfaceValues || []).indexOf(s.value)];
     }),
     received: state.stream ? state.received : 1,
+    // the CPU path's surfaces of this stream taken made from the extraction ahead (docs/web.md,
+    // Streaming), not extracted at their frame
+    takenAhead: ((state.viewer && state.viewer.stats()) || {}).takenAhead || 0,
     // the GPU path's bricks (0: the volume is one texture), those the isovalues cross and those
     // on the GPU (docs/web.md, Paths); its whole uploads and streamed regions (Streaming)
     ...Object.fromEntries(["bricks", "activeBricks", "residentBricks", "volumeUploads",

@@ -94,7 +94,7 @@ using mediso::web::PageCamera;
 struct CPUSurface
 {
   std::vector<float> Points, Normals;
-  std::vector<std::uint32_t> Triangles;
+  std::vector<std::int32_t> Triangles; // as the core writes them (ids below 2^31)
   double Bytes() const
   {
     return 4.0 * (this->Points.size() + this->Normals.size() + this->Triangles.size());
@@ -119,7 +119,16 @@ SurfaceMaker<CPUSurfaceRef> CPUSurfaceMaker()
     surface->Triangles.resize(3 * static_cast<std::size_t>(triangles));
     target.Narrow.Points = surface->Points.data();
     target.Narrow.Normals = surface->Normals.data();
-    target.Narrow.Connectivity = reinterpret_cast<std::int32_t*>(surface->Triangles.data());
+    target.Narrow.Connectivity = surface->Triangles.data();
+    return true;
+  };
+  // A surface extracted ahead while streaming: its arrays moved in, not copied.
+  maker.Adopt = [](const SurfaceKey&, SurfaceArrays& arrays, CPUSurfaceRef& surface)
+  {
+    surface = std::make_shared<CPUSurface>();
+    surface->Points = std::move(arrays.Points);
+    surface->Normals = std::move(arrays.Normals);
+    surface->Triangles = std::move(arrays.Triangles);
     return true;
   };
   maker.Bytes = [](const CPUSurfaceRef& surface) { return surface->Bytes(); };
@@ -533,6 +542,7 @@ public:
       return false;
     }
     this->CPU.BeginStreaming();
+    this->TakenAhead = 0;
     this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
     return true;
   }
@@ -556,6 +566,10 @@ public:
     }
     const int first[3] = { extent[0], extent[2], extent[4] };
     const int last[3] = { extent[1], extent[3], extent[5] };
+    if (!this->CPUPath)
+    {
+      this->CPU.SetAheadIsovalues({}); // the GPU path draws from its texture
+    }
     this->CPU.RegionArrived(first, last);
     std::string error;
     emscripten_webgl_make_context_current(this->Context);
@@ -913,6 +927,7 @@ public:
     stats.set("triangles", this->CPUPath ? this->ShownTriangles : 0.0);
     stats.set("cpuLevel", this->CPULevel);
     stats.set("cacheMB", this->CPU.GetCacheBytes() / 1e6);
+    stats.set("takenAhead", this->TakenAhead);
     stats.set("footprint", std::string(this->Stats.PointFootprint ? "points" : "boxes"));
     stats.set("firstHit", this->Stats.FirstHit);
     stats.set("buildMs", this->LastBuildMs);
@@ -1307,6 +1322,9 @@ private:
     choice.BudgetBytes = this->Budget;
     choice.BudgetBinds = false;
     this->CPU.SetCacheLimit(std::max(this->Budget / 4.0, 0.0));
+    // Streaming: the frame's surfaces are extracted ahead as the bricks arrive (WriteBrick), the
+    // level-3 update then takes them made; after the end, one no longer drawn is forgotten.
+    this->CPU.SetAheadIsovalues(values);
     const double start = emscripten_get_now();
     this->LastAborted = false;
     const SurfacesUpdate update =
@@ -1337,6 +1355,7 @@ private:
     {
       this->CPU.RecordCost(update, (emscripten_get_now() - start) / 1000.0);
     }
+    this->TakenAhead += update.TakenAhead;
     std::vector<CPUSurfaceRef> coarseSurfaces;
     if (!coarse.empty())
     {
@@ -1379,7 +1398,8 @@ private:
       {
         this->MeshesUploaded = true;
         this->Meshes->SetMesh(slot, surface.Points.data(), surface.Normals.data(),
-          static_cast<std::int64_t>(surface.Points.size() / 3), surface.Triangles.data(),
+          static_cast<std::int64_t>(surface.Points.size() / 3),
+          reinterpret_cast<const std::uint32_t*>(surface.Triangles.data()),
           static_cast<std::int64_t>(surface.Triangles.size() / 3));
         this->ShownKeys[slot] = key;
       }
@@ -1425,6 +1445,7 @@ private:
     { this->RunPass(begin, end, body); },
     std::make_shared<SharedCostModel>(), CPULayout };
   std::vector<SurfaceKey> ShownKeys = std::vector<SurfaceKey>(MaximumIsovalues, SurfaceKey{ NAN, -1 });
+  int TakenAhead = 0; // surfaces of this stream the CPU path took extracted ahead
   // Streaming: the server's level 0 and its surfaces, the bricks of the buffer, the isovalues
   // drawn from level 0, and per slot of the last frame whether it was and its triangles.
 #ifdef MEDISO_WEB_THREADS
