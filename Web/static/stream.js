@@ -199,18 +199,15 @@ export async function startStream(level) {
   state.stream = { level, path: state.path, manifest, type, dims, resident: new Uint8Array(count),
     pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, received: 0,
     total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), exact: new Map(),
-    asked: new Set(), requested: [], readyKey: "", error: "", started: false, frameAsked: false };
+    asked: new Set(), requested: [], readyKey: "", error: "", started: false };
   state.received = 0;
-  // The bricks are asked for once the first frame asked of this stream (level 0's) is drawn
-  // (afterEach): on a fast link they would otherwise come first, and their writing and the
-  // server's encoding would hold that frame (the page's start-up, docs/web.md). The bricks the
-  // first surfaces need are asked of the server before that frame (beforeEach), so that the first
-  // requests are theirs. A timer starts them only where no frame has been asked for by then: a
-  // timer that did not wait for the frame under way let the bricks run ahead of a first frame
-  // slowed by a loaded machine, and hold it (TestWebServerPageStreamGPU: half the level had
-  // come before the first image, the rest before whenFull()).
+  // The bricks are asked for once the first frame (level 0's) is drawn (afterEach): on a fast
+  // link they would otherwise come first, and their writing and the server's encoding would
+  // hold that frame (the page's start-up, docs/web.md). The bricks the first surfaces need are
+  // asked of the server before that frame (beforeEach), so that the first requests are theirs;
+  // a timer in case no frame comes.
   const s = state.stream;
-  setTimeout(() => !s.frameAsked && begin(s), 1000);
+  setTimeout(() => begin(s), 1000);
 }
 
 function begin(s) {
@@ -420,7 +417,6 @@ export function setupStream() {
 function beforeEach() {
   const s = state.stream;
   if (s) {
-    s.frameAsked = true;
     askExact(s);
     state.viewer.setCoarseValues(currentValues().filter((v) => !ready(s, v)));
   }
@@ -437,7 +433,7 @@ function fullNow() {
     drawnValues.every((v, i) => v === values[i]);
 }
 function afterEach() {
-  if (state.stream && state.stream.frameAsked && !state.stream.started) {
+  if (state.stream && !state.stream.started) {
     begin(state.stream);
   }
   const stats = state.viewer.stats();
