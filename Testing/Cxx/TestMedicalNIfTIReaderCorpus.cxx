@@ -10,6 +10,7 @@
 // reaches the output window (and ctest's fail pattern) unless unexpected.
 #include "AddressSpaceLimit.h"
 #include "MedicalTestUtilities.h"
+#include "NIfTITestFiles.h"
 #include "vtkMedicalNIfTIReader.h"
 
 #include "vtkCallbackCommand.h"
@@ -40,74 +41,10 @@ using medical_test::Check;
 
 // --- Writing NIfTI files ------------------------------------------------------
 
-// The header fields the corpus varies; the rest are zero.
-struct Fields
-{
-  int Version = 1;
-  std::int64_t Dim[8] = { 3, 4, 3, 2, 1, 1, 1, 1 };
-  double PixDim[8] = { 1.0, 0.5, 0.75, 2.0, 1.0, 1.0, 1.0, 1.0 };
-  int DataType = 4; // INT16
-  int BitPix = 16;
-  double VoxOffset = -1.0; // -1: just after the header and its 4 extension bytes
-  double Slope = 0.0;
-  double Intercept = 0.0;
-  double TOffset = 0.0;
-  bool BigEndian = false;
-};
-
-template<typename T>
-void Put(std::vector<unsigned char>& bytes, std::size_t offset, T value, bool swap)
-{
-  unsigned char raw[sizeof(T)];
-  std::memcpy(raw, &value, sizeof(T));
-  if (swap)
-  {
-    std::reverse(raw, raw + sizeof(T));
-  }
-  std::copy(raw, raw + sizeof(T), bytes.begin() + static_cast<std::ptrdiff_t>(offset));
-}
-
-// The header, its 4 extension bytes (none) and the voxels, as a single file.
-std::vector<unsigned char> Header(const Fields& f)
-{
-  const bool two = f.Version == 2;
-  const std::size_t size = two ? 540 : 348;
-  std::vector<unsigned char> b(size + 4, 0);
-  const bool s = f.BigEndian;
-  const double voxOffset = f.VoxOffset < 0 ? static_cast<double>(size + 4) : f.VoxOffset;
-  Put<std::int32_t>(b, 0, static_cast<std::int32_t>(size), s);
-  if (two)
-  {
-    std::memcpy(b.data() + 4, "n+2\0\r\n\032\n", 8);
-    Put<std::int16_t>(b, 12, static_cast<std::int16_t>(f.DataType), s);
-    Put<std::int16_t>(b, 14, static_cast<std::int16_t>(f.BitPix), s);
-    for (int i = 0; i < 8; ++i)
-    {
-      Put<std::int64_t>(b, 16 + 8 * i, f.Dim[i], s);
-      Put<double>(b, 104 + 8 * i, f.PixDim[i], s);
-    }
-    Put<std::int64_t>(b, 168, static_cast<std::int64_t>(voxOffset), s);
-    Put<double>(b, 176, f.Slope, s);
-    Put<double>(b, 184, f.Intercept, s);
-    Put<double>(b, 216, f.TOffset, s);
-  }
-  else
-  {
-    for (int i = 0; i < 8; ++i)
-    {
-      Put<std::int16_t>(b, 40 + 2 * i, static_cast<std::int16_t>(f.Dim[i]), s);
-      Put<float>(b, 76 + 4 * i, static_cast<float>(f.PixDim[i]), s);
-    }
-    Put<std::int16_t>(b, 70, static_cast<std::int16_t>(f.DataType), s);
-    Put<std::int16_t>(b, 72, static_cast<std::int16_t>(f.BitPix), s);
-    Put<float>(b, 108, static_cast<float>(voxOffset), s);
-    Put<float>(b, 112, static_cast<float>(f.Slope), s);
-    Put<float>(b, 116, static_cast<float>(f.Intercept), s);
-    Put<float>(b, 136, static_cast<float>(f.TOffset), s);
-    std::memcpy(b.data() + 344, "n+1", 4);
-  }
-  return b;
-}
+// The header fields the corpus varies (NIfTITestFiles.h), the header and its 4 extension bytes.
+using Fields = medical_test::NIfTIFields;
+using medical_test::NIfTIHeader;
+using medical_test::PutBytes;
 
 // int16 voxels 0, 37, 74, ... (mod 3000), in the file's byte order.
 std::vector<unsigned char> Int16Voxels(std::size_t count, bool bigEndian, int first = 0)
@@ -115,7 +52,8 @@ std::vector<unsigned char> Int16Voxels(std::size_t count, bool bigEndian, int fi
   std::vector<unsigned char> bytes(2 * count);
   for (std::size_t i = 0; i < count; ++i)
   {
-    Put<std::int16_t>(bytes, 2 * i, static_cast<std::int16_t>((first + 37 * i) % 3000), bigEndian);
+    PutBytes<std::int16_t>(
+      bytes, 2 * i, static_cast<std::int16_t>((first + 37 * i) % 3000), bigEndian);
   }
   return bytes;
 }
@@ -152,7 +90,7 @@ void WriteGzip(const std::string& path, const std::vector<unsigned char>& bytes)
 // A well-formed int16 file of `f` with the corpus's voxels.
 std::vector<unsigned char> Int16File(const Fields& f)
 {
-  std::vector<unsigned char> bytes = Header(f);
+  std::vector<unsigned char> bytes = NIfTIHeader(f);
   Append(bytes, Int16Voxels(Voxels(f), f.BigEndian));
   return bytes;
 }
@@ -325,7 +263,7 @@ std::map<std::string, std::function<void(const std::string&)>> Cases()
     f.BitPix = 8;
     f.Slope = 1.0;
     f.Intercept = -100.0;
-    std::vector<unsigned char> bytes = Header(f);
+    std::vector<unsigned char> bytes = NIfTIHeader(f);
     for (std::size_t i = 0; i < Voxels(f); ++i)
     {
       bytes.push_back(static_cast<unsigned char>((7 * i) % 256));
@@ -335,7 +273,7 @@ std::map<std::string, std::function<void(const std::string&)>> Cases()
       dir + "/shifted-uint8.nii", VTK_SHORT,
       [](vtkIdType i) { return static_cast<double>((7 * i) % 256) - 100.0; }, Dims);
     f.Slope = 0.0; // no scale
-    bytes = Header(f);
+    bytes = NIfTIHeader(f);
     for (std::size_t i = 0; i < Voxels(f); ++i)
     {
       bytes.push_back(static_cast<unsigned char>((7 * i) % 256));
@@ -355,7 +293,7 @@ std::map<std::string, std::function<void(const std::string&)>> Cases()
     f.PixDim[4] = 2.0;
     f.TOffset = 10.0;
     const std::size_t volume = Voxels(f) / 4;
-    std::vector<unsigned char> bytes = Header(f);
+    std::vector<unsigned char> bytes = NIfTIHeader(f);
     for (int t = 0; t < 4; ++t)
     {
       Append(bytes, Int16Voxels(volume, false, 1000 * t));
@@ -429,7 +367,7 @@ std::map<std::string, std::function<void(const std::string&)>> Cases()
     f.Slope = 1.0;
     f.Intercept = -1024.0;
     f.VoxOffset = 0.0;
-    std::vector<unsigned char> header = Header(f);
+    std::vector<unsigned char> header = NIfTIHeader(f);
     header.resize(348);
     std::memcpy(header.data() + 344, "ni1", 4);
     WritePlain(dir + "/ct.hdr", header);
@@ -480,7 +418,7 @@ std::map<std::string, std::function<void(const std::string&)>> Cases()
     ExpectRefused(dir + "/zero.nii", "dim[2] is 0; every dimension must be at least 1");
     f.Dim[2] = 3;
     f.Dim[3] = -5;
-    WritePlain(dir + "/negative.nii", Header(f));
+    WritePlain(dir + "/negative.nii", NIfTIHeader(f));
     ExpectRefused(dir + "/negative.nii", "dim[3] is -5; every dimension must be at least 1");
   };
   cases["DimensionCount"] = [](const std::string& dir)
@@ -534,7 +472,7 @@ std::map<std::string, std::function<void(const std::string&)>> Cases()
   {
     Fields f;
     f.Dim[1] = f.Dim[2] = f.Dim[3] = 32767;
-    std::vector<unsigned char> bytes = Header(f);
+    std::vector<unsigned char> bytes = NIfTIHeader(f);
     Append(bytes, Int16Voxels(13500, false));
     WritePlain(dir + "/huge.nii", bytes);
     ExpectRefused(dir + "/huge.nii",
@@ -598,7 +536,7 @@ std::map<std::string, std::function<void(const std::string&)>> Cases()
     WritePlain(dir + "/empty.nii", std::vector<unsigned char>());
     ExpectRefused(dir + "/empty.nii", "the file is too short for a NIfTI header (0 bytes)");
     Fields f;
-    std::vector<unsigned char> header = Header(f);
+    std::vector<unsigned char> header = NIfTIHeader(f);
     header.resize(200);
     WritePlain(dir + "/short-header.nii", header);
     ExpectRefused(

@@ -10,6 +10,7 @@
 // refused by both with the same message, the core's allocating nothing.
 #include "MedicalTestUtilities.h"
 #include "NIfTIImage.h"
+#include "NIfTITestFiles.h"
 #include "vtkMedicalCoreScalarType.h"
 #include "vtkMedicalNIfTIReader.h"
 
@@ -32,97 +33,27 @@
 namespace
 {
 using medical_test::Check;
+using medical_test::PutBytes;
 
-struct Fields
+// A case: the header's fields (NIfTITestFiles.h), here of a 5x4x3 volume, and, > 0, the length
+// the file is cut to.
+struct Fields : medical_test::NIfTIFields
 {
-  int Version = 1;
-  std::int64_t Dim[8] = { 3, 5, 4, 3, 1, 1, 1, 1 };
-  double PixDim[8] = { 1.0, 0.5, 0.75, 2.0, 1.0, 1.0, 1.0, 1.0 };
-  int SizeOfHeader = 0; // 0: the version's
-  int DataType = 4;     // INT16
-  int BitPix = 16;
-  double VoxOffset = -1.0; // -1: after the header and its 4 extension bytes
-  double Slope = 0.0;
-  double Intercept = 0.0;
-  int QFormCode = 0;
-  int SFormCode = 0;
-  double Quatern[3] = { 0, 0, 0 };
-  double QOffset[3] = { 0, 0, 0 };
-  double SRow[3][4] = { { 0, 0, 0, 0 }, { 0, 0, 0, 0 }, { 0, 0, 0, 0 } };
-  bool BigEndian = false;
-  std::size_t KeepBytes = 0; // > 0: the file cut to this many bytes
+  Fields()
+  {
+    this->Dim[1] = 5;
+    this->Dim[2] = 4;
+    this->Dim[3] = 3;
+  }
+  std::size_t KeepBytes = 0;
 };
 
-template<typename T>
-void Put(std::vector<unsigned char>& bytes, std::size_t offset, T value, bool swap)
-{
-  unsigned char raw[sizeof(T)];
-  std::memcpy(raw, &value, sizeof(T));
-  if (swap)
-  {
-    std::reverse(raw, raw + sizeof(T));
-  }
-  std::copy(raw, raw + sizeof(T), bytes.begin() + static_cast<std::ptrdiff_t>(offset));
-}
-
+// The header of `f`, then its voxels where they are few enough to write.
 std::vector<unsigned char> File(const Fields& f)
 {
-  const bool two = f.Version == 2;
-  const std::size_t size = two ? 540 : 348;
-  std::vector<unsigned char> b(size + 4, 0);
+  std::vector<unsigned char> b = medical_test::NIfTIHeader(f);
   const bool s = f.BigEndian;
-  const double voxOffset = f.VoxOffset < 0 ? static_cast<double>(size + 4) : f.VoxOffset;
-  Put<std::int32_t>(b, 0, f.SizeOfHeader ? f.SizeOfHeader : static_cast<std::int32_t>(size), s);
-  if (two)
-  {
-    std::memcpy(b.data() + 4, "n+2\0\r\n\032\n", 8);
-    Put<std::int16_t>(b, 12, static_cast<std::int16_t>(f.DataType), s);
-    Put<std::int16_t>(b, 14, static_cast<std::int16_t>(f.BitPix), s);
-    for (int i = 0; i < 8; ++i)
-    {
-      Put<std::int64_t>(b, 16 + 8 * i, f.Dim[i], s);
-      Put<double>(b, 104 + 8 * i, f.PixDim[i], s);
-    }
-    Put<std::int64_t>(b, 168, static_cast<std::int64_t>(voxOffset), s);
-    Put<double>(b, 176, f.Slope, s);
-    Put<double>(b, 184, f.Intercept, s);
-    Put<std::int32_t>(b, 344, f.QFormCode, s);
-    Put<std::int32_t>(b, 348, f.SFormCode, s);
-    for (int i = 0; i < 3; ++i)
-    {
-      Put<double>(b, 352 + 8 * i, f.Quatern[i], s);
-      Put<double>(b, 376 + 8 * i, f.QOffset[i], s);
-      for (int c = 0; c < 4; ++c)
-      {
-        Put<double>(b, 400 + 32 * i + 8 * c, f.SRow[i][c], s);
-      }
-    }
-  }
-  else
-  {
-    for (int i = 0; i < 8; ++i)
-    {
-      Put<std::int16_t>(b, 40 + 2 * i, static_cast<std::int16_t>(f.Dim[i]), s);
-      Put<float>(b, 76 + 4 * i, static_cast<float>(f.PixDim[i]), s);
-    }
-    Put<std::int16_t>(b, 70, static_cast<std::int16_t>(f.DataType), s);
-    Put<std::int16_t>(b, 72, static_cast<std::int16_t>(f.BitPix), s);
-    Put<float>(b, 108, static_cast<float>(voxOffset), s);
-    Put<float>(b, 112, static_cast<float>(f.Slope), s);
-    Put<float>(b, 116, static_cast<float>(f.Intercept), s);
-    Put<std::int16_t>(b, 252, static_cast<std::int16_t>(f.QFormCode), s);
-    Put<std::int16_t>(b, 254, static_cast<std::int16_t>(f.SFormCode), s);
-    for (int i = 0; i < 3; ++i)
-    {
-      Put<float>(b, 256 + 4 * i, static_cast<float>(f.Quatern[i]), s);
-      Put<float>(b, 268 + 4 * i, static_cast<float>(f.QOffset[i]), s);
-      for (int c = 0; c < 4; ++c)
-      {
-        Put<float>(b, 280 + 16 * i + 4 * c, static_cast<float>(f.SRow[i][c]), s);
-      }
-    }
-    std::memcpy(b.data() + 344, "n+1", 4);
-  }
+  const double voxOffset = f.VoxOffset < 0 ? static_cast<double>(b.size()) : f.VoxOffset;
   // Voxels: 0, 37, 74, ... (mod 251 for one byte, 3000 else), in the file's byte order.
   long double voxels = 1;
   for (int i = 1; i <= 3; ++i)
@@ -142,11 +73,11 @@ std::vector<unsigned char> File(const Fields& f)
       }
       else if (f.DataType == 16)
       {
-        Put<float>(v, 4 * i, static_cast<float>((37 * i) % 3000) * 0.25f, s);
+        PutBytes<float>(v, 4 * i, static_cast<float>((37 * i) % 3000) * 0.25f, s);
       }
       else if (bytes == 2)
       {
-        Put<std::int16_t>(v, 2 * i, static_cast<std::int16_t>((37 * i) % 3000), s);
+        PutBytes<std::int16_t>(v, 2 * i, static_cast<std::int16_t>((37 * i) % 3000), s);
       }
     }
     b.resize(std::max(b.size(), static_cast<std::size_t>(voxOffset)), 0);

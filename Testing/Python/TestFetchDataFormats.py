@@ -23,19 +23,13 @@ spec.loader.exec_module(fetch_data)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
+from nifti import nifti1_header  # noqa: E402  (Testing/Python/nifti.py)
 
 check = Checks()
 
 
 def nifti_header(endian, dims, spacing, datatype, bitpix):
-    data = bytearray(352)
-    struct.pack_into(endian + "i", data, 0, 348)
-    struct.pack_into(endian + "8h", data, 40, 3, *dims, 1, 1, 1, 1)
-    struct.pack_into(endian + "2h", data, 70, datatype, bitpix)
-    struct.pack_into(endian + "8f", data, 76, 1.0, *spacing, 0, 0, 0, 0)
-    struct.pack_into(endian + "3f", data, 108, 352.0, 1.0, 0.0)
-    data[344:348] = b"n+1\0"
-    return bytes(data)
+    return nifti1_header(dims, spacing, datatype, bitpix, endian=endian, slope=1.0)
 
 
 with tempfile.TemporaryDirectory() as tmp:

@@ -20,22 +20,15 @@ from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
 from paraview import servermanager
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from checks import Checks, captured  # Testing/Python/checks.py
+from nifti import nifti1_header  # Testing/Python/nifti.py
 
 check = Checks()
 
 
 def nifti1(dims, slope=0.0, intercept=0.0, pixdim4=1.0, toffset=0.0):
-    """A single-file NIfTI-1 int16 header (348 bytes and 4 extension bytes)."""
-    header = bytearray(352)
-    struct.pack_into("<i", header, 0, 348)
-    dim = [len(dims)] + list(dims) + [1] * (7 - len(dims))
-    struct.pack_into("<8h", header, 40, *dim)
-    struct.pack_into("<hh", header, 70, 4, 16)  # INT16, bitpix
-    struct.pack_into("<8f", header, 76, 1.0, 0.5, 0.5, 2.0, pixdim4, 1.0, 1.0, 1.0)
-    struct.pack_into("<fff", header, 108, 352.0, slope, intercept)
-    struct.pack_into("<f", header, 136, toffset)
-    header[344:348] = b"n+1\0"
-    return bytes(header)
+    """A single-file NIfTI-1 int16 header (348 bytes and 4 extension bytes), spacing 0.5 x 0.5 x 2."""
+    return nifti1_header(dims, (0.5, 0.5, 2.0), slope=slope, intercept=intercept, time_step=pixdim4,
+                         toffset=toffset)
 
 
 def voxels(count, first=0):

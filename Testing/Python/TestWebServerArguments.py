@@ -11,7 +11,6 @@ process, so a reader that crashes cannot take the server down.
 """
 import os
 import socket
-import struct
 import subprocess
 import sys
 import tempfile
@@ -19,6 +18,7 @@ import tempfile
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import webserver  # noqa: E402  (skips when aiohttp or the plugin is missing)
 from checks import Checks  # noqa: E402
+from nifti import nifti1_header  # noqa: E402  (Testing/Python/nifti.py)
 
 check = Checks(verbose=True)
 work = tempfile.mkdtemp(prefix="mediso-server-arguments-")
@@ -47,18 +47,12 @@ def refused(arguments, code, line, env=None, exact=True):
 
 def nifti(name, dims, datatype=4, bitpix=16, payload=None):
     """A NIfTI-1 file (.nii, int16 unless told) with the given header fields."""
-    header = bytearray(348)
-    struct.pack_into("<i", header, 0, 348)
-    struct.pack_into("<8h", header, 40, 3, *dims, 1, 1, 1, 1)
-    struct.pack_into("<hh", header, 70, datatype, bitpix)
-    struct.pack_into("<8f", header, 76, 1, 1, 1, 1, 1, 1, 1, 1)
-    struct.pack_into("<fff", header, 108, 352.0, 1.0, 0.0)  # vox_offset, scl_slope, scl_inter
-    header[344:348] = b"n+1\0"
+    header = nifti1_header(dims, datatype=datatype, bitpix=bitpix, slope=1.0)
     if payload is None:
         payload = bytes(max(0, dims[0] * dims[1] * dims[2]) * bitpix // 8)
     path = os.path.join(work, name)
     with open(path, "wb") as f:
-        f.write(bytes(header) + bytes(4) + payload)
+        f.write(header + payload)
     return path
 
 

@@ -15,11 +15,11 @@ left out, they lie in patient space, mm to tens of mm away here (the same bounds
 """
 import asyncio
 import os
-import struct
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import webserver  # noqa: E402  (skips when aiohttp or the plugin is missing)
+from nifti import nifti1_header  # noqa: E402  (Testing/Python/nifti.py)
 import aiohttp  # noqa: E402
 import numpy  # noqa: E402
 
@@ -50,18 +50,10 @@ def write_nifti(path, values, direction):
     """A NIfTI-1 file (.nii) whose sform (code 2) places voxel (i, j, k) at
     ORIGIN + direction (SPACING * (i, j, k)); no qform."""
     srow = numpy.asarray(direction) @ numpy.diag(SPACING)
-    header = bytearray(348)
-    struct.pack_into("<i", header, 0, 348)
-    struct.pack_into("<8h", header, 40, 3, *DIMS, 1, 1, 1, 1)
-    struct.pack_into("<hh", header, 70, 4, 16)  # NIFTI_TYPE_INT16, bits
-    struct.pack_into("<8f", header, 76, 1.0, *SPACING, 0, 0, 0, 0)
-    struct.pack_into("<f", header, 108, 352.0)  # vox_offset
-    struct.pack_into("<hh", header, 252, 0, 2)  # qform_code, sform_code (aligned)
-    for r in range(3):
-        struct.pack_into("<4f", header, 280 + 16 * r, *srow[r], ORIGIN[r])
-    header[344:348] = b"n+1\0"
+    header = nifti1_header(DIMS, SPACING, sform=[[*srow[r], ORIGIN[r]] for r in range(3)],
+                           sform_code=2)  # aligned
     with open(path, "wb") as f:
-        f.write(bytes(header) + bytes(4) + values.astype("<i2").tobytes())
+        f.write(header + values.astype("<i2").tobytes())
 
 
 async def page_surface(http, server, dataset):

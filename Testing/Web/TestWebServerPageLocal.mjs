@@ -25,7 +25,7 @@ import { mkdirSync, mkdtempSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
 import { gzipSync } from "node:zlib";
-import { Checks, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
+import { Checks, launchBrowser, niftiBytes, openPage, startServer } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 const folder = mkdtempSync(path.join(tmpdir(), "mediso-local-"));
@@ -46,22 +46,11 @@ function values() {
   return data;
 }
 
+// The volume as a NIfTI, scl_inter -1000 (int16 - 1000 needs int32); `sizeOfHeader` other than
+// 348 for the refused file.
 function nifti({ sizeOfHeader = 348 } = {}) {
-  const header = Buffer.alloc(352);
-  header.writeInt32LE(sizeOfHeader, 0);
-  [3, NX, NY, NZ, 1, 1, 1, 1].forEach((v, i) => header.writeInt16LE(v, 40 + 2 * i));
-  header.writeInt16LE(4, 70); // DT_INT16
-  header.writeInt16LE(16, 72);
-  [1, 0.8, 0.9, 1.25, 1, 1, 1, 1].forEach((v, i) => header.writeFloatLE(v, 76 + 4 * i));
-  header.writeFloatLE(352, 108); // vox_offset
-  header.writeFloatLE(1, 112); // scl_slope
-  header.writeFloatLE(-1000, 116); // scl_inter: int16 - 1000 needs int32
-  header.writeUInt8(10, 123);
-  header.writeInt16LE(1, 254); // sform_code
-  [[0, -0.9, 0, 12], [0.8, 0, 0, -30], [0, 0, 1.25, 5]].forEach((row, r) =>
-    row.forEach((v, c) => header.writeFloatLE(v, 280 + 16 * r + 4 * c)));
-  header.write("n+1\0", 344, "latin1");
-  return Buffer.concat([header, values()]);
+  return niftiBytes([NX, NY, NZ], [0.8, 0.9, 1.25], [[0, -0.9, 0, 12], [0.8, 0, 0, -30], [0, 0, 1.25, 5]],
+    values(), { intercept: -1000, sizeOfHeader });
 }
 
 function metaHeader(dataFile) {

@@ -16,7 +16,8 @@
 // How long the main thread is busy is a timing, so it is measured by the benchmark
 // (Python/benchmark_web.py --interactive: the longest main-thread task, PerformanceObserver
 // "longtask"), not asserted here.
-import { Checks, launchBrowser, openInContext, pageFrames, pageStats, startServer } from "./webserver-harness.mjs";
+import { Checks, installIsovalueTyping, launchBrowser, openInContext, pageFrames, pageStats, startServer }
+  from "./webserver-harness.mjs";
 
 const checks = new Checks();
 const small = await startServer(["phantom:64"]);
@@ -76,35 +77,27 @@ await fast.evaluate(() => window.mediso.setCPULevel(-1));
 }
 
 // --- a change superseded while its refinement is owed ---------------------------------------------
-{
-  const skippedBefore = (await stats(fast)).refinementsSkipped;
-  const before = (await frames(fast)).length;
-  await fast.evaluate(async () => {
-    const box = document.querySelector("#surfaces .isovalue");
-    const type = (v) => {
-      box.value = String(v);
-      box.dispatchEvent(new Event("input"));
-    };
-    type(250);
-    // the coarse frame of 250 shown, its refinement owed: the next change comes now
-    await new Promise((resolve) => {
-      const poll = setInterval(() => {
-        const f = window.mediso.frames();
-        if (f.length && f[f.length - 1].values[0] === 250) {
-          clearInterval(poll);
-          resolve();
-        }
-      }, 1);
-    });
-    type(350);
-  });
-  await fast.waitForFunction(() => {
+// `first` typed in the first isovalue box, then, once its coarse frame is shown and its refinement
+// owed, `second`; waits for the frame of `second` settled, and 300 ms more (nothing owed may still
+// come). The frames from `first` on, the stats after, and the refinements skipped before.
+async function supersede(page, first, second) {
+  const skippedBefore = (await stats(page)).refinementsSkipped;
+  const before = (await frames(page)).length;
+  await installIsovalueTyping(page);
+  await page.evaluate(async ([a, b]) => {
+    window.medisoTyping.type(a);
+    await window.medisoTyping.waitFor((f) => f.values[0] === a);
+    window.medisoTyping.type(b);
+  }, [first, second]);
+  await page.waitForFunction((b) => {
     const f = window.mediso.frames();
-    return f.length && f[f.length - 1].values[0] === 350 && f[f.length - 1].settled;
-  }, null, { timeout: 120000 });
-  await fast.waitForTimeout(300); // nothing owed may still come
-  const steps = (await frames(fast)).slice(before);
-  const s = await stats(fast);
+    return f.length && f[f.length - 1].values[0] === b && f[f.length - 1].settled;
+  }, second, { timeout: 120000 });
+  await page.waitForTimeout(300);
+  return { skippedBefore, steps: (await frames(page)).slice(before), s: await stats(page) };
+}
+{
+  const { skippedBefore, steps, s } = await supersede(fast, 250, 350);
   const m = await main.evaluate(() => window.mediso.setSurfaces([{ value: 350, color: [1, 1, 1], opacity: 1 }]));
   console.log("superseded frames: " + JSON.stringify(steps.map((f) => [f.values, f.cpuLevel, f.settled])));
   const last = steps[steps.length - 1];
@@ -213,33 +206,7 @@ async function drag(page, moves = 12) {
 }
 // A change typed while that refinement is owed: the old one is skipped, the newer one refined.
 {
-  const skippedBefore = (await stats(fast)).refinementsSkipped;
-  const before = (await frames(fast)).length;
-  await fast.evaluate(async () => {
-    const box = document.querySelector("#surfaces .isovalue");
-    const type = (v) => {
-      box.value = String(v);
-      box.dispatchEvent(new Event("input"));
-    };
-    type(250);
-    await new Promise((resolve) => {
-      const poll = setInterval(() => {
-        const f = window.mediso.frames();
-        if (f.length && f[f.length - 1].values[0] === 250) {
-          clearInterval(poll);
-          resolve();
-        }
-      }, 1);
-    });
-    type(350);
-  });
-  await fast.waitForFunction(() => {
-    const f = window.mediso.frames();
-    return f.length && f[f.length - 1].values[0] === 350 && f[f.length - 1].settled;
-  }, null, { timeout: 120000 });
-  await fast.waitForTimeout(300);
-  const steps = (await frames(fast)).slice(before);
-  const s = await stats(fast);
+  const { skippedBefore, steps, s } = await supersede(fast, 250, 350);
   const fullCount = await fast.evaluate(() => window.mediso.cpuCount([350]));
   console.log("GPU superseded frames: " + JSON.stringify(steps.map((f) => [f.values, f.gpuLevel, f.settled])));
   checks.check(steps.length > 0 && steps[0].values[0] === 250 && steps[0].gpuLevel < 3 &&

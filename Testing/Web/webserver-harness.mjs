@@ -242,11 +242,12 @@ export function writeTwoBlobs(file, n, corner, noise) {
  * The bytes of a NIfTI-1 file (.nii), in mm, with an sform of code 1 (scanner) and no qform:
  * `dims` [i, j, k], `spacing` its pixdim, `sform` the three rows (4 numbers each) of the
  * index-to-RAS matrix, `values` the i-fastest values: a Float32Array (float32), else int16 (an
- * Int16Array or their bytes).
+ * Int16Array or their bytes); scl_slope 1 and `intercept`; `sizeOfHeader` other than 348 for a
+ * file the page must refuse.
  */
-export function niftiBytes(dims, spacing, sform, values) {
+export function niftiBytes(dims, spacing, sform, values, { intercept = 0, sizeOfHeader = 348 } = {}) {
   const header = Buffer.alloc(352);
-  header.writeInt32LE(348, 0);
+  header.writeInt32LE(sizeOfHeader, 0);
   [3, ...dims, 1, 1, 1, 1].forEach((v, i) => header.writeInt16LE(v, 40 + 2 * i));
   const float = values instanceof Float32Array;
   header.writeInt16LE(float ? 16 : 4, 70); // DT_FLOAT32 or DT_INT16
@@ -254,6 +255,7 @@ export function niftiBytes(dims, spacing, sform, values) {
   [1, ...spacing, 1, 1, 1, 1].forEach((v, i) => header.writeFloatLE(v, 76 + 4 * i));
   header.writeFloatLE(352, 108); // vox_offset
   header.writeFloatLE(1, 112); // scl_slope
+  header.writeFloatLE(intercept, 116); // scl_inter
   header.writeUInt8(10, 123); // xyzt_units: mm, s
   header.writeInt16LE(0, 252); // qform_code
   header.writeInt16LE(1, 254); // sform_code: scanner
