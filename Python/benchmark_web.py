@@ -5,6 +5,7 @@
     python3 Python/benchmark_web.py --interactive [--inputs phantom:256,ct] [--paths cpu,gpu] [--before main]
     python3 Python/benchmark_web.py --stream [--inputs ct512,phantom:512:noise=40] [--networks 30/40,loopback] [--warm]
     python3 Python/benchmark_web.py --startup [--inputs ct] [--networks 30/40,loopback]
+    python3 Python/benchmark_web.py --bricks [--inputs ct] [--limits 200,200/24] [--sweep 6] [--stills 6]
 
 In one headless Chromium (Debian's, software WebGL2: SwiftShader), on the same volume and canvas
 size: the page's GPU path (the core on WebGL2), its CPU path (the BlockLOD core in WebAssembly at
@@ -39,6 +40,13 @@ level, and the bytes on the wire. Inputs: ct, ct512, or any server spec phantom:
 context under each network (Testing/Web/bench-startup.mjs): when each of the page's requests was
 sent and finished and its bytes on the wire, and the page's marks (its module loaded, the worker
 ready, the first image).
+
+--bricks (issue 31's brick pool): the page's GPU path on each input as one texture and, under each
+forced texture limit (and GPU budget: LIMIT/MB), as bricks drawn from the pool and each as its own
+pyramid (`?brickPool=0`), each in a fresh context in one Chromium (Testing/Web/bench-bricks.mjs): an
+isovalue change to its full-level frame and the part of it that built the pyramids (medians over the
+sweep's isovalues, the first left out), a still frame (median, the camera turned 2 degrees each),
+and the primitives, bricks and pool slots. Inputs: ct, ct512 or phantom:N[:noise=HU].
 """
 import argparse
 import json
@@ -96,6 +104,10 @@ def parse_args(argv):
     p.add_argument("--warm", action="store_true",
                    help="--stream: before the pages, have the server encode the whole level and "
                         "every brick once (both are kept), so that neither page waits for it")
+    p.add_argument("--bricks", action="store_true",
+                   help="the GPU path as one texture, from the brick pool and per brick (issue 31)")
+    p.add_argument("--limits", default="200,200/24",
+                   help="--bricks: forced texture limits, each optionally /GPU budget in MB")
     return p.parse_args(argv)
 
 
@@ -435,8 +447,74 @@ def parse_networks(text):
     return networks
 
 
+def main_bricks(args, argv):
+    started = time.strftime("%Y-%m-%d %H:%M:%S")
+    load_before = load_average()
+    t0 = time.perf_counter()
+    stills = args.stills or 6  # --stills, 6 by default here
+    configs = [{"name": "one texture", "query": ""}]
+    for spec in args.limits.split(","):
+        limit, _, budget = spec.partition("/")
+        query = "&maxTextureSize=" + limit + ("&gpuBudgetMB=" + budget if budget else "")
+        what = "limit " + limit + (", " + budget + " MB" if budget else "")
+        configs += [{"name": what + ": pool", "query": query},
+                    {"name": what + ": per brick", "query": query + "&brickPool=0"}]
+    results = {}
+    for name in args.inputs.split(","):
+        data = volume_path(name) if not name.startswith("phantom:") else name
+        work = os.path.join(args.work, "bricks-" + name.replace(":", "-"))
+        os.makedirs(work, exist_ok=True)
+        server, url = start_server(ROOT, args, data)
+        try:
+            lo, hi = (-1000, 1100) if name.startswith("phantom:") else (-1000, 2000)
+            isovalues = [lo + (hi - lo) * (i + 1) / (args.sweep + 1) for i in range(args.sweep)]
+            # bone first (the warm-up change), then the sweep in a turning order
+            isovalues = [400] + isovalues[::2] + isovalues[1::2]
+            config = {"url": url, "size": [int(v) for v in args.size.split("x")], "configs": configs,
+                      "isovalues": isovalues, "stills": stills}
+            config_file = os.path.join(work, "config.json")
+            out_file = os.path.join(work, "result.json")
+            with open(config_file, "w") as f:
+                json.dump(config, f)
+            progress("%s: %d configurations, %d changes and %d still frames each"
+                     % (name, len(configs), len(isovalues) - 1, stills))
+            subprocess.run(["node", os.path.join(WEB, "bench-bricks.mjs"), config_file, out_file],
+                           check=True, cwd=WEB, timeout=3600)
+            with open(out_file) as f:
+                results[name] = json.load(f)
+        finally:
+            server.kill()
+    lines = ["# The page's GPU path: one texture, the brick pool, per-brick pyramids (issue 31)", "",
+             "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv),
+             "- Started %s, %.0f s; load average %s before, %s after" % (
+                 started, time.perf_counter() - t0, load_before, load_average()),
+             "- Machine: nproc %d (%s); Chromium headless, SwiftShader; canvas %s; the viewer in its worker" % (
+                 os.cpu_count() or 0, cpu_model(), args.size), "",
+             "| input | kept as | bricks (active, pool slots, pyramids built) | change to full level ms, "
+             "median | / one texture | its build ms | still frame ms, median | / one texture | primitives (last) |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|"]
+    for name, r in results.items():
+        dense = r["runs"][0]
+        for run in r["runs"]:
+            s = run["stats"]
+            kept = "%d (%d, %d, %d)" % (s["bricks"], s["activeBricks"], s["poolSlots"],
+                                        s["brickPyramidBuilds"]) if s["bricks"] else "-"
+            if s["path"] != "gpu":
+                kept += " (fell back to the %s path)" % s["path"]
+            lines.append("| %s | %s | %s | %.0f | %.2fx | %.0f | %.0f | %.2fx | %d |" % (
+                name, run["name"], kept, run["changeMs"], run["changeMs"] / dense["changeMs"],
+                run["buildMs"], run["still"]["frameMs"], run["still"]["frameMs"] / dense["still"]["frameMs"],
+                s["primitives"]))
+    write_report(lines, args.out)
+    return 0
+
+
 def main(argv):
     args = parse_args(argv)
+    if args.bricks:
+        if args.inputs == "ct,ct512":
+            args.inputs = "ct"
+        return main_bricks(args, argv)
     if args.startup:
         if args.inputs == "ct,ct512":
             args.inputs = "ct"

@@ -301,9 +301,10 @@ window.mediso = {
     // Streaming), not extracted at their frame
     takenAhead: ((state.viewer && state.viewer.stats()) || {}).takenAhead || 0,
     // the GPU path's bricks (0: the volume is one texture), those the isovalues cross and those
-    // on the GPU (docs/web.md, Paths); its whole uploads and streamed regions (Streaming)
-    ...Object.fromEntries(["bricks", "activeBricks", "residentBricks", "volumeUploads",
-      "regionUploads"].map((k) =>
+    // on the GPU (docs/web.md, Paths), their edge, the pool's slots (0: each active brick its own
+    // pyramid) and the pyramids the last build built; its whole uploads and streamed regions
+    ...Object.fromEntries(["bricks", "activeBricks", "residentBricks", "brickPoints", "poolSlots",
+      "brickPyramidBuilds", "volumeUploads", "regionUploads"].map((k) =>
       [k, ((state.viewer && state.viewer.stats()) || {})[k] || 0])),
     view: state.viewer ? state.viewer.getView() : null,
     info: state.viewer ? state.viewer.info() : null,

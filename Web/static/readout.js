@@ -49,6 +49,7 @@ export function updateReadout() {
                          : ["triangles", String(state.triangles) + " (level " + state.cpuLevel +
                            (state.interactive ? ", while dragging" : state.settled ? "" : ", refining") + ")"],
     ...(state.frameNote ? [["this frame", state.frameNote]] : []),
+    ...(bricksText() ? [["GPU volume", bricksText()]] : []),
     ...(state.stream ? [["streaming", streamNote()]] : []),
     ["bytes received", state.bytesReceived.toLocaleString()],
     ["bytes sent", state.bytesSent.toLocaleString()],
@@ -61,6 +62,22 @@ export function updateReadout() {
     return tr;
   }));
   $("overlay").textContent = fpsText();
+}
+
+/**
+ * How the GPU path holds a volume it keeps as bricks (over the texture limit or the GPU budget:
+ * docs/web.md, Paths): the bricks, those the isovalues cross, and whether they are drawn from
+ * the one pool texture with one pyramid or each as its own pyramid. "" for one texture.
+ */
+function bricksText() {
+  const s = (state.path === "gpu" && state.viewer && state.viewer.stats()) || {};
+  if (!(s.bricks > 0)) {
+    return "";
+  }
+  return s.bricks + " bricks of " + s.brickPoints + " points, " + s.activeBricks + " crossed, " +
+    s.residentBricks + " resident; " + (s.poolSlots > 0
+    ? "drawn from a pool of " + s.poolSlots + " slots (one pyramid)"
+    : "each crossed brick drawn as its own pyramid (" + s.brickPyramidBuilds + ")");
 }
 
 /** The dataset's line: name, size, type, bytes and range. */

@@ -206,6 +206,7 @@ export class RemoteViewer {
   setBudget(bytes) { this.call("setBudget", bytes); }
   setMaxTextureSize(texels) { this.call("setMaxTextureSize", texels); }
   setGPUBudget(bytes) { this.call("setGPUBudget", bytes); }
+  setBrickPool(on) { this.call("setBrickPool", on); }
   /** The estimator's table, from the worker (a promise). */
   estimates() { return this.ask("estimates"); }
   clearResultMesh() { this.call("clearResultMesh"); }

@@ -110,6 +110,11 @@ export async function startViewer(canvas, probe, moduleLoaded = () => {}) {
   if (params.get("gpuBudgetMB")) {
     state.viewer.setGPUBudget(1e6 * (Number(params.get("gpuBudgetMB")) || 0));
   }
+  // Such bricks drawn each as its own pyramid instead of from the one pool texture (tests and
+  // benchmarks: the pool against per-brick drawing).
+  if (params.get("brickPool") === "0") {
+    state.viewer.setBrickPool(false);
+  }
   if (!debug) { // the renderer as the module's context names it
     state.unmaskedRenderer = state.viewer.info().renderer;
     state.software = /SwiftShader|llvmpipe|softpipe|Software/i.test(state.unmaskedRenderer);

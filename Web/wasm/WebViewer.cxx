@@ -319,6 +319,20 @@ public:
   }
 
   /**
+   * Whether a volume kept as bricks is drawn from one pool texture with one pyramid
+   * (IsosurfaceScene::SetBrickPool, on by default) or each active brick as its own pyramid. The
+   * page turns it off from ?brickPool=0 (tests and benchmarks: the pool against per-brick
+   * drawing in the same browser); it takes effect at the next setVolume.
+   */
+  void SetBrickPool(bool on)
+  {
+    if (this->Scene)
+    {
+      this->Scene->SetBrickPool(on);
+    }
+  }
+
+  /**
    * The image sample distance of the next frames, 1 to 8: above 1 the
    * surfaces are drawn into a framebuffer 1/distance the size along each
    * axis and scaled up to the canvas, as VTK's volume mappers do with
@@ -949,6 +963,11 @@ public:
     stats.set("bricks", static_cast<double>(bricks.Bricks));
     stats.set("activeBricks", static_cast<double>(bricks.ActiveBricks));
     stats.set("residentBricks", static_cast<double>(bricks.ResidentBricks));
+    // The bricks' edge in points, the pool's slots (0: no pool, each active brick its own
+    // pyramid) and the pyramids the last build built (1 with the pool).
+    stats.set("brickPoints", static_cast<double>(bricks.BrickPoints));
+    stats.set("poolSlots", static_cast<double>(bricks.PoolSlots));
+    stats.set("brickPyramidBuilds", static_cast<double>(bricks.BrickPyramidBuilds));
     stats.set("overBudget", !this->CPUPath && bricks.OverBudget);
     // Whole volume uploads and streamed regions (sub-region uploads) of the GPU path's texture.
     stats.set("volumeUploads", static_cast<double>(bricks.VolumeUploads));
@@ -1642,6 +1661,7 @@ EMSCRIPTEN_BINDINGS(mediso_web)
     .function("setBudget", &WebViewer::SetBudget)
     .function("setMaxTextureSize", &WebViewer::SetMaxTextureSize)
     .function("setGPUBudget", &WebViewer::SetGPUBudget)
+    .function("setBrickPool", &WebViewer::SetBrickPool)
     .function("setSampleDistance", &WebViewer::SetSampleDistance)
     .function("setGPULevel", &WebViewer::SetGPULevel)
     .function("chooseFrame", &WebViewer::ChooseFrame)
