@@ -31,14 +31,20 @@
 // 4. The CPU fallback (ForceCPUFallback): an interactive render with a tiny
 //    budget draws a coarser Block LOD level with fewer triangles, the still
 //    render after it level 3 and the same image as before.
-// GPU path needed for 1-3 (a machine without it skips, 125).
+// 5. The render window's cost outside the mapper (a renderer that sleeps in
+//    its StartEvent) is measured and taken off the budget: the same budget
+//    draws the full volume at every pixel without it and a coarser frame
+//    with it, steadily, and the full frame again once it is gone.
+// GPU path needed for 1-3 and 5 (a machine without it skips, 125).
 #include "IsoMapperTestScenes.h"
 #include "MedicalTestUtilities.h"
 
-#include "BlockLOD.h"     // MakeCoarseCopy, the samples of a level
-#include "HistoPyramid.h" // the CPU model's counts
+#include "BlockLOD.h"       // MakeCoarseCopy, the samples of a level
+#include "FrameFixedCost.h" // its history's length
+#include "HistoPyramid.h"   // the CPU model's counts
 
 #include "vtkActor.h"
+#include "vtkCallbackCommand.h"
 #include "vtkCamera.h"
 #include "vtkContourValues.h"
 #include "vtkDataArray.h"
@@ -53,10 +59,13 @@
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace
@@ -209,7 +218,10 @@ void CheckGPUScene(
   Check(
     predict(1.0) > predict(8.0), name + ": the model predicts a coarser distance to be cheaper");
   const double between = std::sqrt(predict(1.0) * predict(8.0));
-  mapper->SetInteractiveFrameBudget(between);
+  // The budget is the whole frame's: the window's measured cost outside the
+  // mapper (what this frame will take off it) is added, so that the mapper's
+  // part is `between`.
+  mapper->SetInteractiveFrameBudget(between + mapper->GetWindowFixedSeconds());
   scene.Render(InteractiveRate);
   std::printf(
     "%s interactive, budget %.4f s: %s\n", name.c_str(), between, Describe(mapper).c_str());
@@ -386,6 +398,99 @@ void CheckGPUScene(
       mapper->GetLastMeasuredSeconds() == 0.0,
     name + ": InteractiveAdjust off draws interactive renders at full quality");
 }
+// Sleeps `ClientData` seconds: a renderer whose frame costs that much more
+// outside the mapper (a slow prop, a post-process pass).
+void SleepCallback(vtkObject*, unsigned long, void* seconds, void*)
+{
+  std::this_thread::sleep_for(std::chrono::duration<double>(*static_cast<double*>(seconds)));
+}
+
+// 5. The window's fixed cost: a budget that fits the full volume at every
+//    pixel with room to spare does so; the same budget in a window whose
+//    renderer takes nearly all of it besides the mapper (a delay in its
+//    StartEvent) draws a coarser frame once the mapper has measured it (half
+//    its history of frames), and steadily (a coarser frame does not make the
+//    window look cheaper again); the delay gone, the full volume at every
+//    pixel comes back; the still image is unchanged throughout.
+void CheckWindowFixedCost(vtkImageData* phantom,
+  const std::vector<iso_test::Look>& looks,
+  const std::string& name)
+{
+  Scene scene(phantom, looks);
+  vtkHistoPyramidIsoMapper* mapper = scene.Mapper;
+  std::vector<double> own;
+  std::vector<unsigned char> still;
+  for (int frame = 0; frame < 4; ++frame)
+  {
+    still = scene.Render(StillRate);
+    own.push_back(mapper->GetLastMeasuredSeconds());
+  }
+  std::sort(own.begin(), own.end());
+  const double drawing = own[own.size() / 2];
+  const double fixed = mapper->GetWindowFixedSeconds();
+  // Room for the mapper's full frame twice over, and for the window's own cost twice.
+  const double budget = 2.0 * drawing + 2.0 * fixed;
+  const double delay = budget - 0.5 * drawing;
+  std::printf("%s window: still frame's drawing %.4f s, window's fixed cost %.4f s, budget %.4f "
+              "s, delay %.4f s\n",
+    name.c_str(),
+    drawing,
+    fixed,
+    budget,
+    delay);
+  Check(drawing > 0.0 && fixed >= 0.0 && fixed < budget,
+    name + ": the mapper's drawing and the window's cost are measured on still frames");
+  mapper->SetInteractiveFrameBudget(budget);
+  auto interactiveFrames = [&](int frames, const char* what)
+  {
+    std::vector<bool> full;
+    for (int frame = 0; frame < frames; ++frame)
+    {
+      const auto start = std::chrono::steady_clock::now();
+      scene.Render(InteractiveRate);
+      const double window =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      full.push_back(mapper->GetLastLevel() == 3 && mapper->GetLastSampleDistance() == 1.0);
+      std::printf("%s window, %s, frame %d: %s; window %.4f s, fixed cost %.4f s, budget left "
+                  "%.4f s\n",
+        name.c_str(),
+        what,
+        frame,
+        Describe(mapper).c_str(),
+        window,
+        mapper->GetWindowFixedSeconds(),
+        mapper->GetLastBudgetSeconds());
+    }
+    return full;
+  };
+
+  // Without the delay: the full volume at every pixel.
+  std::vector<bool> full = interactiveFrames(3, "no delay");
+  Check(full == std::vector<bool>(3, true),
+    name + ": a budget with room for the whole frame draws the full volume at every pixel");
+
+  // With it: a coarser frame once the delay holds most of the history, every frame after.
+  double seconds = delay;
+  vtkNew<vtkCallbackCommand> sleep;
+  sleep->SetCallback(SleepCallback);
+  sleep->SetClientData(&seconds);
+  const unsigned long tag = scene.Renderer->AddObserver(vtkCommand::StartEvent, sleep);
+  const int follow = static_cast<int>(mediso::FrameFixedCost::HistoryLength / 2 + 1);
+  full = interactiveFrames(follow + 3, "delay");
+  Check(mapper->GetWindowFixedSeconds() >= 0.9 * delay &&
+      mapper->GetLastBudgetSeconds() <= budget - 0.9 * delay,
+    name + ": the window's fixed cost is measured (the delay, at least) and taken off the budget");
+  Check(std::count(full.begin() + follow, full.end(), true) == 0,
+    name + ": with the delay measured every frame is coarser than the full volume at every pixel");
+  scene.Renderer->RemoveObserver(tag);
+
+  // The delay gone: the whole frame fits again.
+  full = interactiveFrames(follow + 3, "delay removed");
+  Check(std::count(full.begin() + follow + 1, full.end(), true) == 2,
+    name + ": without the delay the full volume at every pixel comes back");
+  Check(scene.Render(StillRate) == still && mapper->GetLastSampleDistance() == 1.0,
+    name + ": the still image is unchanged");
+}
 } // namespace
 
 int TestHistoPyramidIsoMapperInteractive(int, char*[])
@@ -445,5 +550,7 @@ int TestHistoPyramidIsoMapperInteractive(int, char*[])
   }
   CheckGPUScene(phantom, { skin, bone }, "opaque");
   CheckGPUScene(phantom, { skinGlass, bone }, "translucent skin");
+  CheckWindowFixedCost(phantom, { skin, bone }, "opaque");
+  CheckWindowFixedCost(phantom, { skinGlass, bone }, "translucent skin");
   return medical_test::Finish("TestHistoPyramidIsoMapperInteractive");
 }
