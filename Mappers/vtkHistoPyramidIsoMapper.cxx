@@ -154,8 +154,9 @@ struct vtkHistoPyramidIsoMapper::Internals
   // and timed its drawing gives the window's seconds (StartEvent to
   // EndEvent: the clear, the other props, post-processing, the blit and the
   // swap) less the mapper's own; the interactive choice is made for the
-  // budget less their median (mediso::FrameFixedCost). The first such frame
-  // of a window is left out: it creates the window and its context.
+  // budget less their median (mediso::FrameFixedCost). The window's first
+  // frame with this mapper (which creates the window and its context) is not
+  // seen: the mapper starts to observe the window during it.
   mediso::FrameFixedCost WindowCost;
   vtkWeakPointer<vtkRenderWindow> Window;
   unsigned long WindowStartTag = 0;
@@ -164,7 +165,6 @@ struct vtkHistoPyramidIsoMapper::Internals
   bool InFrame = false;    // between the window's StartEvent and EndEvent
   double OwnSeconds = 0.0; // this mapper's timed drawing within the frame
   bool OwnTimed = false;   // whether it drew and timed in this frame
-  bool FirstFrame = true;  // the window's first frame with this mapper's drawing
 
   ~Internals() { this->Unwatch(); }
 
@@ -177,7 +177,6 @@ struct vtkHistoPyramidIsoMapper::Internals
     }
     this->Unwatch();
     this->WindowCost.Reset();
-    this->FirstFrame = true;
     this->InFrame = false;
     this->OwnTimed = false;
     this->OwnSeconds = 0.0;
@@ -210,14 +209,7 @@ struct vtkHistoPyramidIsoMapper::Internals
     if (this->InFrame && this->OwnTimed)
     {
       const double window = std::chrono::duration<double>(Clock::now() - this->FrameStart).count();
-      if (this->FirstFrame)
-      {
-        this->FirstFrame = false;
-      }
-      else
-      {
-        this->WindowCost.Observe(window, this->OwnSeconds);
-      }
+      this->WindowCost.Observe(window, this->OwnSeconds);
     }
     this->InFrame = false;
     this->OwnTimed = false;

@@ -315,7 +315,9 @@ public:
    * mapper draws. The mapper measures that part on the window's frames in
    * which it drew (the window's StartEvent to EndEvent, less its own timed
    * drawing; the median of the last frames, mediso::FrameFixedCost: a
-   * stalled frame moves nothing, the window's first frame is left out) and
+   * stalled frame moves nothing; the window's first frame with this mapper,
+   * which creates the context, is not seen: the mapper starts to observe
+   * the window during it) and
    * chooses an interactive frame for what is left of the budget.
    * GetWindowFixedSeconds() is that part as measured so far, what the next
    * frame takes off its budget (0 until the window's second frame with this
