@@ -3,6 +3,7 @@
 
 #include "vtkBlockLODIsosurfaces.h"
 #include "vtkColorTransferFunction.h"
+#include "vtkCommand.h"
 #include "vtkContourValues.h"
 #include "vtkDataArray.h"
 #include "vtkDiscretizableColorTransferFunction.h"
@@ -19,8 +20,10 @@
 #include "vtkRenderer.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
+#include "vtkWeakPointer.h"
 #include "vtk_glew.h"
 
+#include "FrameFixedCost.h"
 #include "IsosurfaceScene.h"
 
 #include <algorithm>
@@ -146,6 +149,82 @@ struct vtkHistoPyramidIsoMapper::Internals
     return cells;
   }
 
+  // The render window's frames around this mapper's (issue 30: the budget is
+  // the whole frame's). Each frame of the window in which this mapper drew
+  // and timed its drawing gives the window's seconds (StartEvent to
+  // EndEvent: the clear, the other props, post-processing, the blit and the
+  // swap) less the mapper's own; the interactive choice is made for the
+  // budget less their median (mediso::FrameFixedCost). The window's first
+  // frame with this mapper (which creates the window and its context) is not
+  // seen: the mapper starts to observe the window during it.
+  mediso::FrameFixedCost WindowCost;
+  vtkWeakPointer<vtkRenderWindow> Window;
+  unsigned long WindowStartTag = 0;
+  unsigned long WindowEndTag = 0;
+  Clock::time_point FrameStart;
+  bool InFrame = false;    // between the window's StartEvent and EndEvent
+  double OwnSeconds = 0.0; // this mapper's timed drawing within the frame
+  bool OwnTimed = false;   // whether it drew and timed in this frame
+
+  ~Internals() { this->Unwatch(); }
+
+  // Observe `window`'s frames (another window: forget the last one's).
+  void Watch(vtkRenderWindow* window)
+  {
+    if (window == this->Window.GetPointer())
+    {
+      return;
+    }
+    this->Unwatch();
+    this->WindowCost.Reset();
+    this->InFrame = false;
+    this->OwnTimed = false;
+    this->OwnSeconds = 0.0;
+    this->Window = window;
+    if (window)
+    {
+      this->WindowStartTag =
+        window->AddObserver(vtkCommand::StartEvent, this, &Internals::OnWindowStart);
+      this->WindowEndTag = window->AddObserver(vtkCommand::EndEvent, this, &Internals::OnWindowEnd);
+    }
+  }
+  void Unwatch()
+  {
+    if (vtkRenderWindow* window = this->Window.GetPointer())
+    {
+      window->RemoveObserver(this->WindowStartTag);
+      window->RemoveObserver(this->WindowEndTag);
+    }
+    this->Window = nullptr;
+  }
+  void OnWindowStart()
+  {
+    this->FrameStart = Clock::now();
+    this->InFrame = true;
+    this->OwnSeconds = 0.0;
+    this->OwnTimed = false;
+  }
+  void OnWindowEnd()
+  {
+    if (this->InFrame && this->OwnTimed)
+    {
+      const double window = std::chrono::duration<double>(Clock::now() - this->FrameStart).count();
+      this->WindowCost.Observe(window, this->OwnSeconds);
+    }
+    this->InFrame = false;
+    this->OwnTimed = false;
+    this->OwnSeconds = 0.0;
+  }
+  // This mapper's timed drawing, within the window's frame if one is open.
+  void AddOwnSeconds(double seconds)
+  {
+    if (this->InFrame)
+    {
+      this->OwnSeconds += seconds;
+      this->OwnTimed = true;
+    }
+  }
+
   // Active pairs of a GPU volume level: drawn, else estimated from the full level's.
   std::uint64_t EstimatedPairs(int level) const
   {
@@ -192,6 +271,12 @@ const char* vtkHistoPyramidIsoMapper::GetLastRenderPathAsString() const
     default:
       return "none";
   }
+}
+
+//------------------------------------------------------------------------------
+double vtkHistoPyramidIsoMapper::GetWindowFixedSeconds() const
+{
+  return this->Impl->WindowCost.Seconds();
 }
 
 //------------------------------------------------------------------------------
@@ -285,6 +370,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   this->LastPredictedSeconds = 0.0;
   this->LastPredictedOneOffSeconds = 0.0;
   this->LastMeasuredSeconds = 0.0;
+  this->LastBudgetSeconds = 0.0;
 
   // Say a message once (per distinct text), as an error or a warning.
   auto sayOnce = [&](bool error, const std::string& text)
@@ -464,8 +550,11 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   const double allocated = vol->GetAllocatedRenderTime();
   const bool adjust = this->InteractiveAdjust;
   const bool interactive = adjust && allocated < 1.0;
-  const double budget =
-    this->InteractiveFrameBudget > 0.0 ? this->InteractiveFrameBudget : allocated;
+  // The budget is the whole frame's: the window's cost outside this mapper,
+  // measured over its last frames, is taken off it (see Internals::Watch).
+  impl.Watch(ren->GetRenderWindow());
+  const double budget = impl.WindowCost.BudgetLeft(
+    this->InteractiveFrameBudget > 0.0 ? this->InteractiveFrameBudget : allocated);
   int width = 0, height = 0;
   ren->GetTiledSize(&width, &height);
   bool translucent = false;
@@ -493,6 +582,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     impl.CountedStamp = scalars->GetMTime();
   }
   this->LastInteractive = interactive;
+  this->LastBudgetSeconds = interactive ? budget : 0.0;
   const std::uint64_t fullPixels = mediso::FrameTimeModel::ShadedPixels(width, height, 1.0);
   auto trianglesAt = [&](int level) { return impl.EstimatedTriangles(level); };
   auto gpuCandidate = [&](int level, float distance, std::uint64_t primitives)
@@ -538,6 +628,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       this->LastPredictedOneOffSeconds = impl.Model.PredictOneOff(predicted.Work);
       glFinish();
       this->LastMeasuredSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+      impl.AddOwnSeconds(this->LastMeasuredSeconds);
       mediso::FrameWork work = predicted.Work;
       work.Primitives = this->NumberOfFallbackTriangles;
       const bool uploaded =
@@ -618,6 +709,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       // Timed to the frame's end: a GL frame's calls return before its work is done.
       glFinish();
       this->LastMeasuredSeconds = std::chrono::duration<double>(Clock::now() - gpuStart).count();
+      impl.AddOwnSeconds(this->LastMeasuredSeconds);
       // Observed with the one-off work it did: the full level's pyramid (the
       // first frame, with the volume's upload, or after an isovalue change),
       // a coarse level's on its first frame of these values, the programs
@@ -787,4 +879,6 @@ void vtkHistoPyramidIsoMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LastPredictedSeconds: " << this->LastPredictedSeconds << "\n";
   os << indent << "LastPredictedOneOffSeconds: " << this->LastPredictedOneOffSeconds << "\n";
   os << indent << "LastMeasuredSeconds: " << this->LastMeasuredSeconds << "\n";
+  os << indent << "LastBudgetSeconds: " << this->LastBudgetSeconds << "\n";
+  os << indent << "WindowFixedSeconds: " << this->GetWindowFixedSeconds() << "\n";
 }

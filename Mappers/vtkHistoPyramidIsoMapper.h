@@ -70,8 +70,10 @@
  * the render window's DesiredUpdateRate shared among its props: the rule
  * vtkGPUVolumeRayCastMapper's AutoAdjustSampleDistances uses; ParaView's
  * interactive renders ask for 5 frames a second, its still ones for 0.002)
- * is drawn within InteractiveFrameBudget seconds as the frame-time model
- * (mediso::FrameTimeModel, fitted from this mapper's own frames) predicts:
+ * is drawn within InteractiveFrameBudget seconds, less the render window's
+ * measured cost outside this mapper (GetWindowFixedSeconds()), as the
+ * frame-time model (mediso::FrameTimeModel, fitted from this mapper's own
+ * frames) predicts:
  * the GPU path at the finest image sample distance predicted within the
  * budget (the surfaces drawn into a reduced target, then up to the viewport
  * with their depth), the CPU fallback at the finest Block LOD level
@@ -305,6 +307,28 @@ public:
   vtkGetMacro(LastMeasuredSeconds, double);
   ///@}
 
+  ///@{
+  /**
+   * The budget of a frame is the whole frame's, the render window's included
+   * (issue 30): the window's clear, the other props, post-processing such as
+   * ParaView's FXAA, the blit and the swap take part of it whatever this
+   * mapper draws. The mapper measures that part on the window's frames in
+   * which it drew (the window's StartEvent to EndEvent, less its own timed
+   * drawing; the median of the last frames, mediso::FrameFixedCost: a
+   * stalled frame moves nothing; the window's first frame with this mapper,
+   * which creates the context, is not seen: the mapper starts to observe
+   * the window during it) and
+   * chooses an interactive frame for what is left of the budget.
+   * GetWindowFixedSeconds() is that part as measured so far, what the next
+   * frame takes off its budget (0 until the window's second frame with this
+   * mapper's drawing, and while InteractiveAdjust is off: frames are then
+   * untimed); GetLastBudgetSeconds() the budget left that the last frame was
+   * chosen for (0 for a still frame).
+   */
+  double GetWindowFixedSeconds() const;
+  vtkGetMacro(LastBudgetSeconds, double);
+  ///@}
+
 #if !defined(__VTK_WRAP__)
   /// The frame-time model fitted from this mapper's frames.
   const mediso::FrameTimeModel& GetFrameTimeModel() const;
@@ -451,6 +475,7 @@ private:
   double LastPredictedSeconds = 0.0;
   double LastPredictedOneOffSeconds = 0.0;
   double LastMeasuredSeconds = 0.0;
+  double LastBudgetSeconds = 0.0;
   bool LastGPUPathWorked = false;
   mediso::IsosurfaceSceneStats GPUStats;
   std::uint64_t NumberOfFallbackTriangles = 0;

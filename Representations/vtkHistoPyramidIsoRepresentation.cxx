@@ -189,6 +189,12 @@ double vtkHistoPyramidIsoRepresentation::GetLastMeasuredSeconds()
 }
 
 //------------------------------------------------------------------------------
+double vtkHistoPyramidIsoRepresentation::GetWindowFixedSeconds()
+{
+  return this->IsoMapper->GetWindowFixedSeconds();
+}
+
+//------------------------------------------------------------------------------
 void vtkHistoPyramidIsoRepresentation::SetDiffuseColor(double r, double g, double b)
 {
   this->IsoMapper->SetSolidColor(r, g, b);

@@ -162,6 +162,12 @@ public:
   double GetLastMeasuredSeconds();
   ///@}
 
+  /**
+   * The view's window's measured cost outside the mapper, which interactive
+   * frames take off their budget (vtkHistoPyramidIsoMapper::GetWindowFixedSeconds()).
+   */
+  double GetWindowFixedSeconds();
+
   ///@{
   /**
    * Colouring of the surfaces (see the class description): the solid colour,

@@ -821,7 +821,7 @@ int main(int argc, char* argv[])
               opt.InteractiveLevels.find("triangles") != std::string::npos);
             scene.Window->SetDesiredUpdateRate(1000.0);
             std::vector<double> frameTimes, distances, predicted, measured, errors, levels, paths,
-              oneOff;
+              oneOff, fixedCost, budgetLeft;
             int within = 0;
             // Frames that made something before drawing (a level's build or
             // extraction, a program), and how many of them were within 25%.
@@ -846,6 +846,10 @@ int main(int argc, char* argv[])
                 hp->GetLastPredictedSeconds() + hp->GetLastPredictedOneOffSeconds());
               oneOff.push_back(hp->GetLastPredictedOneOffSeconds());
               measured.push_back(hp->GetLastMeasuredSeconds());
+              // The window's cost outside the mapper that this frame took off
+              // the budget, and the budget its drawing was chosen for.
+              budgetLeft.push_back(hp->GetLastBudgetSeconds());
+              fixedCost.push_back(std::max(0.0, opt.InteractiveBudget - budgetLeft.back()));
               const double error =
                 std::abs(predicted.back() - measured.back()) / std::max(measured.back(), 1e-9);
               errors.push_back(error);
@@ -892,6 +896,8 @@ int main(int argc, char* argv[])
               .Add("frame_distance", distances)
               .Add("frame_path", paths)
               .Add("frame_predicted_one_off_s", oneOff)
+              .Add("frame_window_fixed_s", fixedCost)
+              .Add("window_fixed_median_s", Summarise(fixedCost).Median)
               .Add("one_off_frames", static_cast<double>(oneOffFrames))
               .Add("one_off_within_25", static_cast<double>(oneOffWithin))
               .Add("still_after_distance", hp->GetLastSampleDistance())
@@ -902,6 +908,11 @@ int main(int argc, char* argv[])
               opt.Input.c_str(), windowText.c_str(), opt.InteractiveBudget, is.Median, s.Median,
               Summarise(distances).Median, Summarise(predicted).Median, Summarise(measured).Median,
               100.0 * within / std::max(1, opt.Frames));
+            std::printf("%s %s interactive: the window's cost outside the mapper, taken off the "
+                        "budget, median %.4f s\n",
+              opt.Input.c_str(),
+              windowText.c_str(),
+              Summarise(fixedCost).Median);
           }
           std::printf("%s %s %s iso %g: %d frames, median %.4f s (%.1f fps), min %.4f s, "
                       "total %.1f s, %.0f elements, path %s\n",

@@ -31,14 +31,21 @@
 // 4. The CPU fallback (ForceCPUFallback): an interactive render with a tiny
 //    budget draws a coarser Block LOD level with fewer triangles, the still
 //    render after it level 3 and the same image as before.
-// GPU path needed for 1-3 (a machine without it skips, 125).
+// 5. The render window's cost outside the mapper (a renderer that sleeps in
+//    its StartEvent) is measured and taken off the budget: the same rule for
+//    the budget draws the full volume at every pixel without it and a
+//    coarser frame with it, steadily, and the full frame again once it is
+//    gone.
+// GPU path needed for 1-3 and 5 (a machine without it skips, 125).
 #include "IsoMapperTestScenes.h"
 #include "MedicalTestUtilities.h"
 
-#include "BlockLOD.h"     // MakeCoarseCopy, the samples of a level
-#include "HistoPyramid.h" // the CPU model's counts
+#include "BlockLOD.h"       // MakeCoarseCopy, the samples of a level
+#include "FrameFixedCost.h" // its history's length
+#include "HistoPyramid.h"   // the CPU model's counts
 
 #include "vtkActor.h"
+#include "vtkCallbackCommand.h"
 #include "vtkCamera.h"
 #include "vtkContourValues.h"
 #include "vtkDataArray.h"
@@ -53,10 +60,13 @@
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace
@@ -209,7 +219,10 @@ void CheckGPUScene(
   Check(
     predict(1.0) > predict(8.0), name + ": the model predicts a coarser distance to be cheaper");
   const double between = std::sqrt(predict(1.0) * predict(8.0));
-  mapper->SetInteractiveFrameBudget(between);
+  // The budget is the whole frame's: the window's measured cost outside the
+  // mapper (what this frame will take off it) is added, so that the mapper's
+  // part is `between`.
+  mapper->SetInteractiveFrameBudget(between + mapper->GetWindowFixedSeconds());
   scene.Render(InteractiveRate);
   std::printf(
     "%s interactive, budget %.4f s: %s\n", name.c_str(), between, Describe(mapper).c_str());
@@ -386,6 +399,110 @@ void CheckGPUScene(
       mapper->GetLastMeasuredSeconds() == 0.0,
     name + ": InteractiveAdjust off draws interactive renders at full quality");
 }
+// Sleeps `ClientData` seconds: a renderer whose frame costs that much more
+// outside the mapper (a slow prop, a post-process pass).
+void SleepCallback(vtkObject*, unsigned long, void* seconds, void*)
+{
+  std::this_thread::sleep_for(std::chrono::duration<double>(*static_cast<double*>(seconds)));
+}
+
+// 5. The window's fixed cost. Each interactive frame's budget is twice what
+//    the frame-time model predicts for the full volume at every pixel, plus
+//    the window's cost measured on the still frames before (the same rule in
+//    every phase; scaled to the model so that the machine's load does not
+//    decide): without a delay the frame is the full volume at every pixel;
+//    with a renderer that sleeps one and a half budgets in its StartEvent it
+//    is coarser once the mapper has measured the delay (half its history of
+//    frames), every frame after (a coarser frame does not make the window
+//    look cheaper again), and the budget left is at most the budget less the
+//    delay; the delay gone, the full frame comes back; the still image is
+//    unchanged throughout.
+void CheckWindowFixedCost(vtkImageData* phantom,
+  const std::vector<iso_test::Look>& looks,
+  const std::string& name)
+{
+  Scene scene(phantom, looks);
+  vtkHistoPyramidIsoMapper* mapper = scene.Mapper;
+  std::vector<unsigned char> still;
+  for (int frame = 0; frame < 3; ++frame)
+  {
+    still = scene.Render(StillRate);
+  }
+  const double fixed = mapper->GetWindowFixedSeconds();
+  mediso::FrameWork fullFrame;
+  fullFrame.Method = mediso::FrameMethod::CellRasterisation;
+  fullFrame.Primitives = mapper->GetNumberOfPrimitives();
+  fullFrame.Pixels = mediso::FrameTimeModel::ShadedPixels(Size, Size, 1.0);
+  fullFrame.Translucent = looks.front().Opacity < 1.0;
+  std::printf("%s window: still frame %.4f s, the window's cost outside the mapper %.4f s\n",
+    name.c_str(),
+    mapper->GetLastMeasuredSeconds(),
+    fixed);
+  Check(mapper->GetLastMeasuredSeconds() > 0.0 && fixed > 0.0,
+    name + ": the mapper's drawing and the window's cost are measured on still frames");
+
+  double delay = 0.0; // what the renderer sleeps in this frame (0: no observer)
+  double budget = 0.0;
+  auto interactiveFrames = [&](int frames, const char* what, std::vector<double>* delays)
+  {
+    std::vector<bool> full;
+    for (int frame = 0; frame < frames; ++frame)
+    {
+      budget = 2.0 * mapper->GetFrameTimeModel().PredictDrawing(fullFrame) + fixed;
+      mapper->SetInteractiveFrameBudget(budget);
+      if (delays)
+      {
+        delay = 1.5 * budget;
+        delays->push_back(delay);
+      }
+      const auto start = std::chrono::steady_clock::now();
+      scene.Render(InteractiveRate);
+      const double window =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      full.push_back(mapper->GetLastLevel() == 3 && mapper->GetLastSampleDistance() == 1.0);
+      std::printf("%s window, %s, frame %d: %s; budget %.4f s, window %.4f s, the window's cost "
+                  "now %.4f s, budget left %.4f s\n",
+        name.c_str(),
+        what,
+        frame,
+        Describe(mapper).c_str(),
+        budget,
+        window,
+        mapper->GetWindowFixedSeconds(),
+        mapper->GetLastBudgetSeconds());
+    }
+    return full;
+  };
+
+  // Without the delay: the full volume at every pixel.
+  std::vector<bool> full = interactiveFrames(3, "no delay", nullptr);
+  Check(full == std::vector<bool>(3, true),
+    name + ": a budget with room for the whole frame draws the full volume at every pixel");
+
+  // With it: a coarser frame once the delay holds most of the history, every frame after.
+  vtkNew<vtkCallbackCommand> sleep;
+  sleep->SetCallback(SleepCallback);
+  sleep->SetClientData(&delay);
+  const unsigned long tag = scene.Renderer->AddObserver(vtkCommand::StartEvent, sleep);
+  const int follow = static_cast<int>(mediso::FrameFixedCost::HistoryLength / 2 + 1);
+  std::vector<double> delays;
+  full = interactiveFrames(follow + 3, "delay", &delays);
+  scene.Renderer->RemoveObserver(tag);
+  // Most of the history holds delayed frames: its median is at least the shortest delay.
+  const double shortest = *std::min_element(delays.begin(), delays.end());
+  Check(mapper->GetWindowFixedSeconds() >= shortest &&
+      mapper->GetLastBudgetSeconds() <= std::max(0.0, budget - shortest) + 1e-12,
+    name + ": the window's cost is measured (the delay, at least) and taken off the budget");
+  Check(std::count(full.begin() + follow, full.end(), true) == 0,
+    name + ": with the delay measured every frame is coarser than the full volume at every pixel");
+
+  // The delay gone: the whole frame fits again once the history has followed.
+  full = interactiveFrames(follow + 2, "delay removed", nullptr);
+  Check(std::count(full.begin() + follow, full.end(), true) == 2,
+    name + ": without the delay the full volume at every pixel comes back");
+  Check(scene.Render(StillRate) == still && mapper->GetLastSampleDistance() == 1.0,
+    name + ": the still image is unchanged");
+}
 } // namespace
 
 int TestHistoPyramidIsoMapperInteractive(int, char*[])
@@ -445,5 +562,7 @@ int TestHistoPyramidIsoMapperInteractive(int, char*[])
   }
   CheckGPUScene(phantom, { skin, bone }, "opaque");
   CheckGPUScene(phantom, { skinGlass, bone }, "translucent skin");
+  CheckWindowFixedCost(phantom, { skin, bone }, "opaque");
+  CheckWindowFixedCost(phantom, { skinGlass, bone }, "translucent skin");
   return medical_test::Finish("TestHistoPyramidIsoMapperInteractive");
 }

@@ -5,7 +5,9 @@
 - The advanced properties exist with their defaults: HistoPyramidInteractiveAdjust on,
   HistoPyramidInteractiveFrameBudget 0.1 s; the information properties
   (HistoPyramidLastInteractive, LastSampleDistance, LastLevel, LastPredictedSeconds,
-  LastMeasuredSeconds) exist.
+  LastMeasuredSeconds, WindowFixedSeconds) exist.
+- The view's window's cost outside the representation is measured on its frames (issue 30:
+  interactive frames take it off the budget): positive after two still renders.
 - Still renders (the view's StillRender) draw every pixel of the full level, timed.
 - With a tiny budget, the view's InteractiveRender (a camera move) draws on the GPU path at a
   sample distance above 1 on a coarse volume level (HistoPyramidInteractiveVolumeLevels, on by
@@ -33,7 +35,8 @@ phantom.UpdatePipeline()
 view, display = hp.make_scene(phantom)
 
 INFO = ["HistoPyramidLastInteractive", "HistoPyramidLastSampleDistance", "HistoPyramidLastLevel",
-        "HistoPyramidLastPredictedSeconds", "HistoPyramidLastMeasuredSeconds"]
+        "HistoPyramidLastPredictedSeconds", "HistoPyramidLastMeasuredSeconds",
+        "HistoPyramidWindowFixedSeconds"]
 for name in ["HistoPyramidInteractiveAdjust", "HistoPyramidInteractiveFrameBudget",
              "HistoPyramidInteractiveTriangleLevels", "HistoPyramidInteractiveVolumeLevels"] + INFO:
     check(display.GetProperty(name) is not None, "the display has %s" % name)
@@ -54,6 +57,7 @@ def last_frame():
         "level": int(value("HistoPyramidLastLevel")),
         "predicted": float(value("HistoPyramidLastPredictedSeconds")),
         "measured": float(value("HistoPyramidLastMeasuredSeconds")),
+        "window_fixed": float(value("HistoPyramidWindowFixedSeconds")),
     })
     return info
 
@@ -69,6 +73,8 @@ check(still["interactive"] == 0 and still["distance"] == 1.0 and still["level"] 
       "a still render draws every pixel of the full level (got %r)" % still)
 check(still["measured"] > 0.0 and still["predicted"] > 0.0,
       "a still frame is timed and predicted (got %r)" % still)
+check(still["window_fixed"] > 0.0,
+      "the view's window's cost outside the representation is measured (got %r)" % still)
 before = hp.screenshot(view, os.path.join(args.out, "InteractiveStillBefore.png"))
 
 display.HistoPyramidInteractiveFrameBudget = 1e-7

@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "FrameFixedCost.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mediso
+{
+
+//------------------------------------------------------------------------------
+void FrameFixedCost::Observe(double windowSeconds, double ownSeconds)
+{
+  if (!std::isfinite(windowSeconds) || !std::isfinite(ownSeconds) || windowSeconds < 0.0 ||
+    ownSeconds < 0.0)
+  {
+    return;
+  }
+  this->Recent[this->Frames % HistoryLength] = std::max(0.0, windowSeconds - ownSeconds);
+  ++this->Frames;
+}
+
+//------------------------------------------------------------------------------
+double FrameFixedCost::Seconds() const
+{
+  const std::size_t kept = std::min(this->Frames, HistoryLength);
+  if (kept == 0)
+  {
+    return 0.0;
+  }
+  std::array<double, HistoryLength> sorted = this->Recent;
+  // The lower median of an even count: of two frames, a stalled one does not
+  // decide (nor does the first frame's window creation, where a host counts it).
+  const std::size_t middle = (kept - 1) / 2;
+  std::nth_element(sorted.begin(), sorted.begin() + middle, sorted.begin() + kept);
+  return sorted[middle];
+}
+
+//------------------------------------------------------------------------------
+double FrameFixedCost::BudgetLeft(double budget) const
+{
+  if (!std::isfinite(budget))
+  {
+    return budget;
+  }
+  return std::max(0.0, budget - this->Seconds());
+}
+
+//------------------------------------------------------------------------------
+void FrameFixedCost::Reset()
+{
+  this->Recent.fill(0.0);
+  this->Frames = 0;
+}
+
+} // namespace mediso

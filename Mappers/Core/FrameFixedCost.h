@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: BSD-3-Clause
+/**
+ * @file FrameFixedCost.h
+ * @brief The part of a window's frame that one representation's drawing does
+ * not include (no VTK, no GL), measured, so that the representation chooses
+ * its interactive level for the budget that is left.
+ *
+ * A host's frame budget (issue 30: an interactive frame within 0.1 s) is the
+ * whole frame a user waits for: the window's clear, the other props, a
+ * post-process pass (FXAA), the blit to the window and the swap, and the
+ * representation's own drawing. FrameTimeModel predicts the representation's
+ * drawing only (its coefficients are fitted to the representation's own timed
+ * frames), so a representation that spends the whole budget on its drawing
+ * makes a frame over the budget by the window's cost. VTK's volume mappers
+ * make the same mistake: vtkGPUVolumeRayCastMapper compares its own time with
+ * the prop's allocated render time, which is the whole frame's share.
+ *
+ * FrameFixedCost keeps the difference, frame by frame:
+ *
+ *     fixed = window's frame seconds - the representation's own seconds
+ *
+ * and Seconds() is the median of the last HistoryLength differences. The
+ * representation then chooses for BudgetLeft(budget) = budget - Seconds().
+ *
+ * Why it does not oscillate: the representation's own seconds are timed to
+ * the end of its work (glFinish), and they are what the frame-time model is
+ * fitted to, so each part of the frame is counted once, either in the model
+ * (what a level changes) or here (what it does not). A coarser frame does not
+ * make the rest of the window look slower; where some of the window's work
+ * does depend on the level (llvmpipe flushes earlier props' drawing at the
+ * representation's glFinish), it lands in the model's fixed coefficient, not
+ * here. Why a median: a frame stalled by the machine's load, or one that
+ * resized or created the window, is one sample of several and moves nothing;
+ * a lasting change (another prop shown, FXAA turned on) is followed once it
+ * is most of the history (HistoryLength / 2 + 1 frames).
+ *
+ * Bad input: a non-finite or negative time is not observed; a difference
+ * below zero counts as zero (the window cannot cost less than nothing); with
+ * no frame observed Seconds() is 0, so a host's first frames choose as they
+ * did before the window was measured.
+ *
+ * @sa FrameTimeModel
+ */
+#ifndef mediso_FrameFixedCost_h
+#define mediso_FrameFixedCost_h
+
+#include <array>
+#include <cstddef>
+
+namespace mediso
+{
+
+class FrameFixedCost
+{
+public:
+  /// The frames whose differences the median is taken over.
+  static constexpr std::size_t HistoryLength = 9;
+
+  /**
+   * One frame: the window's seconds (its render from start to end) and the
+   * representation's own timed seconds within it. Ignored when either is
+   * negative or not finite.
+   */
+  void Observe(double windowSeconds, double ownSeconds);
+
+  /// The window's cost outside the representation: the median of the last frames (0: none).
+  double Seconds() const;
+
+  /// `budget` less Seconds(), never below 0 (a non-finite budget is returned as it is).
+  double BudgetLeft(double budget) const;
+
+  /// Frames observed so far (all of them, not only those kept).
+  std::size_t GetNumberOfFrames() const { return this->Frames; }
+
+  /// Forget every frame (a new window).
+  void Reset();
+
+private:
+  std::array<double, HistoryLength> Recent{};
+  std::size_t Frames = 0;
+};
+
+} // namespace mediso
+
+#endif
