@@ -233,20 +233,13 @@ FrameTimeModel::OneOffCoefficients FrameTimeModel::OneOffPrior(FrameMethod metho
 {
   // A software renderer's, of the right order rather than exact: the first
   // frame at a new level is predicted from it, and that frame's time then
-  // scales it. As with the drawing's prior, the shape matters more than the
-  // size: the first switch scales the prior to this machine, and the split
-  // between program and elements is what the next level's switch is
-  // predicted from. A GPU level's program is its pyramid walk, compiled with
-  // the level's layout: on llvmpipe the first frame of the CT's volume levels
-  // 1 and 2 took 0.27-0.32 s beyond its drawing whether the level had 110 k or
-  // 884 k cells, so the program, not the cells, is most of it (with 0.03 s a
-  // program, the second level's switch was predicted at 0.6 of what it took).
-  // The meshes' program is a plain shader (tens of milliseconds). A GPU
-  // level's cell costs its share of the coarse copy, the upload and the build
-  // passes; a triangle its extraction's output and its upload. The
-  // estimator's seconds are taken as they are.
+  // scales it. A program is a compile and link of the isosurface shaders
+  // (tens of milliseconds on llvmpipe); a GPU level's cell costs its share of
+  // the coarse copy, the upload and the build passes; a triangle its
+  // extraction's output and its upload. The estimator's seconds are taken
+  // as they are.
   OneOffCoefficients prior;
-  prior.PerProgram = method == FrameMethod::CellRasterisation ? 0.25 : 0.03;
+  prior.PerProgram = 0.03;
   prior.PerElement = method == FrameMethod::CellRasterisation ? 3e-8 : 1e-7;
   prior.ExtractScale = 1.0;
   return prior;

@@ -427,31 +427,6 @@ int main()
     Check(model.ChooseWholeFrame(candidates, 0.03) == 2,
       "ChooseWholeFrame: the first whose whole frame fits");
   }
-  // A GPU level's first frame is mostly its program (the pyramid walk,
-  // compiled with the level's layout), not its cells: on llvmpipe the CT's
-  // volume levels 2 and 1 (884 k and 110 k cells) took 0.27-0.32 s each
-  // beyond their drawing. After one such switch, the next one is predicted
-  // from the prior's split between program and cells scaled to it; with a
-  // program at 0.03 s (the cells most of the prior) the switch to level 1
-  // was predicted at 0.68 of what it took.
-  {
-    FrameTimeModel model;
-    const double compile = 0.25, cell = 5e-8;
-    const auto oneOff = [&](const mediso::FrameWork& work)
-    { return compile * work.Programs + cell * static_cast<double>(work.BuildElements); };
-    for (int i = 0; i < 6; ++i)
-    {
-      const auto still = gpuWork(545570, 1.0, 0, 0);
-      model.Observe(still, drawing(still));
-    }
-    const auto switchTo2 = gpuWork(150000, 2.0, level2Cells, 1);
-    model.Observe(switchTo2, drawing(switchTo2) + oneOff(switchTo2));
-    const auto switchTo1 = gpuWork(40000, 2.0, level1Cells, 1);
-    Check(Near(model.PredictOneOff(switchTo1), oneOff(switchTo1), 0.25) &&
-        Near(model.Predict(switchTo1), drawing(switchTo1) + oneOff(switchTo1), 0.25),
-      "after one level's switch, the next level's (its program most of it): within 25% (" +
-        Number(model.PredictOneOff(switchTo1)) + " vs " + Number(oneOff(switchTo1)) + ")");
-  }
   // The first frame at a level of triangles (an extraction, the estimator's
   // seconds reported) when the host has drawn no triangles yet: the next
   // frame, the level's drawing alone, is predicted within 25% (before, such
