@@ -87,8 +87,7 @@ struct vtkHistoPyramidIsoMapper::Internals
 
   // Warm's key of the programs a frame compiles. A GPU frame's is its volume
   // level's and translucency's: the pyramid walk is compiled with the level's
-  // layout (its levels and their constants), and compiling it is most of a
-  // level's first frame on a software renderer; a sample distance compiles
+  // layout (its levels and their constants); a sample distance compiles
   // nothing (its framebuffer is resized, its full-screen pass is compiled
   // once). A fallback frame's is its translucency's alone: every Block LOD
   // level is drawn by the same polygon shaders, a new level only uploads.
