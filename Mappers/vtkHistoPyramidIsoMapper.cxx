@@ -79,25 +79,23 @@ struct vtkHistoPyramidIsoMapper::Internals
   std::set<std::string> Said;
 
   // The frame-time model and what it is fed: every frame, with the one-off
-  // work it did (a level's pyramid or extraction, the programs and buffers of
-  // a level, distance and translucency not drawn before: Warm says which
-  // were), so that the model predicts the frames that switch level too.
+  // work it did (a level's pyramid or extraction, the programs of a level
+  // and translucency not drawn before: Warm says which were), so that the
+  // model predicts the frames that switch level too.
   mediso::FrameTimeModel Model;
   std::set<std::pair<int, bool>> Warm;
   // The Block LOD level the fallback drew last (-1: none): another level's
   // triangles are uploaded again (one vtkPolyDataMapper draws them all).
   int LastTriangleLevel = -1;
 
-  // Warm's key of a GPU frame at a volume level and distance, and of a
-  // fallback frame at a level.
-  static std::pair<int, bool> GPUKey(int level, double distance, bool translucent)
-  {
-    return { 1000 * level + static_cast<int>(std::lround(100.0 * distance)), translucent };
-  }
-  static std::pair<int, bool> TrianglesKey(int level, bool translucent)
-  {
-    return { -1 - level, translucent };
-  }
+  // Warm's key of the programs a frame compiles. A GPU frame's is its volume
+  // level's and translucency's: the pyramid walk is compiled with the level's
+  // layout (its levels and their constants); a sample distance compiles
+  // nothing (its framebuffer is resized, its full-screen pass is compiled
+  // once). A fallback frame's is its translucency's alone: every Block LOD
+  // level is drawn by the same polygon shaders, a new level only uploads.
+  static std::pair<int, bool> GPUKey(int level, bool translucent) { return { level, translucent }; }
+  static std::pair<int, bool> TrianglesKey(bool translucent) { return { -1, translucent }; }
   // The fallback's triangles per level for the current values and input
   // (-1: not drawn yet), which its interactive choice predicts from.
   std::array<double, 4> LevelTriangles = { { -1.0, -1.0, -1.0, -1.0 } };
@@ -634,7 +632,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       const bool uploaded =
         impl.Fallback->GetLastFrameExtracted() || level != impl.LastTriangleLevel;
       work.BuildElements = uploaded ? this->NumberOfFallbackTriangles : 0;
-      work.Programs = impl.Warm.insert(Internals::TrianglesKey(level, translucent)).second ? 1 : 0;
+      work.Programs = impl.Warm.insert(Internals::TrianglesKey(translucent)).second ? 1 : 0;
       impl.Model.Observe(work, this->LastMeasuredSeconds);
     }
     impl.LevelTriangles[static_cast<std::size_t>(level)] =
@@ -712,8 +710,8 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       impl.AddOwnSeconds(this->LastMeasuredSeconds);
       // Observed with the one-off work it did: the full level's pyramid (the
       // first frame, with the volume's upload, or after an isovalue change),
-      // a coarse level's on its first frame of these values, the programs
-      // and buffers of a level, distance and translucency not drawn before.
+      // a coarse level's on its first frame of these values, the program of
+      // a level and translucency not drawn before (not of a distance).
       mediso::FrameWork work = chosenWork;
       work.Primitives = this->GPUStats.Primitives;
       work.BuildElements = 0;
@@ -726,8 +724,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       {
         work.BuildElements += Internals::LevelCells(dims, this->LastLevel);
       }
-      const std::pair<int, bool> key =
-        Internals::GPUKey(this->LastLevel, this->LastSampleDistance, chosenWork.Translucent);
+      const std::pair<int, bool> key = Internals::GPUKey(this->LastLevel, chosenWork.Translucent);
       work.Programs = impl.Warm.insert(key).second ? 1 : 0;
       impl.Model.Observe(work, this->LastMeasuredSeconds);
     }
@@ -771,8 +768,8 @@ void vtkHistoPyramidIsoMapper::AddOneOffWork(mediso::FrameTimeModel::Candidate& 
   // What a candidate would make before it draws, as known before the frame:
   // a GPU level not built for these values (its pairs unknown) builds its
   // pyramid; a Block LOD level not drawn for them extracts, and a level other
-  // than the last one drawn uploads its triangles; a level, distance and
-  // translucency not drawn before sets up its program and buffers.
+  // than the last one drawn uploads its triangles; a program not compiled
+  // before (Internals::GPUKey, TrianglesKey) is compiled.
   const Internals& impl = *this->Impl;
   mediso::FrameWork& work = candidate.Work;
   const std::size_t level = static_cast<std::size_t>(candidate.Level);
@@ -781,18 +778,14 @@ void vtkHistoPyramidIsoMapper::AddOneOffWork(mediso::FrameTimeModel::Candidate& 
     const bool built =
       candidate.Level == FullLevel ? impl.Primitives > 0 : impl.LevelPairs[level] > 0;
     work.BuildElements = built ? 0 : Internals::LevelCells(dims, candidate.Level);
-    work.Programs = impl.Warm.count(Internals::GPUKey(
-                      candidate.Level, candidate.SampleDistance, work.Translucent))
-      ? 0
-      : 1;
+    work.Programs = impl.Warm.count(Internals::GPUKey(candidate.Level, work.Translucent)) ? 0 : 1;
   }
   else
   {
     const bool drawn =
       impl.LevelTriangles[level] >= 0.0 && candidate.Level == impl.LastTriangleLevel;
     work.BuildElements = drawn ? 0 : work.Primitives;
-    work.Programs =
-      impl.Warm.count(Internals::TrianglesKey(candidate.Level, work.Translucent)) ? 0 : 1;
+    work.Programs = impl.Warm.count(Internals::TrianglesKey(work.Translucent)) ? 0 : 1;
   }
 }
 

@@ -130,7 +130,8 @@ struct FrameWork
   /// Elements the frame makes: the cells of the GPU volume levels whose pyramids it builds
   /// (CellRasterisation), or the triangles it extracts and uploads (Triangles).
   std::uint64_t BuildElements = 0;
-  /// Programs (and their buffers) the frame sets up: a level, distance or look not drawn before.
+  /// Programs the frame compiles (a host counts what compiles: a GPU volume level's pyramid
+  /// walk per level and translucency, a mesh program once; a new sample distance compiles none).
   std::uint32_t Programs = 0;
   /// The extraction estimator's seconds for the surfaces the frame extracts (where known).
   double ExtractSeconds = 0.0;

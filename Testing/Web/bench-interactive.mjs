@@ -84,7 +84,10 @@ for (const path of config.paths) {
         steadyMs: median(steady.map((f) => f.ms)), steadyFrames: steady.length,
         levels: [...new Set(drag.map((f) => f.cpuLevel))], sampleDistances: [...new Set(drag.map((f) => f.sampleDistance))],
         gpuLevels: [...new Set(drag.map((f) => f.gpuLevel).filter((k) => k !== undefined))],
-        predictionError: median(drag.filter((f) => f.predictedMs > 0).map((f) => Math.abs(f.predictedMs - f.ms) / f.ms)) };
+        predictionError: median(drag.filter((f) => f.predictedMs > 0).map((f) => Math.abs(f.predictedMs - f.ms) / f.ms)),
+        // each drag frame as drawn and as predicted (what the error above is a median of)
+        frameList: drag.map((f) => ({ level: f.cpuLevel, gpuLevel: f.gpuLevel, sampleDistance: f.sampleDistance,
+          elements: path === "gpu" ? f.primitives : f.triangles, ms: f.ms, predictedMs: f.predictedMs })) };
     } else {
       run.drag = { frameMs: median(sampled), frames: null, rate: null, levels: null, sampleDistances: [1] };
     }

@@ -821,7 +821,7 @@ public:
   /// frame is then given to the frame-time model with its time to here and
   /// the one-off work it did (GPU path: the pyramids it built; CPU path: the
   /// estimator's seconds of its extraction and the triangles it uploaded;
-  /// either: the program of a level, distance and look not drawn before),
+  /// either: a program not compiled before, WarmKey),
   /// which the model keeps apart from the drawing.
   void Finish()
   {
@@ -842,10 +842,7 @@ public:
       {
         work.BuildElements = this->FrameBuildCells;
       }
-      work.Programs = this->Warm.insert(this->WarmKey(level, this->DrawnSampleDistance, work))
-                        .second
-        ? 1
-        : 0;
+      work.Programs = this->Warm.insert(this->WarmKey(level, work)).second ? 1 : 0;
       this->Times.Observe(work, seconds);
     }
     this->FrameDrawn = false;
@@ -915,13 +912,12 @@ public:
     if (this->CPUPath)
     {
       // Predicted with the rest of its one-off work: a level not shown uploads its triangles
-      // (after extracting those not cached), a level not drawn before sets up its buffers.
+      // (after extracting those not cached); the first frame compiles the meshes' program.
       FrameWork& work = candidates[chosen].Work;
       const int level = candidates[chosen].Level;
       const bool shown = work.ExtractSeconds <= 0.0 && level == this->CPULevel;
       work.BuildElements = shown ? 0 : work.Primitives;
-      work.Programs =
-        this->Warm.count(this->WarmKey(level, candidates[chosen].SampleDistance, work)) ? 0 : 1;
+      work.Programs = this->Warm.count(this->WarmKey(level, work)) ? 0 : 1;
     }
     val out = val::object();
     out.set("level", candidates[chosen].Level);
@@ -1069,7 +1065,7 @@ private:
         c.SampleDistance = static_cast<float>(distance);
         c.Work = this->Work(pairs, distance);
         c.Work.BuildElements = builtNow ? 0 : this->LevelCells(level);
-        c.Work.Programs = this->Warm.count(this->WarmKey(level, distance, c.Work)) ? 0 : 1;
+        c.Work.Programs = this->Warm.count(this->WarmKey(level, c.Work)) ? 0 : 1;
         candidates.push_back(c);
       }
     }
@@ -1114,12 +1110,20 @@ private:
     return cells;
   }
 
-  // Warm's key: a path, level, sample distance and translucency drawn before (their programs
-  // and buffers made).
-  static std::array<int, 4> WarmKey(int level, double sampleDistance, const FrameWork& work)
+  // Warm's key: the programs a frame compiles, where a frame's one-off work
+  // counts one (FrameWork::Programs). The GPU path compiles its pyramid walk
+  // per volume level (the level's layout is compiled in) and translucency; the
+  // CPU path's meshes have one program whatever their level or translucency; a
+  // sample distance compiles nothing on either (its framebuffer is resized,
+  // the blit needs no program). Keyed by the distance as well, every new
+  // distance of a drag was predicted to pay a level's set-up.
+  static std::array<int, 3> WarmKey(int level, const FrameWork& work)
   {
-    return { static_cast<int>(work.Method), level,
-      static_cast<int>(std::lround(100.0 * sampleDistance)), work.Translucent ? 1 : 0 };
+    if (work.Method == FrameMethod::Triangles)
+    {
+      return { static_cast<int>(work.Method), 0, 0 };
+    }
+    return { static_cast<int>(work.Method), level, work.Translucent ? 1 : 0 };
   }
 
   // The last frame's work, as drawn.
@@ -1451,7 +1455,7 @@ private:
   // The one-off work of the frame being drawn (Finish() reports it), and what was drawn before.
   double FrameExtractSeconds = 0.0;
   std::uint64_t FrameBuildCells = 0;
-  std::set<std::array<int, 4>> Warm;
+  std::set<std::array<int, 3>> Warm;
   bool MeshesUploaded = false; // the last frame made or uploaded a CPU path surface
   glcore::Name Sampled, SampledColor, SampledDepth; // a sampled frame's framebuffer
   int SampledSize[2] = { 0, 0 };
