@@ -16,7 +16,8 @@
 // How long the main thread is busy is a timing, so it is measured by the benchmark
 // (Python/benchmark_web.py --interactive: the longest main-thread task, PerformanceObserver
 // "longtask"), not asserted here.
-import { Checks, installIsovalueTyping, launchBrowser, openInContext, pageFrames, pageStats, startServer }
+import { Checks, installIsovalueTyping, launchBrowser, framesAfter, lastFrameSeq, openInContext, pageStats,
+  startServer }
   from "./webserver-harness.mjs";
 
 const checks = new Checks();
@@ -26,7 +27,6 @@ const browser = await launchBrowser();
 // The page, with `query` after the token.
 const open = (server, query) => openInContext(browser, server.url + query);
 const stats = pageStats;
-const frames = pageFrames;
 const settle = (page) => page.waitForFunction(() => window.mediso.stats().settled, null, { timeout: 120000 });
 const BONE = { value: 400, color: [1, 1, 1], opacity: 1 };
 
@@ -63,9 +63,9 @@ await worker.close();
 const fast = await open(small, "&path=cpu&frameBudget=1&refineDelay=2000");
 await fast.evaluate(() => window.mediso.setCPULevel(-1));
 {
-  const before = (await frames(fast)).length;
+  const before = await lastFrameSeq(fast);
   const s = await fast.evaluate((v) => window.mediso.setSurfaces([Object.assign({}, v, { value: 300 })]), BONE);
-  const steps = (await frames(fast)).slice(before);
+  const steps = await framesAfter(fast, before);
   const m = await main.evaluate(() => window.mediso.setSurfaces([{ value: 300, color: [1, 1, 1], opacity: 1 }]));
   const full = await main.evaluate(() => window.mediso.setCPULevel(3));
   console.log("refinement frames: " + JSON.stringify(steps.map((f) => [f.values, f.cpuLevel, f.settled])));
@@ -82,7 +82,7 @@ await fast.evaluate(() => window.mediso.setCPULevel(-1));
 // come). The frames from `first` on, the stats after, and the refinements skipped before.
 async function supersede(page, first, second) {
   const skippedBefore = (await stats(page)).refinementsSkipped;
-  const before = (await frames(page)).length;
+  const before = await lastFrameSeq(page);
   await installIsovalueTyping(page);
   await page.evaluate(async ([a, b]) => {
     window.medisoTyping.type(a);
@@ -94,7 +94,7 @@ async function supersede(page, first, second) {
     return f.length && f[f.length - 1].values[0] === b && f[f.length - 1].settled;
   }, second, { timeout: 120000 });
   await page.waitForTimeout(300);
-  return { skippedBefore, steps: (await frames(page)).slice(before), s: await stats(page) };
+  return { skippedBefore, steps: await framesAfter(page, before), s: await stats(page) };
 }
 {
   const { skippedBefore, steps, s } = await supersede(fast, 250, 350);
@@ -126,11 +126,11 @@ async function drag(page, moves = 12) {
   return during;
 }
 {
-  const before = (await frames(fast)).length;
+  const before = await lastFrameSeq(fast);
   const during = await drag(fast);
   await settle(fast);
   await fast.waitForTimeout(200);
-  const steps = (await frames(fast)).slice(before);
+  const steps = await framesAfter(fast, before);
   const s = await stats(fast);
   const coarse = steps.filter((f) => f.interactive && f.cpuLevel < 3);
   const said = during.find((d) => d.interactive && d.cpuLevel < 3 && /dragging/.test(d.frameNote));
@@ -150,11 +150,11 @@ async function drag(page, moves = 12) {
 }
 {
   await fast.evaluate(() => window.mediso.setPath("gpu"));
-  const before = (await frames(fast)).length;
+  const before = await lastFrameSeq(fast);
   const during = await drag(fast, 16);
   await settle(fast);
   await fast.waitForTimeout(200);
-  const steps = (await frames(fast)).slice(before);
+  const steps = await framesAfter(fast, before);
   const s = await stats(fast);
   const sampled = steps.filter((f) => f.interactive && f.sampleDistance > 1);
   const said = during.find((d) => d.interactive && d.sampleDistance > 1);
@@ -187,9 +187,9 @@ async function drag(page, moves = 12) {
 // ?frameBudget=1: no frame fits 1 ms, so a change's first answer is the coarsest candidate (volume
 // level 1: its pyramid built, not the volume's); the refinement builds and draws the full volume.
 {
-  const before = (await frames(fast)).length;
+  const before = await lastFrameSeq(fast);
   const s = await fast.evaluate((v) => window.mediso.setSurfaces([Object.assign({}, v, { value: 300 })]), BONE);
-  const steps = (await frames(fast)).slice(before);
+  const steps = await framesAfter(fast, before);
   const first = steps[0] || {};
   const coarseCount = first.gpuLevel >= 0 ? await fast.evaluate(([v, k]) => window.mediso.cpuCount(v, k),
     [[300], first.gpuLevel]) : -1;

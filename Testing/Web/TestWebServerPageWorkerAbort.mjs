@@ -13,7 +13,8 @@
 //   same core, not in a worker);
 // - without the generation word (?abort=0, as on a page that is not cross-origin isolated),
 //   stats() says a refinement runs to its end, and it does.
-import { Checks, installIsovalueTyping, launchBrowser, openInContext, pageFrames, pageStats, startServer } from "./webserver-harness.mjs";
+import { Checks, installIsovalueTyping, launchBrowser, framesAfter, lastFrameSeq, openInContext, pageStats,
+  startServer } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 const server = await startServer(["phantom:64"]);
@@ -22,7 +23,6 @@ const SLOW_MS = 6000;
 
 const open = (query) => openInContext(browser, server.url + query);
 const stats = pageStats;
-const frames = pageFrames;
 
 // The main thread's triangles at level 3 (the reference).
 const main = await open("&path=cpu&worker=0");
@@ -41,7 +41,7 @@ for (const [name, mode] of Object.entries(MODES)) {
   checks.check(s0.renderer === "worker" && s0.abortable === true && /stops/.test(s0.abortNote),
     name + ": the worker can stop a running refinement (cross-origin isolated): " +
     JSON.stringify({ renderer: s0.renderer, abortable: s0.abortable, abortNote: s0.abortNote }));
-  const before = (await frames(page)).length;
+  const before = await lastFrameSeq(page);
   await installIsovalueTyping(page);
   const timing = await page.evaluate(async () => {
     const { type, waitFor } = window.medisoTyping;
@@ -60,7 +60,7 @@ for (const [name, mode] of Object.entries(MODES)) {
     return f.length && f[f.length - 1].values[0] === 350 && f[f.length - 1].settled;
   }, null, { timeout: 120000 });
   await page.waitForTimeout(300); // nothing owed may still come
-  const steps = (await frames(page)).slice(before);
+  const steps = await framesAfter(page, before);
   const s = await stats(page);
   console.log(name + ": frames " + JSON.stringify(steps.map((f) => [f.values, f.cpuLevel, f.settled])) +
     "; the newer change's first frame " + Math.round(timing.firstMs) + " ms after it");
@@ -93,7 +93,7 @@ for (const [name, mode] of Object.entries(MODES)) {
   const s0 = await stats(page);
   checks.check(s0.abortable === false && /runs to its end/.test(s0.abortNote),
     "without the word, stats() says a refinement runs to its end: " + JSON.stringify(s0.abortNote));
-  const before = (await frames(page)).length;
+  const before = await lastFrameSeq(page);
   await page.evaluate(async () => {
     const box = document.querySelector("#surfaces .isovalue");
     box.value = "250";
@@ -106,7 +106,7 @@ for (const [name, mode] of Object.entries(MODES)) {
     const f = window.mediso.frames();
     return f.length && f[f.length - 1].values[0] === 350 && f[f.length - 1].settled;
   }, null, { timeout: 120000 });
-  const steps = (await frames(page)).slice(before);
+  const steps = await framesAfter(page, before);
   const s = await stats(page);
   checks.check(s.refinementsAborted === 0 && steps.some((f) => f.values[0] === 250 && f.cpuLevel === 3),
     "without the word nothing is aborted and the older change was refined (" +

@@ -54,7 +54,11 @@ for (const path of config.paths) {
       await page.evaluate((surfaces) => window.mediso.setSurfaces(surfaces), config.surfaces);
       await page.waitForFunction(() => window.mediso.stats().settled !== false, null, { timeout: 300000 });
     }
-    const before = await page.evaluate(() => (window.mediso.frames ? window.mediso.frames().length : 0));
+    // By `seq` where the page numbers its frames (its log keeps the last 200), else by position.
+    const before = await page.evaluate(() => {
+      const f = window.mediso.frames ? window.mediso.frames() : [];
+      return { length: f.length, seq: f.length ? f[f.length - 1].seq : 0 };
+    });
     const box = await page.locator("#view").boundingBox();
     const x = box.x + box.width / 2, y = box.y + box.height / 2;
     await page.mouse.move(x, y);
@@ -70,7 +74,7 @@ for (const path of config.paths) {
     const dragSeconds = (Date.now() - t0) / 1000;
     await page.waitForFunction(() => window.mediso.stats().settled !== false, null, { timeout: 300000 });
     await page.waitForTimeout(500);
-    const frames = await page.evaluate((n) => (window.mediso.frames ? window.mediso.frames().slice(n) : null), before);
+    const frames = await page.evaluate((n) => (window.mediso.frames ? window.mediso.frames().filter((f, i) => (f.seq === undefined ? i >= n.length : f.seq > n.seq)) : null), before);
     if (frames) {
       const drag = frames.filter((f) => f.interactive);
       // steady: without each (level, sample distance)'s first drag frame, which may build the

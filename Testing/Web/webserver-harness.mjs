@@ -163,7 +163,15 @@ export async function openInContext(browser, url, viewport = { width: 1000, heig
 
 /** The page's window.mediso.stats() and frames(). */
 export const pageStats = (page) => page.evaluate(() => window.mediso.stats());
-export const pageFrames = (page) => page.evaluate(() => window.mediso.frames());
+/** The `seq` of the page's newest frame (0 before any): framesAfter's mark. */
+export const lastFrameSeq = (page) => page.evaluate(() => {
+  const f = window.mediso.frames();
+  return f.length ? f[f.length - 1].seq : 0;
+});
+
+/** The page's frames drawn after the one numbered `seq` (by number: the log keeps only the last 200). */
+export const framesAfter = (page, seq) =>
+  page.evaluate((n) => window.mediso.frames().filter((f) => f.seq > n), seq);
 
 /**
  * Gives the page window.medisoTyping, for steps timed inside it: type(v) puts v in the first

@@ -79,5 +79,6 @@ export const state = Object.seal({
   stream: null,
   surfaceLevels: [],
   received: 0,
-  frameLog: [], // the last 200 frames: [{values, cpuLevel, triangles, primitives, sampleDistance, interactive, settled, ms, predictedMs}]
+  framesLogged: 0, // frames drawn since the page began: the newest frame's `seq`
+  frameLog: [], // the last 200 frames: [{seq, values, cpuLevel, triangles, primitives, sampleDistance, interactive, settled, ms, predictedMs}]
 });

@@ -184,7 +184,7 @@ function recordFrame(ms, stats) {
   state.sampleDistance = stats.sampleDistance || 1;
   state.gpuLevel = stats.gpuLevel ?? state.facts.levels.count - 1;
   state.frameNote = stats.note || "";
-  state.frameLog.push({ id: stats.id, values: stats.values, cpuLevel: stats.cpuLevel,
+  state.frameLog.push({ seq: ++state.framesLogged, id: stats.id, values: stats.values, cpuLevel: stats.cpuLevel,
     triangles: stats.triangles, primitives: stats.primitives, sampleDistance: state.sampleDistance,
     gpuLevel: state.gpuLevel,
     interactive: state.interactive, settled: state.settled, ms, predictedMs: stats.predictedMs || 0,
