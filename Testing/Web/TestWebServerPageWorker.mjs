@@ -217,4 +217,37 @@ async function drag(page, moves = 12) {
     " by the CPU model), the older refinement skipped (" + skippedBefore + " -> " + s.refinementsSkipped + ")");
 }
 
+// --- a GPU drag whose first frame outlasts the drag ------------------------------------------------
+// The first drag frame on a volume level builds that level's pyramid and first uses its programs:
+// on a loaded machine seconds, longer than the whole drag. ?slowFirstDragFrame=3000 makes it so:
+// stats().settled must stay false until the frame after the drag is drawn (it said true from the
+// frame before the drag, and a test that waited for it found none of the drag's frames), and the
+// drag's late frame comes before the still frame.
+{
+  const slow = await open(small, "&path=gpu&frameBudget=1&slowFirstDragFrame=3000");
+  await slow.evaluate((s) => window.mediso.setSurfaces([s]), BONE);
+  const before = (await frames(slow)).length;
+  // Asked for and read in one task of the page, so its answer cannot have come in between.
+  const owed = await slow.evaluate(() => {
+    document.dispatchEvent(new KeyboardEvent("keydown", { key: "ArrowLeft" }));
+    return window.mediso.stats().settled;
+  });
+  checks.check(owed === false, "a frame asked for and not yet drawn: stats().settled is " + owed);
+  await settle(slow);
+  await slow.waitForFunction((n) => window.mediso.frames().length > n, before); // the turn's frame
+  const turned = (await frames(slow)).length;
+  await drag(slow, 6);
+  await settle(slow);
+  const steps = (await frames(slow)).slice(turned);
+  const s = await stats(slow);
+  console.log("slow GPU drag frames [interactive, gpuLevel, sampleDistance, settled]: " +
+    JSON.stringify(steps.map((f) => [f.interactive, f.gpuLevel, f.sampleDistance, f.settled])));
+  const last = steps[steps.length - 1] || {};
+  checks.check(steps.some((f) => f.interactive && f.gpuLevel < 3) &&
+    !last.interactive && last.settled && last.gpuLevel === 3 && s.settled && !s.interactive,
+    "GPU path, a drag whose first frame outlasts it: " + steps.filter((f) => f.interactive).length +
+    " drag frame(s), then the still frame (level " + last.gpuLevel + "), before stats() says settled");
+  await slow.close();
+}
+
 await checks.finish(browser, small);

@@ -24,10 +24,11 @@ export class RemoteViewer {
    * its module at once, while this thread loads its own (the page's start-up, docs/web.md).
    * `threads`: the worker loads the threaded module; `budgetMs`: the frame budget (0: the
    * worker's); `abort`: false to let a running refinement run to its end; `slowExtractionMs`,
-   * `slowPass`, `refineDelayMs`: test hooks (render-worker.js). Returns {worker, ready}, ready a
-   * promise of the worker's "ready" message, for start().
+   * `slowPass`, `refineDelayMs`, `slowFirstDragFrameMs`: test hooks (render-worker.js). Returns
+   * {worker, ready}, ready a promise of the worker's "ready" message, for start().
    */
-  static launch(canvas, { threads, budgetMs, abort, slowExtractionMs, slowPass, refineDelayMs }) {
+  static launch(canvas, { threads, budgetMs, abort, slowExtractionMs, slowPass, refineDelayMs,
+    slowFirstDragFrameMs }) {
     const worker = new Worker("static/render-worker.js");
     const offscreen = canvas.transferControlToOffscreen();
     const base = new URL("static/", location.href).href;
@@ -37,7 +38,7 @@ export class RemoteViewer {
     });
     ready.catch(() => {}); // start() awaits it
     worker.postMessage({ op: "init", canvas: offscreen, base, threads, budgetMs, abort, slowExtractionMs,
-      slowPass, refineDelayMs },
+      slowPass, refineDelayMs, slowFirstDragFrameMs },
       [offscreen]);
     return { worker, ready };
   }

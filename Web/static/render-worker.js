@@ -73,6 +73,11 @@ function applySize() {
 // ?refineDelay=MS, a test hook: a test's next change then surely comes before it begins).
 let budgetSeconds = 0.1;
 let refineDelayMs = 40;
+// The first frame of a drag is shown this much later (the page's ?slowFirstDragFrame=MS, a test
+// hook): on the GPU path that frame builds its volume level's pyramid and first uses its
+// programs, which took seconds on a loaded machine, longer than the whole drag.
+let slowFirstDragFrameMs = 0;
+let dragging = false; // the last frame drawn was a drag's
 
 function post(message, transfer) {
   self.postMessage(message, transfer || []);
@@ -93,6 +98,9 @@ async function init(m) {
   }
   if (m.refineDelayMs > 0) {
     refineDelayMs = m.refineDelayMs;
+  }
+  if (m.slowFirstDragFrameMs > 0) {
+    slowFirstDragFrameMs = m.slowFirstDragFrameMs;
   }
   viewer = new M.WebViewer("#view");
   shareGeneration(m.abort !== false, m.slowExtractionMs, m.slowPass);
@@ -173,7 +181,23 @@ function draw(frame, level, distance, gpuLevel = M.NumberOfLevels - 1) {
   stats.abortable = !!generationWord;
   stats.abortNote = abortNote;
   stats.budgetMs = 1000 * budgetSeconds;
+  if (slowFirstDragFrameMs > 0 && frame.interactive && !dragging) {
+    pause(slowFirstDragFrameMs);
+  }
+  dragging = !!frame.interactive;
   return stats;
+}
+
+// Holds this worker for `ms` (slowFirstDragFrameMs): asleep where it may wait on a
+// SharedArrayBuffer, else busy.
+function pause(ms) {
+  if (self.crossOriginIsolated && typeof SharedArrayBuffer === "function") {
+    Atomics.wait(new Int32Array(new SharedArrayBuffer(4)), 0, 0, ms);
+    return;
+  }
+  for (const end = performance.now() + ms; performance.now() < end;) {
+    // waiting
+  }
 }
 
 function pump() {
