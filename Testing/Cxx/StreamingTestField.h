@@ -140,6 +140,23 @@ struct StreamingField
     return d;
   }
 };
+/// A volume's full-level surface of `isovalue`, as the dense filter extracts it (Plan, then
+/// Generate into arrays sized by the plan).
+inline mediso::SurfaceArrays ExtractFullLevel(mediso::BlockLODVolume& volume, double isovalue)
+{
+  mediso::ExtractionPlan plan;
+  volume.Plan(isovalue, mediso::NumberOfLevels - 1, plan);
+  mediso::SurfaceArrays mesh;
+  mesh.Points.resize(3 * plan.GetNumberOfPoints());
+  mesh.Normals.resize(mesh.Points.size());
+  mesh.Triangles.resize(3 * plan.GetNumberOfTriangles());
+  mediso::SurfaceBuffers<std::int32_t> out;
+  out.Points = mesh.Points.data();
+  out.Normals = mesh.Normals.data();
+  out.Connectivity = mesh.Triangles.data();
+  volume.Generate(plan, out);
+  return mesh;
+}
 } // namespace medical_test
 
 #endif

@@ -32,24 +32,10 @@ namespace
 {
 using medical_test::Check;
 using medical_test::StreamingField;
+using medical_test::ExtractFullLevel;
 
 constexpr int FullLevel = mediso::NumberOfLevels - 1;
 
-mediso::SurfaceArrays Extract(mediso::BlockLODVolume& volume, double isovalue)
-{
-  mediso::ExtractionPlan plan;
-  volume.Plan(isovalue, FullLevel, plan);
-  mediso::SurfaceArrays mesh;
-  mesh.Points.resize(3 * plan.GetNumberOfPoints());
-  mesh.Normals.resize(mesh.Points.size());
-  mesh.Triangles.resize(3 * plan.GetNumberOfTriangles());
-  mediso::SurfaceBuffers<std::int32_t> out;
-  out.Points = mesh.Points.data();
-  out.Normals = mesh.Normals.data();
-  out.Connectivity = mesh.Triangles.data();
-  volume.Generate(plan, out);
-  return mesh;
-}
 
 // A surface whatever the order of its points and triangles: each triangle as
 // its three vertices (point and normal), turned to begin with its smallest
@@ -167,7 +153,7 @@ int main()
   std::vector<mediso::SurfaceArrays> expected;
   for (double v : isovalues)
   {
-    expected.push_back(Extract(dense, v));
+    expected.push_back(ExtractFullLevel(dense, v));
     Check(!expected.back().Triangles.empty(),
       "the dense surface at " + std::to_string(v) + " has triangles");
   }
@@ -217,7 +203,7 @@ int main()
       }
       else
       {
-        CheckSame(got, Extract(volume, isovalues[s]), what + " (not ready: the resident blocks')");
+        CheckSame(got, ExtractFullLevel(volume, isovalues[s]), what + " (not ready: the resident blocks')");
       }
       mediso::SurfaceArrays again;
       Check(!volume.TakeAhead(isovalues[s], again), what + ": no longer held once taken");

@@ -28,27 +28,8 @@ namespace
 using medical_test::Check;
 using medical_test::StreamingField;
 
-struct Mesh
-{
-  std::vector<float> Points, Normals;
-  std::vector<std::int32_t> Triangles;
-};
-
-Mesh Extract(mediso::BlockLODVolume& volume, double isovalue)
-{
-  mediso::ExtractionPlan plan;
-  volume.Plan(isovalue, mediso::NumberOfLevels - 1, plan);
-  Mesh mesh;
-  mesh.Points.resize(3 * plan.GetNumberOfPoints());
-  mesh.Normals.resize(mesh.Points.size());
-  mesh.Triangles.resize(3 * plan.GetNumberOfTriangles());
-  mediso::SurfaceBuffers<std::int32_t> out;
-  out.Points = mesh.Points.data();
-  out.Normals = mesh.Normals.data();
-  out.Connectivity = mesh.Triangles.data();
-  volume.Generate(plan, out);
-  return mesh;
-}
+using Mesh = mediso::SurfaceArrays;
+using medical_test::ExtractFullLevel;
 } // namespace
 
 int main()
@@ -60,7 +41,7 @@ int main()
   std::vector<Mesh> expected;
   for (double v : isovalues)
   {
-    expected.push_back(Extract(dense, v));
+    expected.push_back(ExtractFullLevel(dense, v));
     Check(!expected.back().Triangles.empty(),
       "the dense surface at " + std::to_string(v) + " has triangles");
   }
@@ -78,7 +59,7 @@ int main()
     "streaming, nothing resident");
   for (double v : isovalues)
   {
-    Check(Extract(streamed, v).Triangles.empty(), "no triangle before any brick");
+    Check(ExtractFullLevel(streamed, v).Triangles.empty(), "no triangle before any brick");
   }
   const int outsideFirst[3] = { 100, 0, 0 }, outsideLast[3] = { 120, 5, 5 };
   Check(streamed.RegionArrived(outsideFirst, outsideLast) == 0,
@@ -107,7 +88,7 @@ int main()
       {
         continue;
       }
-      const Mesh got = Extract(streamed, isovalues[s]);
+      const Mesh got = ExtractFullLevel(streamed, isovalues[s]);
       const std::string stage = "after " + std::to_string(n + 1) + " of " + std::to_string(count) +
         " bricks, isovalue " + std::to_string(isovalues[s]);
       Check(got.Triangles == expected[s].Triangles, stage + ": the dense surface's triangles");
@@ -130,7 +111,7 @@ int main()
   Check(!streamed.IsStreaming(), "streaming ended");
   for (int s = 0; s < 2; ++s)
   {
-    const Mesh got = Extract(streamed, isovalues[s]);
+    const Mesh got = ExtractFullLevel(streamed, isovalues[s]);
     Check(got.Triangles == expected[s].Triangles && got.Points == expected[s].Points,
       "after the end, the dense surface");
   }

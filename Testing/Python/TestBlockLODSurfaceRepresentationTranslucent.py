@@ -22,8 +22,6 @@ import argparse
 import os
 
 from paraview.simple import *  # noqa: F401,F403 (pvpython idiom)
-from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
-from vtkmodules.util.numpy_support import vtk_to_numpy
 
 import blocklod_display
 import checks
@@ -68,15 +66,7 @@ view.ResetCamera()
 
 
 def window_pixels():
-    """The image the last render left in the view's window (no new render)."""
-    grab = vtkWindowToImageFilter()
-    grab.SetInput(view.GetRenderWindow())
-    grab.ShouldRerenderOff()
-    grab.ReadFrontBufferOff()
-    grab.Update()
-    image = grab.GetOutput()
-    w, h, _ = image.GetDimensions()
-    return vtk_to_numpy(image.GetPointData().GetScalars()).reshape(h, w, -1)[:, :, :3].astype(int)
+    return blocklod_display.window_pixels(view)
 
 
 def still():

@@ -1,8 +1,11 @@
 """What the Block LOD Surface display's tests share (pvpython).
 
     info = frame_info(display)   # {"level": ..., "triangles": ..., "lod": ..., "translucency": ...}
+    pixels = window_pixels(view) # the image the last render left in the window
 """
 from paraview.modules.vtkRemotingCore import vtkPVSession
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
 
 
 def frame_info(display):
@@ -22,3 +25,15 @@ def frame_info(display):
             "triangles": int(value("BlockLODInteractiveTriangles")),
             "lod": int(value("BlockLODLastRenderUsedLOD")),
             "translucency": int(value("BlockLODLastRenderTranslucency"))}
+
+
+def window_pixels(view):
+    """The RGB image the last render left in `view`'s window (no new render), rows bottom first."""
+    grab = vtkWindowToImageFilter()
+    grab.SetInput(view.GetRenderWindow())
+    grab.ShouldRerenderOff()
+    grab.ReadFrontBufferOff()
+    grab.Update()
+    image = grab.GetOutput()
+    w, h, _ = image.GetDimensions()
+    return vtk_to_numpy(image.GetPointData().GetScalars()).reshape(h, w, -1)[:, :, :3].astype(int)

@@ -8,7 +8,7 @@
 // times, as bench-interactive.mjs's stills).
 //   node bench-bricks.mjs CONFIG.json OUT.json
 // CONFIG: {url, size: [w, h], configs: [{name, query}], isovalues: [...], stills}
-import { launch } from "./page.mjs";
+import { launch, turnStills } from "./page.mjs";
 import { readFileSync, writeFileSync } from "node:fs";
 
 const [configFile, outFile] = process.argv.slice(2);
@@ -36,20 +36,7 @@ for (const { name, query } of config.configs) {
       primitives: s.primitives, activeBricks: s.activeBricks, poolSlots: s.poolSlots,
       brickPyramidBuilds: s.brickPyramidBuilds, path: s.path });
   }
-  const n = await page.evaluate(() => window.mediso.frames().length);
-  await page.evaluate(async (count) => {
-    for (let i = 0; i < count; ++i) {
-      const v = window.mediso.getView();
-      const a = 2 * Math.PI / 180, f = v.focalPoint, u = v.viewUp;
-      const d = [0, 1, 2].map((k) => v.position[k] - f[k]);
-      const dot = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
-      const cross = [u[1] * d[2] - u[2] * d[1], u[2] * d[0] - u[0] * d[2], u[0] * d[1] - u[1] * d[0]];
-      const r = [0, 1, 2].map((k) => d[k] * Math.cos(a) + cross[k] * Math.sin(a) + u[k] * dot * (1 - Math.cos(a)));
-      await window.mediso.setView({ position: [0, 1, 2].map((k) => f[k] + r[k]), focalPoint: f, viewUp: u,
-        viewAngle: v.viewAngle, parallelScale: v.parallelScale });
-    }
-  }, config.stills);
-  const stills = (await page.evaluate(() => window.mediso.frames())).slice(n).filter((f) => !f.interactive && f.settled);
+  const stills = await turnStills(page, config.stills);
   run.still = { frameMs: median(stills.map((f) => f.ms)), frames: stills.length };
   run.changeMs = median(run.changes.map((c) => c.ms));
   run.buildMs = median(run.changes.map((c) => c.buildMs));

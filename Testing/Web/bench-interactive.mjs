@@ -10,7 +10,7 @@
 //          surfaces (optional: [{value, opacity}], drawn before the drag: e.g. skin 0.3 over bone),
 //          stills (optional: still frames after the drag, the camera turned 2 degrees each),
 //          moveMs (optional: the wait after each mouse move, 30 by default)}
-import { launch } from "./page.mjs";
+import { frameMark, framesSince, launch, turnStills } from "./page.mjs";
 import { readFileSync, writeFileSync } from "node:fs";
 
 const [configFile, outFile] = process.argv.slice(2);
@@ -54,11 +54,7 @@ for (const path of config.paths) {
       await page.evaluate((surfaces) => window.mediso.setSurfaces(surfaces), config.surfaces);
       await page.waitForFunction(() => window.mediso.stats().settled !== false, null, { timeout: 300000 });
     }
-    // By `seq` where the page numbers its frames (its log keeps the last 200), else by position.
-    const before = await page.evaluate(() => {
-      const f = window.mediso.frames ? window.mediso.frames() : [];
-      return { length: f.length, seq: f.length ? f[f.length - 1].seq : 0 };
-    });
+    const before = await frameMark(page);
     const box = await page.locator("#view").boundingBox();
     const x = box.x + box.width / 2, y = box.y + box.height / 2;
     await page.mouse.move(x, y);
@@ -74,7 +70,7 @@ for (const path of config.paths) {
     const dragSeconds = (Date.now() - t0) / 1000;
     await page.waitForFunction(() => window.mediso.stats().settled !== false, null, { timeout: 300000 });
     await page.waitForTimeout(500);
-    const frames = await page.evaluate((n) => (window.mediso.frames ? window.mediso.frames().filter((f, i) => (f.seq === undefined ? i >= n.length : f.seq > n.seq)) : null), before);
+    const frames = await framesSince(page, before);
     if (frames) {
       const drag = frames.filter((f) => f.interactive);
       // steady: without each (level, sample distance)'s first drag frame, which may build the
@@ -99,21 +95,7 @@ for (const path of config.paths) {
     if (config.stills) {
       // still frames of the same scene: the camera turned about its view-up by 2 degrees each,
       // every frame awaited at its full level (the frames' own times, as the drag's)
-      const n = await page.evaluate(() => window.mediso.frames().length);
-      await page.evaluate(async (count) => {
-        for (let i = 0; i < count; ++i) {
-          const v = window.mediso.getView();
-          const a = 2 * Math.PI / 180, f = v.focalPoint, u = v.viewUp;
-          const d = [0, 1, 2].map((k) => v.position[k] - f[k]);
-          const dot = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
-          const cross = [u[1] * d[2] - u[2] * d[1], u[2] * d[0] - u[0] * d[2], u[0] * d[1] - u[1] * d[0]];
-          const r = [0, 1, 2].map((k) => d[k] * Math.cos(a) + cross[k] * Math.sin(a) + u[k] * dot * (1 - Math.cos(a)));
-          await window.mediso.setView({ position: [0, 1, 2].map((k) => f[k] + r[k]), focalPoint: f, viewUp: u,
-            viewAngle: v.viewAngle, parallelScale: v.parallelScale });
-        }
-      }, config.stills);
-      const stills = (await page.evaluate(() => window.mediso.frames())).slice(n)
-        .filter((f) => !f.interactive && f.settled);
+      const stills = await turnStills(page, config.stills);
       run.still = { frameMs: median(stills.map((f) => f.ms)), frames: stills.length,
         levels: [...new Set(stills.map((f) => (path === "gpu" ? f.gpuLevel : f.cpuLevel)))],
         sampleDistances: [...new Set(stills.map((f) => f.sampleDistance))] };

@@ -21,6 +21,37 @@ export async function launch({ webgl = true } = {}) {
   });
 }
 
+// A mark of the page's frame log (window.mediso.frames()), for framesSince.
+export const frameMark = (page) => page.evaluate(() => {
+  const f = window.mediso.frames ? window.mediso.frames() : [];
+  return { length: f.length, seq: f.length ? f[f.length - 1].seq : 0 };
+});
+
+// The frames drawn since `mark`: by `seq` where the page numbers them (its log keeps the last 200),
+// else by position (a page from before that); null where the page has no frame log.
+export const framesSince = (page, mark) => page.evaluate((n) => (window.mediso.frames
+  ? window.mediso.frames().filter((f, i) => (f.seq === undefined ? i >= n.length : f.seq > n.seq))
+  : null), mark);
+
+// Still frames of the page's scene: the camera turned about its view-up by 2 degrees `count` times,
+// each frame awaited at its full level; returns the still frames drawn (settled, not interactive).
+export async function turnStills(page, count) {
+  const mark = await frameMark(page);
+  await page.evaluate(async (n) => {
+    for (let i = 0; i < n; ++i) {
+      const v = window.mediso.getView();
+      const a = 2 * Math.PI / 180, f = v.focalPoint, u = v.viewUp;
+      const d = [0, 1, 2].map((k) => v.position[k] - f[k]);
+      const dot = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
+      const cross = [u[1] * d[2] - u[2] * d[1], u[2] * d[0] - u[0] * d[2], u[0] * d[1] - u[1] * d[0]];
+      const r = [0, 1, 2].map((k) => d[k] * Math.cos(a) + cross[k] * Math.sin(a) + u[k] * dot * (1 - Math.cos(a)));
+      await window.mediso.setView({ position: [0, 1, 2].map((k) => f[k] + r[k]), focalPoint: f, viewUp: u,
+        viewAngle: v.viewAngle, parallelScale: v.parallelScale });
+    }
+  }, count);
+  return ((await framesSince(page, mark)) || []).filter((f) => !f.interactive && f.settled);
+}
+
 // Opens the page and waits until it has drawn its first frame or said why it cannot.
 export async function open(browser, url, log = () => {}) {
   const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
