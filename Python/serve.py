@@ -48,6 +48,7 @@ from serve_jobs import (FORMATS, RESULT_GRACE_S, RESULTS_PER_SESSION, Operations
 from serve_messages import LEVEL_STRIDES, BadRequest, parse_message  # noqa: E402
 import serve_upload  # noqa: E402  (a local volume uploaded once: POST /api/upload)
 from serve_static import StaticFiles  # noqa: E402  (the page's files, gzip'd)
+from serve_work import VOLUME_WORK  # noqa: E402  (the volume work's own threads)
 
 MAX_FRAME = 1024 * 1024        # above this aiohttp closes the socket (1009, message too big)
 MAX_SESSIONS = 64              # WebSockets open at once
@@ -267,7 +268,7 @@ async def volume(request):
     loop = asyncio.get_running_loop()
     if d.digest is None:  # once per dataset, off the event loop
         if d.ident not in state.fingerprints:
-            state.fingerprints[d.ident] = loop.run_in_executor(None, d.fingerprint)
+            state.fingerprints[d.ident] = loop.run_in_executor(VOLUME_WORK, d.fingerprint)
         await asyncio.shield(state.fingerprints[d.ident])
     validators = {"ETag": d.etag(k), "Cache-Control": VOLUME_CACHE_CONTROL}
     if d.modified is not None:
@@ -276,7 +277,7 @@ async def volume(request):
         return web.Response(status=304, headers=validators)
     key = (d.ident, k)
     if key not in state.encoding:  # each level is encoded once
-        state.encoding[key] = loop.run_in_executor(None, d.encode, k)
+        state.encoding[key] = loop.run_in_executor(VOLUME_WORK, d.encode, k)
     body = await asyncio.shield(state.encoding[key])
     level = d.describe()["levels"][k]
     headers = dict(validators, **{
@@ -382,9 +383,9 @@ async def warm_up(state, prepare_bricks):
     loop = asyncio.get_running_loop()
     for d in state.datasets:
         if (d.ident, 0) not in state.encoding:
-            state.encoding[(d.ident, 0)] = loop.run_in_executor(None, d.encode, 0)
+            state.encoding[(d.ident, 0)] = loop.run_in_executor(VOLUME_WORK, d.encode, 0)
         if d.ident not in state.fingerprints:
-            state.fingerprints[d.ident] = loop.run_in_executor(None, d.fingerprint)
+            state.fingerprints[d.ident] = loop.run_in_executor(VOLUME_WORK, d.fingerprint)
         prepare_bricks(d, len(LEVEL_STRIDES) - 1)
 
 

@@ -51,6 +51,7 @@ import zlib
 from aiohttp import web
 
 from serve_messages import LEVEL_STRIDES
+from serve_work import VOLUME_WORK
 
 BRICK_POINTS = 64  # points a side of a brick: a multiple of BlockLOD's 8 (BrickGrid)
 APRON = 1          # the page's gradients read one point more on each side
@@ -335,7 +336,8 @@ class Encoder:
     def __init__(self, dataset, k, counts):
         loop = asyncio.get_running_loop()
         self.dataset, self.k = dataset, k
-        self.encoding = loop.run_in_executor(None, lambda: choose_encoding(dataset.level(k), counts))
+        self.encoding = loop.run_in_executor(
+            VOLUME_WORK, lambda: choose_encoding(dataset.level(k), counts))
         self.bodies = {}  # id -> task of its Segment
         self.queue = list(range(counts[0] * counts[1] * counts[2]))[::-1]  # popped from the end
         self.tasks = [asyncio.ensure_future(self.ahead()) for _ in range(self.ENCODE_AHEAD)]
@@ -343,7 +345,7 @@ class Encoder:
     async def encode(self, brick):
         encoding = await asyncio.shield(self.encoding)
         return await asyncio.get_running_loop().run_in_executor(
-            None, encode, self.dataset, self.k, brick, encoding)
+            VOLUME_WORK, encode, self.dataset, self.k, brick, encoding)
 
     def body(self, brick):
         if brick not in self.bodies:
@@ -381,7 +383,8 @@ def handler(find, not_modified, cache_control):
         """The future of level k's manifest of dataset d (made once, off the event loop)."""
         key = (d.ident, k)
         if key not in manifests:
-            manifests[key] = asyncio.get_running_loop().run_in_executor(None, manifest, d, k)
+            manifests[key] = asyncio.get_running_loop().run_in_executor(
+                VOLUME_WORK, manifest, d, k)
         return manifests[key]
 
     async def bricks(request):
@@ -391,7 +394,7 @@ def handler(find, not_modified, cache_control):
         key = (d.ident, k)
         m = await asyncio.shield(prepared(d, k))
         if key not in encoders:  # for the requests that follow the manifest, while level 0 goes
-            blocks[key] = loop.run_in_executor(None, lambda: block_ranges(d.level(k)))
+            blocks[key] = loop.run_in_executor(VOLUME_WORK, lambda: block_ranges(d.level(k)))
             encoders[key] = Encoder(d, k, m["bricks"])
         if "ids" not in request.query and "need" not in request.query:
             return web.json_response(m, headers={"Cache-Control": "no-store"})
@@ -404,7 +407,7 @@ def handler(find, not_modified, cache_control):
             return web.json_response({"level": k, "need": need}, headers={"Cache-Control": "no-store"})
         ids = parse_ids(request.query["ids"], len(m["ranges"]))
         if d.ident not in fingerprints:
-            fingerprints[d.ident] = loop.run_in_executor(None, d.fingerprint)
+            fingerprints[d.ident] = loop.run_in_executor(VOLUME_WORK, d.fingerprint)
         digest = await asyncio.shield(fingerprints[d.ident])
         encoding = await asyncio.shield(encoders[key].encoding)
         validators = {"ETag": '"%s-%d-b%s-%s-%s"' % (digest, k, "_".join(map(str, ids)), ENCODING,

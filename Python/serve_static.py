@@ -58,7 +58,8 @@ class StaticFiles:
         raise web.HTTPNotFound()
 
     def gzipped(self, path, stat):
-        """A future of `path`'s gzip'd bytes at version `stat` (made once, off the event loop)."""
+        """A future of `path`'s gzip'd bytes at version `stat` (made once, off the event loop, on
+        the default executor: the volume work has its own, serve_work.py)."""
         entry = self.compressed.get(path)
         if entry is None or entry[:2] != (stat.st_mtime_ns, stat.st_size):
             loop = asyncio.get_running_loop()
