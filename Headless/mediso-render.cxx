@@ -100,7 +100,9 @@ Context:
                         GL_NVX_gpu_memory_info or GL_ATI_meminfo, else 1 GiB);
                         MB are 10^6 bytes, as in ParaView; a volume over it is kept as bricks
   --no-brick-pool       keep each resident brick as its own texture and pyramid
-                        (default: the bricks in one pool texture with one pyramid)
+                        (default: the bricks in one pool texture with one pyramid,
+                        where it takes at most 3x their own pyramids' GPU memory;
+                        --stats's pool_reason says why not)
 MEDISO_EGL_PLATFORM=surfaceless|device|default picks the EGL display.
 )";
 
@@ -786,6 +788,7 @@ int Run(int argc, char* argv[])
            << ", \"resident_bricks\": " << stats.ResidentBricks
            << ", \"pool_slots\": " << stats.PoolSlots
            << ", \"brick_pyramid_builds\": " << stats.BrickPyramidBuilds
+           << ", \"pool_reason\": " << JsonString(scene.Scene.GetBrickPoolReason())
            << ", \"gpu_budget_mb\": " << scene.Scene.GetGPUMemoryBudget() / 1e6 << "}";
       std::printf("%s\n", json.str().c_str());
     }

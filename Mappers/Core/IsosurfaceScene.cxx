@@ -49,6 +49,14 @@ std::string Megabytes(std::uint64_t bytes)
   return text.str();
 }
 
+// "2x", "1.5x": a ratio as the reasons say it.
+std::string RatioText(double ratio)
+{
+  std::ostringstream text;
+  text << ratio << "x";
+  return text.str();
+}
+
 std::string Size(const int points[3])
 {
   return std::to_string(points[0]) + "x" + std::to_string(points[1]) + "x" +
@@ -145,6 +153,9 @@ struct IsosurfaceScene::Internals
   std::unordered_map<std::int64_t, int> PoolSlot;
   BrickResidency PoolResidency;
   bool PoolDrawn = false;
+  // Why the last update of a bricked volume drew its bricks without the
+  // pool ("" where the pool held them).
+  std::string PoolReason;
 
   int TextureLimit() const
   {
@@ -211,12 +222,13 @@ struct IsosurfaceScene::Internals
     this->Stats.Bricks = this->Stats.ActiveBricks = this->Stats.ResidentBricks = 0;
     this->Stats.BrickPoints = 0;
     this->Stats.OverBudget = false;
+    this->PoolReason.clear();
   }
   bool AdoptBricks(const VolumeDescription& volume, const std::string& why, std::string& error);
   bool UpdateBricks(const std::vector<double>& values, std::string& error);
   bool UpdatePool(const std::vector<std::int64_t>& active, const std::vector<double>& values,
     bool& held, std::string& error);
-  bool ChoosePoolSlots(std::size_t count, int side, int slots[3]) const;
+  bool ChoosePoolSlots(std::size_t count, int side, int slots[3], std::uint64_t& bytes) const;
   std::vector<std::int64_t> VisibilityOrder(const IsosurfaceFrame& frame) const;
   std::vector<IsosurfacePiece> Pieces(const IsosurfaceFrame& frame) const;
 };
@@ -387,6 +399,11 @@ bool IsosurfaceScene::GetBrickPool() const
   return this->Impl->UsePool;
 }
 
+std::string IsosurfaceScene::GetBrickPoolReason() const
+{
+  return this->IsBricked() ? this->Impl->PoolReason : std::string();
+}
+
 int IsosurfaceScene::ChooseBrickPoints(ScalarType type, int maxTextureSize, std::uint64_t budget)
 {
   for (int k = 8; k > 4; --k)
@@ -474,6 +491,7 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
     return false;
   }
   stats.BrickPyramidBuilds = 0;
+  this->PoolReason = this->UsePool ? "" : "the brick pool is off";
   if (this->UsePool)
   {
     bool held = false;
@@ -486,7 +504,8 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
       }
       return built;
     }
-    // The pool cannot hold them within the limit and the budget: the bricks' own pyramids.
+    // The pool cannot hold them within the limit and the budget, or would
+    // cost more than MaximumPoolMemoryRatio times their own pyramids: those.
     this->ReleasePool();
   }
   // Bricks in use first become the most recent, so that only others make room.
@@ -568,8 +587,10 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
 
 // The slots per axis of a pool for `count` bricks of `side` points a side
 // within the texture limit, HistoPyramidGL::MaximumSlots and the budget: the
-// fewest bytes among the boxes of the fewest slots. False where none holds them.
-bool IsosurfaceScene::Internals::ChoosePoolSlots(std::size_t count, int side, int slots[3]) const
+// fewest bytes among the boxes of the fewest slots, and those bytes. False
+// where none holds them.
+bool IsosurfaceScene::Internals::ChoosePoolSlots(
+  std::size_t count, int side, int slots[3], std::uint64_t& bytes) const
 {
   const int limit = this->TextureLimit();
   const int most[3] = { 4 * limit / side, limit / side, limit / side }; // 4 points to a texel in x
@@ -586,19 +607,20 @@ bool IsosurfaceScene::Internals::ChoosePoolSlots(std::size_t count, int side, in
         continue;
       }
       const int points[3] = { static_cast<int>(x) * side, y * side, z * side };
-      const std::uint64_t bytes = HistoPyramidGL::EstimateGPUMemoryBytes(this->Volume.Type, points);
-      if (bytes > this->GetBudget() || (fewest >= 0 && x * plane > fewest) ||
-        (x * plane == fewest && bytes >= best))
+      const std::uint64_t need = HistoPyramidGL::EstimateGPUMemoryBytes(this->Volume.Type, points);
+      if (need > this->GetBudget() || (fewest >= 0 && x * plane > fewest) ||
+        (x * plane == fewest && need >= best))
       {
         continue;
       }
       fewest = x * plane;
-      best = bytes;
+      best = need;
       slots[0] = static_cast<int>(x);
       slots[1] = y;
       slots[2] = z;
     }
   }
+  bytes = best;
   return fewest > 0;
 }
 
@@ -615,33 +637,71 @@ bool IsosurfaceScene::Internals::UpdatePool(const std::vector<std::int64_t>& act
   {
     side *= 2;
   }
-  // A slot is a cube: where the volume is thinner than a brick on an axis (a
-  // 4x4x2100 volume's bricks are 4x4x251 points), its bricks would fill a
-  // sliver of their slots. The pool then is not worth its memory; the bricks'
-  // own textures fit them.
-  {
-    int extent[6], points[3];
-    this->BrickTexture(0, extent, points); // the first brick is a whole one where any is
-    if (8.0 * points[0] * points[1] * points[2] < static_cast<double>(side) * side * side)
-    {
-      return false;
-    }
-  }
   if (!this->Pool || static_cast<std::size_t>(this->Pool->GetNumberOfSlots()) < active.size())
   {
-    // Room for the next power of two of bricks where that fits: a growing set
-    // of bricks then seldom makes a new pool (and uploads every brick again),
-    // and the pyramid, whose levels are padded to powers of two, is no larger
-    // than for the active bricks alone.
+    // A slot is a cube of a power of two: it holds a brick of 2^k - 8 points
+    // with a margin (27 points in 32, 59 in 64), but a brick thinner than the
+    // slot on an axis (96x96x251 points in 256, a long thin volume's) fills a
+    // fraction of it, and the pool's texture and pyramid, cubes of slots, then
+    // hold several times the bricks' own pyramids (those of 96x96x251 padded
+    // to 128x128x256). The pool is weighed against what the same bricks cost
+    // as their own pyramids and made only within MaximumPoolMemoryRatio of it.
+    std::uint64_t own = 0;
+    for (const std::int64_t brick : active)
+    {
+      own += this->BrickBytes(brick);
+    }
+    // Room for the next power of two of bricks where that fits and stays
+    // within the ratio: a growing set of bricks then seldom makes a new pool
+    // (and uploads every brick again), and the pyramid, whose levels are
+    // padded to powers of two, is no larger than for the active bricks alone.
+    // Else a pool for the active bricks alone.
     std::size_t room = 1;
     while (room < active.size())
     {
       room *= 2;
     }
-    int slots[3];
-    if (!this->ChoosePoolSlots(room, side, slots) &&
-      !this->ChoosePoolSlots(active.size(), side, slots))
+    int slots[3] = { 0, 0, 0 };
+    std::uint64_t bytes = 0, least = 0;
+    std::size_t leastSlots = 0;
+    bool chosen = false;
+    for (const std::size_t count : { room, active.size() })
     {
+      if (count == 0 || !this->ChoosePoolSlots(count, side, slots, bytes))
+      {
+        continue;
+      }
+      if (leastSlots == 0 || bytes < least)
+      {
+        least = bytes;
+        leastSlots = static_cast<std::size_t>(slots[0]) * slots[1] * slots[2];
+      }
+      if (static_cast<double>(bytes) <= MaximumPoolMemoryRatio * static_cast<double>(own))
+      {
+        chosen = true;
+        break;
+      }
+    }
+    if (!chosen)
+    {
+      if (active.empty())
+      {
+        this->PoolReason = "no brick is crossed";
+      }
+      else if (leastSlots == 0)
+      {
+        this->PoolReason = "a pool of " + std::to_string(side) + "-point slots for the " +
+          std::to_string(active.size()) + " crossed bricks exceeds the texture limit of " +
+          std::to_string(this->TextureLimit()) + " or the budget of " +
+          Megabytes(this->GetBudget());
+      }
+      else
+      {
+        this->PoolReason = "a pool of " + std::to_string(leastSlots) + " slots of " +
+          std::to_string(side) + " points would take " + Megabytes(least) +
+          " of GPU memory, over " + RatioText(MaximumPoolMemoryRatio) + " the " + Megabytes(own) +
+          " of the " + std::to_string(active.size()) + " crossed bricks' own pyramids";
+      }
       return false;
     }
     this->ReleasePool();
@@ -652,6 +712,7 @@ bool IsosurfaceScene::Internals::UpdatePool(const std::vector<std::int64_t>& act
     if (!this->Pool->AllocatePool(this->Volume.Type, side, slots, cells, this->Parallel, why))
     {
       this->ReleasePool(); // a context that cannot make it: the bricks' own pyramids
+      this->PoolReason = "the context cannot make the pool: " + why;
       return false;
     }
     this->Pool->ShareProgramsWith(*this->Pyramid); // after the allocation, which starts afresh

@@ -159,13 +159,38 @@ public:
    * the pool, built once per isovalue change and drawn in one pass. The
    * bricks are those of ChooseBrickPoints(), pool or not. Where the pool
    * cannot hold the active bricks within the limit and the budget (a forced
-   * limit near the brick's size leaves room for few slots), they are drawn
-   * as their own pyramids, as with the pool off. A change takes effect at
-   * the next SetVolume().
+   * limit near the brick's size leaves room for few slots), or where it would
+   * take more than MaximumPoolMemoryRatio times the GPU memory of the same
+   * bricks as their own pyramids (bricks thinner than their cubic slots, as a
+   * long thin volume's: 96x96x251 points in slots of 256), they are drawn as
+   * their own pyramids, as with the pool off, and GetBrickPoolReason() says
+   * why. A change takes effect at the next SetVolume().
    */
   void SetBrickPool(bool on);
   bool GetBrickPool() const;
   ///@}
+
+  /**
+   * The most GPU memory a new pool may take, as a multiple of the active
+   * bricks' own pyramids (each brick's texture and its pyramid padded to
+   * powers of two): 3. A cube brick's slot alone costs up to 1.66x its own
+   * pyramid (27 points in 32: the texture's margin), a volume's last bricks
+   * on an axis are thinner than the others but take whole slots, and a pool
+   * made with room for the next power of two of bricks costs up to 2x more;
+   * where that room would exceed the ratio the pool is made for the active
+   * bricks alone, and where that still would, there is no pool. Bricks thin
+   * on a whole axis (96x96x251 points in slots of 256: 6.8x) stay out.
+   */
+  static constexpr double MaximumPoolMemoryRatio = 3.0;
+
+  /**
+   * Why the last update of a volume kept as bricks drew its active bricks
+   * as their own pyramids and not from the pool (the pool off, a pool over
+   * the limit or the budget, or over MaximumPoolMemoryRatio, with its bytes
+   * and the bricks'); "" where the pool holds them or the volume is one
+   * texture.
+   */
+  std::string GetBrickPoolReason() const;
 
   /**
    * The brick edge (points, a multiple of 8) for a volume of `type` under a

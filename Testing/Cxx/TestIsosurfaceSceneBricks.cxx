@@ -13,7 +13,10 @@
 // checked the same way on a phantom whose active bricks it holds (one pyramid built per isovalue
 // change for all of them, one pass drawn), with slots reused across isovalue changes within a
 // budget; where it cannot hold them (a limit of 32) and with the pool off, the bricks' own
-// pyramids. Exit 125 (skip) where no such context can be made.
+// pyramids, and on a long thin volume whose bricks fill a fraction of their slots (a pool there
+// would take over IsosurfaceScene::MaximumPoolMemoryRatio the GPU memory of the bricks' own
+// pyramids) the bricks' own pyramids with the reason. Exit 125 (skip) where no such context can
+// be made.
 #include "GLApi.h"
 #include "GLApiFunctions.h"
 #include "HeadlessTestUtilities.h"
@@ -200,14 +203,15 @@ void RunCases(const std::shared_ptr<const GLApi>& gl, Target& target, const std:
     const std::uint64_t expected = BruteForceCount(values, dims, isos);
     const IsosurfaceSceneStats& s = bricked.GetStats();
     std::printf("%s: %llu primitives (brute force %llu), %llu of %llu bricks of %d active, "
-                "%llu resident, %llu GPU bytes, %llu pool slots, %llu pyramids built\n",
+                "%llu resident, %llu GPU bytes, %llu pool slots, %llu pyramids built%s%s\n",
       name.c_str(), static_cast<unsigned long long>(bricked.GetActivePairs()),
       static_cast<unsigned long long>(expected), static_cast<unsigned long long>(s.ActiveBricks),
       static_cast<unsigned long long>(s.Bricks), s.BrickPoints,
       static_cast<unsigned long long>(s.ResidentBricks),
       static_cast<unsigned long long>(bricked.GetGPUMemoryBytes()),
       static_cast<unsigned long long>(s.PoolSlots),
-      static_cast<unsigned long long>(s.BrickPyramidBuilds));
+      static_cast<unsigned long long>(s.BrickPyramidBuilds),
+      bricked.GetBrickPoolReason().empty() ? "" : ": ", bricked.GetBrickPoolReason().c_str());
     if (how.Pool && how.PoolHolds)
     {
       Check(s.PoolSlots >= s.ActiveBricks && s.BrickPyramidBuilds == 1,
@@ -281,6 +285,58 @@ int main(int argc, char* argv[])
     held.PoolHolds = true;
     RunCases(gl, target, pyramid_checks::MakePhantom(edge, 40.0, 3), edge, { cases[1] },
       "int16 49x25x49", held);
+  }
+
+  // A long thin volume (its bricks 26x26x58 points, each an eighth of a 64-point slot, as the
+  // 96x96x2100 phantom's bricks of 96x96x251 points fill 256-point slots): a pool would take
+  // over 6x the GPU memory of the bricks' own pyramids, so they are drawn as their own, the
+  // reason says so, and the scene takes at most MaximumPoolMemoryRatio the bytes of the same
+  // scene with the pool off; the counts exact, and drawn (a volume this thin covers too few
+  // pixels of the test's image for the image comparison).
+  {
+    const int thin[3] = { 26, 26, 500 };
+    const std::vector<std::int16_t> values = pyramid_checks::MakePhantom(thin, 40.0, 5);
+    VolumeDescription volume;
+    volume.Type = ScalarType::Int16;
+    volume.Data = values.data();
+    std::copy(thin, thin + 3, volume.Dims);
+    std::uint64_t bytes[2] = { 0, 0 };
+    std::string reasons[2];
+    for (int pool = 0; pool < 2; ++pool)
+    {
+      IsosurfaceScene scene(nullptr);
+      scene.SetContext(gl);
+      scene.SetMaxTextureSize(128);
+      scene.SetGPUMemoryBudget(24u << 20); // bricks of 56 points in 64-point slots
+      scene.SetBrickPool(pool == 1);
+      scene.SetSurfaces({ skin, bone });
+      Check(scene.SetVolume(volume, error) && scene.IsBricked() && scene.Update(error) &&
+          scene.GetActivePairs() == BruteForceCount(values, thin, { -500.0, 400.0 }),
+        "26x26x500: bricks, the exact count (" + error + ")");
+      const IsosurfaceSceneStats& s = scene.GetStats();
+      Check(s.PoolSlots == 0 && s.BrickPyramidBuilds == s.ActiveBricks && s.ActiveBricks > 1 &&
+          s.Bricks > 8,
+        "26x26x500: several bricks, each active one its own pyramid");
+      std::string drawError;
+      Check(!target.Draw(scene, View(thin, 60, 20, false), drawError).empty() &&
+          scene.GetStats().Primitives == scene.GetActivePairs(),
+        "26x26x500: drawn (" + drawError + ")");
+      bytes[pool] = scene.GetGPUMemoryBytes();
+      reasons[pool] = scene.GetBrickPoolReason();
+      std::printf("26x26x500, pool %s: %llu GPU bytes, %llu pool slots: %s\n", pool ? "on" : "off",
+        static_cast<unsigned long long>(bytes[pool]),
+        static_cast<unsigned long long>(scene.GetStats().PoolSlots), reasons[pool].c_str());
+      scene.Release();
+    }
+    char ratio[32];
+    std::snprintf(ratio, sizeof(ratio), "%gx", IsosurfaceScene::MaximumPoolMemoryRatio);
+    Check(static_cast<double>(bytes[1]) <=
+        IsosurfaceScene::MaximumPoolMemoryRatio * static_cast<double>(bytes[0]),
+      "26x26x500: the pool on takes at most " + std::string(ratio) +
+        " the GPU memory of the bricks' own pyramids");
+    Check(reasons[0] == "the brick pool is off" &&
+        reasons[1].find("crossed bricks' own pyramids") != std::string::npos,
+      "26x26x500: the reasons say the pool is off, and over the ratio");
   }
 
   // Float data with NaN values: cells with a NaN corner count nothing, in bricks too.
@@ -363,7 +419,10 @@ int main(int argc, char* argv[])
       VolumeDescription largeVolume = volume;
       largeVolume.Data = ramp.data();
       std::copy(large, large + 3, largeVolume.Dims);
-      const std::vector<double> isos = { 30.5, 85.5, 130.5, 30.5, 85.5, 130.5 };
+      // The columns of whole bricks (x 0-55 and 56-111): the last (112-149, 38 points wide,
+      // its bricks of 18 and 8 points in y and z) is thin enough beside its 64-point slots that
+      // a pool for it alone would take over MaximumPoolMemoryRatio its own pyramids.
+      const std::vector<double> isos = { 30.5, 85.5, 30.5, 85.5, 30.5, 85.5 };
       std::uint64_t most = 0;
       for (const double iso : isos)
       {

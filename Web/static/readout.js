@@ -67,7 +67,8 @@ export function updateReadout() {
 /**
  * How the GPU path holds a volume it keeps as bricks (over the texture limit or the GPU budget:
  * docs/web.md, Paths): the bricks, those the isovalues cross, and whether they are drawn from
- * the one pool texture with one pyramid or each as its own pyramid. "" for one texture.
+ * the one pool texture with one pyramid or each as its own pyramid, and why not from the pool
+ * (stats().poolReason). "" for one texture.
  */
 function bricksText() {
   const s = (state.path === "gpu" && state.viewer && state.viewer.stats()) || {};
@@ -77,7 +78,8 @@ function bricksText() {
   return s.bricks + " bricks of " + s.brickPoints + " points, " + s.activeBricks + " crossed, " +
     s.residentBricks + " resident; " + (s.poolSlots > 0
     ? "drawn from a pool of " + s.poolSlots + " slots (one pyramid)"
-    : "each crossed brick drawn as its own pyramid (" + s.brickPyramidBuilds + ")");
+    : "each crossed brick drawn as its own pyramid (" + s.brickPyramidBuilds + ")" +
+      (s.poolReason ? ": " + s.poolReason : ""));
 }
 
 /** The dataset's line: name, size, type, bytes and range. */

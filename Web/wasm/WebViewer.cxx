@@ -964,6 +964,10 @@ public:
     stats.set("brickPoints", static_cast<double>(bricks.BrickPoints));
     stats.set("poolSlots", static_cast<double>(bricks.PoolSlots));
     stats.set("brickPyramidBuilds", static_cast<double>(bricks.BrickPyramidBuilds));
+    // Why the crossed bricks are drawn each as its own pyramid ("" from the pool): the pool
+    // off, or one that would not fit or would take over 3x their own pyramids' GPU memory.
+    stats.set("poolReason",
+      this->Scene && !this->CPUPath ? this->Scene->GetBrickPoolReason() : std::string());
     stats.set("overBudget", !this->CPUPath && bricks.OverBudget);
     // Whole volume uploads and streamed regions (sub-region uploads) of the GPU path's texture.
     stats.set("volumeUploads", static_cast<double>(bricks.VolumeUploads));
