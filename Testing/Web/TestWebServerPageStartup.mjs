@@ -15,7 +15,7 @@ import { readFileSync } from "node:fs";
 import http from "node:http";
 import path from "node:path";
 import zlib from "node:zlib";
-import { Checks, ROOT, launchBrowser, openPage, startServer } from "./webserver-harness.mjs";
+import { Checks, ROOT, launchBrowser, openEmulated, startServer } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 const server = await startServer(["phantom:128"]);
@@ -89,20 +89,18 @@ checks.check(imported.size > 10 && !missing.length && !extra.length,
 // ---------------------------------------------------------------- the page, throttled
 const browser = await launchBrowser();
 async function open(query) {
-  const context = await browser.newContext({ viewport: { width: 900, height: 600 } });
-  const page = await context.newPage();
-  const cdp = await context.newCDPSession(page);
-  const requests = new Map();
-  cdp.on("Network.requestWillBeSent", (e) => requests.set(e.requestId,
-    { url: e.request.url.replace(/[?&]token=[^&]*/, ""), sent: e.timestamp }));
-  cdp.on("Network.responseReceived", (e) => Object.assign(requests.get(e.requestId) || {},
-    { encoding: e.response.headers["Content-Encoding"] || e.response.headers["content-encoding"] || "" }));
-  cdp.on("Network.loadingFinished", (e) => Object.assign(requests.get(e.requestId) || {},
-    { end: e.timestamp, bytes: e.encodedDataLength }));
-  await cdp.send("Network.enable");
-  await cdp.send("Network.emulateNetworkConditions", { offline: false, latency: 40,
-    downloadThroughput: 30e6 / 8, uploadThroughput: 30e6 / 8 });
-  await openPage(page, { url: server.url + "&path=cpu&size=400x300" + query });
+  const { page, requests } = await openEmulated(browser, server.url + "&path=cpu&size=400x300" + query, {
+    viewport: { width: 900, height: 600 }, mbit: 30,
+    watch: async (context, page, cdp) => {
+      const requests = new Map();
+      cdp.on("Network.requestWillBeSent", (e) => requests.set(e.requestId,
+        { url: e.request.url.replace(/[?&]token=[^&]*/, ""), sent: e.timestamp }));
+      cdp.on("Network.responseReceived", (e) => Object.assign(requests.get(e.requestId) || {},
+        { encoding: e.response.headers["Content-Encoding"] || e.response.headers["content-encoding"] || "" }));
+      cdp.on("Network.loadingFinished", (e) => Object.assign(requests.get(e.requestId) || {},
+        { end: e.timestamp, bytes: e.encodedDataLength }));
+      return { requests };
+    } });
   const list = [...requests.values()];
   const find = (pattern) => list.filter((r) => pattern.test(r.url));
   return { page, list, find };

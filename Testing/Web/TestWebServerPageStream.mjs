@@ -20,7 +20,7 @@
 import { mkdtempSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
-import { Checks, countWire, launchBrowser, openPage, startServer, writeTwoBlobs } from "./webserver-harness.mjs";
+import { Checks, countWire, launchBrowser, openEmulated, startServer, writeTwoBlobs } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 // Two blobs in a 256^3 int16 NIfTI (bricks of 64: 4 per axis): a large one in the middle, whose
@@ -73,17 +73,8 @@ const browser = await launchBrowser();
 const surface = (value) => ({ value, color: [1, 1, 1], opacity: 1 });
 
 async function open(query, throttle) {
-  const context = await browser.newContext({ viewport: { width: 900, height: 600 } });
-  const page = await context.newPage();
-  const wire = await countWire(context, page);
-  if (throttle) {
-    const cdp = await context.newCDPSession(page);
-    await cdp.send("Network.enable");
-    await cdp.send("Network.emulateNetworkConditions", { offline: false, latency: 40,
-      downloadThroughput: (throttle * 1e6) / 8, uploadThroughput: (throttle * 1e6) / 8 });
-  }
-  await openPage(page, { url: server.url + query });
-  return { page, wire };
+  return openEmulated(browser, server.url + query, { viewport: { width: 900, height: 600 }, mbit: throttle || 0,
+    watch: async (context, page) => ({ wire: await countWire(context, page) }) });
 }
 
 // The streaming page, at 5 Mbit/s and 40 ms (the predicted bricks are 0.76x the level: slower than the

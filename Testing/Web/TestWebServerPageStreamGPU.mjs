@@ -16,7 +16,7 @@
 import { mkdtempSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
-import { Checks, countWire, launchBrowser, openPage, startServer, writeTwoBlobs } from "./webserver-harness.mjs";
+import { Checks, countWire, launchBrowser, openEmulated, startServer, writeTwoBlobs } from "./webserver-harness.mjs";
 
 const checks = new Checks();
 // Two blobs in a 192^3 int16 NIfTI (bricks of 64: 3 per axis): a large one in the middle, whose
@@ -34,17 +34,8 @@ const surface = (value) => ({ value, color: [1, 1, 1], opacity: 1 });
 const VALUES = [FIRST, SMALL];
 
 async function open(query, throttle) {
-  const context = await browser.newContext({ viewport: { width: 640, height: 480 } });
-  const page = await context.newPage();
-  const wire = await countWire(context, page);
-  if (throttle) {
-    const cdp = await context.newCDPSession(page);
-    await cdp.send("Network.enable");
-    await cdp.send("Network.emulateNetworkConditions", { offline: false, latency: 40,
-      downloadThroughput: (throttle * 1e6) / 8, uploadThroughput: (throttle * 1e6) / 8 });
-  }
-  await openPage(page, { url: server.url + query });
-  return { page, wire };
+  return openEmulated(browser, server.url + query, { viewport: { width: 640, height: 480 }, mbit: throttle || 0,
+    watch: async (context, page) => ({ wire: await countWire(context, page) }) });
 }
 
 // The CPU model's counts of each value at level 0 (a page that fetched level 0 whole: its volume
