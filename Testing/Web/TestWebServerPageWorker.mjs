@@ -226,7 +226,7 @@ async function drag(page, moves = 12) {
 {
   const slow = await open(small, "&path=gpu&frameBudget=1&slowFirstDragFrame=3000");
   await slow.evaluate((s) => window.mediso.setSurfaces([s]), BONE);
-  const before = (await frames(slow)).length;
+  const before = await lastFrameSeq(slow);
   // Asked for and read in one task of the page, so its answer cannot have come in between.
   const owed = await slow.evaluate(() => {
     document.dispatchEvent(new KeyboardEvent("keydown", { key: "ArrowLeft" }));
@@ -234,11 +234,11 @@ async function drag(page, moves = 12) {
   });
   checks.check(owed === false, "a frame asked for and not yet drawn: stats().settled is " + owed);
   await settle(slow);
-  await slow.waitForFunction((n) => window.mediso.frames().length > n, before); // the turn's frame
-  const turned = (await frames(slow)).length;
+  await slow.waitForFunction((n) => window.mediso.frames().some((f) => f.seq > n), before); // the turn's frame
+  const turned = await lastFrameSeq(slow);
   await drag(slow, 6);
   await settle(slow);
-  const steps = (await frames(slow)).slice(turned);
+  const steps = await framesAfter(slow, turned);
   const s = await stats(slow);
   console.log("slow GPU drag frames [interactive, gpuLevel, sampleDistance, settled]: " +
     JSON.stringify(steps.map((f) => [f.interactive, f.gpuLevel, f.sampleDistance, f.settled])));
