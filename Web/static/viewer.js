@@ -261,9 +261,18 @@ export function renderNow(interactive = false) {
   return ms;
 }
 
-/** Resolves when the newest frame asked for is drawn at its full level (automation). */
-export function drawn() {
-  return state.remote && latest ? latest.settled : Promise.resolve();
+/**
+ * Resolves when the newest frame asked for is drawn at its full level and shown (automation).
+ * The worker's canvas reaches this page's canvas when the worker's task that drew it ends, which
+ * can be after its answer has arrived here: a screenshot taken at the answer could show the frame
+ * before (TestWebServerPageView's left view once read the anterior view's picture). Two animation
+ * frames after the answer, the page has shown it.
+ */
+export async function drawn() {
+  if (state.remote && latest) {
+    await latest.settled;
+    await new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(resolve)));
+  }
 }
 
 /**
