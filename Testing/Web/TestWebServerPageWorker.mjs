@@ -68,7 +68,8 @@ await fast.evaluate(() => window.mediso.setCPULevel(-1));
   const steps = await framesAfter(fast, before);
   const m = await main.evaluate(() => window.mediso.setSurfaces([{ value: 300, color: [1, 1, 1], opacity: 1 }]));
   const full = await main.evaluate(() => window.mediso.setCPULevel(3));
-  console.log("refinement frames: " + JSON.stringify(steps.map((f) => [f.values, f.cpuLevel, f.settled])));
+  console.log("refinement frames [values, level, settled, predicted ms]: " +
+    JSON.stringify(steps.map((f) => [f.values, f.cpuLevel, f.settled, Math.round(f.predictedMs * 10) / 10])));
   checks.check(steps.length >= 2 && steps[0].values[0] === 300 && steps[0].cpuLevel < 3 && !steps[0].settled,
     "a change is drawn first at a coarse level (" + (steps[0] || {}).cpuLevel + ") within a 1 ms budget");
   checks.check(s.settled && s.cpuLevel === 3 && s.triangles === full.triangles && m.path === "cpu",
@@ -99,7 +100,10 @@ async function supersede(page, first, second) {
 {
   const { skippedBefore, steps, s } = await supersede(fast, 250, 350);
   const m = await main.evaluate(() => window.mediso.setSurfaces([{ value: 350, color: [1, 1, 1], opacity: 1 }]));
-  console.log("superseded frames: " + JSON.stringify(steps.map((f) => [f.values, f.cpuLevel, f.settled])));
+  console.log("superseded frames [values, level, settled, predicted ms]: " +
+    JSON.stringify(steps.map((f) => [f.values, f.cpuLevel, f.settled, Math.round(f.predictedMs * 10) / 10])));
+  checks.check(steps.length && steps[0].values[0] === 250 && steps[0].cpuLevel < 3 && !steps[0].settled,
+    "the older change is drawn first at a coarse level (" + (steps[0] || {}).cpuLevel + "), its refinement owed");
   const last = steps[steps.length - 1];
   checks.check(last.values[0] === 350 && last.settled && last.cpuLevel === 3 && s.triangles === m.triangles,
     "the last frame is the newer change's surface at the full level (" + s.triangles + " triangles, " +

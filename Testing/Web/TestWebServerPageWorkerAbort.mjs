@@ -12,7 +12,8 @@
 // - the newer change ends at level 3 with the triangles of level 3 on the main-thread page (the
 //   same core, not in a worker);
 // - without the generation word (?abort=0, as on a page that is not cross-origin isolated),
-//   stats() says a refinement runs to its end, and it does.
+//   stats() says a refinement runs to its end, and it does (the hook then holds the refinement in
+//   the worker, which reads no message meanwhile).
 import { Checks, installIsovalueTyping, launchBrowser, framesAfter, lastFrameSeq, openInContext, pageStats,
   startServer } from "./webserver-harness.mjs";
 
@@ -86,21 +87,24 @@ for (const [name, mode] of Object.entries(MODES)) {
 
 // Without the word (?abort=0, as where the page is not cross-origin isolated): stats() says a
 // refinement runs to its end, and the superseded change's refinement does (no abort counted).
+// ?slowExtraction holds each refinement 3 s in the worker before it draws (without the word
+// the hook is the worker's), so that the newer change, typed a second after the older one's
+// coarse frame, surely comes while the older one's refinement runs.
 {
-  const page = await open("&path=cpu&frameBudget=1&abort=0");
+  const page = await open("&path=cpu&frameBudget=1&abort=0&slowExtraction=3000");
   await page.evaluate(() => window.mediso.setCPULevel(-1));
   await page.evaluate(() => window.mediso.setSurfaces([{ value: 300, color: [1, 1, 1], opacity: 1 }]));
   const s0 = await stats(page);
   checks.check(s0.abortable === false && /runs to its end/.test(s0.abortNote),
     "without the word, stats() says a refinement runs to its end: " + JSON.stringify(s0.abortNote));
   const before = await lastFrameSeq(page);
+  await installIsovalueTyping(page);
   await page.evaluate(async () => {
-    const box = document.querySelector("#surfaces .isovalue");
-    box.value = "250";
-    box.dispatchEvent(new Event("input"));
+    const { type, waitFor } = window.medisoTyping;
+    type(250);
+    await waitFor((f) => f.values[0] === 250);
     await new Promise((resolve) => setTimeout(resolve, 1000));
-    box.value = "350";
-    box.dispatchEvent(new Event("input"));
+    type(350);
   });
   await page.waitForFunction(() => {
     const f = window.mediso.frames();
@@ -108,8 +112,9 @@ for (const [name, mode] of Object.entries(MODES)) {
   }, null, { timeout: 120000 });
   const steps = await framesAfter(page, before);
   const s = await stats(page);
-  checks.check(s.refinementsAborted === 0 && steps.some((f) => f.values[0] === 250 && f.cpuLevel === 3),
-    "without the word nothing is aborted and the older change was refined (" +
+  const refined = steps.findIndex((f) => f.values[0] === 250 && f.cpuLevel === 3);
+  checks.check(s.refinementsAborted === 0 && refined >= 0 && steps.findIndex((f) => f.values[0] === 350) > refined,
+    "without the word nothing is aborted and the older change was refined before the newer one was drawn (" +
     JSON.stringify(steps.map((f) => [f.values, f.cpuLevel, f.settled])) + ")");
   await page.context().close();
 }

@@ -53,6 +53,10 @@ let streamGrid = null; // {dims, brick, size, length, scratch}: the streamed lev
 let generationWord = null;
 let aborted = 0;
 let abortNote = ""; // what stats() says about it
+// Without the word, the page's ?slowExtraction=MS holds each refinement MS before it draws, the
+// worker not reading its messages meanwhile, as a long refinement would (a test hook: a newer
+// change then surely comes while a refinement runs, however fast or loaded the machine).
+let unwatchedRefinementMs = 0;
 
 // The canvas's new size, applied with the next frame drawn: resizing clears the canvas, and a
 // worker's OffscreenCanvas is shown at the end of each of its tasks, so a resize in one task and
@@ -117,6 +121,7 @@ function shareGeneration(abort, slowExtractionMs, slowPass) {
   const address = viewer.ready() ? viewer.generationWord() : 0;
   if (!abort) {
     abortNote = "A refinement that has begun runs to its end (asked for by ?abort=0).";
+    unwatchedRefinementMs = slowExtractionMs > 0 ? slowExtractionMs : 0;
     return;
   }
   if (address && M.HEAPU8.buffer instanceof SharedArrayBuffer) {
@@ -283,6 +288,9 @@ function refineNow() {
   }
   const { id, frame } = refine;
   refine = null;
+  if (unwatchedRefinementMs > 0) {
+    pause(unwatchedRefinementMs);
+  }
   const stats = drawWatched(frame);
   if (!stats) {
     return; // obsolete: the newer frame's message is next

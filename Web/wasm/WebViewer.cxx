@@ -854,7 +854,7 @@ public:
    * the CPU path, the estimator's seconds for an extraction not yet cached:
    * {level, sampleDistance, predictedMs, fullMs} for the current isovalues.
    * CPU path: the finest level, at most the one the memory budget allows,
-   * whose extraction and drawing fit, then (`interactive`: a drag's frame)
+   * whose extraction, upload and drawing fit, then (`interactive`: a drag's frame)
    * level 0 at image sample distances 1.5 to 8 (the coarsest when none
    * does). GPU path:
    * the full volume at the smallest image sample distance whose frame fits
@@ -880,6 +880,11 @@ public:
         }
         c.Work = this->Work(static_cast<std::uint64_t>(triangles), 1.0);
         c.Work.ExtractSeconds = this->ExtractSeconds(level);
+        // Its one-off work as well: a level not shown uploads its triangles (after extracting
+        // those not cached), and a look not drawn before compiles the meshes' program.
+        const bool shown = c.Work.ExtractSeconds <= 0.0 && level == this->CPULevel;
+        c.Work.BuildElements = shown ? 0 : c.Work.Primitives;
+        c.Work.Programs = this->Warm.count(this->WarmKey(level, c.Work)) ? 0 : 1;
         candidates.push_back(c);
       }
       // A drag whose level 0 is over the budget: level 0 on fewer pixels (on software WebGL about
@@ -893,6 +898,8 @@ public:
           c.SampleDistance = static_cast<float>(distance);
           c.Work = this->Work(levelZero.Work.Primitives, distance);
           c.Work.ExtractSeconds = levelZero.Work.ExtractSeconds;
+          c.Work.BuildElements = levelZero.Work.BuildElements;
+          c.Work.Programs = levelZero.Work.Programs; // a distance compiles nothing (WarmKey)
           candidates.push_back(c);
         }
       }
@@ -901,7 +908,8 @@ public:
     {
       this->AddGPUCandidates(candidates);
     }
-    // CPU path: the drawing and the extraction of the surfaces not cached, as before. GPU path:
+    // CPU path: the whole frame (the drawing, the extraction of the surfaces not cached, the
+    // upload of a level not shown). GPU path:
     // while the full volume's pyramid is built for these surfaces (a drag), the level a drag
     // holds, on the drawing (a level's build is paid on its first frame); after an isovalue
     // change, when every candidate's pyramid has to be built, on the whole frame, so that the
@@ -909,16 +917,6 @@ public:
     const bool wholeFrame = this->CPUPath || !this->FullLevelBuiltForSurfaces();
     const std::size_t chosen = wholeFrame ? this->Times.ChooseWholeFrame(candidates, budgetSeconds)
                                           : this->Times.Choose(candidates, budgetSeconds);
-    if (this->CPUPath)
-    {
-      // Predicted with the rest of its one-off work: a level not shown uploads its triangles
-      // (after extracting those not cached); the first frame compiles the meshes' program.
-      FrameWork& work = candidates[chosen].Work;
-      const int level = candidates[chosen].Level;
-      const bool shown = work.ExtractSeconds <= 0.0 && level == this->CPULevel;
-      work.BuildElements = shown ? 0 : work.Primitives;
-      work.Programs = this->Warm.count(this->WarmKey(level, work)) ? 0 : 1;
-    }
     val out = val::object();
     out.set("level", candidates[chosen].Level);
     out.set("sampleDistance", candidates[chosen].SampleDistance);
