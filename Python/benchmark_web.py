@@ -49,6 +49,7 @@ sweep's isovalues, the first left out), a still frame (median, the camera turned
 and the primitives, bricks and pool slots. Inputs: ct, ct512 or phantom:N[:noise=HU].
 """
 import argparse
+import contextlib
 import json
 import os
 import shutil
@@ -61,7 +62,6 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from benchmark_common import (ROOT, cpu_model, data_dir, free_port, load_average,  # noqa: E402
                               progress_printer, write_report)
 
-HERE = os.path.dirname(os.path.abspath(__file__))
 progress = progress_printer("web-bench")
 WEB = os.path.join(ROOT, "Testing", "Web")
 TYPES = {"MET_CHAR": "int8", "MET_UCHAR": "uint8", "MET_SHORT": "int16", "MET_USHORT": "uint16",
@@ -155,8 +155,7 @@ def volume_path(name):
 def run_input(args, name):
     path = volume_path(name)
     header, raw = read_mha(path)
-    work = os.path.join(args.work, name)
-    os.makedirs(work, exist_ok=True)
+    work = work_folder(args, "", name)
     with open(os.path.join(work, "volume.raw"), "wb") as f:
         f.write(raw)
     subprocess.run([os.path.join(WEB, "node_modules", ".bin", "esbuild"),
@@ -164,19 +163,12 @@ def run_input(args, name):
                     "--minify", "--log-level=warning", "--outfile=" + os.path.join(work, "vtkjs-bench.js")],
                    check=True)
     shutil.copy(os.path.join(WEB, "bench", "vtkjs.html"), work)
-    port, static_port = free_port(), free_port()
-    token = "bench-%d" % port
-    server = subprocess.Popen([shutil.which("pvpython"), "--no-mpi", os.path.join(HERE, "serve.py"),
-                               "--plugin", args.plugin, "--wasm", args.wasm, "--data", path,
-                               "--port", str(port), "--token=" + token],
-                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    server, page_url = start_server(ROOT, args, path)
+    static_port = free_port()
     static = subprocess.Popen([sys.executable, "-m", "http.server", str(static_port), "--bind",
                                "127.0.0.1", "--directory", work],
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        for line in server.stdout:
-            if "open http" in line:
-                break
         lo_hi = None
         # the isovalues: equidistant inside the data range (its ends left out)
         import array
@@ -187,18 +179,11 @@ def run_input(args, name):
         isovalues = [lo_hi[0] + (lo_hi[1] - lo_hi[0]) * (i + 1) / (args.sweep + 1)
                      for i in range(args.sweep)]
         size = [int(v) for v in args.size.split("x")]
-        config = {"pageUrl": "http://127.0.0.1:%d/?token=%s" % (port, token),
+        config = {"pageUrl": page_url,
                   "vtkjsUrl": "http://127.0.0.1:%d/vtkjs.html" % static_port,
                   "volume": {"url": "volume.raw", **header}, "size": size, "isovalues": isovalues}
-        config_file = os.path.join(work, "config.json")
-        out_file = os.path.join(work, "result.json")
-        with open(config_file, "w") as f:
-            json.dump(config, f)
         progress("%s: %d isovalues, %s" % (name, args.sweep, args.size))
-        subprocess.run(["node", os.path.join(WEB, "bench.mjs"), config_file, out_file], check=True,
-                       cwd=WEB, timeout=3600)
-        with open(out_file) as f:
-            result = json.load(f)
+        result = run_script(work, "bench.mjs", config)
     finally:
         server.kill()
         static.kill()
@@ -222,18 +207,46 @@ def start_server(root, args, data):
     return server, "http://127.0.0.1:%d/?token=%s" % (port, token)
 
 
-def run_interactive(args, name, before_root):
+@contextlib.contextmanager
+def serving(args, name, trees):
+    """Input `name` (ct, ct512, or a server spec phantom:N[:noise=HU] as serve.py takes it) served
+    by serve.py of each tree in `trees` (label -> tree, started in that order); yields label -> page
+    URL and stops the servers however the block ends."""
     data = volume_path(name) if not name.startswith("phantom:") else name
-    work = os.path.join(args.work, "interactive-" + name.replace(":", "-"))
-    os.makedirs(work, exist_ok=True)
     servers = []
     try:
-        pages = {}
-        if before_root:
-            before, pages["before"] = start_server(before_root, args, data)
-            servers.append(before)
-        after, pages["after"] = start_server(ROOT, args, data)
-        servers.append(after)
+        urls = {}
+        for label, root in trees.items():
+            server, urls[label] = start_server(root, args, data)
+            servers.append(server)
+        yield urls
+    finally:
+        for server in servers:
+            server.kill()
+
+
+def work_folder(args, prefix, name):
+    """The input's folder under --work for a mode's files (its config, its result), made."""
+    work = os.path.join(args.work, prefix + name.replace(":", "-"))
+    os.makedirs(work, exist_ok=True)
+    return work
+
+
+def run_script(work, script, config):
+    """Testing/Web/`script` run by node with `config`, both in the folder `work`; its result."""
+    config_file = os.path.join(work, "config.json")
+    out_file = os.path.join(work, "result.json")
+    with open(config_file, "w") as f:
+        json.dump(config, f)
+    subprocess.run(["node", os.path.join(WEB, script), config_file, out_file], check=True, cwd=WEB,
+                   timeout=3600)
+    with open(out_file) as f:
+        return json.load(f)
+
+
+def run_interactive(args, name, before_root):
+    trees = {"before": before_root, "after": ROOT} if before_root else {"after": ROOT}
+    with serving(args, name, trees) as pages:
         lo, hi = (-1000, 1100) if name.startswith("phantom:") else (-1000, 2000)
         isovalues = [400, -500, 300, 500, -300, 200, 600]
         isovalues = [v for v in isovalues if lo < v < hi][:max(1, args.changes) + 1]
@@ -243,19 +256,9 @@ def run_interactive(args, name, before_root):
         if args.scene == "skin-bone":
             config["surfaces"] = [{"value": -500, "opacity": 0.3, "color": [0.93, 0.75, 0.62]},
                                   {"value": 400}]
-        config_file = os.path.join(work, "config.json")
-        out_file = os.path.join(work, "result.json")
-        with open(config_file, "w") as f:
-            json.dump(config, f)
         progress("%s: the page before and after, %d changes and a drag of %d moves per path"
                  % (name, len(isovalues) - 1, args.moves))
-        subprocess.run(["node", os.path.join(WEB, "bench-interactive.mjs"), config_file, out_file],
-                       check=True, cwd=WEB, timeout=3600)
-        with open(out_file) as f:
-            return json.load(f)
-    finally:
-        for server in servers:
-            server.kill()
+        return run_script(work_folder(args, "interactive-", name), "bench-interactive.mjs", config)
 
 
 def main_interactive(args, argv):
@@ -350,25 +353,13 @@ def main_stream(args, argv):
              "| bytes at full level (level received) |",
              "|---|---|---|---:|---:|---:|---:|---:|"]
     for name in args.inputs.split(","):
-        data = volume_path(name) if not name.startswith("phantom:") else name
-        work = os.path.join(args.work, "stream-" + name.replace(":", "-"))
-        os.makedirs(work, exist_ok=True)
-        server, url = start_server(ROOT, args, data)
-        try:
+        with serving(args, name, {"page": ROOT}) as urls:
             if args.warm:
-                warm(url)
-            config_file = os.path.join(work, "config.json")
-            out_file = os.path.join(work, "result.json")
-            with open(config_file, "w") as f:
-                json.dump({"url": url, "size": [int(v) for v in args.size.split("x")],
-                           "networks": networks, "repeats": args.repeats}, f)
+                warm(urls["page"])
             progress("%s: whole and streamed, %s" % (name, args.networks))
-            subprocess.run(["node", os.path.join(WEB, "bench-stream.mjs"), config_file, out_file],
-                           check=True, cwd=WEB, timeout=3600)
-            with open(out_file) as f:
-                runs = json.load(f)["runs"]
-        finally:
-            server.kill()
+            runs = run_script(work_folder(args, "stream-", name), "bench-stream.mjs",
+                              {"url": urls["page"], "size": [int(v) for v in args.size.split("x")],
+                               "networks": networks, "repeats": args.repeats})["runs"]
         for network in networks:
             whole = {}
             for mode in ("whole", "stream"):
@@ -403,23 +394,11 @@ def main_startup(args, argv, networks):
              "canvas %s; each run in a fresh context; ms from navigation" % (
                  time.strftime("%Y-%m-%d %H:%M:%S"), load_average(), args.size)]
     for name in args.inputs.split(","):
-        data = volume_path(name) if not name.startswith("phantom:") else name
-        work = os.path.join(args.work, "startup-" + name.replace(":", "-"))
-        os.makedirs(work, exist_ok=True)
-        server, url = start_server(ROOT, args, data)
-        try:
-            config_file = os.path.join(work, "config.json")
-            out_file = os.path.join(work, "result.json")
-            with open(config_file, "w") as f:
-                json.dump({"url": url, "size": [int(v) for v in args.size.split("x")],
-                           "networks": networks, "repeats": args.repeats}, f)
+        with serving(args, name, {"page": ROOT}) as urls:
             progress("%s: start-up, %s" % (name, args.networks))
-            subprocess.run(["node", os.path.join(WEB, "bench-startup.mjs"), config_file, out_file],
-                           check=True, cwd=WEB, timeout=3600)
-            with open(out_file) as f:
-                runs = json.load(f)["runs"]
-        finally:
-            server.kill()
+            runs = run_script(work_folder(args, "startup-", name), "bench-startup.mjs",
+                              {"url": urls["page"], "size": [int(v) for v in args.size.split("x")],
+                               "networks": networks, "repeats": args.repeats})["runs"]
         for run in runs:
             marks = ", ".join("%s %.0f" % (m["name"][len("mediso:"):], m["at"]) for m in run["marks"])
             lines += ["", "## %s, %s: first image %d ms (%s)" % (name, run["network"], run["firstMs"], marks),
@@ -461,29 +440,16 @@ def main_bricks(args, argv):
                     {"name": what + ": per brick", "query": query + "&brickPool=0"}]
     results = {}
     for name in args.inputs.split(","):
-        data = volume_path(name) if not name.startswith("phantom:") else name
-        work = os.path.join(args.work, "bricks-" + name.replace(":", "-"))
-        os.makedirs(work, exist_ok=True)
-        server, url = start_server(ROOT, args, data)
-        try:
+        with serving(args, name, {"page": ROOT}) as urls:
             lo, hi = (-1000, 1100) if name.startswith("phantom:") else (-1000, 2000)
             isovalues = [lo + (hi - lo) * (i + 1) / (args.sweep + 1) for i in range(args.sweep)]
             # bone first (the warm-up change), then the sweep in a turning order
             isovalues = [400] + isovalues[::2] + isovalues[1::2]
-            config = {"url": url, "size": [int(v) for v in args.size.split("x")], "configs": configs,
+            config = {"url": urls["page"], "size": [int(v) for v in args.size.split("x")], "configs": configs,
                       "isovalues": isovalues, "stills": stills}
-            config_file = os.path.join(work, "config.json")
-            out_file = os.path.join(work, "result.json")
-            with open(config_file, "w") as f:
-                json.dump(config, f)
             progress("%s: %d configurations, %d changes and %d still frames each"
                      % (name, len(configs), len(isovalues) - 1, stills))
-            subprocess.run(["node", os.path.join(WEB, "bench-bricks.mjs"), config_file, out_file],
-                           check=True, cwd=WEB, timeout=3600)
-            with open(out_file) as f:
-                results[name] = json.load(f)
-        finally:
-            server.kill()
+            results[name] = run_script(work_folder(args, "bricks-", name), "bench-bricks.mjs", config)
     lines = ["# The page's GPU path: one texture, the brick pool, per-brick pyramids (issue 31)", "",
              "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv),
              "- Started %s, %.0f s; load average %s before, %s after" % (

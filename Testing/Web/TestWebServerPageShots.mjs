@@ -12,8 +12,9 @@
 //   anterior view with its orientation marker on the phantom (RAS), a NIfTI in RAS and a DICOM
 //   series in LPS (Python/write_dicom_series.py, DCMTK) of the same synthetic head; the page laid
 //   out wide (1100x620: the slice views in a column) and narrow (600x760: the panel under the
-//   view), its changing readouts hidden; a view set through the URL, reloaded: the image after
-//   the reload equals the one before (at most 0.1% of the pixels off by more than 40) and the
+//   view), its changing readouts hidden, and no blank band in its panel (no gap of PANEL_GAP_PX
+//   between what the panel shows, in the shot and as its user sees it); a view set through the
+//   URL, reloaded: the image after the reload equals the one before (at most 0.1% of the pixels off by more than 40) and the
 //   baseline; the crosshair (moved off the centre) drawn in the 3D view where the camera projects
 //   it (within 1 px of the test's own projection) and brought back by the URL (xh=).
 // - two fingers (Chromium's touch events through CDP, pointers of type "touch"): spread from 100 to
@@ -127,8 +128,53 @@ const settle = (page) => page.evaluate(async () => {
   await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
 });
 // What changes from run to run (frames per second, timings, bytes) is hidden, not masked: the
-// layout stays as it is.
-const HIDE = "#overlay, #readout, #why, #renderer { visibility: hidden !important; }";
+// layout stays as it is. The notes under the path's controls (#why: the path and the WebGL2
+// renderer; #renderer: the worker) are the same at every run in this browser and stay shown:
+// hidden, they left a blank band in the wide layout's panel where its user reads them.
+const HIDE = "#overlay, #readout { visibility: hidden !important; }";
+
+// The largest vertical gap between what the panel shows (text, controls, canvases) within the
+// window, in CSS px, and what comes below it: a box that keeps its height with nothing shown in it
+// (a note hidden, an empty row) is a blank band in the panel. Line spacing and the margins above
+// a heading leave less than PANEL_GAP_PX.
+const PANEL_GAP_PX = 40;
+const panelGap = (page) => page.evaluate(() => {
+  const panel = document.getElementById("panel");
+  const box = panel.getBoundingClientRect();
+  const top = Math.max(box.top, 0), bottom = Math.min(box.bottom, innerHeight);
+  const shown = (e) => getComputedStyle(e).visibility === "visible";
+  const spans = [];
+  const add = (r, e) => {
+    const a = Math.max(r.top, top), b = Math.min(r.bottom, bottom);
+    if (r.width > 0 && b > a) {
+      spans.push([a, b, e]);
+    }
+  };
+  const walker = document.createTreeWalker(panel, NodeFilter.SHOW_ELEMENT | NodeFilter.SHOW_TEXT);
+  for (let n = walker.nextNode(); n; n = walker.nextNode()) {
+    if (n.nodeType === Node.TEXT_NODE) {
+      if (n.textContent.trim() && shown(n.parentElement)) {
+        const range = document.createRange();
+        range.selectNodeContents(n);
+        for (const r of range.getClientRects()) {
+          add(r, n.parentElement);
+        }
+      }
+    } else if (n.matches("input, select, button, canvas, progress, textarea") && shown(n)) {
+      add(n.getBoundingClientRect(), n);
+    }
+  }
+  spans.sort((x, y) => x[0] - y[0]);
+  let reach = spans.length ? spans[0][1] : top;
+  let gap = { px: 0, at: 0, above: "" };
+  for (const [a, b, e] of spans) {
+    if (a - reach > gap.px) {
+      gap = { px: a - reach, at: reach, above: e.id || e.textContent.trim().slice(0, 30) || e.tagName };
+    }
+    reach = Math.max(reach, b);
+  }
+  return gap;
+});
 
 async function stageShot(page) {
   await page.addStyleTag({ content: HIDE });
@@ -281,8 +327,16 @@ for (const [name, width, height] of [["wide", 1100, 620], ["narrow", 600, 760]])
   const hidden = await page.addStyleTag({ content: HIDE });
   await settle(page);
   await againstBaseline("layout-" + name, await page.screenshot({ animations: "disabled" }));
+  for (const [what, shown] of [["as in its shot", true], ["as its user sees it", false]]) {
+    if (!shown) {
+      await hidden.evaluate((e) => e.remove());
+    }
+    const gap = await panelGap(page);
+    checks.check(gap.px < PANEL_GAP_PX, name + " layout, " + what + ": no blank band in the panel (largest " +
+      "gap " + gap.px.toFixed(0) + " px, at y " + gap.at.toFixed(0) + " above " + JSON.stringify(gap.above) +
+      "; less than " + PANEL_GAP_PX + ")");
+  }
   if (DOCS) { // the page as its user sees it, readouts and all; the wide one 1024x576 (a smaller file)
-    await hidden.evaluate((e) => e.remove());
     if (name === "wide") {
       await page.setViewportSize({ width: 1024, height: 576 });
       await page.waitForFunction(() => Math.abs(document.getElementById("view").width -
