@@ -56,8 +56,12 @@ struct ProcessFrames
     bool AskBlend = false;
     bool AskPeel = false;
     // The view's depth peeling was switched off for this frame (on again at
-    // the renderer's end); the model counts the frame as one pass.
+    // the renderer's end).
     bool Blended = false;
+    // The frame drew its translucent geometry in one blended pass (switched
+    // off above, or a view that does not peel): a kind of frame of its own
+    // for the model, dearer than an opaque one.
+    bool OnePass = false;
     bool Started = false;
   };
   std::mutex Mutex;
@@ -336,9 +340,12 @@ bool vtkBlockLODSurfaceRepresentation::MakeLevelLOD()
       work.Translucent =
         work.Translucent || Frames().OthersTranslucent(this->ObservedRenderer.GetPointer(), this);
     }
-    // The model's translucent frames are peeled ones; a frame blended in one
-    // pass costs what an opaque frame does, plus a full-viewport resolve.
-    work.Translucent = work.Translucent && !this->BlendsInteractiveFrames();
+    // A translucent frame blended in one pass is its own kind of frame for
+    // the model: no peels, but the blended pass's targets and resolve over
+    // the whole view (counted as an opaque frame, it was predicted 30 ms
+    // short at level 2 of the head CT, docs/blocklod.md).
+    work.Blended = this->BlendsInteractiveFrames() ||
+      (this->ObservedRenderer && !this->ObservedRenderer->GetUseDepthPeeling());
     for (int level = still; level >= 0; --level)
     {
       const bool allowed =
@@ -421,6 +428,8 @@ double* vtkBlockLODSurfaceRepresentation::GetPredictedStillSeconds()
   std::lock_guard<std::mutex> lock(Frames().Mutex);
   const void* renderer = this->ObservedRenderer.GetPointer();
   work.Translucent = work.Translucent || (renderer && Frames().OthersTranslucent(renderer, this));
+  // A still frame peels when the view does.
+  work.Blended = renderer && !this->ObservedRenderer->GetUseDepthPeeling();
   for (int level = 0; level < Levels; ++level)
   {
     if (triangles[level] >= 0.0)
@@ -694,7 +703,8 @@ void vtkBlockLODSurfaceRepresentation::OnRenderEnd()
   const int* size = this->ObservedRenderer->GetSize();
   work.Pixels = static_cast<std::uint64_t>(std::max(0, size[0])) *
     static_cast<std::uint64_t>(std::max(0, size[1]));
-  work.Translucent = drawn.Translucent && !drawn.Blended;
+  work.Translucent = drawn.Translucent;
+  work.Blended = drawn.OnePass;
   Frames().Model.Observe(work, drawn.RendererSeconds);
 }
 
@@ -719,6 +729,7 @@ void vtkBlockLODSurfaceRepresentation::OnRendererStart()
       this->ObservedRenderer->SetUseDepthPeeling(0);
       frame->second.Blended = true;
     }
+    frame->second.OnePass = !this->ObservedRenderer->GetUseDepthPeeling();
   }
   // Every display says how it is drawn, after the switch above.
   if (!this->DrawsTranslucent)

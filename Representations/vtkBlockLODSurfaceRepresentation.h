@@ -72,7 +72,10 @@
  * still one) is the view's. The blended image is not the peeled one (layers
  * weighted by depth instead of composited in order): close to it on a
  * single-colour surface, and the camera is moving. The frame-time model
- * counts such a frame as one pass (an opaque frame's pair).
+ * keeps such frames apart (FrameWork::Blended, a kind of frame with its own
+ * coefficients): the blended pass costs less than peeling but more than an
+ * opaque frame of the same triangles (its targets and resolve cover the whole
+ * view), and a level chosen as if it drew opaque overran the budget.
  *
  * What interactive frames draw is readable on the rendering process:
  * GetInteractiveLevel() (the level of the LOD geometry, -1 when it is not a

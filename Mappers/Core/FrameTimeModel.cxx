@@ -229,6 +229,25 @@ FrameTimeModel::Coefficients FrameTimeModel::Prior(FrameMethod method, bool tran
   return prior;
 }
 
+FrameTimeModel::Coefficients FrameTimeModel::BlendedPrior(FrameMethod method)
+{
+  // The opaque prior with the blended pass's work added. Each translucent
+  // fragment is blended into two floating-point targets (accumulation and
+  // revealage) instead of depth-tested into one, so a triangle costs more;
+  // the pass clears those targets, copies the opaque depth and resolves them
+  // over the whole viewport, so the fixed and per-pixel work about double.
+  // llvmpipe in ParaView (docs/blocklod.md, issue 30): the head CT's level-2
+  // frame (262 k triangles, 1024x768) took 1.6 times the opaque frame's
+  // renderer time, the level-0 frame (11 k) about twice; these factors give
+  // 1.6 and 1.9 at the opaque prior's scale. Far below the peeled prior:
+  // there are no peels.
+  Coefficients prior = Prior(method, false);
+  prior.Seconds *= 2.0;
+  prior.PerPrimitive *= 1.5;
+  prior.PerPixel *= 2.0;
+  return prior;
+}
+
 FrameTimeModel::OneOffCoefficients FrameTimeModel::OneOffPrior(FrameMethod method)
 {
   // A software renderer's, of the right order rather than exact: the first
@@ -256,6 +275,24 @@ std::size_t FrameTimeModel::Key(FrameMethod method, bool translucent)
   return 2 * m + (translucent ? 1 : 0);
 }
 
+std::size_t FrameTimeModel::Key(const FrameWork& kind)
+{
+  // The blended pairs follow the four of Key(method, translucent).
+  if (kind.Translucent && kind.Blended)
+  {
+    return 4 + MethodKey(kind.Method);
+  }
+  return Key(kind.Method, kind.Translucent);
+}
+
+FrameTimeModel::Coefficients FrameTimeModel::PriorOf(std::size_t key)
+{
+  const bool blended = key >= 4;
+  const std::size_t m = blended ? key - 4 : key / 2;
+  const FrameMethod method = m == 0 ? FrameMethod::CellRasterisation : FrameMethod::Triangles;
+  return blended ? BlendedPrior(method) : Prior(method, key % 2 == 1);
+}
+
 void FrameTimeModel::Observe(const FrameWork& work, double seconds)
 {
   if (!std::isfinite(seconds) || seconds < 0.0 ||
@@ -263,7 +300,7 @@ void FrameTimeModel::Observe(const FrameWork& work, double seconds)
   {
     return;
   }
-  Pair& pair = this->Pairs[Key(work.Method, work.Translucent)];
+  Pair& pair = this->Pairs[Key(work)];
   if (work.HasOneOff())
   {
     // Kept apart from the drawing frames. A pair without a drawing frame yet
@@ -280,7 +317,7 @@ void FrameTimeModel::Observe(const FrameWork& work, double seconds)
       const double share = drawing + oneOff > 0.0 ? drawing / (drawing + oneOff) : 1.0;
       pair.Samples.push_back(
         { DrawingCounts(work), std::max(seconds - oneOff, 0.5 * share * seconds) });
-      this->Refit(work.Method, work.Translucent);
+      this->Refit(Key(work));
     }
     OneOffFit& fit = this->OneOffs[MethodKey(work.Method)];
     fit.Samples.push_back({ work, seconds });
@@ -296,7 +333,7 @@ void FrameTimeModel::Observe(const FrameWork& work, double seconds)
   {
     pair.Samples.pop_front();
   }
-  this->Refit(work.Method, work.Translucent);
+  this->Refit(Key(work));
   // The one-off frames' residuals are measured against the drawing fit.
   if (!this->OneOffs[MethodKey(work.Method)].Samples.empty())
   {
@@ -321,33 +358,43 @@ void FrameTimeModel::RefitOneOff(FrameMethod method)
   fit.Fitted = AsOneOffCoefficients(Solve(residuals, prior, prior, scale));
 }
 
-void FrameTimeModel::Refit(FrameMethod method, bool translucent)
+void FrameTimeModel::Refit(std::size_t key)
 {
-  Pair& pair = this->Pairs[Key(method, translucent)];
+  Pair& pair = this->Pairs[key];
   double scale = 1.0;
   // Anchored to the prior's shape; the scale found is the frames' ratio to
   // the prior, what a pair without frames borrows (Anchor()).
-  const Vector3 prior = AsVector(Prior(method, translucent));
+  const Vector3 prior = AsVector(PriorOf(key));
   pair.Fitted = AsCoefficients(Solve(pair.Samples, prior, prior, scale));
   pair.PriorScale = scale;
 }
 
-FrameTimeModel::Coefficients FrameTimeModel::Anchor(FrameMethod method, bool translucent) const
+FrameTimeModel::Coefficients FrameTimeModel::Anchor(std::size_t key) const
 {
   // The prior, scaled as the frames of another pair scale theirs: how much
   // faster or slower than the priors this machine is. Only the scale
   // transfers, not a fitted split: a translucent frame's split differs in
   // kind from an opaque one's (depth peeling's full-viewport passes), and a
-  // method's from the other's. The same method drawn the other way says it
-  // first; else the other method's pair with more frames.
-  const Coefficients prior = Prior(method, translucent);
+  // method's from the other's. The same method drawn another way says it
+  // first (opaque and peeled each other's, then the blended pair; the
+  // blended pair the opaque one, then the peeled); else the other method's
+  // opaque or peeled pair with more frames.
+  const Coefficients prior = PriorOf(key);
+  const bool blended = key >= 4;
+  const std::size_t m = blended ? key - 4 : key / 2;
+  const FrameMethod method = m == 0 ? FrameMethod::CellRasterisation : FrameMethod::Triangles;
+  const bool translucent = blended || key % 2 == 1;
+  const std::size_t siblings[2] = { blended ? Key(method, false) : Key(method, !translucent),
+    blended ? Key(method, true) : 4 + m };
   const Pair* source = nullptr;
-  const Pair& sibling = this->Pairs[Key(method, !translucent)];
-  if (!sibling.Samples.empty())
+  for (std::size_t sibling : siblings)
   {
-    source = &sibling;
+    if (!source && !this->Pairs[sibling].Samples.empty())
+    {
+      source = &this->Pairs[sibling];
+    }
   }
-  else
+  if (!source)
   {
     const FrameMethod otherMethod = method == FrameMethod::CellRasterisation
       ? FrameMethod::Triangles
@@ -567,7 +614,7 @@ double FrameTimeModel::PredictDrawing(const FrameWork& work) const
   {
     return Prior(FrameMethod::CellRasterisation, true).Evaluate(work);
   }
-  return this->Fit(work.Method, work.Translucent).Evaluate(work);
+  return this->FitOf(Key(work)).Evaluate(work);
 }
 
 double FrameTimeModel::PredictOneOff(const FrameWork& work) const
@@ -614,8 +661,22 @@ std::size_t FrameTimeModel::ObservationCount(FrameMethod method, bool translucen
 
 FrameTimeModel::Coefficients FrameTimeModel::Fit(FrameMethod method, bool translucent) const
 {
-  const Pair& pair = this->Pairs[Key(method, translucent)];
-  return pair.Samples.empty() ? this->Anchor(method, translucent) : pair.Fitted;
+  return this->FitOf(Key(method, translucent));
+}
+
+FrameTimeModel::Coefficients FrameTimeModel::FitOf(std::size_t key) const
+{
+  const Pair& pair = this->Pairs[key];
+  return pair.Samples.empty() ? this->Anchor(key) : pair.Fitted;
+}
+
+std::size_t FrameTimeModel::ObservationCount(const FrameWork& kind) const
+{
+  if (kind.Method != FrameMethod::CellRasterisation && kind.Method != FrameMethod::Triangles)
+  {
+    return 0;
+  }
+  return this->Pairs[Key(kind)].Samples.size();
 }
 
 void FrameTimeModel::Reset()

@@ -17,7 +17,14 @@
  * pyramid to find it) and c the cost of one shaded pixel at the image sample
  * distance (Pixels = viewport pixels / distance^2). Each pair (method,
  * translucent) has its own a, b, c: translucent frames sort and blend, so their
- * costs differ in kind, not only in size.
+ * costs differ in kind, not only in size. A translucent frame blended in one
+ * pass (FrameWork::Blended: VTK's weighted blended order-independent
+ * transparency, which ParaView's render view draws when depth peeling is off)
+ * is a third kind per method, with its own a, b, c: it has no peels, so it
+ * costs far less than a peeled frame, but more than an opaque one (issue 30:
+ * a Block LOD level-2 frame of the head CT took 1.6 times the opaque frame's
+ * renderer time on llvmpipe), and counting it as either kind mispredicts it
+ * and pulls that kind's fit.
  *
  * Why linear: a rasteriser's work is a sum over primitives and over fragments,
  * and the two counts are what a level (fewer active cells) and a sample
@@ -52,7 +59,8 @@
  * The anchor is the prior (Prior()), whose shape is a software renderer's
  * (llvmpipe, SwiftShader) as measured and whose size is conservative. A pair
  * without frames predicts its prior scaled as the frames of the same method
- * drawn the other way (opaque for translucent and back) scale theirs, else as
+ * drawn another way (opaque for translucent and back, the opaque for a
+ * blended pair) scale theirs, else as
  * the other method's do: how fast this machine is transfers, a fitted split
  * does not (a translucent frame's split differs in kind from an opaque one's:
  * depth peeling's full-viewport passes). Before any frame at all the prior
@@ -125,6 +133,10 @@ struct FrameWork
   std::uint64_t Primitives = 0; ///< active cell-isovalue pairs drawn, or triangles
   std::uint64_t Pixels = 0;     ///< pixels shaded: viewport pixels / (sample distance)^2
   bool Translucent = false;
+  /// With Translucent: the translucent layers blended in one pass (weighted blended
+  /// order-independent transparency: two floating-point targets and one full-viewport resolve)
+  /// instead of peeled or sorted; a kind of frame with coefficients of its own (BlendedPrior()).
+  bool Blended = false;
 
   // One-off work, done before the frame draws (0 when it only draws what is made):
   /// Elements the frame makes: the cells of the GPU volume levels whose pyramids it builds
@@ -165,6 +177,8 @@ public:
   /// The conservative coefficients used before a pair has frames, and the shape
   /// the fit is anchored to.
   static Coefficients Prior(FrameMethod method, bool translucent);
+  /// The same for translucent frames blended in one pass (FrameWork::Blended).
+  static Coefficients BlendedPrior(FrameMethod method);
 
   /// The three coefficients of a method's one-off work: seconds = PerProgram *
   /// Programs + PerElement * BuildElements + ExtractScale * ExtractSeconds.
@@ -198,6 +212,9 @@ public:
   bool HasObservations(FrameMethod method, bool translucent) const;
   /// Frames currently kept for a pair (at most HistoryLength).
   std::size_t ObservationCount(FrameMethod method, bool translucent) const;
+  /// Frames currently kept for the kind of frame `kind` is (its method, translucency and
+  /// whether it is blended in one pass; its counts do not matter).
+  std::size_t ObservationCount(const FrameWork& kind) const;
   /// The fitted coefficients of a pair (before any frame: its prior, scaled
   /// as another pair's frames scale theirs).
   Coefficients Fit(FrameMethod method, bool translucent) const;
@@ -246,12 +263,17 @@ private:
     OneOffCoefficients Fitted;
   };
   static std::size_t Key(FrameMethod method, bool translucent);
+  // The pair of a frame's kind: Key()'s, or its method's blended pair.
+  static std::size_t Key(const FrameWork& kind);
   static std::size_t MethodKey(FrameMethod method);
+  // The prior of a pair.
+  static Coefficients PriorOf(std::size_t key);
   // A pair's prediction before any of its frames: its prior, scaled as the
-  // same method drawn the other way scales its frames, else as the other
+  // same method drawn another way scales its frames, else as the other
   // method's do, else the prior.
-  Coefficients Anchor(FrameMethod method, bool translucent) const;
-  void Refit(FrameMethod method, bool translucent);
+  Coefficients Anchor(std::size_t key) const;
+  Coefficients FitOf(std::size_t key) const;
+  void Refit(std::size_t key);
   void RefitOneOff(FrameMethod method);
   // The robust, recency-weighted, non-negative fit of x in counts . x =
   // seconds, anchored to `anchor` scaled to the frames, relative to `prior`.
@@ -261,7 +283,8 @@ private:
     const std::vector<double>& anchored, const std::vector<double>& weight, const Vector3& anchor,
     double& priorScale);
 
-  std::array<Pair, 4> Pairs;
+  // Per method: opaque, translucent (peeled or sorted), translucent blended in one pass.
+  std::array<Pair, 6> Pairs;
   std::array<OneOffFit, 2> OneOffs;
 };
 

@@ -315,6 +315,52 @@ int main()
     Check(Near(model.Predict(coarseT), 0.2, 1e-9),
       "one translucent frame: predicted as measured (" + Number(model.Predict(coarseT)) + ")");
 
+    // Translucent frames blended in one pass (issue 30: ParaView's weighted
+    // blended order-independent pass, what a Block LOD display draws while
+    // the camera moves): a kind of their own, dearer than opaque frames of
+    // the same work and far cheaper than peeled ones. Before their first
+    // frame: their prior at the opaque frames' scale; their frames go to
+    // their own pair and leave the opaque and peeled predictions alone.
+    auto coarseB = coarseT;
+    coarseB.Blended = true;
+    auto levelTwoB = Work(FrameMethod::Triangles, 262016, viewport, true);
+    levelTwoB.Blended = true;
+    const FrameTimeModel::Coefficients pb = FrameTimeModel::BlendedPrior(FrameMethod::Triangles);
+    for (const auto& w : { coarseB, levelTwoB })
+    {
+      auto opaqueW = w;
+      opaqueW.Translucent = false;
+      Check(pb.Evaluate(w) > 1.4 * po.Evaluate(opaqueW) && pb.Evaluate(w) < pt.Evaluate(w),
+        "the blended prior lies between the opaque and the peeled ones (" +
+          Number(pb.Evaluate(w)) + " vs " + Number(po.Evaluate(opaqueW)) + " and " +
+          Number(pt.Evaluate(w)) + ")");
+    }
+    Check(Near(model.Predict(coarseB), 2.5 * pb.Evaluate(coarseB), 1e-6),
+      "no blended frame yet: the blended prior at the opaque frames' scale (" +
+        Number(model.Predict(coarseB)) + " vs " + Number(2.5 * pb.Evaluate(coarseB)) + ")");
+    const double opaqueBefore = model.Predict(coarse);
+    const double peeledBefore = model.Predict(coarseT);
+    const std::size_t opaqueFrames = model.ObservationCount(FrameMethod::Triangles, false);
+    for (int i = 0; i < 5; ++i)
+    {
+      model.Observe(coarseB, 1.6 * opaqueBefore);
+    }
+    Check(model.ObservationCount(coarseB) == 5 &&
+        model.ObservationCount(FrameMethod::Triangles, false) == opaqueFrames &&
+        model.ObservationCount(coarseT) == 1,
+      "blended frames are kept in a pair of their own (" +
+        std::to_string(model.ObservationCount(coarseB)) + " blended, " +
+        std::to_string(model.ObservationCount(FrameMethod::Triangles, false)) + " opaque)");
+    Check(Near(model.Predict(coarseB), 1.6 * opaqueBefore, 1e-6),
+      "blended frames: predicted as measured (" + Number(model.Predict(coarseB)) + " vs " +
+        Number(1.6 * opaqueBefore) + ")");
+    Check(model.Predict(coarse) == opaqueBefore && model.Predict(coarseT) == peeledBefore,
+      "and the opaque and peeled predictions are unchanged by them");
+    auto opaqueFlagged = coarse;
+    opaqueFlagged.Blended = true;
+    Check(model.Predict(opaqueFlagged) == opaqueBefore,
+      "an opaque frame is opaque whatever its Blended flag says");
+
     // Triangles never drawn, the cell rasteriser's frames three times its
     // prior: triangles predicted at three times theirs.
     FrameTimeModel gpu;
