@@ -303,20 +303,19 @@ void FrameTimeModel::Observe(const FrameWork& work, double seconds)
   Pair& pair = this->Pairs[Key(work)];
   if (work.HasOneOff())
   {
-    // Kept apart from the drawing frames. A pair without a drawing frame yet
-    // learns from this one too (else its next frame would again be predicted
-    // from the prior): the frame less its predicted one-off work (the
-    // estimator's seconds, or a rate learnt from other levels, are nearer
-    // this machine than an unseen pair's prior), but never less than half its
-    // share in proportion to the two predictions (one-off work predicted too
-    // long must not leave the drawing nothing).
-    if (pair.Samples.empty())
+    // Kept apart from the drawing frames, except where the drawing has to
+    // learn from it (OneOffTeachesDrawing).
+    if (this->OneOffTeachesDrawing(work, seconds))
     {
       const double drawing = this->PredictDrawing(work);
       const double oneOff = this->PredictOneOff(work);
       const double share = drawing + oneOff > 0.0 ? drawing / (drawing + oneOff) : 1.0;
       pair.Samples.push_back(
         { DrawingCounts(work), std::max(seconds - oneOff, 0.5 * share * seconds) });
+      while (pair.Samples.size() > HistoryLength)
+      {
+        pair.Samples.pop_front();
+      }
       this->Refit(Key(work));
     }
     OneOffFit& fit = this->OneOffs[MethodKey(work.Method)];
@@ -339,6 +338,29 @@ void FrameTimeModel::Observe(const FrameWork& work, double seconds)
   {
     this->RefitOneOff(work.Method);
   }
+}
+
+bool FrameTimeModel::OneOffTeachesDrawing(const FrameWork& work, double seconds) const
+{
+  // A pair without a drawing frame yet learns from this one (else its next
+  // frame would again be predicted from the prior). So does a pair whose
+  // drawing alone is predicted longer than this whole frame took: one-off
+  // work takes no less than nothing, so the drawing fit is wrong for this
+  // work, and the frame is the only news of it. That happens where a pair's
+  // first frame paid one-off work its prediction did not hold (the page's
+  // first frame on SwiftShader: a shader compile of seconds, against the
+  // prior's tens of milliseconds), so its drawing sample was that frame
+  // nearly whole, and every frame after it that drew more also made
+  // something (the CPU path uploads each level it switches to): without
+  // this, a drawing fit seeded 10-20x too slow met a drag unchanged (issue
+  // 30, the 512^3 phantom on the page's CPU path). Taken as the seed is:
+  // the frame less its predicted one-off work (the estimator's seconds, or a
+  // rate learnt from other levels, are nearer this machine than an unseen
+  // pair's prior), but never less than half its share in proportion to the
+  // two predictions (one-off work predicted too long must not leave the
+  // drawing nothing).
+  const Pair& pair = this->Pairs[Key(work)];
+  return pair.Samples.empty() || this->PredictDrawing(work) > seconds;
 }
 
 void FrameTimeModel::RefitOneOff(FrameMethod method)

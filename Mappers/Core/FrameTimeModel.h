@@ -87,7 +87,12 @@
  * non-negative fit anchored to OneOffPrior()). Its first frame at a pair
  * with no drawing frame yet teaches the drawing as well: the frame is split
  * between the two in proportion to their predictions, so the next frame is
- * not predicted from the bare prior again.
+ * not predicted from the bare prior again. So does a frame that took less
+ * than its drawing alone is predicted to take (one-off work cannot take less
+ * than nothing, so the drawing fit is wrong there): a first frame whose
+ * one-off work was far over its prediction (a shader compile on a software
+ * WebGL2) otherwise seeds a drawing fit many times too slow, which frames
+ * that always make something (a level switched to) never correct.
  *
  * Choose() picks on the drawing alone: the level a drag can hold, whose
  * one-off work is paid once (choosing on the whole frame would keep a drag on
@@ -275,6 +280,10 @@ private:
   Coefficients FitOf(std::size_t key) const;
   void Refit(std::size_t key);
   void RefitOneOff(FrameMethod method);
+  // Whether a frame with one-off work is also a sample of its pair's drawing:
+  // the pair has no drawing frame yet, or its drawing alone is predicted
+  // longer than the whole frame took.
+  bool OneOffTeachesDrawing(const FrameWork& work, double seconds) const;
   // The robust, recency-weighted, non-negative fit of x in counts . x =
   // seconds, anchored to `anchor` scaled to the frames, relative to `prior`.
   static Vector3 Solve(const std::deque<Sample>& samples, const Vector3& prior,
