@@ -517,9 +517,16 @@ FrameTimeModel::Vector3 FrameTimeModel::SolveWeighted(const std::vector<Vector3>
   // said the opposite of "not determined": on the 512^3 phantom two frames of
   // one level at distances 4 and 6, 1.6% apart the wrong way, made the pixels
   // free, and volume level 0 at distance 1 was predicted at 0.034 s for a
-  // frame of 0.146 s (docs/histopyramid.md, *The phantom's frame: the pixel
-  // term held*).
-  Vector3 best = priorPhi;
+  // frame of 0.146 s (docs/histopyramid.md, *The 512^3 phantom's frame*).
+  // An anchor below zero (the one-off fit's, when its frames took less than
+  // their drawing's prediction) is held at zero: nothing costs less than
+  // nothing, and the support with every coefficient held stays feasible.
+  Vector3 held;
+  for (int j = 0; j < 3; ++j)
+  {
+    held[j] = std::max(0.0, priorPhi[j]);
+  }
+  Vector3 best = held;
   double bestObjective = std::numeric_limits<double>::infinity();
   for (int mask = 0; mask < 8; ++mask)
   {
@@ -533,7 +540,7 @@ FrameTimeModel::Vector3 FrameTimeModel::SolveWeighted(const std::vector<Vector3>
       {
         if (!free[c])
         {
-          rhs[r] -= a[r][c] * priorPhi[c];
+          rhs[r] -= a[r][c] * held[c];
         }
       }
     }
@@ -546,7 +553,7 @@ FrameTimeModel::Vector3 FrameTimeModel::SolveWeighted(const std::vector<Vector3>
     {
       if (!free[j])
       {
-        phi[j] = priorPhi[j];
+        phi[j] = held[j];
       }
     }
     bool feasible = true;
