@@ -167,8 +167,8 @@ int main()
   }
 
   // Non-negative coefficients: frames whose unconstrained fit has a negative
-  // intercept (cost falls faster than the counts) get a = 0, and no
-  // prediction is negative.
+  // intercept (cost falls faster than the counts) do not determine it, which
+  // keeps the anchor's value (non-negative), and no prediction is negative.
   {
     FrameTimeModel model;
     const std::uint64_t p[] = { 1000000, 500000, 250000, 100000 };
