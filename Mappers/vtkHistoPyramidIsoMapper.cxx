@@ -156,6 +156,10 @@ struct vtkHistoPyramidIsoMapper::Internals
   // frame with this mapper (which creates the window and its context) is not
   // seen: the mapper starts to observe the window during it.
   mediso::FrameFixedCost WindowCost;
+  // How far the last interactive frames overran their predictions: the
+  // choice is made for the budget left divided by one plus that margin
+  // (mediso::FrameTimeSpread; issue 30, the 512^3 phantom's frame).
+  mediso::FrameTimeSpread Spread;
   vtkWeakPointer<vtkRenderWindow> Window;
   unsigned long WindowStartTag = 0;
   unsigned long WindowEndTag = 0;
@@ -275,6 +279,12 @@ const char* vtkHistoPyramidIsoMapper::GetLastRenderPathAsString() const
 double vtkHistoPyramidIsoMapper::GetWindowFixedSeconds() const
 {
   return this->Impl->WindowCost.Seconds();
+}
+
+//------------------------------------------------------------------------------
+double vtkHistoPyramidIsoMapper::GetPredictionMargin() const
+{
+  return this->Impl->Spread.Margin();
 }
 
 //------------------------------------------------------------------------------
@@ -551,8 +561,8 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   // The budget is the whole frame's: the window's cost outside this mapper,
   // measured over its last frames, is taken off it (see Internals::Watch).
   impl.Watch(ren->GetRenderWindow());
-  const double budget = impl.WindowCost.BudgetLeft(
-    this->InteractiveFrameBudget > 0.0 ? this->InteractiveFrameBudget : allocated);
+  const double budget = impl.Spread.BudgetLeft(impl.WindowCost.BudgetLeft(
+    this->InteractiveFrameBudget > 0.0 ? this->InteractiveFrameBudget : allocated));
   int width = 0, height = 0;
   ren->GetTiledSize(&width, &height);
   bool translucent = false;
@@ -634,6 +644,10 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       work.BuildElements = uploaded ? this->NumberOfFallbackTriangles : 0;
       work.Programs = impl.Warm.insert(Internals::TrianglesKey(translucent)).second ? 1 : 0;
       impl.Model.Observe(work, this->LastMeasuredSeconds);
+      if (interactive && !work.HasOneOff())
+      {
+        impl.Spread.Observe(this->LastPredictedSeconds, this->LastMeasuredSeconds);
+      }
     }
     impl.LevelTriangles[static_cast<std::size_t>(level)] =
       static_cast<double>(this->NumberOfFallbackTriangles);
@@ -727,6 +741,10 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       const std::pair<int, bool> key = Internals::GPUKey(this->LastLevel, chosenWork.Translucent);
       work.Programs = impl.Warm.insert(key).second ? 1 : 0;
       impl.Model.Observe(work, this->LastMeasuredSeconds);
+      if (interactive && !work.HasOneOff())
+      {
+        impl.Spread.Observe(this->LastPredictedSeconds, this->LastMeasuredSeconds);
+      }
     }
     else
     {

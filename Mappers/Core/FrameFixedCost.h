@@ -39,6 +39,9 @@
  * no frame observed Seconds() is 0, so a host's first frames choose as they
  * did before the window was measured.
  *
+ * FrameTimeSpread, below, keeps the other thing a host takes off its budget:
+ * how far its last interactive frames overran their predictions.
+ *
  * @sa FrameTimeModel
  */
 #ifndef mediso_FrameFixedCost_h
@@ -73,6 +76,62 @@ public:
   std::size_t GetNumberOfFrames() const { return this->Frames; }
 
   /// Forget every frame (a new window).
+  void Reset();
+
+private:
+  std::array<double, HistoryLength> Recent{};
+  std::size_t Frames = 0;
+};
+
+/**
+ * How far a host's chosen frames overran their predictions, measured on its
+ * last interactive frames, and the budget that leaves (issue 30, the 512^3
+ * phantom's interactive frame).
+ *
+ * A host chooses the finest candidate predicted within its budget. Where the
+ * candidates near the budget lie close together (a coarse level's frames at
+ * sample distances 4 to 8 all cost about its primitives), the chosen frame is
+ * predicted right at the budget, and a model that is right on average still
+ * puts half the frames over it; a model that misses the scene by a few
+ * percent (work it does not count, such as a reduced frame's composite up to
+ * the viewport) puts most of them over. The margin is what the frames show,
+ * not a constant: each interactive frame without one-off work gives its
+ * ratio measured / predicted, and
+ *
+ *     Margin() = (the Quantile-th of the last HistoryLength ratios) - 1, at least 0
+ *     BudgetLeft(budget) = budget / (1 + Margin())
+ *
+ * so that about three frames in four of a steady drag are predicted to fit
+ * with their own measured error. A model that predicts the frames it chose
+ * within their noise keeps a margin of that noise (a few percent on llvmpipe);
+ * one that over-predicts keeps none. A stalled frame is one ratio of nine and
+ * moves the quantile by one place.
+ *
+ * Bad input: a ratio that is not finite and positive (a prediction or a time
+ * not finite or not positive) is not observed; with none observed the margin
+ * is 0 and the budget is returned as it is.
+ */
+class FrameTimeSpread
+{
+public:
+  /// The frames whose ratios the quantile is taken over.
+  static constexpr std::size_t HistoryLength = 9;
+  /// The quantile of the ratios the margin is taken at (three frames in four).
+  static constexpr double Quantile = 0.75;
+
+  /// One interactive frame: its predicted and measured seconds (its drawing only).
+  void Observe(double predictedSeconds, double measuredSeconds);
+
+  /// The measured overrun the next choice allows for (0: none, or no frame yet).
+  double Margin() const;
+
+  /// `budget` / (1 + Margin()) (a non-finite or negative budget is returned as it is).
+  double BudgetLeft(double budget) const;
+
+  /// Frames observed so far (all of them, not only those kept).
+  std::size_t GetNumberOfFrames() const { return this->Frames; }
+
+  /// Forget every frame.
   void Reset();
 
 private:

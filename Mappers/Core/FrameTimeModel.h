@@ -37,7 +37,9 @@
  * frame counts as much as a 1 s one), weighted by recency (each newer frame
  * weighs 1 / RecencyDecay times the one before it, so a change of load or of
  * machine is followed within a few frames), with a, b, c >= 0 (solved exactly
- * over the 8 supports of the three coefficients). A frame sequence rarely
+ * over the 8 supports of the three coefficients; a coefficient the frames
+ * would make negative is not determined by them and keeps the anchor's value,
+ * below, rather than zero). A frame sequence rarely
  * varies all three counts (a rotation keeps both), so the fit is anchored to
  * the prior, scaled to the frames: a small ridge term pulls (a, b, c) towards
  * s * (a0, b0, c0), s the least-squares scale of the prior to the frames.

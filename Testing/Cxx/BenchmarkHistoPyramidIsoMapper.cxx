@@ -821,7 +821,7 @@ int main(int argc, char* argv[])
               opt.InteractiveLevels.find("triangles") != std::string::npos);
             scene.Window->SetDesiredUpdateRate(1000.0);
             std::vector<double> frameTimes, distances, predicted, measured, errors, levels, paths,
-              oneOff, fixedCost, budgetLeft;
+              oneOff, fixedCost, budgetLeft, margins;
             int within = 0;
             // Frames that made something before drawing (a level's build or
             // extraction, a program), and how many of them were within 25%.
@@ -831,6 +831,9 @@ int main(int argc, char* argv[])
             for (int f = 0; f < opt.Frames; ++f)
             {
               scene.Rotate(1.0);
+              // The margin this frame's choice divides its budget by (the
+              // last frames' measured overrun, GetPredictionMargin()).
+              margins.push_back(hp->GetPredictionMargin());
               frameTimes.push_back(scene.Frame());
               distances.push_back(hp->GetLastSampleDistance());
               levels.push_back(hp->GetLastLevel());
@@ -849,7 +852,8 @@ int main(int argc, char* argv[])
               // The window's cost outside the mapper that this frame took off
               // the budget, and the budget its drawing was chosen for.
               budgetLeft.push_back(hp->GetLastBudgetSeconds());
-              fixedCost.push_back(std::max(0.0, opt.InteractiveBudget - budgetLeft.back()));
+              fixedCost.push_back(
+                std::max(0.0, opt.InteractiveBudget - budgetLeft.back() * (1.0 + margins.back())));
               const double error =
                 std::abs(predicted.back() - measured.back()) / std::max(measured.back(), 1e-9);
               errors.push_back(error);
@@ -898,6 +902,8 @@ int main(int argc, char* argv[])
               .Add("frame_predicted_one_off_s", oneOff)
               .Add("frame_window_fixed_s", fixedCost)
               .Add("window_fixed_median_s", Summarise(fixedCost).Median)
+              .Add("frame_margin", margins)
+              .Add("margin_median", Summarise(margins).Median)
               .Add("one_off_frames", static_cast<double>(oneOffFrames))
               .Add("one_off_within_25", static_cast<double>(oneOffWithin))
               .Add("still_after_distance", hp->GetLastSampleDistance())

@@ -2,7 +2,8 @@
 // FrameFixedCost on synthetic frames: the window's cost outside a
 // representation is the median of the last frames' differences, a stalled
 // frame moves nothing, a lasting change is followed within half the history,
-// the budget left never goes below zero, and bad input is not observed.
+// the budget left never goes below zero, and bad input is not observed; and
+// FrameTimeSpread, the margin of the last frames' measured overrun.
 #include "FrameFixedCost.h"
 #include "MedicalTestUtilities.h"
 
@@ -107,6 +108,45 @@ int main()
     cost.Observe(0.5, 0.0);
     cost.Reset();
     Check(cost.GetNumberOfFrames() == 0 && cost.Seconds() == 0.0, "Reset forgets every frame");
+  }
+
+  // FrameTimeSpread: the margin is the 75th percentile of the last frames'
+  // measured / predicted ratios, less one, never below zero.
+  {
+    using mediso::FrameTimeSpread;
+    FrameTimeSpread spread;
+    Check(spread.Margin() == 0.0 && spread.BudgetLeft(0.1) == 0.1,
+      "spread: no frames, no margin, the whole budget");
+    spread.Observe(0.09, 0.099);
+    Check(
+      std::fabs(spread.Margin() - 0.1) < 1e-12 && std::fabs(spread.BudgetLeft(0.11) - 0.1) < 1e-12,
+      "spread: one frame 10% over, a 10% margin");
+    spread.Reset();
+    // The phantom's steady frames: most 1-3% over, one 10% over, one stalled.
+    const double ratios[] = { 1.01, 1.02, 1.03, 1.01, 1.10, 1.02, 3.0, 1.03, 1.02 };
+    for (double r : ratios)
+    {
+      spread.Observe(0.09, 0.09 * r);
+    }
+    Check(std::fabs(spread.Margin() - 0.03) < 1e-9,
+      "spread: the 7th of 9 ratios (a stall and one 10% frame move it one place)");
+    for (int i = 0; i < 9; ++i)
+    {
+      spread.Observe(0.09, 0.08);
+    }
+    Check(spread.Margin() == 0.0 && spread.BudgetLeft(0.1) == 0.1,
+      "spread: over-predicted frames keep no margin, once they are the history");
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const std::size_t frames = spread.GetNumberOfFrames();
+    spread.Observe(0.0, 0.1);
+    spread.Observe(0.1, 0.0);
+    spread.Observe(-0.1, 0.1);
+    spread.Observe(nan, 0.1);
+    spread.Observe(0.1, std::numeric_limits<double>::infinity());
+    Check(spread.GetNumberOfFrames() == frames,
+      "spread: zero, negative, NaN or infinite times are not observed");
+    Check(spread.BudgetLeft(-1.0) == -1.0 && std::isnan(spread.BudgetLeft(nan)),
+      "spread: a negative or NaN budget is returned as it is");
   }
 
   return medical_test::Finish("TestFrameFixedCostCore passed");
