@@ -169,7 +169,8 @@ public:
    * ratio, else weighed as a new one (a pool made for many bricks gives way
    * to a smaller one, or to the bricks' own pyramids, when the isovalues
    * come to cross few; bricks that the pool now holds within the ratio are
-   * drawn from one again). A change takes effect at the next SetVolume().
+   * drawn from one again). Turning the pool on or off takes effect at the
+   * next SetVolume().
    */
   void SetBrickPool(bool on);
   bool GetBrickPool() const;
