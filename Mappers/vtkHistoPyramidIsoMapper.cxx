@@ -711,6 +711,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     this->LastGPUPathWorked = true;
     this->FallbackReason.clear();
     this->GPUStats = gpu->GetStats();
+    this->LastBrickPoolReason = gpu->GetBrickPoolReason();
     this->LastFootprint = this->GPUStats.PointFootprint ? PointFootprint : BoxFootprint;
     this->LastSampleDistance = this->GPUStats.SampleDistance;
     this->LastLevel = this->GPUStats.Level;
@@ -882,6 +883,8 @@ void vtkHistoPyramidIsoMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "InteractiveAdjust: " << this->InteractiveAdjust << "\n";
   os << indent << "InteractiveFrameBudget: " << this->InteractiveFrameBudget << "\n";
   os << indent << "GPUMemoryBudget: " << this->GPUMemoryBudget << " MB\n";
+  os << indent << "LastBrickPoolSlots: " << this->GPUStats.PoolSlots << "\n";
+  os << indent << "LastBrickPoolReason: " << this->LastBrickPoolReason << "\n";
   os << indent << "InteractiveTriangleLevels: " << this->InteractiveTriangleLevels << "\n";
   os << indent << "InteractiveVolumeLevels: " << this->InteractiveVolumeLevels << "\n";
   os << indent << "LastInteractive: " << this->LastInteractive << "\n";

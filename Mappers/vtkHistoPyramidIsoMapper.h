@@ -263,6 +263,21 @@ public:
 
   ///@{
   /**
+   * Whether the last GPU frame drew a volume kept as bricks from the brick
+   * pool (the crossed bricks in the slots of one texture, one pyramid over
+   * them; mediso::IsosurfaceScene::SetBrickPool()): the pool's slots (0:
+   * no pool), and why not ("" where the pool drew them, and for one
+   * texture): the pool over the texture limit or the budget, or over
+   * mediso::IsosurfaceScene::MaximumPoolMemoryRatio the memory of the
+   * crossed bricks as their own pyramids, which then drew them. Decided again
+   * at each isovalue change.
+   */
+  std::uint64_t GetLastBrickPoolSlots() const { return this->GPUStats.PoolSlots; }
+  const std::string& GetLastBrickPoolReason() const { return this->LastBrickPoolReason; }
+  ///@}
+
+  ///@{
+  /**
    * Let an interactive GPU frame whose coarsest sample distance is still
    * predicted over the budget draw a coarser Block LOD level's triangles
    * instead (see the class description). Off: interactive GPU frames stay
@@ -474,6 +489,7 @@ private:
 
   int LastRenderPath = NoPath;
   std::string FallbackReason;
+  std::string LastBrickPoolReason;
   bool ForceCPUFallback = false;
   bool AllowPointFootprint = true;
   int LastFootprint = BoxFootprint;

@@ -172,6 +172,12 @@ const mediso::IsosurfaceSceneStats& vtkOpenGLHistoPyramidIsosurfaces::GetStats()
 }
 
 //------------------------------------------------------------------------------
+std::string vtkOpenGLHistoPyramidIsosurfaces::GetBrickPoolReason() const
+{
+  return this->Impl->Scene.GetBrickPoolReason();
+}
+
+//------------------------------------------------------------------------------
 std::uint64_t vtkOpenGLHistoPyramidIsosurfaces::GetGPUMemoryBytes() const
 {
   return this->Impl->Scene.GetGPUMemoryBytes();

@@ -111,6 +111,13 @@ public:
    */
   const mediso::IsosurfaceSceneStats& GetStats() const;
 
+  /**
+   * Why the last update of a volume kept as bricks drew them as their own
+   * pyramids and not from the pool ("" where the pool did, and for one
+   * texture): mediso::IsosurfaceScene::GetBrickPoolReason().
+   */
+  std::string GetBrickPoolReason() const;
+
   /// GPU memory held for the volume (volume and pyramid), and the first-hit buffers.
   std::uint64_t GetGPUMemoryBytes() const;
   std::uint64_t GetFrameBufferBytes() const;

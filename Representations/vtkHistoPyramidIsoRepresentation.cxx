@@ -280,6 +280,18 @@ double* vtkHistoPyramidIsoRepresentation::GetLastBricks()
 }
 
 //------------------------------------------------------------------------------
+double vtkHistoPyramidIsoRepresentation::GetBrickPoolSlots()
+{
+  return static_cast<double>(this->IsoMapper->GetLastBrickPoolSlots());
+}
+
+//------------------------------------------------------------------------------
+const char* vtkHistoPyramidIsoRepresentation::GetBrickPoolReason()
+{
+  return this->IsoMapper->GetLastBrickPoolReason().c_str();
+}
+
+//------------------------------------------------------------------------------
 const char* vtkHistoPyramidIsoRepresentation::GetFallbackReason()
 {
   return this->IsoMapper->GetFallbackReason().c_str();
@@ -639,6 +651,8 @@ void vtkHistoPyramidIsoRepresentation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "RenderPath: " << this->GetRenderPath() << "\n";
   os << indent << "Footprint: " << this->GetFootprint() << "\n";
   os << indent << "FallbackReason: " << this->IsoMapper->GetFallbackReason() << "\n";
+  os << indent << "BrickPoolSlots: " << this->IsoMapper->GetLastBrickPoolSlots() << "\n";
+  os << indent << "BrickPoolReason: " << this->IsoMapper->GetLastBrickPoolReason() << "\n";
   os << indent << "NumberOfPrimitives: " << this->IsoMapper->GetNumberOfPrimitives() << "\n";
   os << indent << "IsoMapper:\n";
   this->IsoMapper->PrintSelf(os, indent.GetNextIndent());

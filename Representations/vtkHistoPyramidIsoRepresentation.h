@@ -150,6 +150,16 @@ public:
 
   ///@{
   /**
+   * Whether the last GPU frame drew those bricks from the brick pool: its
+   * slots (0: no pool), and why not ("" where the pool drew them, and for
+   * one texture; vtkHistoPyramidIsoMapper::GetLastBrickPoolReason()).
+   */
+  double GetBrickPoolSlots();
+  const char* GetBrickPoolReason();
+  ///@}
+
+  ///@{
+  /**
    * What the last frame on this process did: interactive (1) or still (0),
    * its image sample distance and Block LOD level, the seconds predicted
    * and measured (see vtkHistoPyramidIsoMapper). Doubles for the

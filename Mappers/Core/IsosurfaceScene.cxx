@@ -153,6 +153,9 @@ struct IsosurfaceScene::Internals
   std::unordered_map<std::int64_t, int> PoolSlot;
   BrickResidency PoolResidency;
   bool PoolDrawn = false;
+  // The pool's GPU memory as ChoosePoolSlots() estimated it when it was made,
+  // weighed again at every isovalue change (KeepsPool()).
+  std::uint64_t PoolBytes = 0;
   // Why the last update of a bricked volume drew its bricks without the
   // pool ("" where the pool held them).
   std::string PoolReason;
@@ -200,6 +203,7 @@ struct IsosurfaceScene::Internals
     this->PoolSlot.clear();
     this->PoolResidency.Clear();
     this->PoolDrawn = false;
+    this->PoolBytes = 0;
     this->Stats.PoolSlots = 0;
   }
   void ReleaseBrickPyramids()
@@ -229,6 +233,7 @@ struct IsosurfaceScene::Internals
   bool UpdatePool(const std::vector<std::int64_t>& active, const std::vector<double>& values,
     bool& held, std::string& error);
   bool ChoosePoolSlots(std::size_t count, int side, int slots[3], std::uint64_t& bytes) const;
+  bool KeepsPool(const std::vector<std::int64_t>& active, std::uint64_t own) const;
   std::vector<std::int64_t> VisibilityOrder(const IsosurfaceFrame& frame) const;
   std::vector<IsosurfacePiece> Pieces(const IsosurfaceFrame& frame) const;
 };
@@ -488,6 +493,10 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
       " of its " + std::to_string(this->Grid.GetNumberOfBricks()) +
       " bricks that the isovalues cross need " + Megabytes(need) +
       " of GPU memory, over the budget of " + Megabytes(this->GetBudget());
+    // Neither the pool nor the bricks' own pyramids draw them (a pool there
+    // is stays for the next isovalues that fit).
+    this->PoolReason = "the " + std::to_string(active.size()) + " crossed bricks need " +
+      Megabytes(need) + " of GPU memory, over the budget of " + Megabytes(this->GetBudget());
     return false;
   }
   stats.BrickPyramidBuilds = 0;
@@ -624,6 +633,22 @@ bool IsosurfaceScene::Internals::ChoosePoolSlots(
   return fewest > 0;
 }
 
+// Whether the pool there is stays for the `active` bricks, whose own
+// pyramids take `own` bytes: it holds them, within MaximumPoolMemoryRatio of
+// `own`, the bound a new pool is made within. A pool made for more bricks
+// (room for 32 when 18 were crossed) is otherwise weighed again as a new one
+// when the isovalues come to cross fewer or thinner bricks (a smaller pool
+// is made, or none), so that whether the pool draws follows the current
+// isovalues, not those the pool was made for. No brick crossed keeps none,
+// as a scene with no pool yet would decide.
+bool IsosurfaceScene::Internals::KeepsPool(
+  const std::vector<std::int64_t>& active, std::uint64_t own) const
+{
+  return this->Pool && !active.empty() &&
+    static_cast<std::size_t>(this->Pool->GetNumberOfSlots()) >= active.size() &&
+    static_cast<double>(this->PoolBytes) <= MaximumPoolMemoryRatio * static_cast<double>(own);
+}
+
 // The active bricks in the pool and the pool's pyramid built over them.
 // `held` false (and nothing changed but the pool let go) where the pool
 // cannot hold them; else the result is the build's.
@@ -637,20 +662,21 @@ bool IsosurfaceScene::Internals::UpdatePool(const std::vector<std::int64_t>& act
   {
     side *= 2;
   }
-  if (!this->Pool || static_cast<std::size_t>(this->Pool->GetNumberOfSlots()) < active.size())
+  // A slot is a cube of a power of two: it holds a brick of 2^k - 8 points
+  // with a margin (27 points in 32, 59 in 64), but a brick thinner than the
+  // slot on an axis (96x96x251 points in 256, a long thin volume's) fills a
+  // fraction of it, and the pool's texture and pyramid, cubes of slots, then
+  // hold several times the bricks' own pyramids (those of 96x96x251 padded
+  // to 128x128x256). The pool is weighed against what the same bricks cost
+  // as their own pyramids and made or kept only within
+  // MaximumPoolMemoryRatio of it.
+  std::uint64_t own = 0;
+  for (const std::int64_t brick : active)
   {
-    // A slot is a cube of a power of two: it holds a brick of 2^k - 8 points
-    // with a margin (27 points in 32, 59 in 64), but a brick thinner than the
-    // slot on an axis (96x96x251 points in 256, a long thin volume's) fills a
-    // fraction of it, and the pool's texture and pyramid, cubes of slots, then
-    // hold several times the bricks' own pyramids (those of 96x96x251 padded
-    // to 128x128x256). The pool is weighed against what the same bricks cost
-    // as their own pyramids and made only within MaximumPoolMemoryRatio of it.
-    std::uint64_t own = 0;
-    for (const std::int64_t brick : active)
-    {
-      own += this->BrickBytes(brick);
-    }
+    own += this->BrickBytes(brick);
+  }
+  if (!this->KeepsPool(active, own))
+  {
     // Room for the next power of two of bricks where that fits and stays
     // within the ratio: a growing set of bricks then seldom makes a new pool
     // (and uploads every brick again), and the pyramid, whose levels are
@@ -720,6 +746,7 @@ bool IsosurfaceScene::Internals::UpdatePool(const std::vector<std::int64_t>& act
     this->PoolBrick.assign(count, -1);
     this->PoolOwns.assign(count, 0);
     this->PoolResidency.SetBudget(count);
+    this->PoolBytes = bytes;
     stats.PoolSlots = count;
   }
   held = true;

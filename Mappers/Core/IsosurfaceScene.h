@@ -164,14 +164,20 @@ public:
    * bricks as their own pyramids (bricks thinner than their cubic slots, as a
    * long thin volume's: 96x96x251 points in slots of 256), they are drawn as
    * their own pyramids, as with the pool off, and GetBrickPoolReason() says
-   * why. A change takes effect at the next SetVolume().
+   * why. The choice is made again at every isovalue change for the bricks
+   * the new isovalues cross: a pool is kept while it holds them within that
+   * ratio, else weighed as a new one (a pool made for many bricks gives way
+   * to a smaller one, or to the bricks' own pyramids, when the isovalues
+   * come to cross few; bricks that the pool now holds within the ratio are
+   * drawn from one again). Turning the pool on or off takes effect at the
+   * next SetVolume().
    */
   void SetBrickPool(bool on);
   bool GetBrickPool() const;
   ///@}
 
   /**
-   * The most GPU memory a new pool may take, as a multiple of the active
+   * The most GPU memory a pool may take, made or kept, as a multiple of the active
    * bricks' own pyramids (each brick's texture and its pyramid padded to
    * powers of two): 3. A cube brick's slot alone costs up to 1.66x its own
    * pyramid (27 points in 32: the texture's margin), a volume's last bricks
@@ -187,8 +193,9 @@ public:
    * Why the last update of a volume kept as bricks drew its active bricks
    * as their own pyramids and not from the pool (the pool off, a pool over
    * the limit or the budget, or over MaximumPoolMemoryRatio, with its bytes
-   * and the bricks'); "" where the pool holds them or the volume is one
-   * texture.
+   * and the bricks'), or that the active bricks alone are over the budget
+   * (the update failed: neither draws them); "" where the pool holds them or
+   * the volume is one texture.
    */
   std::string GetBrickPoolReason() const;
 

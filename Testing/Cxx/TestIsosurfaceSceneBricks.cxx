@@ -237,6 +237,223 @@ void RunCases(const std::shared_ptr<const GLApi>& gl, Target& target, const std:
   dense.Release();
   bricked.Release();
 }
+
+// A ramp along x over `dims` (each value its point's x), so that an isovalue between two whole
+// numbers crosses one column of bricks, all of it.
+std::vector<std::int16_t> MakeRamp(const int dims[3])
+{
+  std::vector<std::int16_t> ramp(static_cast<std::size_t>(dims[0]) * dims[1] * dims[2]);
+  for (std::size_t i = 0; i < ramp.size(); ++i)
+  {
+    ramp[i] = static_cast<std::int16_t>(i % static_cast<std::size_t>(dims[0]));
+  }
+  return ramp;
+}
+
+// A scene kept as bricks (a texture limit of 128 and `budget`), the pool on or off.
+void SetUpBricks(
+  IsosurfaceScene& scene, const std::shared_ptr<const GLApi>& gl, std::uint64_t budget, bool pool)
+{
+  scene.SetContext(gl);
+  scene.SetMaxTextureSize(128);
+  scene.SetGPUMemoryBudget(budget);
+  scene.SetBrickPool(pool);
+}
+
+// What a bricked scene made for `isos` alone does with `volume`.
+struct Alone
+{
+  bool Updated = false;
+  std::uint64_t PoolSlots = 0;
+  std::uint64_t Bytes = 0;
+  std::string Reason;
+};
+
+Alone UpdateAlone(const std::shared_ptr<const GLApi>& gl, const VolumeDescription& volume,
+  const std::vector<double>& isos, std::uint64_t budget, bool pool)
+{
+  IsosurfaceScene scene(nullptr);
+  SetUpBricks(scene, gl, budget, pool);
+  std::vector<IsosurfaceLook> looks;
+  for (const double iso : isos)
+  {
+    looks.push_back(Look(iso, 1, 1, 1, 1));
+  }
+  scene.SetSurfaces(looks);
+  std::string error;
+  Alone alone;
+  alone.Updated = scene.SetVolume(volume, error) && scene.IsBricked() && scene.Update(error);
+  alone.PoolSlots = scene.GetStats().PoolSlots;
+  alone.Bytes = scene.GetGPUMemoryBytes();
+  alone.Reason = scene.GetBrickPoolReason();
+  scene.Release();
+  return alone;
+}
+
+// What a run of isovalue changes showed: a pool, the bricks' own pyramids, active bricks over
+// the budget, a pool given up for a smaller one.
+struct PoolChanges
+{
+  bool Pooled = false, Own = false, Over = false, MadeSmaller = false;
+};
+
+// One scene over `values` taken through `changes` (each a list of isovalues); after each it
+// draws as a scene made for those isovalues alone decides: from the pool, from the bricks' own
+// pyramids with the same reason, or not at all with the same over-budget reason; its count the
+// dense volume's brute-force count, its frame's primitives that count, and a pool within
+// MaximumPoolMemoryRatio the GPU memory of the same bricks as their own pyramids.
+PoolChanges RunPoolChanges(const std::shared_ptr<const GLApi>& gl, Target& target,
+  const std::vector<std::int16_t>& values, const int dims[3], std::uint64_t budget,
+  const std::vector<std::vector<double>>& changes, const std::string& prefix)
+{
+  VolumeDescription volume;
+  volume.Type = ScalarType::Int16;
+  volume.Data = values.data();
+  std::copy(dims, dims + 3, volume.Dims);
+  volume.Stamp = 1;
+  std::string error;
+  IsosurfaceScene scene(nullptr);
+  SetUpBricks(scene, gl, budget, true);
+  Check(scene.SetVolume(volume, error) && scene.IsBricked(), prefix + ": bricks (" + error + ")");
+  PoolChanges seen;
+  std::uint64_t lastSlots = 0;
+  for (std::size_t i = 0; i < changes.size(); ++i)
+  {
+    const std::vector<double>& isos = changes[i];
+    std::string name = prefix + ", change " + std::to_string(i) + " to";
+    std::vector<IsosurfaceLook> looks;
+    for (const double iso : isos)
+    {
+      char text[32];
+      std::snprintf(text, sizeof(text), " %g", iso);
+      name += text;
+      looks.push_back(Look(iso, 1, 1, 1, 1));
+    }
+    const Alone fresh = UpdateAlone(gl, volume, isos, budget, true);
+    scene.SetSurfaces(looks);
+    error.clear();
+    const bool updated = scene.Update(error);
+    const IsosurfaceSceneStats& s = scene.GetStats();
+    const std::string reason = scene.GetBrickPoolReason();
+    std::printf("%s: %s, %llu active, %llu pool slots (alone %llu), %llu pyramids built, %llu GPU "
+                "bytes%s%s\n",
+      name.c_str(), updated ? "drawn" : "not drawn",
+      static_cast<unsigned long long>(s.ActiveBricks), static_cast<unsigned long long>(s.PoolSlots),
+      static_cast<unsigned long long>(fresh.PoolSlots),
+      static_cast<unsigned long long>(s.BrickPyramidBuilds),
+      static_cast<unsigned long long>(scene.GetGPUMemoryBytes()), reason.empty() ? "" : ": ",
+      reason.c_str());
+    Check(updated == fresh.Updated && (!updated || (s.PoolSlots > 0) == (fresh.PoolSlots > 0)) &&
+        reason == fresh.Reason,
+      name + ": decided as a scene made for these isovalues alone (" +
+        (fresh.PoolSlots > 0 ? std::string("the pool") : "no pool: " + fresh.Reason) + ")");
+    if (!updated)
+    {
+      seen.Over = true;
+      Check(s.OverBudget && error.find("over the budget") != std::string::npos &&
+          reason.find("over the budget") != std::string::npos,
+        name + ": over the budget, said by the update and the pool's reason (" + error + ")");
+      continue;
+    }
+    const std::uint64_t expected = BruteForceCount(values, dims, isos);
+    Check(scene.GetActivePairs() == expected, name + ": the dense volume's count");
+    std::string drawError;
+    Check(!target.Draw(scene, View(dims, 20.0 * static_cast<double>(i), 10, false), drawError)
+             .empty() &&
+        scene.GetStats().Primitives == expected,
+      name + ": drawn, its primitives the count (" + drawError + ")");
+    if (s.PoolSlots > 0)
+    {
+      seen.Pooled = true;
+      Check(reason.empty() && s.BrickPyramidBuilds == 1, name + ": one pyramid over the pool");
+      const std::uint64_t own = UpdateAlone(gl, volume, isos, budget, false).Bytes;
+      Check(static_cast<double>(scene.GetGPUMemoryBytes()) <=
+          IsosurfaceScene::MaximumPoolMemoryRatio * static_cast<double>(own),
+        name + ": the pool within the ratio of the bricks' own pyramids (" + std::to_string(own) +
+          " bytes)");
+      seen.MadeSmaller = seen.MadeSmaller || (lastSlots > 0 && s.PoolSlots < lastSlots);
+      lastSlots = s.PoolSlots;
+    }
+    else
+    {
+      seen.Own = true;
+      Check(s.BrickPyramidBuilds == s.ActiveBricks && !reason.empty(),
+        name + ": each brick its own pyramid, with the reason");
+      lastSlots = 0;
+    }
+  }
+  scene.Release();
+  return seen;
+}
+
+// Whether the pool draws follows the isovalues of each change, not those it was made for
+// (issue 31: the pool re-checked when the crossed bricks change), in bricks of 56 points.
+void CheckPoolFollowsIsovalues(const std::shared_ptr<const GLApi>& gl, Target& target)
+{
+  const int dims[3] = { 150, 130, 120 };
+  // On the ramp, the columns of bricks x 0-55 (isovalue 30.5), 56-111 (85.5) and 112-149
+  // (130.5: 38 points wide, so thin that a pool would take over MaximumPoolMemoryRatio their own
+  // pyramids). The budget holds a pool of two columns: one column's pool, the thin column's
+  // own pyramids, back, two columns' pool (room for 20), one column again (a pool of 20 slots
+  // for 9 bricks would be over the ratio: a smaller pool), the thin column after it (9 bricks
+  // that the pool's 10 slots would hold, over the ratio: their own pyramids).
+  {
+    const std::vector<std::int16_t> ramp = MakeRamp(dims);
+    VolumeDescription volume;
+    volume.Type = ScalarType::Int16;
+    volume.Data = ramp.data();
+    std::copy(dims, dims + 3, volume.Dims);
+    const std::vector<double> one = { 30.5 }, two = { 30.5, 85.5 }, thin = { 130.5 };
+    const std::uint64_t budget = UpdateAlone(gl, volume, two, 24u << 20, true).Bytes;
+    const PoolChanges seen = RunPoolChanges(gl, target, ramp, dims, budget,
+      { one, thin, one, two, one, thin, two, thin }, "pool follows the isovalues, ramp");
+    Check(seen.Pooled && seen.Own && seen.MadeSmaller,
+      "pool follows the isovalues, ramp: the pool, the bricks' own pyramids and a smaller pool "
+      "for fewer bricks were all seen");
+  }
+  // Blobs of -2000 in one brick and -1000 in three others (-1500 crosses one brick, -500 four),
+  // and spikes of 1000 every 8 points (500 crosses all 27 bricks). The budget is below what all
+  // the bricks take as their own pyramids: the four bricks' pool, all of them over the budget,
+  // the pool back, one brick (a smaller pool), over the budget, one brick, four.
+  {
+    std::vector<std::int16_t> values(static_cast<std::size_t>(dims[0]) * dims[1] * dims[2], 0);
+    const int blobs[4][4] = { { 28, 28, 28, -2000 }, { 84, 28, 28, -1000 }, { 28, 84, 28, -1000 },
+      { 84, 84, 84, -1000 } };
+    for (int z = 0; z < dims[2]; ++z)
+    {
+      for (int y = 0; y < dims[1]; ++y)
+      {
+        for (int x = 0; x < dims[0]; ++x)
+        {
+          std::int16_t v = (x % 8 == 4 && y % 8 == 4 && z % 8 == 4) ? 1000 : 0;
+          for (const auto& b : blobs)
+          {
+            const int dx = x - b[0], dy = y - b[1], dz = z - b[2];
+            v = dx * dx + dy * dy + dz * dz <= 100 ? static_cast<std::int16_t>(b[3]) : v;
+          }
+          values[(static_cast<std::size_t>(z) * dims[1] + y) * dims[0] + x] = v;
+        }
+      }
+    }
+    VolumeDescription volume;
+    volume.Type = ScalarType::Int16;
+    volume.Data = values.data();
+    std::copy(dims, dims + 3, volume.Dims);
+    const std::vector<double> oneBrick = { -1500.5 }, fourBricks = { -500.5 }, all = { 500.5 };
+    const std::uint64_t pool = UpdateAlone(gl, volume, fourBricks, 24u << 20, true).Bytes;
+    const std::uint64_t own = UpdateAlone(gl, volume, all, 24u << 20, false).Bytes;
+    std::printf("pool follows the isovalues, blobs: four bricks' pool %llu bytes, all bricks' own "
+                "pyramids %llu\n",
+      static_cast<unsigned long long>(pool), static_cast<unsigned long long>(own));
+    Check(pool < own, "pool follows the isovalues, blobs: the pool of four below all bricks");
+    const PoolChanges seen = RunPoolChanges(gl, target, values, dims, (pool + own) / 2,
+      { fourBricks, all, fourBricks, oneBrick, all, oneBrick, fourBricks },
+      "pool follows the isovalues, blobs");
+    Check(seen.Pooled && seen.Over && seen.MadeSmaller,
+      "pool follows the isovalues, blobs: the pool, over the budget and back, and a smaller pool "
+      "for fewer bricks were all seen");
+  }
+}
 } // namespace
 
 int main(int argc, char* argv[])
@@ -411,11 +628,7 @@ int main(int argc, char* argv[])
     // recently used inactive bricks give up their slots to new ones, the pool stays. A ramp
     // along x, so that each isovalue crosses one column of 3x3 bricks of 56 points.
     {
-      std::vector<std::int16_t> ramp(static_cast<std::size_t>(large[0]) * large[1] * large[2]);
-      for (std::size_t i = 0; i < ramp.size(); ++i)
-      {
-        ramp[i] = static_cast<std::int16_t>(i % static_cast<std::size_t>(large[0]));
-      }
+      const std::vector<std::int16_t> ramp = MakeRamp(large);
       VolumeDescription largeVolume = volume;
       largeVolume.Data = ramp.data();
       std::copy(large, large + 3, largeVolume.Dims);
@@ -509,6 +722,7 @@ int main(int argc, char* argv[])
       "default limits: one texture again, the same count (" + error + ")");
     scene.Release();
   }
+  CheckPoolFollowsIsovalues(gl, target);
   return medical_test::Finish(
     es ? "TestIsosurfaceSceneBricks es passed" : "TestIsosurfaceSceneBricks gl passed");
 }

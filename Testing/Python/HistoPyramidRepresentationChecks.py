@@ -140,6 +140,9 @@ def render_info(display, location=vtkPVSession.RENDER_SERVER):
         "framebuffer_bytes": int(value("HistoPyramidFrameBufferBytes")),
         # the bricks the volume is kept as (0: one texture), those the isovalues cross, resident
         "bricks": [int(b) for b in display.GetProperty("HistoPyramidLastBricks")],
+        # the brick pool's slots the last GPU frame drew those bricks from (0: none), and why not
+        "pool_slots": int(value("HistoPyramidBrickPoolSlots")),
+        "pool_reason": value("HistoPyramidBrickPoolReason"),
     }
 
 
