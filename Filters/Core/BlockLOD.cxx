@@ -552,7 +552,13 @@ template <typename T>
 Volume<T> MakeCoarseCopy(const Volume<T>& full, int level, std::vector<T>& storage,
   const ParallelFor& parallel)
 {
-  const int stride = LevelStride(level);
+  return MakeStrideCopy(full, LevelStride(level), storage, parallel);
+}
+
+template <typename T>
+Volume<T> MakeStrideCopy(const Volume<T>& full, int stride, std::vector<T>& storage,
+  const ParallelFor& parallel)
+{
   Volume<T> coarse = full;
   coarse.SampleStride = stride;
   std::vector<int> points[3];
@@ -1215,6 +1221,7 @@ BlockSums CountBlocks(const Volume<T>& volume, const BlockRanges& ranges, Triang
 
 #define MEDISO_INSTANTIATE(T)                                                                      \
   template Volume<T> MakeCoarseCopy<T>(const Volume<T>&, int, std::vector<T>&, const ParallelFor&); \
+  template Volume<T> MakeStrideCopy<T>(const Volume<T>&, int, std::vector<T>&, const ParallelFor&); \
   template void ComputeBlockRanges<T>(const Volume<T>&, BlockRanges&, const ParallelFor&);         \
   template bool PlanExtraction<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable, double, \
     int, ExtractionPlan&, const ParallelFor&, const std::function<bool()>&);                       \

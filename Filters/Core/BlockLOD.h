@@ -191,6 +191,14 @@ template <typename T>
 Volume<T> MakeCoarseCopy(const Volume<T>& full, int level, std::vector<T>& storage,
   const ParallelFor& parallel);
 
+/// MakeCoarseCopy's samples at any stride, a power of two (1 returns a copy
+/// of the volume): every stride-th point and the last of each axis. The GPU
+/// path's volume level -1 (stride 16, IsosurfaceScene::CoarsestLevel) samples
+/// the volume this way, coarser than any Block LOD level.
+template <typename T>
+Volume<T> MakeStrideCopy(const Volume<T>& full, int stride, std::vector<T>& storage,
+  const ParallelFor& parallel);
+
 /// Computes BlockRanges of a volume (one read of the data, in parallel).
 template <typename T>
 void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const ParallelFor& parallel);

@@ -78,7 +78,8 @@ struct IsosurfaceFrame
   /// The volume level drawn: 3 the volume itself; 2, 1 or 0 its samples at Block LOD's strides
   /// 2, 4 or 8 (BlockLOD.h's LevelStride(), the samples of vtkBlockLODContour's levels), a
   /// coarse volume with its own pyramid that IsosurfaceScene makes on the level's first frame
-  /// (interactive frames: about 1 / stride^2 of the primitives). Its cells are drawn
+  /// (interactive frames: about 1 / stride^2 of the primitives); -1 the samples at stride 16,
+  /// the GPU path's own (IsosurfaceScene::CoarsestLevel). Its cells are drawn
   /// stride times larger, so the frame shows the exact trilinear surface of the coarse volume
   /// where the level's cells are (see IsosurfaceScene::UpdateLevel()).
   int Level = 3;

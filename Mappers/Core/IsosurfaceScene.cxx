@@ -35,8 +35,10 @@ bool SameVolume(const VolumeDescription& a, const VolumeDescription& b)
     std::equal(a.Dims, a.Dims + 3, b.Dims);
 }
 
-// The full level (the volume itself) and the coarse ones below it, as Block LOD numbers them.
+// The full level (the volume itself) and the coarse ones below it, as Block LOD numbers them,
+// down to the scene's own CoarsestLevel (-1).
 constexpr int FullLevel = NumberOfLevels - 1;
+constexpr int CoarseLevels = FullLevel - IsosurfaceScene::CoarsestLevel;
 
 // Points a brick's texture holds: the points its cells and their gradients read.
 constexpr int BrickApron = 1;
@@ -77,16 +79,20 @@ struct IsosurfaceScene::Internals
   VolumeDescription Volume;
   std::vector<double> BuiltValues;
 
-  // The coarse levels (index = level, 0 to 2): made on a level's first frame, forgotten
-  // with the volume.
+  // The coarse levels (index = level - CoarsestLevel, levels -1 to 2: At()): made on a level's
+  // first frame, forgotten with the volume.
   struct CoarseLevel
   {
     std::unique_ptr<HistoPyramidGL> Pyramid;
     std::vector<double> BuiltValues;
   };
-  std::array<CoarseLevel, FullLevel> Coarse;
+  std::array<CoarseLevel, CoarseLevels> Coarse;
   // A coarse level's samples from the host (SetCoarseSource(); null Data: sampled here).
-  std::array<VolumeDescription, FullLevel> CoarseSources;
+  std::array<VolumeDescription, CoarseLevels> CoarseSources;
+  static std::size_t At(int level)
+  {
+    return static_cast<std::size_t>(level - IsosurfaceScene::CoarsestLevel);
+  }
 
   // Streaming (BeginStreaming()): the runs of BlockCells points per axis that hold their values.
   struct Streaming
@@ -1034,13 +1040,13 @@ bool IsosurfaceScene::UpdateLevel(int level, std::string& error)
   {
     return this->Update(error);
   }
-  if (level < 0 || level > FullLevel)
+  if (level < CoarsestLevel || level > FullLevel)
   {
-    error = "no volume level " + std::to_string(level) + " (levels are 0 to 3)";
+    error = "no volume level " + std::to_string(level) + " (levels are -1 to 3)";
     return false;
   }
   std::vector<double> values = impl.Values();
-  Internals::CoarseLevel& coarse = impl.Coarse[static_cast<std::size_t>(level)];
+  Internals::CoarseLevel& coarse = impl.Coarse[Internals::At(level)];
   if (values.empty() || (impl.HasVolume && coarse.Pyramid && values == coarse.BuiltValues))
   {
     return true;
@@ -1069,8 +1075,8 @@ bool IsosurfaceScene::UpdateLevel(int level, std::string& error)
 // every level). A streaming volume's values are not all there: only a host's samples then.
 bool IsosurfaceScene::Internals::UploadCoarse(int level, std::string& error)
 {
-  CoarseLevel& coarse = this->Coarse[static_cast<std::size_t>(level)];
-  const VolumeDescription& source = this->CoarseSources[static_cast<std::size_t>(level)];
+  CoarseLevel& coarse = this->Coarse[At(level)];
+  const VolumeDescription& source = this->CoarseSources[At(level)];
   coarse.Pyramid.reset(new HistoPyramidGL(this->GL));
   bool uploaded = false;
   if (source.Data)
@@ -1094,7 +1100,7 @@ bool IsosurfaceScene::Internals::UploadCoarse(int level, std::string& error)
         std::copy(this->Volume.Dims, this->Volume.Dims + 3, full.Dims);
         std::vector<T> samples;
         const mediso::Volume<T> sampled =
-          MakeCoarseCopy(full, level, samples, SerialIfEmpty(this->Parallel));
+          MakeStrideCopy(full, VolumeLevelStride(level), samples, SerialIfEmpty(this->Parallel));
         uploaded = coarse.Pyramid->UploadVolume(
           this->Volume.Type, samples.data(), sampled.Dims, this->Parallel, error);
       });
@@ -1110,9 +1116,9 @@ bool IsosurfaceScene::SetCoarseSource(
   int level, const VolumeDescription& samples, std::string& error)
 {
   Internals& impl = *this->Impl;
-  if (level < 0 || level >= FullLevel)
+  if (level < CoarsestLevel || level >= FullLevel)
   {
-    error = "no coarse volume level " + std::to_string(level) + " (coarse levels are 0 to 2)";
+    error = "no coarse volume level " + std::to_string(level) + " (coarse levels are -1 to 2)";
     return false;
   }
   if (samples.Data && (samples.Dims[0] < 2 || samples.Dims[1] < 2 || samples.Dims[2] < 2))
@@ -1120,8 +1126,8 @@ bool IsosurfaceScene::SetCoarseSource(
     error = "a coarse level's samples need at least 2 points per axis, not " + Size(samples.Dims);
     return false;
   }
-  impl.CoarseSources[static_cast<std::size_t>(level)] = samples;
-  Internals::CoarseLevel& coarse = impl.Coarse[static_cast<std::size_t>(level)];
+  impl.CoarseSources[Internals::At(level)] = samples;
+  Internals::CoarseLevel& coarse = impl.Coarse[Internals::At(level)];
   if (coarse.Pyramid)
   {
     coarse.Pyramid->Release();
@@ -1197,12 +1203,13 @@ bool IsosurfaceScene::BeginStreaming(std::string& error)
   impl.Stream = std::move(stream);
   impl.Pyramid->EmptyTiles();
   impl.BuiltValues.clear();
-  for (std::size_t level = 1; level < impl.Coarse.size(); ++level)
+  for (int level = CoarsestLevel; level < FullLevel; ++level)
   {
-    // Levels 1 and 2 were sampled from values that have not arrived.
-    if (!impl.CoarseSources[level].Data)
+    // Levels -1, 1 and 2 were sampled from values that have not arrived (level 0 is the
+    // server's, SetCoarseSource()).
+    if (level != 0 && !impl.CoarseSources[Internals::At(level)].Data)
     {
-      this->SetCoarseSource(static_cast<int>(level), VolumeDescription(), error);
+      this->SetCoarseSource(level, VolumeDescription(), error);
     }
   }
   return true;
@@ -1266,7 +1273,7 @@ bool IsosurfaceScene::EndStreaming(std::string& error)
   }
   const bool whole = impl.Stream.Missing == 0;
   impl.Stream = Internals::Streaming();
-  for (int level = 0; level < FullLevel; ++level)
+  for (int level = CoarsestLevel; level < FullLevel; ++level)
   {
     this->SetCoarseSource(level, VolumeDescription(), error);
   }
@@ -1318,8 +1325,8 @@ bool IsosurfaceScene::Render(const IsosurfaceFrame& frame, std::string& error)
     // level's cells are. A last cell shorter than the stride (an axis of n points with
     // (n - 1) % stride != 0) is drawn a whole stride long: up to stride - 1 voxels past
     // the volume's far faces, in interactive frames only.
-    pyramid = impl.Coarse[static_cast<std::size_t>(frame.Level)].Pyramid.get();
-    const double stride = LevelStride(frame.Level);
+    pyramid = impl.Coarse[Internals::At(frame.Level)].Pyramid.get();
+    const double stride = VolumeLevelStride(frame.Level);
     for (int r = 0; r < 4; ++r)
     {
       for (int c = 0; c < 3; ++c)
@@ -1403,11 +1410,11 @@ std::uint64_t IsosurfaceScene::GetActivePairs(int level) const
   {
     return this->GetActivePairs();
   }
-  if (level < 0 || level > FullLevel)
+  if (level < CoarsestLevel || level > FullLevel)
   {
     return 0;
   }
-  const Internals::CoarseLevel& coarse = impl.Coarse[static_cast<std::size_t>(level)];
+  const Internals::CoarseLevel& coarse = impl.Coarse[Internals::At(level)];
   return coarse.Pyramid && coarse.Pyramid->IsBuilt() && !coarse.BuiltValues.empty() &&
       coarse.BuiltValues == impl.Values()
     ? coarse.Pyramid->GetTotal()
@@ -1421,11 +1428,11 @@ std::vector<double> IsosurfaceScene::GetBuiltValues(int level) const
   {
     return impl.BuiltValues;
   }
-  if (level < 0 || level > FullLevel)
+  if (level < CoarsestLevel || level > FullLevel)
   {
     return {};
   }
-  const Internals::CoarseLevel& coarse = impl.Coarse[static_cast<std::size_t>(level)];
+  const Internals::CoarseLevel& coarse = impl.Coarse[Internals::At(level)];
   return coarse.Pyramid && coarse.Pyramid->IsBuilt() ? coarse.BuiltValues : std::vector<double>();
 }
 
@@ -1435,13 +1442,23 @@ std::uint64_t IsosurfaceScene::EstimateActivePairs(std::uint64_t fullPairs, int 
   {
     return fullPairs;
   }
-  const std::uint64_t stride = static_cast<std::uint64_t>(LevelStride(std::max(level, 0)));
+  const std::uint64_t stride =
+    static_cast<std::uint64_t>(VolumeLevelStride(std::max(level, CoarsestLevel)));
   return std::max<std::uint64_t>(1, fullPairs / (stride * stride));
+}
+
+int IsosurfaceScene::VolumeLevelStride(int level)
+{
+  if (level == CoarsestLevel)
+  {
+    return 2 * LevelStride(0);
+  }
+  return level >= 0 && level <= FullLevel ? LevelStride(level) : 0;
 }
 
 std::array<int, 3> IsosurfaceScene::LevelDimensions(const int points[3], int level)
 {
-  const int stride = LevelStride(std::max(0, std::min(level, FullLevel)));
+  const int stride = VolumeLevelStride(std::max(CoarsestLevel, std::min(level, FullLevel)));
   std::array<int, 3> dims = { { 0, 0, 0 } };
   for (int a = 0; a < 3; ++a)
   {

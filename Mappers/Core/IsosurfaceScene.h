@@ -26,7 +26,11 @@
  * again when the isovalues change (UpdateLevel()). On a software rasteriser
  * the GPU path's frame is bound by its primitives (each walks the pyramid in
  * the vertex stage), which a coarse level divides by about stride^2 where
- * fewer pixels do not help.
+ * fewer pixels do not help. Below Block LOD's levels, level -1
+ * (CoarsestLevel, stride 16) is the GPU path's alone: where level 0's
+ * primitives are still over a host's budget (a 512^3 volume on a software
+ * WebGL2), it divides them by about 4 again; made the same way, from
+ * MakeStrideCopy(), its cells a whole stride long as level 0's.
  *
  * These are the scene's one upload decision and one build decision, as
  * vtkOpenGLGPUVolumeRayCastMapper keeps one ShaderRebuildNeeded predicate;
@@ -251,7 +255,7 @@ public:
    * goes back to sampling the volume. The level's texture and pyramid are
    * made again at its next frame. Forgotten with the volume (a SetVolume()
    * that uploads) and at EndStreaming(). False, with the reason, for a level
-   * outside 0..2 or samples of under 2 points on an axis.
+   * outside -1..2 or samples of under 2 points on an axis.
    */
   bool SetCoarseSource(int level, const VolumeDescription& samples, std::string& error);
 
@@ -274,14 +278,22 @@ public:
    */
   bool Update(std::string& error);
 
+  /// The coarsest volume level: stride 16, one point in 16 along each axis (no Block LOD level).
+  static constexpr int CoarsestLevel = -1;
+
+  /// A volume level's stride: LevelStride(level) for Block LOD's levels 0 to 3, 16 for
+  /// CoarsestLevel (0 outside CoarsestLevel..3).
+  static int VolumeLevelStride(int level);
+
   /**
    * Update() for a volume level (IsosurfaceFrame::Level): 3 is Update();
-   * 2, 1 and 0 sample the volume at LevelStride(level) (the samples of Block
-   * LOD's level, the last point of each axis included), upload the samples
-   * as the level's own volume texture (once per volume) and build its
-   * pyramid when the surfaces' values changed since its last build. False,
-   * with the reason, for a level outside 0..3, without a volume, or when the
-   * upload or the build fails. Render() calls it for the frame's level.
+   * 2, 1, 0 and -1 sample the volume at VolumeLevelStride(level) (2, 1, 0:
+   * the samples of Block LOD's level, the last point of each axis included),
+   * upload the samples as the level's own volume texture (once per volume)
+   * and build its pyramid when the surfaces' values changed since its last
+   * build. False, with the reason, for a level outside -1..3, without a
+   * volume, or when the upload or the build fails. Render() calls it for the
+   * frame's level.
    */
   bool UpdateLevel(int level, std::string& error);
 
@@ -320,14 +332,14 @@ public:
    */
   static std::uint64_t EstimateActivePairs(std::uint64_t fullPairs, int level);
 
-  /// The points of a level's samples per axis (Block LOD's: every stride-th and the last).
+  /// The points of a level's samples per axis (every VolumeLevelStride()-th and the last).
   static std::array<int, 3> LevelDimensions(const int points[3], int level);
 
   /// What the scene did (see IsosurfaceSceneStats).
   const IsosurfaceSceneStats& GetStats() const;
 
   /// Bytes of GPU memory held now for the volume (its texture and the pyramid, with the coarse
-  /// levels made: at most 1/8 + 1/64 + 1/512 of the volume's).
+  /// levels made: at most 1/8 + 1/64 + 1/512 + 1/4096 of the volume's).
   std::uint64_t GetGPUMemoryBytes() const;
 
   /// The volume texture's size in texels for a volume of `points` (4 points to a texel along x).

@@ -8,12 +8,13 @@
 //    can be made;
 //  - exit 1 on any mismatch.
 // Also the scene's coarse volume levels (IsosurfaceScene::UpdateLevel()):
-// at Block LOD levels 0, 1 and 2 the pyramid's total equals the CPU model's
-// count on that level's samples (MakeCoarseCopy, odd sizes: a shorter last
-// cell on some axes), each level is built once per set of isovalues and again
-// after a change, a change's update of a coarse level builds that level
-// only (GetBuiltValues() says which values each level is built for), and a
-// level outside 0..3 is refused with a reason.
+// at Block LOD levels 0, 1 and 2 and the scene's level -1 (stride 16) the
+// pyramid's total equals the CPU model's count on that level's samples
+// (MakeCoarseCopy / MakeStrideCopy, odd sizes: a shorter last cell on some
+// axes), each level is built once per set of isovalues and again after a
+// change, a change's update of a coarse level builds that level only
+// (GetBuiltValues() says which values each level is built for), and a level
+// outside -1..3 is refused with a reason.
 #include "HeadlessTestUtilities.h"
 #include "HistoPyramidGLChecks.h"
 
@@ -53,7 +54,7 @@ void CheckCoarseLevels(const std::shared_ptr<const mediso::GLApi>& gl)
     scene.SetSurfaces(looks);
     Check(scene.Update(error), "coarse levels: the full level did not build: " + error);
     const std::uint64_t fullPairs = scene.GetActivePairs();
-    for (int level = 0; level < 3; ++level)
+    for (int level = mediso::IsosurfaceScene::CoarsestLevel; level < 3; ++level)
     {
       const std::uint64_t builds = scene.GetStats().CoarseBuilds;
       const bool built = scene.UpdateLevel(level, error) && scene.UpdateLevel(level, error);
@@ -61,8 +62,9 @@ void CheckCoarseLevels(const std::shared_ptr<const mediso::GLApi>& gl)
       Check(scene.GetStats().CoarseBuilds == builds + 1,
         "coarse level " + std::to_string(level) + ": built once per set of isovalues");
       std::vector<std::int16_t> samples;
-      const mediso::Volume<std::int16_t> coarse =
-        mediso::MakeCoarseCopy(full, level, samples, mediso::SerialFor);
+      const mediso::Volume<std::int16_t> coarse = level >= 0
+        ? mediso::MakeCoarseCopy(full, level, samples, mediso::SerialFor)
+        : mediso::MakeStrideCopy(full, 16, samples, mediso::SerialFor);
       const std::array<int, 3> expected = mediso::IsosurfaceScene::LevelDimensions(dims, level);
       Check(std::equal(coarse.Dims, coarse.Dims + 3, expected.begin()),
         "coarse level " + std::to_string(level) + ": LevelDimensions differs from Block LOD's");
@@ -97,8 +99,9 @@ void CheckCoarseLevels(const std::shared_ptr<const mediso::GLApi>& gl)
         scene.GetStats().PyramidBuilds == fullBuilds,
       "a change's coarse level: only level 1 is built for the new value, the full level keeps "
       "the old ones");
-    Check(scene.GetBuiltValues(2) == before && scene.GetBuiltValues(-1).empty(),
-      "coarse level 2 still holds the old values, level -1 none");
+    Check(scene.GetBuiltValues(2) == before && scene.GetBuiltValues(-1) == before &&
+        scene.GetBuiltValues(-2).empty(),
+      "coarse levels 2 and -1 still hold the old values, level -2 none");
     Check(scene.Update(error) && scene.GetBuiltValues(3) == std::vector<double>{ 100.0 },
       "the full level's build after it: " + error);
   }
@@ -106,6 +109,8 @@ void CheckCoarseLevels(const std::shared_ptr<const mediso::GLApi>& gl)
       mediso::IsosurfaceScene::EstimateGPUMemoryBytes(mediso::ScalarType::Int16, dims),
     "coarse levels: their GPU memory is not counted");
   Check(!scene.UpdateLevel(4, error) && !error.empty(), "coarse levels: level 4 is not refused");
+  error.clear();
+  Check(!scene.UpdateLevel(-2, error) && !error.empty(), "coarse levels: level -2 is not refused");
   scene.Release();
 }
 } // namespace

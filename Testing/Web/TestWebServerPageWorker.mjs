@@ -7,8 +7,8 @@
 // - a change superseded while its refinement is owed never shows the old surface at the end,
 //   and the refinement is skipped;
 // - a drag draws coarser (CPU path: a level, then level 0 on fewer pixels; GPU path: an image
-//   sample distance and a coarse volume level, the volume sampled every 2nd, 4th or 8th point,
-//   whose primitives are the CPU model's count on that level's samples), says so in
+//   sample distance and a coarse volume level, the volume sampled every 2nd, 4th, 8th or 16th
+//   point, whose primitives are the CPU model's count on that level's samples), says so in
 //   window.mediso.stats(), and the still frame after it is back at full level and every pixel;
 // - on the GPU path a change is drawn first on a coarse volume level (its primitives the CPU
 //   model's count on the level's samples) and refined to the full volume, and a change superseded
@@ -166,17 +166,18 @@ async function drag(page, moves = 12) {
     "an image sample distance above 1 (largest " + Math.max(1, ...steps.map((f) => f.sampleDistance)).toFixed(2) +
     "), said in stats()");
   checks.check(!s.interactive && s.sampleDistance === 1, "GPU path: the still frame after the drag has every pixel");
-  // A 1 ms budget: no frame fits, so the drag draws the coarsest candidate, volume level 0 (the
-  // volume sampled every 8th point).
+  // A 1 ms budget: no frame fits, so the drag draws the coarsest candidate, volume level -1 (the
+  // volume sampled every 16th point; below level 0, the coarsest Block LOD level).
   const level = steps.filter((f) => f.interactive && f.gpuLevel < 3);
-  const saidLevel = during.find((d) => d.interactive && d.gpuLevel < 3 && /volume level/.test(d.frameNote));
+  const saidLevel = during.find((d) => d.interactive && d.gpuLevel === -1 &&
+    /volume level -1, one point in 16 along each axis/.test(d.frameNote));
   const last = level[level.length - 1];
   const coarseCount = last ? await fast.evaluate(([v, k]) => window.mediso.cpuCount(v, k),
     [last.values, last.gpuLevel]) : -1;
   const fullCount = await fast.evaluate((v) => window.mediso.cpuCount(v), steps[steps.length - 1].values);
   console.log("GPU drag frames [gpuLevel, sampleDistance, primitives]: " +
     JSON.stringify(steps.map((f) => [f.gpuLevel, f.sampleDistance, f.primitives])));
-  checks.check(level.length > 0 && !!saidLevel && last.gpuLevel === 0,
+  checks.check(level.length > 0 && !!saidLevel && last.gpuLevel === -1,
     "GPU path: " + level.length + " of the drag's frames on a coarse volume level (" + (last || {}).gpuLevel +
     "), said in stats(): " + JSON.stringify(saidLevel && { gpuLevel: saidLevel.gpuLevel, frameNote: saidLevel.frameNote }));
   checks.check(last && last.primitives === coarseCount && coarseCount > 0 && coarseCount < fullCount,
@@ -189,13 +190,13 @@ async function drag(page, moves = 12) {
 
 // --- the GPU path's change: a coarse volume level first, then the full volume ------------------------
 // ?frameBudget=1: no frame fits 1 ms, so a change's first answer is the coarsest candidate (volume
-// level 1: its pyramid built, not the volume's); the refinement builds and draws the full volume.
+// level -1: its pyramid built, not the volume's); the refinement builds and draws the full volume.
 {
   const before = await lastFrameSeq(fast);
   const s = await fast.evaluate((v) => window.mediso.setSurfaces([Object.assign({}, v, { value: 300 })]), BONE);
   const steps = await framesAfter(fast, before);
   const first = steps[0] || {};
-  const coarseCount = first.gpuLevel >= 0 ? await fast.evaluate(([v, k]) => window.mediso.cpuCount(v, k),
+  const coarseCount = Number.isInteger(first.gpuLevel) ? await fast.evaluate(([v, k]) => window.mediso.cpuCount(v, k),
     [[300], first.gpuLevel]) : -1;
   const fullCount = await fast.evaluate(() => window.mediso.cpuCount([300]));
   console.log("GPU change frames [values, gpuLevel, sampleDistance, primitives, settled]: " +

@@ -269,7 +269,7 @@ function pump() {
 function gpuFrameNote(gpuLevel, distance) {
   const parts = [];
   if (gpuLevel < M.NumberOfLevels - 1) {
-    parts.push("volume level " + gpuLevel + ", one point in " + M.levelStride(gpuLevel) +
+    parts.push("volume level " + gpuLevel + ", one point in " + M.gpuLevelStride(gpuLevel) +
       " along each axis");
   }
   if (distance > 1) {

@@ -3,6 +3,7 @@
 
 #include "BlockLOD.h"
 #include "HistoPyramid.h"
+#include "IsosurfaceScene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -136,7 +137,8 @@ val PageCamera::GetView() const
 double CountActivePairs(
   ScalarType type, const void* data, const int dims[3], const val& isovalues, int level)
 {
-  if (!data || ScalarTypeSize(type) == 0 || level < 0 || level >= NumberOfLevels)
+  if (!data || ScalarTypeSize(type) == 0 || level < IsosurfaceScene::CoarsestLevel ||
+    level >= NumberOfLevels)
   {
     return 0.0;
   }
@@ -157,7 +159,8 @@ double CountActivePairs(
       std::vector<T> samples;
       if (level < NumberOfLevels - 1)
       {
-        volume = MakeCoarseCopy(volume, level, samples, SerialFor);
+        volume =
+          MakeStrideCopy(volume, IsosurfaceScene::VolumeLevelStride(level), samples, SerialFor);
       }
       for (std::uint32_t count : HistoPyramid::CountCrossings(volume.Data, volume.Dims, values))
       {

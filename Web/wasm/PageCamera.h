@@ -133,8 +133,9 @@ void BindPageCamera(const emscripten::class_<Holder>& bound)
  * The CPU model's count of active (cell, isovalue) pairs of a volume of
  * `type`, x fastest, at `data` with `dims` points, for the isovalues of the
  * JavaScript array `isovalues`, on Block LOD's samples of `level` (3: the
- * volume itself; 2, 1, 0: every 2nd, 4th, 8th point and the last, the GPU
- * path's coarse volume levels); 0 for no data, an unknown type or level.
+ * volume itself; 2, 1, 0, -1: every 2nd, 4th, 8th, 16th point and the last,
+ * the GPU path's coarse volume levels, IsosurfaceScene::VolumeLevelStride);
+ * 0 for no data, an unknown type or level.
  */
 double CountActivePairs(ScalarType type, const void* data, const int dims[3],
   const emscripten::val& isovalues, int level);

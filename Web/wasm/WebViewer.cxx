@@ -396,11 +396,15 @@ public:
   /**
    * The GPU path's volume level of the next frames (IsosurfaceFrame::Level):
    * 3 the volume; 2, 1 or 0 the volume sampled at Block LOD's stride 2, 4 or
-   * 8, a coarse volume and pyramid the scene makes on the level's first frame
-   * (about 1 / stride^2 of the primitives). The page's worker sets it for the
-   * frames of a drag (chooseFrame's level); 3 for still frames.
+   * 8, -1 at stride 16 (IsosurfaceScene::CoarsestLevel), a coarse volume and
+   * pyramid the scene makes on the level's first frame (about 1 / stride^2 of
+   * the primitives). The page's worker sets it for the frames of a drag
+   * (chooseFrame's level); 3 for still frames.
    */
-  void SetGPULevel(int level) { this->GPULevel = std::max(0, std::min(NumberOfLevels - 1, level)); }
+  void SetGPULevel(int level)
+  {
+    this->GPULevel = std::max(IsosurfaceScene::CoarsestLevel, std::min(NumberOfLevels - 1, level));
+  }
 
   /// The estimator's table for the current isovalues: per level, triangles, MB and seconds.
   val Estimates()
@@ -859,8 +863,9 @@ public:
    * does). GPU path:
    * the full volume at the smallest image sample distance whose frame fits
    * (1 to 8), else the coarse volume levels 2, 1 and 0 (strides 2, 4, 8) the
-   * same way, from each level's active pairs (estimated from the full level's
-   * before its first frame). fullMs: the prediction of the full frame (level
+   * same way, then level -1 (stride 16: where level 0's primitives alone are
+   * over the budget), from each level's active pairs (estimated from the full
+   * level's before its first frame). fullMs: the prediction of the full frame (level
    * the memory allows, every pixel), which the page states when it is over.
    */
   val ChooseFrame(double budgetSeconds, bool interactive)
@@ -1046,7 +1051,7 @@ private:
   }
 
   // The GPU path's candidates, finest first: the full volume at each sample distance, then the
-  // coarse volume levels 2, 1 and 0 (strides 2, 4, 8) the same way, each from its pyramid's
+  // coarse volume levels 2, 1, 0 and -1 (strides 2, 4, 8, 16) the same way, each from its pyramid's
   // active pairs when built for these surfaces, else estimated from the full level's
   // (IsosurfaceScene). A software rasteriser's frame costs about its primitives, so only a
   // coarser volume brings a large surface within the budget there.
@@ -1054,7 +1059,7 @@ private:
   {
     const std::uint64_t full = this->Scene ? this->Scene->GetActivePairs() : 0;
     const std::vector<double> values = this->SurfaceValues();
-    for (int level : { NumberOfLevels - 1, 2, 1, 0 })
+    for (int level : { NumberOfLevels - 1, 2, 1, 0, IsosurfaceScene::CoarsestLevel })
     {
       const std::uint64_t built = this->Scene ? this->Scene->GetActivePairs(level) : 0;
       const bool builtNow = this->Scene && this->Scene->GetBuiltValues(level) == values;
@@ -1103,7 +1108,7 @@ private:
   std::uint64_t LevelCells(int level) const
   {
     const int* dims = this->Viewpoint.GetPlacement().Dimensions;
-    const int stride = 1 << (NumberOfLevels - 1 - level);
+    const int stride = IsosurfaceScene::VolumeLevelStride(level);
     std::uint64_t cells = 1;
     for (int a = 0; a < 3; ++a)
     {
@@ -1639,6 +1644,9 @@ EMSCRIPTEN_BINDINGS(mediso_web)
   emscripten::function("scalarTypes", &ScalarTypes);
   emscripten::constant("NumberOfLevels", NumberOfLevels);
   emscripten::function("levelStride", &Stride);
+  // The GPU path's volume levels' strides (stats().gpuLevel: -1 to 3; IsosurfaceScene).
+  emscripten::constant("CoarsestGPULevel", IsosurfaceScene::CoarsestLevel);
+  emscripten::function("gpuLevelStride", &IsosurfaceScene::VolumeLevelStride);
   emscripten::constant("MaximumIsovalues", MaximumIsovalues);
   emscripten::function("gpuVolume", &GPUVolume);
   emscripten::function("looksLikeHounsfieldUnits", &LooksLikeHounsfieldUnits);
