@@ -277,10 +277,14 @@ function pump() {
   }
 }
 
-// After a settled GPU frame, in a task of its own: the frame a drag would be drawn as, made
-// ready (WebViewer.prepareDrag), unless a newer frame is asked for by then (its message here, or
-// the page's generation word moved on). It holds this worker for a pyramid build and one coarse
-// frame, as the drag's first frame did before; a frame asked for meanwhile waits for it.
+// After a settled GPU frame, in a task of its own prepareDelayMs later: the frame a drag would be
+// drawn as, made ready (WebViewer.prepareDrag), unless a newer frame is asked for by then (its
+// message here, or the page's generation word moved on). It holds this worker for a pyramid
+// build and one coarse frame, as the drag's first frame did before; a frame asked for meanwhile
+// waits for it. The delay lets the settled frame reach the page first (the worker's canvas is
+// shown after the task that drew it, and a task queued at once could run before that) and lets
+// a burst of still frames (keys held, a slider) pass without one.
+const prepareDelayMs = 100;
 function schedulePrepare(frame) {
   clearTimeout(prepareTimer);
   if (!prepareDragOn || path !== "gpu" || streaming) {
@@ -300,7 +304,7 @@ function schedulePrepare(frame) {
     } else if (r.error) {
       post({ op: "error", message: "preparing the drag's frame: " + r.error });
     }
-  }, 0);
+  }, prepareDelayMs);
 }
 
 // What a coarse GPU frame drew: the volume level (every stride-th point) and the sample distance.
