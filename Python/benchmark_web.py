@@ -261,6 +261,29 @@ def run_interactive(args, name, before_root):
         return run_script(work_folder(args, "interactive-", name), "bench-interactive.mjs", config)
 
 
+def first_drag_lines(results):
+    """The first drag frame after the scene's change, apart from the steady ones (issue 30): the
+    first frame on its level for the new isovalues, which built that level's pyramid and first used
+    its programs unless the worker made them ready after the change (render-worker.js)."""
+    lines = ["", "The drag's first frame (after the scene's change), apart from the steady frames:", "",
+             "| input | path | page | first drag frame ms | predicted ms | built a pyramid | level / sample "
+             "distance | wait from the first move ms | steady drag frame ms, median | made ready ahead ms |",
+             "|---|---|---|---:|---:|---|---|---:|---:|---:|"]
+    for name, r in results.items():
+        for run in r["runs"]:
+            f = run["drag"].get("first")
+            if not f:
+                continue
+            made = run.get("dragPrepared") or {}
+            lines.append("| %s | %s | %s | %.0f | %.0f | %s | %s / %s | %s | %s | %s |" % (
+                name, run["path"], run["page"], f["ms"], f.get("predictedMs") or 0,
+                {True: "yes", False: "no"}.get(f.get("pyramidBuilt"), "-"), f.get("level"), f.get("sampleDistance"),
+                "%.0f" % f["waitMs"] if f.get("waitMs") is not None else "-",
+                "%.0f" % run["drag"]["steadyMs"] if run["drag"].get("steadyMs") else "-",
+                "%.0f (level %s)" % (made["ms"], made.get("level")) if made.get("ms") else "-"))
+    return lines
+
+
 def main_interactive(args, argv):
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     load_before = load_average()
@@ -323,6 +346,7 @@ def main_interactive(args, argv):
               and run["drag"]["predictionError"] == run["drag"]["predictionError"]]
     lines += ["", "The frame-time model's median error on the drag frames it chose (after): " +
               (", ".join(errors) or "none recorded") + "."]
+    lines += first_drag_lines(results)
     write_report(lines, args.out)
     return 0
 

@@ -153,7 +153,14 @@ async function drag(page, moves = 12) {
     "CPU path: the still frame after the drag is at level " + s.cpuLevel + ", sample distance " + s.sampleDistance);
 }
 {
-  await fast.evaluate(() => window.mediso.setPath("gpu"));
+  // The first GPU frame of these isovalues is the full volume's (the change was on the CPU path);
+  // the drag's level (volume level -1: no frame fits 1 ms) is made ready after it, in the worker's
+  // idle time (stats().dragPrepared), so the drag's first frame builds no pyramid (before, it
+  // built that level's pyramid and first used its programs: seconds on a loaded machine).
+  const preparedBefore = (await stats(fast)).dragPreparedCount || 0;
+  const switched = await fast.evaluate(() => window.mediso.setPath("gpu"));
+  const prepared = await fast.waitForFunction((n) => window.mediso.stats().dragPreparedCount > n,
+    preparedBefore, { timeout: 120000 }).then(() => stats(fast), () => null);
   const before = await lastFrameSeq(fast);
   const during = await drag(fast, 16);
   await settle(fast);
@@ -186,6 +193,17 @@ async function drag(page, moves = 12) {
   checks.check(s.gpuLevel === 3 && s.primitives === fullCount,
     "GPU path: the still frame after the drag draws the full volume (level " + s.gpuLevel + ", " +
     s.primitives + " primitives)");
+  const firstDrag = steps.find((f) => f.interactive) || {};
+  const made = (prepared || {}).dragPrepared || {};
+  console.log("GPU drag made ready: " + JSON.stringify(made) + "; its first frame: " +
+    JSON.stringify({ gpuLevel: firstDrag.gpuLevel, sampleDistance: firstDrag.sampleDistance,
+      pyramidBuilt: firstDrag.pyramidBuilt, ms: firstDrag.ms }));
+  checks.check(switched.gpuLevel === 3 && made.level === -1 &&
+    JSON.stringify(made.values) === JSON.stringify(firstDrag.values) &&
+    firstDrag.gpuLevel === made.level && firstDrag.pyramidBuilt === false,
+    "GPU path: the drag's level (" + made.level + ") was made ready for these isovalues after the still " +
+    "frame, and the drag's first frame (level " + firstDrag.gpuLevel + ") built no pyramid (" +
+    firstDrag.pyramidBuilt + ")");
 }
 
 // --- the GPU path's change: a coarse volume level first, then the full volume ------------------------

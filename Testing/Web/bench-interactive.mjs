@@ -61,10 +61,15 @@ for (const path of config.paths) {
     await page.mouse.down();
     const sampled = [];
     const t0 = Date.now();
+    const movedAt = await page.evaluate(() => performance.now()); // the drag's first move, in the page's clock
     for (let i = 1; i <= config.moves; ++i) {
       await page.mouse.move(x + 4 * i, y + i);
       await page.waitForTimeout(config.moveMs || 30);
       sampled.push(await page.evaluate(() => window.mediso.stats().lastFrameMs));
+      if (i === 1) {
+        // the drag's frame made ready after the scene's change (render-worker.js), if it was
+        run.dragPrepared = await page.evaluate(() => window.mediso.stats().dragPrepared);
+      }
     }
     await page.mouse.up();
     const dragSeconds = (Date.now() - t0) / 1000;
@@ -88,6 +93,13 @@ for (const path of config.paths) {
         // each drag frame as drawn and as predicted (what the error above is a median of)
         frameList: drag.map((f) => ({ level: f.cpuLevel, gpuLevel: f.gpuLevel, sampleDistance: f.sampleDistance,
           elements: path === "gpu" ? f.primitives : f.triangles, ms: f.ms, predictedMs: f.predictedMs })) };
+      // the drag's first frame (after the scene's change: the first on its level for these
+      // isovalues), apart: its time in the worker, the prediction, whether it built a pyramid,
+      // and its wait from the first mouse move to its answer (what the user waits for)
+      const first = drag[0];
+      run.drag.first = first && { ms: first.ms, predictedMs: first.predictedMs, pyramidBuilt: first.pyramidBuilt,
+        level: path === "gpu" ? first.gpuLevel : first.cpuLevel, sampleDistance: first.sampleDistance,
+        waitMs: first.answeredAt !== undefined ? first.answeredAt - movedAt : null };
     } else {
       run.drag = { frameMs: median(sampled), frames: null, rate: null, levels: null, sampleDistances: [1] };
     }

@@ -300,6 +300,10 @@ window.mediso = {
     // the CPU path's surfaces of this stream taken made from the extraction ahead (docs/web.md,
     // Streaming), not extracted at their frame
     takenAhead: ((state.viewer && state.viewer.stats()) || {}).takenAhead || 0,
+    // the GPU frame a drag would be drawn as, made ready after the last settled frame
+    // (render-worker.js: {level, sampleDistance, ms, values}, null before any), and how often
+    dragPrepared: ((state.viewer && state.viewer.stats()) || {}).dragPrepared || null,
+    dragPreparedCount: ((state.viewer && state.viewer.stats()) || {}).dragPreparedCount || 0,
     // the GPU path's bricks (0: the volume is one texture), those the isovalues cross and those
     // on the GPU (docs/web.md, Paths), their edge, the pool's slots (0: each active brick its own
     // pyramid) and the pyramids the last build built; its whole uploads and streamed regions

@@ -24,11 +24,12 @@ export class RemoteViewer {
    * its module at once, while this thread loads its own (the page's start-up, docs/web.md).
    * `threads`: the worker loads the threaded module; `budgetMs`: the frame budget (0: the
    * worker's); `abort`: false to let a running refinement run to its end; `slowExtractionMs`,
-   * `slowPass`, `refineDelayMs`, `slowFirstDragFrameMs`: test hooks (render-worker.js). Returns
+   * `slowPass`, `refineDelayMs`, `slowFirstDragFrameMs`: test hooks (render-worker.js);
+   * `prepareDrag`: false to leave a drag's level to the drag (render-worker.js). Returns
    * {worker, ready}, ready a promise of the worker's "ready" message, for start().
    */
   static launch(canvas, { threads, budgetMs, abort, slowExtractionMs, slowPass, refineDelayMs,
-    slowFirstDragFrameMs }) {
+    slowFirstDragFrameMs, prepareDrag }) {
     const worker = new Worker("static/render-worker.js");
     const offscreen = canvas.transferControlToOffscreen();
     const base = new URL("static/", location.href).href;
@@ -38,7 +39,7 @@ export class RemoteViewer {
     });
     ready.catch(() => {}); // start() awaits it
     worker.postMessage({ op: "init", canvas: offscreen, base, threads, budgetMs, abort, slowExtractionMs,
-      slowPass, refineDelayMs, slowFirstDragFrameMs },
+      slowPass, refineDelayMs, slowFirstDragFrameMs, prepareDrag },
       [offscreen]);
     return { worker, ready };
   }
@@ -94,6 +95,10 @@ export class RemoteViewer {
         }
         return !done;
       });
+    } else if (m.op === "prepared") {
+      // a drag's frame made ready in the idle time (render-worker.js): said by stats() now, not
+      // only with the next frame
+      this.lastStats = Object.assign({}, this.lastStats, { dragPrepared: m.value, dragPreparedCount: m.count });
     } else if (m.op === "error") {
       this.lastStats = Object.assign({}, this.lastStats, { error: m.message });
       console.error("render worker: " + m.message);

@@ -16,7 +16,8 @@
 //                                                        streamEnd answers the level's bytes)
 //   {op: "frame", id, surfaces, view, interactive, generation}  the frame wanted now
 // Messages out: {op: "ready", ok, error, info, generation}, {op: "answer", id, value},
-//   {op: "frame", id, stats, settled}, {op: "error", message}.
+//   {op: "frame", id, stats, settled}, {op: "error", message},
+//   {op: "prepared", value, count} (a drag's frame made ready ahead: schedulePrepare).
 //
 // Frames. Only the newest frame wanted is drawn: messages that arrived while a frame was drawn
 // are all applied first, and the frames they asked for collapse into the last one. On the CPU
@@ -83,6 +84,16 @@ let refineDelayMs = 40;
 let slowFirstDragFrameMs = 0;
 let dragging = false; // the last frame drawn was a drag's
 
+// The GPU frame a drag would be drawn as, made ready in the idle time after a settled frame
+// (WebViewer.prepareDrag: its volume level's pyramid built for the current isovalues, its
+// programs compiled, nothing shown), so that the first drag frame after a change does not pay
+// for them: {level, sampleDistance, built, ms, values} of the last time it built anything, and
+// how many times it did. ?prepareDrag=0 (a test and benchmark hook) leaves it to the drag.
+let prepareDragOn = true;
+let prepared = null;
+let preparedCount = 0;
+let prepareTimer = 0;
+
 function post(message, transfer) {
   self.postMessage(message, transfer || []);
 }
@@ -106,6 +117,7 @@ async function init(m) {
   if (m.slowFirstDragFrameMs > 0) {
     slowFirstDragFrameMs = m.slowFirstDragFrameMs;
   }
+  prepareDragOn = m.prepareDrag !== false;
   viewer = new M.WebViewer("#view");
   shareGeneration(m.abort !== false, m.slowExtractionMs, m.slowPass);
   post({ op: "ready", ok: viewer.ready(), error: viewer.error(), info: viewer.info(),
@@ -186,6 +198,8 @@ function draw(frame, level, distance, gpuLevel = M.NumberOfLevels - 1) {
   stats.abortable = !!generationWord;
   stats.abortNote = abortNote;
   stats.budgetMs = 1000 * budgetSeconds;
+  stats.dragPrepared = prepared;
+  stats.dragPreparedCount = preparedCount;
   if (slowFirstDragFrameMs > 0 && frame.interactive && !dragging) {
     pause(slowFirstDragFrameMs);
   }
@@ -262,7 +276,40 @@ function pump() {
       refine.timer = setTimeout(refineNow, refineDelayMs);
     }
     post({ op: "frame", id: frame.id, stats });
+    if (stats.settled && stats.ok) {
+      schedulePrepare(frame);
+    }
   }
+}
+
+// After a settled GPU frame, in a task of its own prepareDelayMs later: the frame a drag would be
+// drawn as, made ready (WebViewer.prepareDrag), unless a newer frame is asked for by then (its
+// message here, or the page's generation word moved on). It holds this worker for a pyramid
+// build and one coarse frame, as the drag's first frame did before; a frame asked for meanwhile
+// waits for it. The delay lets the settled frame reach the page first (the worker's canvas is
+// shown after the task that drew it, and a task queued at once could run before that) and lets
+// a burst of still frames (keys held, a slider) pass without one.
+const prepareDelayMs = 100;
+function schedulePrepare(frame) {
+  clearTimeout(prepareTimer);
+  if (!prepareDragOn || path !== "gpu" || streaming) {
+    return;
+  }
+  prepareTimer = setTimeout(() => {
+    if (wanted || refine || scheduled || path !== "gpu" || streaming ||
+        (generationWord && Atomics.load(generationWord, 0) !== (frame.generation | 0))) {
+      return;
+    }
+    const r = viewer.prepareDrag(budgetSeconds);
+    if (r.built) {
+      ++preparedCount;
+      prepared = { level: r.level, sampleDistance: r.sampleDistance, ms: r.ms,
+        values: frame.surfaces.map((s) => s.value) };
+      post({ op: "prepared", value: prepared, count: preparedCount });
+    } else if (r.error) {
+      post({ op: "error", message: "preparing the drag's frame: " + r.error });
+    }
+  }, prepareDelayMs);
 }
 
 // What a coarse GPU frame drew: the volume level (every stride-th point) and the sample distance.
@@ -299,6 +346,9 @@ function refineNow() {
   stats.settled = true;
   stats.note = "";
   post({ op: "frame", id, stats });
+  if (stats.ok) {
+    schedulePrepare(frame);
+  }
 }
 
 // A refinement's frame drawn with the module watching the generation word: null when a newer

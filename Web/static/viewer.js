@@ -77,7 +77,8 @@ export async function startViewer(canvas, probe, moduleLoaded = () => {}) {
       slowExtractionMs: Number(params.get("slowExtraction")) || 0,
       slowPass: Number(params.get("slowPass")) || 1,
       refineDelayMs: Number(params.get("refineDelay")) || 0,
-      slowFirstDragFrameMs: Number(params.get("slowFirstDragFrame")) || 0 });
+      slowFirstDragFrameMs: Number(params.get("slowFirstDragFrame")) || 0,
+      prepareDrag: params.get("prepareDrag") !== "0" });
   state.remote = inWorker;
   const debug = probe.getExtension("WEBGL_debug_renderer_info");
   state.unmaskedRenderer = debug ? probe.getParameter(debug.UNMASKED_RENDERER_WEBGL) : "";
@@ -189,6 +190,7 @@ function recordFrame(ms, stats) {
     triangles: stats.triangles, primitives: stats.primitives, sampleDistance: state.sampleDistance,
     gpuLevel: state.gpuLevel,
     interactive: state.interactive, settled: stats.settled !== false, ms, predictedMs: stats.predictedMs || 0,
+    pyramidBuilt: !!stats.pyramidBuilt, answeredAt: performance.now(),
     surfaceValues: stats.surfaceValues || [], coarse: stats.coarse || [],
     surfaceTriangles: stats.surfaceTriangles || [] });
   if (state.frameLog.length > 200) {

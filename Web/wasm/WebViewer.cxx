@@ -807,7 +807,7 @@ public:
         return false;
       }
     }
-    if (sampled)
+    if (sampled && !this->Rehearsing)
     {
       f.BindFramebuffer(GL_READ_FRAMEBUFFER, this->Sampled.Get());
       f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
@@ -914,12 +914,8 @@ public:
       this->AddGPUCandidates(candidates);
     }
     // CPU path: the whole frame (the drawing, the extraction of the surfaces not cached, the
-    // upload of a level not shown). GPU path:
-    // while the full volume's pyramid is built for these surfaces (a drag), the level a drag
-    // holds, on the drawing (a level's build is paid on its first frame); after an isovalue
-    // change, when every candidate's pyramid has to be built, on the whole frame, so that the
-    // first answer is a level whose build fits as well.
-    const bool wholeFrame = this->CPUPath || !this->FullLevelBuiltForSurfaces();
+    // upload of a level not shown). GPU path: ChooseOnWholeFrame.
+    const bool wholeFrame = this->ChooseOnWholeFrame(interactive);
     const std::size_t chosen = wholeFrame ? this->Times.ChooseWholeFrame(candidates, budgetSeconds)
                                           : this->Times.Choose(candidates, budgetSeconds);
     val out = val::object();
@@ -928,6 +924,89 @@ public:
     out.set("predictedMs", 1000.0 * this->Times.Predict(candidates[chosen].Work));
     out.set("fullMs", 1000.0 * this->Times.Predict(candidates[0].Work));
     out.set("memoryLevel", memoryLevel);
+    return out;
+  }
+
+  /**
+   * Makes ready, in the idle time after a still frame, the GPU frame a drag would be drawn as,
+   * so that the first drag frame after an isovalue change (or a switch to the GPU path) does not
+   * pay for it: the candidate a drag holds (ChooseFrame's on the drawing alone,
+   * FrameTimeModel::Choose, within `budgetSeconds`) has its volume level's pyramid built for the
+   * current isovalues and its programs compiled, by drawing that frame once into the sampled
+   * framebuffer, never shown (the canvas keeps the still frame; a drag at every pixel is
+   * rehearsed at distance 2: only a sampled frame stays off the canvas, and a distance compiles
+   * nothing). The page's worker calls it once a GPU frame is settled and no newer one is asked
+   * for. Nothing is done on the CPU path, while the scene streams (a coarse level samples points
+   * not all there yet), or where that level is built for these isovalues and its programs were
+   * used (WarmKey). The rehearsal is not observed by the frame-time model (it draws no blit and
+   * is not shown); the frame after it reports its own work as before.
+   * Returns {level, sampleDistance, built, ms}: built is true when it built or compiled
+   * anything, ms its time (0 otherwise), error where the frame could not be drawn.
+   */
+  val PrepareDrag(double budgetSeconds)
+  {
+    val out = val::object();
+    out.set("built", false);
+    out.set("ms", 0.0);
+    if (this->CPUPath || !this->Ready() || !this->Data || !this->Scene ||
+      this->Frame.Surfaces.empty() || this->Scene->IsStreaming())
+    {
+      return out;
+    }
+    std::vector<FrameTimeModel::Candidate> candidates;
+    this->AddGPUCandidates(candidates);
+    const FrameTimeModel::Candidate drag =
+      candidates[this->Times.Choose(candidates, budgetSeconds)];
+    out.set("level", drag.Level);
+    out.set("sampleDistance", drag.SampleDistance);
+    const std::array<int, 3> key = this->WarmKey(drag.Level, drag.Work);
+    if (this->Scene->GetBuiltValues(drag.Level) == this->SurfaceValues() && this->Warm.count(key))
+    {
+      return out;
+    }
+    // What the last shown frame says (GetStats) is kept: the rehearsal is not a frame.
+    const double distance = this->SampleDistance;
+    const int gpuLevel = this->GPULevel;
+    const IsosurfaceSceneStats shown = this->Stats;
+    const double buildMs = this->LastBuildMs, frameMs = this->LastFrameMs;
+    const double drawnDistance = this->DrawnSampleDistance;
+    const std::uint64_t buildCells = this->FrameBuildCells;
+    const std::string lastError = this->LastError;
+    const double start = emscripten_get_now();
+    this->SetGPULevel(drag.Level);
+    this->SampleDistance = std::max(2.0, static_cast<double>(drag.SampleDistance));
+    bool ok = false;
+    if (this->PrepareSampled())
+    {
+      this->Rehearsing = true;
+      ok = this->Render();
+      this->Rehearsing = false;
+    }
+    if (ok)
+    {
+      // Waits for the GPU (the compilation and the draw are done by the time it returns), so
+      // that a drag's first frame does not find them still queued.
+      unsigned char pixel[4];
+      this->GL->F().ReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, pixel);
+      this->Warm.insert(key);
+      out.set("built", true);
+      out.set("ms", emscripten_get_now() - start);
+    }
+    else
+    {
+      out.set("error", this->LastError.empty() ? std::string("no sampled framebuffer")
+                                               : this->LastError);
+    }
+    this->GL->F().BindFramebuffer(GL_FRAMEBUFFER, 0);
+    this->FrameDrawn = false;
+    this->SampleDistance = distance;
+    this->GPULevel = gpuLevel;
+    this->Stats = shown;
+    this->LastBuildMs = buildMs;
+    this->LastFrameMs = frameMs;
+    this->DrawnSampleDistance = drawnDistance;
+    this->FrameBuildCells = buildCells;
+    this->LastError = lastError;
     return out;
   }
 
@@ -944,6 +1023,9 @@ public:
     stats.set("footprint", std::string(this->Stats.PointFootprint ? "points" : "boxes"));
     stats.set("firstHit", this->Stats.FirstHit);
     stats.set("buildMs", this->LastBuildMs);
+    // Whether the last frame built a pyramid (its volume level's, for new isovalues or on the
+    // level's first frame) before drawing; a drag frame on a level made ahead (PrepareDrag) did not.
+    stats.set("pyramidBuilt", this->FrameBuildCells > 0);
     stats.set("sampleDistance", this->DrawnSampleDistance);
     stats.set("pixels",
       static_cast<double>(this->Viewpoint.GetWidth()) * this->Viewpoint.GetHeight() /
@@ -1048,6 +1130,20 @@ private:
   bool FullLevelBuiltForSurfaces() const
   {
     return this->Scene && this->Scene->GetBuiltValues(NumberOfLevels - 1) == this->SurfaceValues();
+  }
+
+  // Whether the GPU path chooses on each candidate's whole frame, its pyramid build and first
+  // programs included (FrameTimeModel::ChooseWholeFrame), or on the drawing alone (Choose):
+  // after an isovalue change, when every candidate's pyramid has to be built, so that the first
+  // answer is a level whose build fits as well; and during a drag, so that a drag frame is never
+  // the one that builds a level for these isovalues when that is over the budget (the first drag
+  // frame after a change built its level's pyramid and first used its programs: seconds on a
+  // loaded machine, against 20-280 ms for the next). A still frame of built surfaces chooses on
+  // the drawing: the level a drag can hold, which PrepareDrag makes ready in the idle time
+  // before the drag, so a drag still reaches a finer level, from its next drag on.
+  bool ChooseOnWholeFrame(bool interactive) const
+  {
+    return this->CPUPath || interactive || !this->FullLevelBuiltForSurfaces();
   }
 
   // The GPU path's candidates, finest first: the full volume at each sample distance, then the
@@ -1464,6 +1560,7 @@ private:
   std::uint64_t FrameBuildCells = 0;
   std::set<std::array<int, 3>> Warm;
   bool MeshesUploaded = false; // the last frame made or uploaded a CPU path surface
+  bool Rehearsing = false; // PrepareDrag's frame: drawn into Sampled only, never shown
   glcore::Name Sampled, SampledColor, SampledDepth; // a sampled frame's framebuffer
   int SampledSize[2] = { 0, 0 };
 
@@ -1679,6 +1776,7 @@ EMSCRIPTEN_BINDINGS(mediso_web)
     .function("setSampleDistance", &WebViewer::SetSampleDistance)
     .function("setGPULevel", &WebViewer::SetGPULevel)
     .function("chooseFrame", &WebViewer::ChooseFrame)
+    .function("prepareDrag", &WebViewer::PrepareDrag)
     .function("estimates", &WebViewer::Estimates)
     .function("setResultMesh", &WebViewer::SetResultMesh)
     .function("clearResultMesh", &WebViewer::ClearResultMesh)
