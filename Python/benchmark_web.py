@@ -349,6 +349,7 @@ def main_stream(args, argv):
              "| input | network | page | first image ms | surfaces at full level ms | whole level ms | bytes "
              "| bytes at full level (level received) |",
              "|---|---|---|---:|---:|---:|---:|---:|"]
+    results = []
     for name in args.inputs.split(","):
         data = volume_path(name) if not name.startswith("phantom:") else name
         work = os.path.join(args.work, "stream-" + name.replace(":", "-"))
@@ -369,6 +370,7 @@ def main_stream(args, argv):
                 runs = json.load(f)["runs"]
         finally:
             server.kill()
+        results.append((name, runs))
         for network in networks:
             whole = {}
             for mode in ("whole", "stream"):
@@ -385,6 +387,7 @@ def main_stream(args, argv):
                     name, network["name"], "whole level (`?stream=0`)" if mode == "whole" else "**streaming**",
                     med("firstMs"), med("fullMs"), ratios[0], med("wholeMs"), ratios[1], med("bytes"),
                     ratios[2], med("bytesAtFull"), 100 * med("receivedAtFull")))
+    lines += stream_parts(results)
     lines[3:3] = ["- Started %s, %.0f s; load average %s before, %s after; medians of %d; %s" % (
         started, time.perf_counter() - t0, load_before, load_average(), args.repeats,
         "warm server (--warm: the level and the bricks encoded before the pages)" if args.warm
@@ -393,6 +396,34 @@ def main_stream(args, argv):
         os.cpu_count() or 0, cpu_model(), args.size)]
     write_report(lines, args.out)
     return 0
+
+
+def stream_parts(results):
+    """Where each streamed page's time went (its stats().streamTimes; bench-stream.mjs), run by run."""
+    lines = ["", "Where the streamed pages' time went (ms from navigation; the worker's decoding and "
+             "writing summed over the bricks; frames: each frame's ms, the part that made and "
+             "uploaded the surfaces, its triangles, L0 where some came from level 0; the whole "
+             "page's frames for comparison):", "",
+             "| input | network | level 0 in | first frame | bricks asked | last answer | last handed over "
+             "| last written | full level | decode ms | write ms | frames | whole page's frames |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|"]
+    frame = lambda f: "%d (%d, %dk%s)" % (f["ms"], f["buildMs"], f["triangles"] / 1000,  # noqa: E731
+                                          " L0" if f["coarse"] else "")
+    for name, runs in results:
+        for r in runs:
+            t = r.get("times")
+            if r["mode"] != "stream" or not t:
+                continue
+            w = t.get("worker") or {}
+            whole = [x for x in runs if x["mode"] == "whole" and x["network"] == r["network"]]
+            whole_frames = ", ".join("%d (%dk)" % (f["ms"], f["triangles"] / 1000)
+                                     for f in (whole[0].get("frames") or [])) if whole else ""
+            lines.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+                name, r["network"], t.get("level0"), t.get("framed"), t.get("requested"),
+                t.get("lastAnswer"), t.get("lastHanded"), w.get("lastBricks"), t.get("full"),
+                w.get("decodeMs"), w.get("writeMs"),
+                ", ".join(frame(f) for f in w.get("frames", [])), whole_frames))
+    return lines
 
 
 def main_startup(args, argv, networks):
