@@ -398,8 +398,8 @@ function writeBricks(m) {
 // benchmark's table of parts, docs/web.md): the bricks' decoding and their writing (WebViewer's
 // writeBrick: the copy into the volume, the BlockLOD residency and the extraction ahead), the
 // first and last batch, and each frame (when it began, its time, the part that made and uploaded
-// the surfaces, how many surfaces came from level 0). Times are the epoch's ms (timeOrigin +
-// now), which the page's thread shares.
+// the surfaces, how many surfaces came from level 0). Times are timeOrigin + now(); the page
+// takes them from `begun`, the stream's start, which it saw answered.
 function now() {
   return performance.timeOrigin + performance.now();
 }
