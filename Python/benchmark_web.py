@@ -34,7 +34,8 @@ it (level 0, then the bricks the surfaces need first), each in a fresh browser c
 Chromium, under each network (MBIT/LATENCY_MS through CDP's Network.emulateNetworkConditions, or
 loopback): the time to the first image, to the current surfaces at the full level, to the whole
 level, and the bytes on the wire. Inputs: ct, ct512, or any server spec phantom:N[:noise=HU]
-(the issue's: the 512-wide CT and phantom:512:noise=40, the default).
+(the issue's: the 512-wide CT and phantom:512:noise=40, the default). Below it, where each
+streamed page's time went (its stats().streamTimes) beside the whole page's frames.
 
 --startup (issue 31's first image): the streaming page's start-up request by request, in a fresh
 context under each network (Testing/Web/bench-startup.mjs): when each of the page's requests was
