@@ -34,7 +34,8 @@ it (level 0, then the bricks the surfaces need first), each in a fresh browser c
 Chromium, under each network (MBIT/LATENCY_MS through CDP's Network.emulateNetworkConditions, or
 loopback): the time to the first image, to the current surfaces at the full level, to the whole
 level, and the bytes on the wire. Inputs: ct, ct512, or any server spec phantom:N[:noise=HU]
-(the issue's: the 512-wide CT and phantom:512:noise=40, the default).
+(the issue's: the 512-wide CT and phantom:512:noise=40, the default). Below it, where each
+streamed page's time went (its stats().streamTimes) beside the whole page's frames.
 
 --startup (issue 31's first image): the streaming page's start-up request by request, in a fresh
 context under each network (Testing/Web/bench-startup.mjs): when each of the page's requests was
@@ -376,6 +377,7 @@ def main_stream(args, argv):
              "| input | network | page | first image ms | surfaces at full level ms | whole level ms | bytes "
              "| bytes at full level (level received) |",
              "|---|---|---|---:|---:|---:|---:|---:|"]
+    results = []
     for name in args.inputs.split(","):
         with serving(args, name, {"page": ROOT}) as urls:
             if args.warm:
@@ -384,6 +386,7 @@ def main_stream(args, argv):
             runs = run_script(work_folder(args, "stream-", name), "bench-stream.mjs",
                               {"url": urls["page"], "size": [int(v) for v in args.size.split("x")],
                                "networks": networks, "repeats": args.repeats})["runs"]
+        results.append((name, runs))
         for network in networks:
             whole = {}
             for mode in ("whole", "stream"):
@@ -400,6 +403,7 @@ def main_stream(args, argv):
                     name, network["name"], "whole level (`?stream=0`)" if mode == "whole" else "**streaming**",
                     med("firstMs"), med("fullMs"), ratios[0], med("wholeMs"), ratios[1], med("bytes"),
                     ratios[2], med("bytesAtFull"), 100 * med("receivedAtFull")))
+    lines += stream_parts(results)
     lines[3:3] = ["- Started %s, %.0f s; load average %s before, %s after; medians of %d; %s" % (
         started, time.perf_counter() - t0, load_before, load_average(), args.repeats,
         "warm server (--warm: the level and the bricks encoded before the pages)" if args.warm
@@ -408,6 +412,34 @@ def main_stream(args, argv):
         os.cpu_count() or 0, cpu_model(), args.size)]
     write_report(lines, args.out)
     return 0
+
+
+def stream_parts(results):
+    """Where each streamed page's time went (its stats().streamTimes; bench-stream.mjs), run by run."""
+    lines = ["", "Where the streamed pages' time went (ms from navigation; the worker's decoding and "
+             "writing summed over the bricks; frames: each frame's ms, the part that made and "
+             "uploaded the surfaces, its triangles, L0 where some came from level 0; the whole "
+             "page's frames for comparison):", "",
+             "| input | network | level 0 in | first frame | bricks asked | last answer | last handed over "
+             "| last written | full level | decode ms | write ms | frames | whole page's frames |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|"]
+    frame = lambda f: "%d (%d, %dk%s)" % (f["ms"], f["buildMs"], f["triangles"] / 1000,  # noqa: E731
+                                          " L0" if f["coarse"] else "")
+    for name, runs in results:
+        for r in runs:
+            t = r.get("times")
+            if r["mode"] != "stream" or not t:
+                continue
+            w = t.get("worker") or {}
+            whole = [x for x in runs if x["mode"] == "whole" and x["network"] == r["network"]]
+            whole_frames = ", ".join("%d (%dk)" % (f["ms"], f["triangles"] / 1000)
+                                     for f in (whole[0].get("frames") or [])) if whole else ""
+            lines.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+                name, r["network"], t.get("level0"), t.get("framed"), t.get("requested"),
+                t.get("lastAnswer"), t.get("lastHanded"), w.get("lastBricks"), t.get("full"),
+                w.get("decodeMs"), w.get("writeMs"),
+                ", ".join(frame(f) for f in w.get("frames", [])), whole_frames))
+    return lines
 
 
 def main_startup(args, argv, networks):

@@ -615,6 +615,50 @@ Volume<T> MakeStrideCopy(const Volume<T>& full, int stride, std::vector<T>& stor
 }
 
 template <typename T>
+bool ComputeBlockRange(const Volume<T>& volume, BlockRanges& ranges, std::int64_t block,
+  std::int64_t& nans, std::int64_t& infinities)
+{
+  const std::int64_t b[3] = { block % ranges.Blocks[0],
+    (block / ranges.Blocks[0]) % ranges.Blocks[1],
+    block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]) };
+  int p0[3], p1[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    p0[a] = static_cast<int>(b[a]) * BlockCells;
+    p1[a] = std::min(p0[a] + BlockCells, volume.Dims[a] - 1);
+  }
+  const std::int64_t sx = volume.Dims[0];
+  const std::int64_t sxy = sx * volume.Dims[1];
+  T lo = std::numeric_limits<T>::max();
+  T hi = std::numeric_limits<T>::lowest();
+  for (int z = p0[2]; z <= p1[2]; ++z)
+  {
+    for (int y = p0[1]; y <= p1[1]; ++y)
+    {
+      const T* row = volume.Data + z * sxy + y * sx;
+      for (int x = p0[0]; x <= p1[0]; ++x)
+      {
+        const T v = row[x];
+        if (IsMissing(v))
+        {
+          ++(std::isnan(static_cast<double>(v)) ? nans : infinities);
+          continue;
+        }
+        lo = v < lo ? v : lo;
+        hi = v > hi ? v : hi;
+      }
+    }
+  }
+  if (!(lo <= hi))
+  {
+    return false;
+  }
+  ranges.Min[block] = static_cast<double>(lo);
+  ranges.Max[block] = static_cast<double>(hi);
+  return true;
+}
+
+template <typename T>
 void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const ParallelFor& parallel)
 {
   for (int a = 0; a < 3; ++a)
@@ -636,51 +680,15 @@ void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const Para
   ranges.Max.assign(numBlocks, -std::numeric_limits<double>::infinity());
   std::vector<std::int64_t> nanPerSlab(ranges.Blocks[2], 0), infPerSlab(ranges.Blocks[2], 0);
 
-  // One z-slab of blocks per task: each block row reads its points once
-  // (the shared face plane is read by both slabs).
-  const std::int64_t sx = volume.Dims[0];
-  const std::int64_t sxy = sx * volume.Dims[1];
+  // One z-slab of blocks per task.
   parallel(0, ranges.Blocks[2], [&](std::int64_t bz0, std::int64_t bz1) {
     for (std::int64_t bz = bz0; bz < bz1; ++bz)
     {
-      const int z0 = static_cast<int>(bz) * BlockCells;
-      const int z1 = std::min(z0 + BlockCells, volume.Dims[2] - 1);
       std::int64_t nans = 0, infinities = 0;
-      for (int by = 0; by < ranges.Blocks[1]; ++by)
+      const std::int64_t slab = bz * ranges.Blocks[1] * ranges.Blocks[0];
+      for (std::int64_t b = slab; b < slab + ranges.Blocks[1] * ranges.Blocks[0]; ++b)
       {
-        const int y0 = by * BlockCells;
-        const int y1 = std::min(y0 + BlockCells, volume.Dims[1] - 1);
-        for (int bx = 0; bx < ranges.Blocks[0]; ++bx)
-        {
-          const int x0 = bx * BlockCells;
-          const int x1 = std::min(x0 + BlockCells, volume.Dims[0] - 1);
-          T lo = std::numeric_limits<T>::max();
-          T hi = std::numeric_limits<T>::lowest();
-          for (int z = z0; z <= z1; ++z)
-          {
-            for (int y = y0; y <= y1; ++y)
-            {
-              const T* row = volume.Data + z * sxy + y * sx;
-              for (int x = x0; x <= x1; ++x)
-              {
-                const T v = row[x];
-                if (IsMissing(v))
-                {
-                  ++(std::isnan(static_cast<double>(v)) ? nans : infinities);
-                  continue;
-                }
-                lo = v < lo ? v : lo;
-                hi = v > hi ? v : hi;
-              }
-            }
-          }
-          const std::int64_t b = (bz * ranges.Blocks[1] + by) * ranges.Blocks[0] + bx;
-          if (lo <= hi)
-          {
-            ranges.Min[b] = static_cast<double>(lo);
-            ranges.Max[b] = static_cast<double>(hi);
-          }
-        }
+        ComputeBlockRange(volume, ranges, b, nans, infinities);
       }
       nanPerSlab[bz] = nans;
       infPerSlab[bz] = infinities;
@@ -1223,6 +1231,8 @@ BlockSums CountBlocks(const Volume<T>& volume, const BlockRanges& ranges, Triang
   template Volume<T> MakeCoarseCopy<T>(const Volume<T>&, int, std::vector<T>&, const ParallelFor&); \
   template Volume<T> MakeStrideCopy<T>(const Volume<T>&, int, std::vector<T>&, const ParallelFor&); \
   template void ComputeBlockRanges<T>(const Volume<T>&, BlockRanges&, const ParallelFor&);         \
+  template bool ComputeBlockRange<T>(                                                              \
+    const Volume<T>&, BlockRanges&, std::int64_t, std::int64_t&, std::int64_t&);                   \
   template bool PlanExtraction<T>(const Volume<T>&, const BlockRanges&, TriangleCaseTable, double, \
     int, ExtractionPlan&, const ParallelFor&, const std::function<bool()>&);                       \
   template void GenerateSurface<T, std::int32_t>(const Volume<T>&, const BlockRanges&,            \

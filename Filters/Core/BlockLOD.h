@@ -203,6 +203,17 @@ Volume<T> MakeStrideCopy(const Volume<T>& full, int stride, std::vector<T>& stor
 template <typename T>
 void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const ParallelFor& parallel);
 
+/// One block's range, as ComputeBlockRanges() takes it (its points, missing
+/// samples left out), into ranges.Min/Max[block]: false, the range left as it
+/// was, when the block holds no number. `nans` and `infinities` count its
+/// missing samples. The values are compared in their own type: a streamed
+/// volume (BlockLODVolume::RegionArrived) takes each block's range when its
+/// points have arrived, and a conversion of every point to double cost that
+/// pass several times the dense one's.
+template <typename T>
+bool ComputeBlockRange(const Volume<T>& volume, BlockRanges& ranges, std::int64_t block,
+  std::int64_t& nans, std::int64_t& infinities);
+
 /// Exact counts for one (isovalue, level), and what pass 2 needs to write it.
 struct ExtractionPlan
 {

@@ -208,45 +208,14 @@ struct BlockLODVolume::TypedImpl : BlockLODVolume::Typed
 
   void BlockRange(std::int64_t block, BlockRanges& ranges) override
   {
-    const std::int64_t bx = block % ranges.Blocks[0];
-    const std::int64_t by = (block / ranges.Blocks[0]) % ranges.Blocks[1];
-    const std::int64_t bz = block / (static_cast<std::int64_t>(ranges.Blocks[0]) * ranges.Blocks[1]);
-    const std::int64_t b[3] = { bx, by, bz };
-    int p0[3], p1[3];
-    for (int a = 0; a < 3; ++a)
+    std::int64_t nans = 0, infinities = 0;
+    if (ComputeBlockRange(this->Full, ranges, block, nans, infinities))
     {
-      p0[a] = static_cast<int>(b[a]) * BlockCells;
-      p1[a] = std::min(p0[a] + BlockCells, this->Full.Dims[a] - 1);
+      ranges.ValueRange[0] = std::min(ranges.ValueRange[0], ranges.Min[block]);
+      ranges.ValueRange[1] = std::max(ranges.ValueRange[1], ranges.Max[block]);
     }
-    const std::int64_t sx = this->Full.Dims[0];
-    const std::int64_t sxy = sx * this->Full.Dims[1];
-    double lo = std::numeric_limits<double>::infinity();
-    double hi = -std::numeric_limits<double>::infinity();
-    for (int z = p0[2]; z <= p1[2]; ++z)
-    {
-      for (int y = p0[1]; y <= p1[1]; ++y)
-      {
-        const T* row = this->Full.Data + z * sxy + y * sx;
-        for (int x = p0[0]; x <= p1[0]; ++x)
-        {
-          const double v = static_cast<double>(row[x]);
-          if (!std::isfinite(v))
-          {
-            ++(std::isnan(v) ? ranges.NaNCount : ranges.InfiniteCount);
-            continue;
-          }
-          lo = std::min(lo, v);
-          hi = std::max(hi, v);
-        }
-      }
-    }
-    ranges.Min[block] = lo;
-    ranges.Max[block] = hi;
-    if (lo <= hi)
-    {
-      ranges.ValueRange[0] = std::min(ranges.ValueRange[0], lo);
-      ranges.ValueRange[1] = std::max(ranges.ValueRange[1], hi);
-    }
+    ranges.NaNCount += nans;
+    ranges.InfiniteCount += infinities;
   }
 
   void ForgetCoarseCopies() override

@@ -42,8 +42,13 @@ for (let repeat = 0; repeat < (config.repeats || 1); ++repeat) {
       await page.waitForFunction(() => window.mediso.stats().received === 1, null, { timeout: 600000, polling: 50 });
       const wholeMs = Date.now() - start;
       await page.waitForTimeout(200);
+      // Where the time went: the stream's marks (stats().streamTimes, ms from navigation) and the
+      // worker's frames (the whole page's too).
+      const parts = await page.evaluate(() => ({ times: window.mediso.stats().streamTimes,
+        frames: window.mediso.frames().map((f) => ({ ms: Math.round(f.ms), cpuLevel: f.cpuLevel,
+          triangles: f.triangles, coarse: f.coarse.filter(Boolean).length })) }));
       runs.push({ network: network.name, mode, firstMs, fullMs, wholeMs, bytes, bytesAtFull,
-        receivedAtFull: full.received, levels: full.levels,
+        receivedAtFull: full.received, levels: full.levels, times: parts.times, frames: parts.frames,
         surfaces: (await page.evaluate(() => window.mediso.getSurfaces())).map((s) => s.value) });
       console.log(JSON.stringify(runs[runs.length - 1]));
       await context.close();

@@ -41,7 +41,7 @@ import { replaceSurfaces, setupSurfaceList } from "./surfaces.js";
 import { afterFrame, change, clearMesh, drawn, fitCanvas, renderNow, requestFrame, showMesh, startViewer }
   from "./viewer.js";
 import { countBytes, request, requestJSON, sessionToken } from "./volume.js";
-import { brickRanges, setupStream, stopStream, streamInfo, whenFull } from "./stream.js";
+import { brickRanges, setupStream, stopStream, streamInfo, streamTimes, whenFull } from "./stream.js";
 
 async function start() {
   const probe = document.createElement("canvas").getContext("webgl2");
@@ -304,6 +304,8 @@ window.mediso = {
     // (render-worker.js: {level, sampleDistance, ms, values}, null before any), and how often
     dragPrepared: ((state.viewer && state.viewer.stats()) || {}).dragPrepared || null,
     dragPreparedCount: ((state.viewer && state.viewer.stats()) || {}).dragPreparedCount || 0,
+    // where the last stream's time went (stream.js's streamTimes; null where the level came whole)
+    streamTimes: streamTimes(),
     // the GPU path's bricks (0: the volume is one texture), those the isovalues cross and those
     // on the GPU (docs/web.md, Paths), their edge, the pool's slots (0: each active brick its own
     // pyramid) and the pyramids the last build built; its whole uploads and streamed regions

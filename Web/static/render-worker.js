@@ -45,6 +45,7 @@ let volumeBytes = 0; // the pointer of the volume in this module's memory
 let streaming = false; // stream.js's bricks are arriving: each surface at level 0 or 3, no coarse first answer
 let coarseBytes = 0; // the pointer of the streamed level 0
 let streamGrid = null; // {dims, brick, size, length, scratch}: the streamed level (writeBricks)
+let streamTimes = null; // where a stream's time goes in this worker (noteStreamFrame; stats().streamTimes)
 
 // The generation word (an Int32Array of one, shared with the page's main thread, which adds one
 // to it on every new set of isovalues and every drag frame before it sends the frame): a running
@@ -275,6 +276,7 @@ function pump() {
       refine = { id: frame.id, key, frame };
       refine.timer = setTimeout(refineNow, refineDelayMs);
     }
+    noteStreamFrame(stats);
     post({ op: "frame", id: frame.id, stats });
     if (stats.settled && stats.ok) {
       schedulePrepare(frame);
@@ -345,6 +347,7 @@ function refineNow() {
   stats.interactive = false;
   stats.settled = true;
   stats.note = "";
+  noteStreamFrame(stats);
   post({ op: "frame", id, stats });
   if (stats.ok) {
     schedulePrepare(frame);
@@ -405,6 +408,8 @@ function startStream(m) {
   streaming = ok;
   freeScratch();
   streamGrid = { dims: m.dims, brick: m.brick, size, length, scratch: 0 };
+  streamTimes = { begun: now(), batches: 0, bricks: 0, decodeMs: 0, writeMs: 0, firstBricks: 0,
+    lastBricks: 0, frames: [], ended: 0 };
   shownKey = "";
   refine = null;
   post({ op: "answer", id: m.id, value: ok ? "" : viewer.stats().error || "the volume cannot be streamed" });
@@ -424,17 +429,47 @@ function writeBricks(m) {
     g.scratch = M._malloc(g.size * g.brick * g.brick * g.brick);
   }
   const body = new Uint8Array(m.body);
+  const t = streamTimes;
+  t.firstBricks = t.firstBricks || now();
   let offset = 0;
   for (const id of m.ids) {
     const box = ownedBox(g.dims, g.brick, id);
     const length = g.size * (box[1] - box[0]) * (box[3] - box[2]) * (box[5] - box[4]);
+    const start = performance.now();
     // A view taken now: the memory may have grown (and been replaced) since the last brick.
     decodeBrickInto(body.subarray(offset, offset + length), g.size, m.predictor, box,
       new Uint8Array(M.HEAPU8.buffer, g.scratch, length));
     offset += length;
+    const decoded = performance.now();
     if (!viewer.writeBrick(id, g.scratch)) {
       throw new Error(viewer.stats().error || "brick " + id + " cannot be written");
     }
+    t.decodeMs += decoded - start;
+    t.writeMs += performance.now() - decoded;
+  }
+  ++t.batches;
+  t.bricks += m.ids.length;
+  t.lastBricks = now();
+}
+
+// Where a stream's time goes in this worker, for the page's stats().streamTimes (the streaming
+// benchmark's table of parts, docs/web.md): the bricks' decoding and their writing (WebViewer's
+// writeBrick: the copy into the volume, the BlockLOD residency and the extraction ahead), the
+// first and last batch, and each frame (when it began, its time, the part that made and uploaded
+// the surfaces, how many surfaces came from level 0). Times are timeOrigin + now(); the page
+// takes them from `begun`, the stream's start, which it saw answered.
+function now() {
+  return performance.timeOrigin + performance.now();
+}
+
+function noteStreamFrame(stats) {
+  const t = streamTimes;
+  if (t && !t.ended) {
+    t.frames.push({ at: now() - stats.ms, ms: stats.ms, buildMs: stats.buildMs || 0,
+      triangles: stats.triangles || 0, coarse: (stats.coarse || []).filter(Boolean).length });
+  }
+  if (t) {
+    stats.streamTimes = Object.assign({}, t, { frames: t.frames.slice() });
   }
 }
 
@@ -465,6 +500,7 @@ self.onmessage = async (event) => {
       }
     } else if (m.op === "volume") {
       streaming = false;
+      streamTimes = null;
       freeScratch();
       if (coarseBytes) {
         viewer.setCoarseVolume(0, 0, [], [], []);
@@ -491,6 +527,9 @@ self.onmessage = async (event) => {
         pump();
       }
     } else if (m.op === "streamEnd") {
+      if (streamTimes) {
+        streamTimes.ended = now();
+      }
       viewer.endStreaming();
       streaming = false;
       const length = streamGrid ? streamGrid.length : 0;

@@ -174,12 +174,14 @@ function ready(s, v) {
 export async function startStream(level) {
   const d = state.dataset;
   state.stream = null;
+  const times = { started: epochNow() };
   const manifest = await requestJSON(manifestURL(d, level));
   if (manifest.ranges.length < 2) {
     await loadVolume(level); // one brick: nothing comes sooner by streaming it
     return;
   }
   const coarse = await fetchLevel(0);
+  times.level0 = epochNow();
   const type = coarse.type;
   const dims = manifest.dims;
   const M = state.module;
@@ -210,7 +212,9 @@ export async function startStream(level) {
     pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, received: 0,
     total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), exact: new Map(),
     asked: new Set(), requested: [], arrived: [], readyKey: "", error: "", started: false, framed: false,
-    batch: Math.max(1, Math.ceil(count / BATCHES)) };
+    batch: Math.max(1, Math.ceil(count / BATCHES)), times };
+  times.begun = epochNow();
+  lastTimes = times;
   state.received = 0;
   // The bricks are asked for once the first frame (level 0's) is drawn (afterEach): on a fast
   // link they would otherwise come first, and their writing and the server's encoding would
@@ -225,6 +229,7 @@ export async function startStream(level) {
 function framed(s) {
   if (s && state.stream === s) {
     s.framed = true;
+    s.times.framed = s.times.framed || epochNow();
     begin(s);
   }
 }
@@ -245,6 +250,7 @@ function begin(s, late = false) {
     return;
   }
   s.started = true;
+  s.times.requested = epochNow();
   fetchMore();
 }
 
@@ -311,6 +317,8 @@ async function fetchBatch(s, ids) {
   if (body.byteLength !== length) {
     throw new Error(body.byteLength + " bytes where the bricks own " + length);
   }
+  s.times.lastAnswer = epochNow();
+  s.times.firstAnswer = s.times.firstAnswer || s.times.lastAnswer;
   s.arrived.push({ ids, body, predictor: response.headers.get("X-Mediso-Predictor") || "none" });
   await handOver(s);
 }
@@ -329,6 +337,7 @@ async function handOver(s) {
   const values = currentValues();
   const needs = (id) => values.some((v) => needed(s, v).has(id));
   const write = (batch) => {
+    s.times.lastHanded = epochNow();
     state.viewer.writeBricks(batch);
     for (const id of batch.ids) {
       s.resident[id] = 1;
@@ -382,7 +391,9 @@ export function brickRanges() {
 // page's copy (this thread's module: the CPU count; the values: slices and histogram).
 async function finish(s) {
   lastStream = s;
+  s.times.ending = epochNow();
   const bytes = new Uint8Array(await state.viewer.endStream());
+  s.times.ended = epochNow();
   if (state.stream !== s) {
     return; // another volume since
   }
@@ -432,11 +443,49 @@ function afterEach() {
   const drawn = stats.surfaceValues || [];
   const full = state.stream ? state.stream.level : drawnLevel();
   state.surfaceLevels = currentValues().map((v) => ((stats.coarse || [])[drawn.indexOf(v)] ? 0 : full));
+  if (lastTimes && !lastTimes.full && fullNow()) {
+    lastTimes.full = epochNow();
+  }
   if (waiting.length && fullNow()) {
     const resolve = waiting;
     waiting = [];
     resolve.forEach((r) => r());
   }
+}
+
+// The times of the last stream (streamTimes), the epoch's ms (performance.timeOrigin + now).
+let lastTimes = null;
+function epochNow() {
+  return performance.timeOrigin + performance.now();
+}
+
+/**
+ * Where the last stream's time went (the streaming benchmark's table of parts, docs/web.md), in
+ * ms from the page's navigation, or null where the level came whole: on this thread, the stream
+ * begun (startStream), level 0 in, the stream set up in the worker, the first frame drawn, the
+ * first bricks asked for, the first and last answer in, the last batch handed to the worker,
+ * every current surface at the full level, and the level's end; in the worker (from its newest
+ * frame's stats), the first and last batch written, the bricks' decoding and writing (writeBrick:
+ * the copy, the residency and the extraction ahead) and each frame (when it began, its time,
+ * the part that made and uploaded the surfaces, its surfaces from level 0).
+ */
+export function streamTimes() {
+  if (!lastTimes) {
+    return null;
+  }
+  const since = (t) => (t ? Math.round(t - performance.timeOrigin) : null);
+  const out = Object.fromEntries(Object.entries(lastTimes).map(([k, t]) => [k, since(t)]));
+  const w = (state.viewer && state.viewer.stats().streamTimes) || null;
+  if (w) {
+    // The worker's clock from its stream's start, which this thread saw answered at `begun`: the
+    // two threads' timeOrigin + now() were seen to differ by a fifth of a second under load.
+    const worker = (t) => (t ? since(lastTimes.begun + t - w.begun) : null);
+    out.worker = { firstBricks: worker(w.firstBricks), lastBricks: worker(w.lastBricks),
+      batches: w.batches, bricks: w.bricks, decodeMs: Math.round(w.decodeMs),
+      writeMs: Math.round(w.writeMs), frames: w.frames.map((f) => ({ at: worker(f.at), ms: Math.round(f.ms),
+        buildMs: Math.round(f.buildMs), triangles: f.triangles, coarse: f.coarse })) };
+  }
+  return out;
 }
 
 /** Resolves when every current surface is drawn at the full level (automation). */
