@@ -8,6 +8,37 @@ namespace mediso
 {
 
 //------------------------------------------------------------------------------
+void RecentFrameValues::Push(double value)
+{
+  this->Recent[this->Frames % HistoryLength] = value;
+  ++this->Frames;
+}
+
+std::size_t RecentFrameValues::Kept() const
+{
+  return std::min(this->Frames, HistoryLength);
+}
+
+double RecentFrameValues::Smallest(std::size_t rank) const
+{
+  const std::size_t kept = this->Kept();
+  if (kept == 0)
+  {
+    return 0.0;
+  }
+  rank = std::min(rank, kept - 1);
+  std::array<double, HistoryLength> sorted = this->Recent;
+  std::nth_element(sorted.begin(), sorted.begin() + rank, sorted.begin() + kept);
+  return sorted[rank];
+}
+
+void RecentFrameValues::Reset()
+{
+  this->Recent.fill(0.0);
+  this->Frames = 0;
+}
+
+//------------------------------------------------------------------------------
 void FrameFixedCost::Observe(double windowSeconds, double ownSeconds)
 {
   if (!std::isfinite(windowSeconds) || !std::isfinite(ownSeconds) || windowSeconds < 0.0 ||
@@ -15,27 +46,17 @@ void FrameFixedCost::Observe(double windowSeconds, double ownSeconds)
   {
     return;
   }
-  this->Recent[this->Frames % HistoryLength] = std::max(0.0, windowSeconds - ownSeconds);
-  ++this->Frames;
+  this->Differences.Push(std::max(0.0, windowSeconds - ownSeconds));
 }
 
-//------------------------------------------------------------------------------
 double FrameFixedCost::Seconds() const
 {
-  const std::size_t kept = std::min(this->Frames, HistoryLength);
-  if (kept == 0)
-  {
-    return 0.0;
-  }
-  std::array<double, HistoryLength> sorted = this->Recent;
+  const std::size_t kept = this->Differences.Kept();
   // The lower median of an even count: of two frames, a stalled one does not
   // decide (nor does the first frame's window creation, where a host counts it).
-  const std::size_t middle = (kept - 1) / 2;
-  std::nth_element(sorted.begin(), sorted.begin() + middle, sorted.begin() + kept);
-  return sorted[middle];
+  return kept == 0 ? 0.0 : this->Differences.Smallest((kept - 1) / 2);
 }
 
-//------------------------------------------------------------------------------
 double FrameFixedCost::BudgetLeft(double budget) const
 {
   if (!std::isfinite(budget))
@@ -43,13 +64,6 @@ double FrameFixedCost::BudgetLeft(double budget) const
     return budget;
   }
   return std::max(0.0, budget - this->Seconds());
-}
-
-//------------------------------------------------------------------------------
-void FrameFixedCost::Reset()
-{
-  this->Recent.fill(0.0);
-  this->Frames = 0;
 }
 
 //------------------------------------------------------------------------------
@@ -65,27 +79,22 @@ void FrameTimeSpread::Observe(double predictedSeconds, double measuredSeconds)
   {
     return;
   }
-  this->Recent[this->Frames % HistoryLength] = ratio;
-  ++this->Frames;
+  this->Ratios.Push(ratio);
 }
 
-//------------------------------------------------------------------------------
 double FrameTimeSpread::Margin() const
 {
-  const std::size_t kept = std::min(this->Frames, HistoryLength);
+  const std::size_t kept = this->Ratios.Kept();
   if (kept == 0)
   {
     return 0.0;
   }
-  std::array<double, HistoryLength> sorted = this->Recent;
   // The nearest rank: of 9 ratios the 7th smallest, of 1 that one.
   const std::size_t rank =
     static_cast<std::size_t>(std::floor(Quantile * static_cast<double>(kept - 1) + 0.5));
-  std::nth_element(sorted.begin(), sorted.begin() + rank, sorted.begin() + kept);
-  return std::max(0.0, sorted[rank] - 1.0);
+  return std::max(0.0, this->Ratios.Smallest(rank) - 1.0);
 }
 
-//------------------------------------------------------------------------------
 double FrameTimeSpread::BudgetLeft(double budget) const
 {
   if (!std::isfinite(budget) || budget < 0.0)
@@ -93,13 +102,6 @@ double FrameTimeSpread::BudgetLeft(double budget) const
     return budget;
   }
   return budget / (1.0 + this->Margin());
-}
-
-//------------------------------------------------------------------------------
-void FrameTimeSpread::Reset()
-{
-  this->Recent.fill(0.0);
-  this->Frames = 0;
 }
 
 } // namespace mediso

@@ -53,11 +53,42 @@
 namespace mediso
 {
 
+/**
+ * The last few values a host measured, frame by frame (a ring of
+ * HistoryLength), and the k-th smallest of those kept: what FrameFixedCost
+ * takes its median of and FrameTimeSpread its quantile of.
+ */
+class RecentFrameValues
+{
+public:
+  /// The frames kept.
+  static constexpr std::size_t HistoryLength = 9;
+
+  /// Keeps `value`, forgetting the oldest once HistoryLength are kept.
+  void Push(double value);
+
+  /// How many are kept (at most HistoryLength).
+  std::size_t Kept() const;
+
+  /// The `rank`-th smallest of those kept (0: the smallest); 0 when none is kept.
+  double Smallest(std::size_t rank) const;
+
+  /// Values pushed so far (all of them, not only those kept).
+  std::size_t GetNumberOfFrames() const { return this->Frames; }
+
+  /// Forget every value.
+  void Reset();
+
+private:
+  std::array<double, HistoryLength> Recent{};
+  std::size_t Frames = 0;
+};
+
 class FrameFixedCost
 {
 public:
   /// The frames whose differences the median is taken over.
-  static constexpr std::size_t HistoryLength = 9;
+  static constexpr std::size_t HistoryLength = RecentFrameValues::HistoryLength;
 
   /**
    * One frame: the window's seconds (its render from start to end) and the
@@ -73,14 +104,13 @@ public:
   double BudgetLeft(double budget) const;
 
   /// Frames observed so far (all of them, not only those kept).
-  std::size_t GetNumberOfFrames() const { return this->Frames; }
+  std::size_t GetNumberOfFrames() const { return this->Differences.GetNumberOfFrames(); }
 
   /// Forget every frame (a new window).
-  void Reset();
+  void Reset() { this->Differences.Reset(); }
 
 private:
-  std::array<double, HistoryLength> Recent{};
-  std::size_t Frames = 0;
+  RecentFrameValues Differences;
 };
 
 /**
@@ -115,7 +145,7 @@ class FrameTimeSpread
 {
 public:
   /// The frames whose ratios the quantile is taken over.
-  static constexpr std::size_t HistoryLength = 9;
+  static constexpr std::size_t HistoryLength = RecentFrameValues::HistoryLength;
   /// The quantile of the ratios the margin is taken at (three frames in four).
   static constexpr double Quantile = 0.75;
 
@@ -129,14 +159,13 @@ public:
   double BudgetLeft(double budget) const;
 
   /// Frames observed so far (all of them, not only those kept).
-  std::size_t GetNumberOfFrames() const { return this->Frames; }
+  std::size_t GetNumberOfFrames() const { return this->Ratios.GetNumberOfFrames(); }
 
   /// Forget every frame.
-  void Reset();
+  void Reset() { this->Ratios.Reset(); }
 
 private:
-  std::array<double, HistoryLength> Recent{};
-  std::size_t Frames = 0;
+  RecentFrameValues Ratios;
 };
 
 } // namespace mediso
