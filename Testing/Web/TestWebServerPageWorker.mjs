@@ -59,8 +59,9 @@ await worker.close();
 // --- refinement: a coarse first answer, then the full level ------------------------------------------
 // ?refineDelay=2000: a coarse frame's refinement waits 2 s before it begins (40 ms otherwise), so
 // that the superseding change below surely comes first, however loaded the machine (a running
-// refinement would be aborted instead: TestWebServerPageWorkerAbort).
-const fast = await open(small, "&path=cpu&frameBudget=1&refineDelay=2000");
+// refinement would be aborted instead: TestWebServerPageWorkerAbort). ?prepareDrag=1: the GPU
+// drag's level made ready after a settled frame (off by default; checked below).
+const fast = await open(small, "&path=cpu&frameBudget=1&refineDelay=2000&prepareDrag=1");
 await fast.evaluate(() => window.mediso.setCPULevel(-1));
 {
   const before = await lastFrameSeq(fast);

@@ -25,7 +25,7 @@ export class RemoteViewer {
    * `threads`: the worker loads the threaded module; `budgetMs`: the frame budget (0: the
    * worker's); `abort`: false to let a running refinement run to its end; `slowExtractionMs`,
    * `slowPass`, `refineDelayMs`, `slowFirstDragFrameMs`: test hooks (render-worker.js);
-   * `prepareDrag`: false to leave a drag's level to the drag (render-worker.js). Returns
+   * `prepareDrag`: true to make a drag's level ready after a settled frame (render-worker.js). Returns
    * {worker, ready}, ready a promise of the worker's "ready" message, for start().
    */
   static launch(canvas, { threads, budgetMs, abort, slowExtractionMs, slowPass, refineDelayMs,

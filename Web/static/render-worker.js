@@ -89,8 +89,11 @@ let dragging = false; // the last frame drawn was a drag's
 // (WebViewer.prepareDrag: its volume level's pyramid built for the current isovalues, its
 // programs compiled, nothing shown), so that the first drag frame after a change does not pay
 // for them: {level, sampleDistance, built, ms, values} of the last time it built anything, and
-// how many times it did. ?prepareDrag=0 (a test and benchmark hook) leaves it to the drag.
-let prepareDragOn = true;
+// how many times it did. Only with ?prepareDrag=1: the preparation holds the worker (0.7 s on the
+// head CT at 1024x768 on SwiftShader), and a drag begun soon after a change waited for it, while
+// without it the drag's first frame is chosen on its whole frame (ChooseOnWholeFrame) and comes
+// at once on a level whose build fits (docs/web.md, The drag's frame made ready ahead).
+let prepareDragOn = false;
 let prepared = null;
 let preparedCount = 0;
 let prepareTimer = 0;
@@ -118,7 +121,7 @@ async function init(m) {
   if (m.slowFirstDragFrameMs > 0) {
     slowFirstDragFrameMs = m.slowFirstDragFrameMs;
   }
-  prepareDragOn = m.prepareDrag !== false;
+  prepareDragOn = m.prepareDrag === true;
   viewer = new M.WebViewer("#view");
   shareGeneration(m.abort !== false, m.slowExtractionMs, m.slowPass);
   post({ op: "ready", ok: viewer.ready(), error: viewer.error(), info: viewer.info(),

@@ -78,7 +78,7 @@ export async function startViewer(canvas, probe, moduleLoaded = () => {}) {
       slowPass: Number(params.get("slowPass")) || 1,
       refineDelayMs: Number(params.get("refineDelay")) || 0,
       slowFirstDragFrameMs: Number(params.get("slowFirstDragFrame")) || 0,
-      prepareDrag: params.get("prepareDrag") !== "0" });
+      prepareDrag: params.get("prepareDrag") === "1" });
   state.remote = inWorker;
   const debug = probe.getExtension("WEBGL_debug_renderer_info");
   state.unmaskedRenderer = debug ? probe.getParameter(debug.UNMASKED_RENDERER_WEBGL) : "";
