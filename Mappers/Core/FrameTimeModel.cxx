@@ -285,12 +285,29 @@ std::size_t FrameTimeModel::Key(const FrameWork& kind)
   return Key(kind.Method, kind.Translucent);
 }
 
+FrameTimeModel::PairKind FrameTimeModel::KindOf(std::size_t key)
+{
+  PairKind kind;
+  kind.Blended = key >= 4;
+  const std::size_t m = kind.Blended ? key - 4 : key / 2;
+  kind.Method = m == 0 ? FrameMethod::CellRasterisation : FrameMethod::Triangles;
+  kind.Translucent = kind.Blended || key % 2 == 1;
+  return kind;
+}
+
 FrameTimeModel::Coefficients FrameTimeModel::PriorOf(std::size_t key)
 {
-  const bool blended = key >= 4;
-  const std::size_t m = blended ? key - 4 : key / 2;
-  const FrameMethod method = m == 0 ? FrameMethod::CellRasterisation : FrameMethod::Triangles;
-  return blended ? BlendedPrior(method) : Prior(method, key % 2 == 1);
+  const PairKind kind = KindOf(key);
+  return kind.Blended ? BlendedPrior(kind.Method) : Prior(kind.Method, kind.Translucent);
+}
+
+void FrameTimeModel::KeepSample(Pair& pair, const Sample& sample)
+{
+  pair.Samples.push_back(sample);
+  while (pair.Samples.size() > HistoryLength)
+  {
+    pair.Samples.pop_front();
+  }
 }
 
 void FrameTimeModel::Observe(const FrameWork& work, double seconds)
@@ -310,12 +327,7 @@ void FrameTimeModel::Observe(const FrameWork& work, double seconds)
       const double drawing = this->PredictDrawing(work);
       const double oneOff = this->PredictOneOff(work);
       const double share = drawing + oneOff > 0.0 ? drawing / (drawing + oneOff) : 1.0;
-      pair.Samples.push_back(
-        { DrawingCounts(work), std::max(seconds - oneOff, 0.5 * share * seconds) });
-      while (pair.Samples.size() > HistoryLength)
-      {
-        pair.Samples.pop_front();
-      }
+      KeepSample(pair, { DrawingCounts(work), std::max(seconds - oneOff, 0.5 * share * seconds) });
       this->Refit(Key(work));
     }
     OneOffFit& fit = this->OneOffs[MethodKey(work.Method)];
@@ -327,11 +339,7 @@ void FrameTimeModel::Observe(const FrameWork& work, double seconds)
     this->RefitOneOff(work.Method);
     return;
   }
-  pair.Samples.push_back({ DrawingCounts(work), seconds });
-  while (pair.Samples.size() > HistoryLength)
-  {
-    pair.Samples.pop_front();
-  }
+  KeepSample(pair, { DrawingCounts(work), seconds });
   this->Refit(Key(work));
   // The one-off frames' residuals are measured against the drawing fit.
   if (!this->OneOffs[MethodKey(work.Method)].Samples.empty())
@@ -402,12 +410,11 @@ FrameTimeModel::Coefficients FrameTimeModel::Anchor(std::size_t key) const
   // blended pair the opaque one, then the peeled); else the other method's
   // opaque or peeled pair with more frames.
   const Coefficients prior = PriorOf(key);
-  const bool blended = key >= 4;
-  const std::size_t m = blended ? key - 4 : key / 2;
-  const FrameMethod method = m == 0 ? FrameMethod::CellRasterisation : FrameMethod::Triangles;
-  const bool translucent = blended || key % 2 == 1;
-  const std::size_t siblings[2] = { blended ? Key(method, false) : Key(method, !translucent),
-    blended ? Key(method, true) : 4 + m };
+  const PairKind kind = KindOf(key);
+  const FrameMethod method = kind.Method;
+  const std::size_t siblings[2] = {
+    kind.Blended ? Key(method, false) : Key(method, !kind.Translucent),
+    kind.Blended ? Key(method, true) : 4 + MethodKey(method) };
   const Pair* source = nullptr;
   for (std::size_t sibling : siblings)
   {

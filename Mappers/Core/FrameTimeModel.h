@@ -273,8 +273,18 @@ private:
   // The pair of a frame's kind: Key()'s, or its method's blended pair.
   static std::size_t Key(const FrameWork& kind);
   static std::size_t MethodKey(FrameMethod method);
+  // What a pair's key names: its method, translucent or not, blended or not.
+  struct PairKind
+  {
+    FrameMethod Method = FrameMethod::CellRasterisation;
+    bool Translucent = false;
+    bool Blended = false;
+  };
+  static PairKind KindOf(std::size_t key);
   // The prior of a pair.
   static Coefficients PriorOf(std::size_t key);
+  // Keeps a drawing sample in `pair`, the oldest forgotten past HistoryLength.
+  static void KeepSample(Pair& pair, const Sample& sample);
   // A pair's prediction before any of its frames: its prior, scaled as the
   // same method drawn another way scales its frames, else as the other
   // method's do, else the prior.
