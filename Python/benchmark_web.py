@@ -93,6 +93,17 @@ def parse_args(argv):
                    help="--interactive: the wait after each mouse move of the drag (ms)")
     p.add_argument("--changes", type=int, default=6,
                    help="--interactive: isovalue changes timed before the drag (at most 6)")
+    p.add_argument("--prepare-drag", default="",
+                   help="--interactive: this page with ?prepareDrag= each of these (e.g. 0,1: an A/B of "
+                        "the drag's frame made ready ahead, render-worker.js), one page each")
+    p.add_argument("--frame-budget", type=int, default=0,
+                   help="--interactive: this page's frame budget in ms (?frameBudget=; 0: the page's, "
+                        "100 ms): on a loaded machine, a budget as many times the page's as its frames "
+                        "are slower keeps the levels a quiet machine would choose")
+    p.add_argument("--drag-after-ms", default="0",
+                   help="--interactive with --scene: idle waits between the scene's settled frame and "
+                        "a drag (the first: the drag of the tables; each further one: the scene "
+                        "changed again, then a drag of its own: the first-drag table)")
     p.add_argument("--stills", type=int, default=0,
                    help="--interactive: still frames after the drag (their median beside the drag's)")
     p.add_argument("--stream", action="store_true",
@@ -251,7 +262,19 @@ def run_interactive(args, name, before_root):
         lo, hi = (-1000, 1100) if name.startswith("phantom:") else (-1000, 2000)
         isovalues = [400, -500, 300, 500, -300, 200, 600]
         isovalues = [v for v in isovalues if lo < v < hi][:max(1, args.changes) + 1]
+        if args.frame_budget:
+            pages["after"] += "&frameBudget=%d" % args.frame_budget
+        if args.prepare_drag:
+            # this tree's page once per ?prepareDrag= value, named after it (a value given again:
+            # the page again, numbered, in the order given, so that A/B runs can alternate)
+            after = pages.pop("after")
+            values = args.prepare_drag.split(",")
+            for i, v in enumerate(values):
+                again = values[:i].count(v)
+                pages["after, prepareDrag=%s%s" % (v, " (%d)" % (again + 1) if again else "")] = \
+                    after + "&prepareDrag=" + v
         config = {"pages": pages, "paths": args.paths.split(","),
+                  "dragAfterMs": [int(v) for v in args.drag_after_ms.split(",")],
                   "size": [int(v) for v in args.size.split("x")], "isovalues": isovalues,
                   "moves": args.moves, "stills": args.stills, "moveMs": args.move_ms}
         if args.scene == "skin-bone":
@@ -265,23 +288,32 @@ def run_interactive(args, name, before_root):
 def first_drag_lines(results):
     """The first drag frame after the scene's change, apart from the steady ones (issue 30): the
     first frame on its level for the new isovalues, which built that level's pyramid and first used
-    its programs unless the worker made them ready after the change (render-worker.js)."""
+    its programs unless the worker made them ready after the change (render-worker.js); one row for
+    the drag of the tables and one for each later drag (--drag-after-ms), with the idle wait
+    between the settled frame and the drag, and what was made ready ahead by the first move (its
+    steps together, and the longest step: the most a drag waits for it)."""
     lines = ["", "The drag's first frame (after the scene's change), apart from the steady frames:", "",
-             "| input | path | page | first drag frame ms | predicted ms | built a pyramid | level / sample "
-             "distance | wait from the first move ms | steady drag frame ms, median | made ready ahead ms |",
-             "|---|---|---|---:|---:|---|---|---:|---:|---:|"]
+             "| input | path | page | drag begun ms after settled | first drag frame ms | predicted ms | "
+             "built a pyramid | level / sample distance | wait from the first move ms | steady drag frame ms, "
+             "median | made ready ahead ms (longest step) |",
+             "|---|---|---|---:|---:|---:|---|---|---:|---:|---:|"]
     for name, r in results.items():
         for run in r["runs"]:
-            f = run["drag"].get("first")
-            if not f:
-                continue
-            made = run.get("dragPrepared") or {}
-            lines.append("| %s | %s | %s | %.0f | %.0f | %s | %s / %s | %s | %s | %s |" % (
-                name, run["path"], run["page"], f["ms"], f.get("predictedMs") or 0,
-                {True: "yes", False: "no"}.get(f.get("pyramidBuilt"), "-"), f.get("level"), f.get("sampleDistance"),
-                "%.0f" % f["waitMs"] if f.get("waitMs") is not None else "-",
-                "%.0f" % run["drag"]["steadyMs"] if run["drag"].get("steadyMs") else "-",
-                "%.0f (level %s)" % (made["ms"], made.get("level")) if made.get("ms") else "-"))
+            drags = [dict(run["drag"], dragPrepared=run.get("dragPrepared"))] + run.get("laterDrags", [])
+            for d in drags:
+                f = d.get("first")
+                if not f:
+                    continue
+                made = d.get("dragPrepared") or {}
+                lines.append("| %s | %s | %s | %s | %.0f | %.0f | %s | %s / %s | %s | %s | %s |" % (
+                    name, run["path"], run["page"], d.get("afterMs", 0), f["ms"], f.get("predictedMs") or 0,
+                    {True: "yes", False: "no"}.get(f.get("pyramidBuilt"), "-"), f.get("level"),
+                    f.get("sampleDistance"),
+                    "%.0f" % f["waitMs"] if f.get("waitMs") is not None else "-",
+                    "%.0f" % d["steadyMs"] if d.get("steadyMs") else "-",
+                    "%.0f (%s, level %s)" % (made["ms"], "%.0f" % made["longestStepMs"]
+                                             if made.get("longestStepMs") is not None else "-",
+                                             made.get("level")) if made.get("ms") else "-"))
     return lines
 
 
@@ -301,6 +333,7 @@ def main_interactive(args, argv):
                                  check=True, stdout=subprocess.PIPE).stdout
         subprocess.run(["tar", "-x", "-C", before_root], input=archive, check=True)
     results = {name: run_interactive(args, name, before_root) for name in args.inputs.split(",")}
+    budget = args.frame_budget or 100
     lines = ["# The page before and after the worker (issue 30)", "",
              "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv),
              "- Started %s, %.0f s; load average %s before, %s after" % (
@@ -308,8 +341,9 @@ def main_interactive(args, argv):
              "- Machine: nproc %d (%s); Chromium headless, SwiftShader; canvas %s" % (
                  os.cpu_count() or 0, cpu_model(), args.size),
              ("- before: `%s`'s page (the viewer on the main thread); after: this tree's (the viewer in a "
-              "worker, frame budget 100 ms); the same WebAssembly module" % args.before) if before_root else
-             "- after: this tree's page (the viewer in a worker, frame budget 100 ms) only (`--before none`)", "",
+              "worker, frame budget %d ms); the same WebAssembly module" % (args.before, budget)) if before_root else
+             "- after: this tree's page (the viewer in a worker, frame budget %d ms) only (`--before none`)"
+             % budget, "",
              "| input | path | page | first visible answer ms, median (max) | full level ms, median | "
              "drag frame ms, median | drag frames/s | drag level / sample distance | longest main-thread task ms |"
              + (" still frame ms, median | drag / still | steady drag frame ms, median (frames) | steady drag / still |"
@@ -343,7 +377,7 @@ def main_interactive(args, argv):
             lines.append(row)
     errors = ["%s %s: %.0f%%" % (name, run["path"], 100 * run["drag"]["predictionError"])
               for name, r in results.items() for run in r["runs"]
-              if run["page"] == "after" and run["drag"].get("predictionError") is not None
+              if run["page"].startswith("after") and run["drag"].get("predictionError") is not None
               and run["drag"]["predictionError"] == run["drag"]["predictionError"]]
     lines += ["", "The frame-time model's median error on the drag frames it chose (after): " +
               (", ".join(errors) or "none recorded") + "."]

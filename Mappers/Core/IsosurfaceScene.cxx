@@ -1078,6 +1078,13 @@ bool IsosurfaceScene::Internals::UploadCoarse(int level, std::string& error)
   CoarseLevel& coarse = this->Coarse[At(level)];
   const VolumeDescription& source = this->CoarseSources[At(level)];
   coarse.Pyramid.reset(new HistoPyramidGL(this->GL));
+  // The build passes' programs depend on the value type only, so a level compiles none that the
+  // volume's pyramid compiled (the first build of a coarse level, a change's first answer or a
+  // drag's level made ready ahead, was mostly compilation on a software rasteriser).
+  if (this->Pyramid)
+  {
+    coarse.Pyramid->ShareProgramsWith(*this->Pyramid);
+  }
   bool uploaded = false;
   if (source.Data)
   {

@@ -205,6 +205,12 @@ async function drag(page, moves = 12) {
     "GPU path: the drag's level (" + made.level + ") was made ready for these isovalues after the still " +
     "frame, and the drag's first frame (level " + firstDrag.gpuLevel + ") built no pyramid (" +
     firstDrag.pyramidBuilt + ")");
+  // In steps, each in a task of its own (the worker reads its messages between them, so that a
+  // drag that comes meanwhile waits for one step only): the level's pyramid, then its programs.
+  checks.check(JSON.stringify((made.steps || []).map((t) => [t.step, t.level])) ===
+    JSON.stringify([["pyramid", -1], ["programs", -1]]) && made.longestStepMs <= made.ms,
+    "GPU path: the drag's level was made in two steps, its pyramid then its programs: " +
+    JSON.stringify(made.steps));
 }
 
 // --- the GPU path's change: a coarse volume level first, then the full volume ------------------------

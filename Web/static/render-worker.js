@@ -86,13 +86,14 @@ let slowFirstDragFrameMs = 0;
 let dragging = false; // the last frame drawn was a drag's
 
 // The GPU frame a drag would be drawn as, made ready in the idle time after a settled frame
-// (WebViewer.prepareDrag: its volume level's pyramid built for the current isovalues, its
-// programs compiled, nothing shown), so that the first drag frame after a change does not pay
-// for them: {level, sampleDistance, built, ms, values} of the last time it built anything, and
-// how many times it did. Only with ?prepareDrag=1: the preparation holds the worker (0.7 s on the
-// head CT at 1024x768 on SwiftShader), and a drag begun soon after a change waited for it, while
-// without it the drag's first frame is chosen on its whole frame (ChooseOnWholeFrame) and comes
-// at once on a level whose build fits (docs/web.md, The drag's frame made ready ahead).
+// (WebViewer.prepareDragStep: its volume level's pyramid built for the current isovalues, its
+// programs compiled, nothing shown; schedulePrepare), so that the first drag frame after a
+// change does not pay for them: {level, sampleDistance, ms, longestStepMs, steps, values} of the
+// last time it made anything, and how many times it did. Only with ?prepareDrag=1: in one piece
+// the preparation held the worker (0.7 s on the head CT at 1024x768 on SwiftShader), and a drag
+// begun soon after a change waited for it, while without it the drag's first frame is chosen on
+// its whole frame (ChooseOnWholeFrame) and comes at once on a level whose build fits
+// (docs/web.md, The drag's frame made ready ahead).
 let prepareDragOn = false;
 let prepared = null;
 let preparedCount = 0;
@@ -231,6 +232,7 @@ function pump() {
   if (wanted) {
     const frame = wanted;
     wanted = null;
+    cancelPrepare(); // a newer frame: the steps left wait for the next settled one
     const key = keyOf(frame.surfaces);
     if (refine) {
       // A newer frame: a change or a drag makes the owed refinement obsolete (skipped); a still
@@ -287,34 +289,59 @@ function pump() {
   }
 }
 
-// After a settled GPU frame, in a task of its own prepareDelayMs later: the frame a drag would be
-// drawn as, made ready (WebViewer.prepareDrag), unless a newer frame is asked for by then (its
-// message here, or the page's generation word moved on). It holds this worker for a pyramid
-// build and one coarse frame, as the drag's first frame did before; a frame asked for meanwhile
-// waits for it. The delay lets the settled frame reach the page first (the worker's canvas is
-// shown after the task that drew it, and a task queued at once could run before that) and lets
-// a burst of still frames (keys held, a slider) pass without one.
+// After a settled GPU frame, in tasks of their own from prepareDelayMs later: the frame a drag
+// would be drawn as, made ready (WebViewer.prepareDragStep: its volume level's pyramid in one
+// step, its programs in the next), one step per task, so that a frame asked for meanwhile (a
+// drag, a change) is read and drawn before the next step, which is then dropped: the next
+// settled frame schedules the preparation again, and it goes on from what is made. Before each
+// step: dropped where a newer frame is asked for (its message here, or the page's generation word
+// moved on, which the page adds to before it sends a drag frame or a change). A drag that comes
+// during a step waits for that step only. The delay lets the settled frame reach the page first
+// (the worker's canvas is shown after the task that drew it, and a task queued at once could run
+// before that) and lets a burst of still frames (keys held, a slider) pass without one.
 const prepareDelayMs = 100;
 function schedulePrepare(frame) {
-  clearTimeout(prepareTimer);
+  cancelPrepare();
   if (!prepareDragOn || path !== "gpu" || streaming) {
     return;
   }
-  prepareTimer = setTimeout(() => {
-    if (wanted || refine || scheduled || path !== "gpu" || streaming ||
-        (generationWord && Atomics.load(generationWord, 0) !== (frame.generation | 0))) {
-      return;
-    }
-    const r = viewer.prepareDrag(budgetSeconds);
-    if (r.built) {
-      ++preparedCount;
-      prepared = { level: r.level, sampleDistance: r.sampleDistance, ms: r.ms,
-        values: frame.surfaces.map((s) => s.value) };
-      post({ op: "prepared", value: prepared, count: preparedCount });
-    } else if (r.error) {
-      post({ op: "error", message: "preparing the drag's frame: " + r.error });
-    }
-  }, prepareDelayMs);
+  const job = { frame, ms: 0, steps: [] };
+  prepareTimer = setTimeout(() => prepareStep(job), prepareDelayMs);
+}
+
+function cancelPrepare() {
+  clearTimeout(prepareTimer);
+  prepareTimer = 0;
+}
+
+function prepareStep(job) {
+  prepareTimer = 0;
+  const frame = job.frame;
+  if (wanted || refine || scheduled || path !== "gpu" || streaming ||
+      (generationWord && Atomics.load(generationWord, 0) !== (frame.generation | 0))) {
+    return;
+  }
+  const r = viewer.prepareDragStep(budgetSeconds);
+  if (r.error) {
+    post({ op: "error", message: "preparing the drag's frame: " + r.error });
+    return;
+  }
+  if (r.step) {
+    job.ms += r.ms;
+    job.steps.push({ step: r.step, level: r.level, ms: r.ms });
+  }
+  if (!r.done) {
+    prepareTimer = setTimeout(() => prepareStep(job), 0);
+    return;
+  }
+  if (job.steps.length) {
+    ++preparedCount;
+    // ms: this preparation's steps together; longestStepMs: the longest a drag could wait for
+    prepared = { level: r.level, sampleDistance: r.sampleDistance, ms: job.ms,
+      longestStepMs: Math.max(...job.steps.map((t) => t.ms)), steps: job.steps,
+      values: frame.surfaces.map((s) => s.value) };
+    post({ op: "prepared", value: prepared, count: preparedCount });
+  }
 }
 
 // What a coarse GPU frame drew: the volume level (every stride-th point) and the sample distance.

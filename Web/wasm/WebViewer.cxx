@@ -928,25 +928,35 @@ public:
   }
 
   /**
-   * Makes ready, in the idle time after a still frame, the GPU frame a drag would be drawn as,
-   * so that the first drag frame after an isovalue change (or a switch to the GPU path) does not
-   * pay for it: the candidate a drag holds (ChooseFrame's on the drawing alone,
-   * FrameTimeModel::Choose, within `budgetSeconds`) has its volume level's pyramid built for the
-   * current isovalues and its programs compiled, by drawing that frame once into the sampled
-   * framebuffer, never shown (the canvas keeps the still frame; a drag at every pixel is
-   * rehearsed at distance 2: only a sampled frame stays off the canvas, and a distance compiles
-   * nothing). The page's worker calls it once a GPU frame is settled and no newer one is asked
-   * for. Nothing is done on the CPU path, while the scene streams (a coarse level samples points
-   * not all there yet), or where that level is built for these isovalues and its programs were
-   * used (WarmKey). The rehearsal is not observed by the frame-time model (it draws no blit and
-   * is not shown); the frame after it reports its own work as before.
-   * Returns {level, sampleDistance, built, ms}: built is true when it built or compiled
-   * anything, ms its time (0 otherwise), error where the frame could not be drawn.
+   * One step of making ready, in the idle time after a still frame, the GPU frame a drag would be
+   * drawn as, so that the first drag frame after an isovalue change (or a switch to the GPU path)
+   * does not pay for it: the candidate a drag holds (ChooseFrame's on the drawing alone,
+   * FrameTimeModel::Choose, within `budgetSeconds`) gets
+   * -# "pyramid": its volume level's pyramid built for the current isovalues (the level's
+   *    samples uploaded on its first build; the build ends by reading its total back, so the GPU
+   *    is idle again when the step returns), then
+   * -# "programs": its programs compiled, by drawing that frame once into the sampled
+   *    framebuffer, never shown (the canvas keeps the still frame; a drag at every pixel is
+   *    rehearsed at distance 2: only a sampled frame stays off the canvas, and a distance
+   *    compiles nothing), waited for with a one-pixel read-back.
+   * Each call does at most one step, so that the page's worker reads its messages between them: a
+   * drag or a change that comes meanwhile is drawn at once, and the worker calls again after the
+   * next settled frame, which goes on from what is made (nothing is kept here between calls: each
+   * call asks again what a drag would draw and what of it is not ready). A drag that begins after
+   * the first step finds the level's pyramid built (the whole-frame choice, ChooseOnWholeFrame,
+   * then counts only its programs). The pyramid is the one a drag frame would build (the same
+   * UpdateLevel). Nothing is done on the CPU path, while the scene streams (a coarse level
+   * samples points not all there yet), or where that level is built for these isovalues and its
+   * programs were used (WarmKey). The rehearsal is not observed by the frame-time model (it draws
+   * no blit and is not shown); the frame after it reports its own work as before.
+   * Returns {level, sampleDistance, step, done, ms}: step the one done ("" when nothing was
+   * needed), done false when a step is left, ms its time; error where a step failed.
    */
-  val PrepareDrag(double budgetSeconds)
+  val PrepareDragStep(double budgetSeconds)
   {
     val out = val::object();
-    out.set("built", false);
+    out.set("step", std::string());
+    out.set("done", true);
     out.set("ms", 0.0);
     if (this->CPUPath || !this->Ready() || !this->Data || !this->Scene ||
       this->Frame.Surfaces.empty() || this->Scene->IsStreaming())
@@ -960,8 +970,26 @@ public:
     out.set("level", drag.Level);
     out.set("sampleDistance", drag.SampleDistance);
     const std::array<int, 3> key = this->WarmKey(drag.Level, drag.Work);
-    if (this->Scene->GetBuiltValues(drag.Level) == this->SurfaceValues() && this->Warm.count(key))
+    const bool built = this->Scene->GetBuiltValues(drag.Level) == this->SurfaceValues();
+    if (built && this->Warm.count(key))
     {
+      return out;
+    }
+    emscripten_webgl_make_context_current(this->Context);
+    const double start = emscripten_get_now();
+    if (!built)
+    {
+      // Render()'s own build of that level, without the frame: a drag frame finds it made.
+      std::string error;
+      this->Scene->SetSurfaces(this->Frame.Surfaces);
+      if (!this->Scene->UpdateLevel(drag.Level, error))
+      {
+        out.set("error", error);
+        return out;
+      }
+      out.set("step", std::string("pyramid"));
+      out.set("done", this->Warm.count(key) > 0);
+      out.set("ms", emscripten_get_now() - start);
       return out;
     }
     // What the last shown frame says (GetStats) is kept: the rehearsal is not a frame.
@@ -972,7 +1000,6 @@ public:
     const double drawnDistance = this->DrawnSampleDistance;
     const std::uint64_t buildCells = this->FrameBuildCells;
     const std::string lastError = this->LastError;
-    const double start = emscripten_get_now();
     this->SetGPULevel(drag.Level);
     this->SampleDistance = std::max(2.0, static_cast<double>(drag.SampleDistance));
     bool ok = false;
@@ -989,7 +1016,7 @@ public:
       unsigned char pixel[4];
       this->GL->F().ReadPixels(0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, pixel);
       this->Warm.insert(key);
-      out.set("built", true);
+      out.set("step", std::string("programs"));
       out.set("ms", emscripten_get_now() - start);
     }
     else
@@ -1024,7 +1051,8 @@ public:
     stats.set("firstHit", this->Stats.FirstHit);
     stats.set("buildMs", this->LastBuildMs);
     // Whether the last frame built a pyramid (its volume level's, for new isovalues or on the
-    // level's first frame) before drawing; a drag frame on a level made ahead (PrepareDrag) did not.
+    // level's first frame) before drawing; a drag frame on a level made ahead (PrepareDragStep)
+    // did not.
     stats.set("pyramidBuilt", this->FrameBuildCells > 0);
     stats.set("sampleDistance", this->DrawnSampleDistance);
     stats.set("pixels",
@@ -1139,7 +1167,7 @@ private:
   // the one that builds a level for these isovalues when that is over the budget (the first drag
   // frame after a change built its level's pyramid and first used its programs: seconds on a
   // loaded machine, against 20-280 ms for the next). A still frame of built surfaces chooses on
-  // the drawing: the level a drag can hold, which PrepareDrag makes ready in the idle time
+  // the drawing: the level a drag can hold, which PrepareDragStep makes ready in the idle time
   // before the drag, so a drag still reaches a finer level, from its next drag on.
   bool ChooseOnWholeFrame(bool interactive) const
   {
@@ -1560,7 +1588,7 @@ private:
   std::uint64_t FrameBuildCells = 0;
   std::set<std::array<int, 3>> Warm;
   bool MeshesUploaded = false; // the last frame made or uploaded a CPU path surface
-  bool Rehearsing = false; // PrepareDrag's frame: drawn into Sampled only, never shown
+  bool Rehearsing = false;     // PrepareDragStep's rehearsal: drawn into Sampled only, never shown
   glcore::Name Sampled, SampledColor, SampledDepth; // a sampled frame's framebuffer
   int SampledSize[2] = { 0, 0 };
 
@@ -1776,7 +1804,7 @@ EMSCRIPTEN_BINDINGS(mediso_web)
     .function("setSampleDistance", &WebViewer::SetSampleDistance)
     .function("setGPULevel", &WebViewer::SetGPULevel)
     .function("chooseFrame", &WebViewer::ChooseFrame)
-    .function("prepareDrag", &WebViewer::PrepareDrag)
+    .function("prepareDragStep", &WebViewer::PrepareDragStep)
     .function("estimates", &WebViewer::Estimates)
     .function("setResultMesh", &WebViewer::SetResultMesh)
     .function("clearResultMesh", &WebViewer::ClearResultMesh)
