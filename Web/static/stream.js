@@ -216,30 +216,36 @@ export async function startStream(level) {
   times.begun = epochNow();
   lastTimes = times;
   state.received = 0;
-  // The bricks are asked for once the first frame (level 0's) is drawn (afterEach): on a fast
-  // link they would otherwise come first, and their writing and the server's encoding would
-  // hold that frame (the page's start-up, docs/web.md). The bricks the first surfaces need are
-  // asked of the server before that frame (beforeEach), so that the first requests are theirs;
-  // a timer in case no frame comes.
+  // The bricks are asked for as soon as the server has said which ones the first surfaces need
+  // (askExact, sent with the first frame's request: beforeEach), while the worker draws that
+  // frame (level 0's), so that the link and the server work during it; what arrives before the
+  // frame is drawn is held here (handOver), since the worker would write it before drawing and
+  // the first image would wait (the page's start-up, docs/web.md). A timer in case no frame
+  // comes.
   const s = state.stream;
   setTimeout(() => framed(s), 1000);
 }
 
-// The first frame is drawn (or a second has passed without one): the bricks may be asked for.
+// The first frame is drawn (or a second has passed without one): the bricks that came meanwhile
+// may go to the worker, and the bricks be asked for if the need answer has not started them.
 function framed(s) {
   if (s && state.stream === s) {
     s.framed = true;
     s.times.framed = s.times.framed || epochNow();
     begin(s);
+    if (s.arrived.length) {
+      handOver(s);
+    }
   }
 }
 
-// The bricks are asked for once the first frame is drawn and the server has said which bricks
-// the current isovalues need (one round trip, sent before that frame: it has mostly come by
-// then): the batches are then those of the exact sets, the same at every load (BATCHES). A need
-// query that fails (the supersets) or takes over 2 s more does not hold the bricks.
+// The bricks are asked for once the server has said which bricks the current isovalues need
+// (one round trip, sent with the first frame's request; begin runs again at its answer), or once
+// the first frame is drawn with no need query sent: the batches are then those of the exact
+// sets, the same at every load (BATCHES). A need query that fails (the supersets) or takes over
+// 2 s more does not hold the bricks.
 function begin(s, late = false) {
-  if (!s || state.stream !== s || s.started || !s.framed) {
+  if (!s || state.stream !== s || s.started || (!s.framed && !s.asked.size)) {
     return;
   }
   askExact(s);
@@ -331,8 +337,8 @@ async function fetchBatch(s, ids) {
 // that a surface's last brick asks for would hold that frame. They go as soon as every current
 // surface has its bricks (after that frame's request), or a brick has failed.
 async function handOver(s) {
-  if (state.stream !== s) {
-    return;
+  if (state.stream !== s || !s.framed) {
+    return; // held until the first frame is drawn (afterEach hands them over then)
   }
   const values = currentValues();
   const needs = (id) => values.some((v) => needed(s, v).has(id));
@@ -434,9 +440,8 @@ function fullNow() {
 }
 function afterEach() {
   if (state.stream && !state.stream.framed) {
-    framed(state.stream);
-  }
-  if (state.stream && state.stream.arrived.length) {
+    framed(state.stream); // hands over what came meanwhile
+  } else if (state.stream && state.stream.arrived.length) {
     handOver(state.stream); // a change since may need them, or need nothing more
   }
   const stats = state.viewer.stats();
