@@ -23,8 +23,15 @@ import { afterFrame, beforeFrame, renderNow } from "./viewer.js";
 import { fetchLevel, levelURL, loadVolume, mallocZeros, prefetch, request, requestJSON,
   typedValues } from "./volume.js";
 
-// Requests in flight at once (a browser opens 6 connections to a host over HTTP/1.1).
-const IN_FLIGHT = 6;
+// Requests in flight at once. Two keep the link and the server busy (a batch is 11-22 bricks,
+// about 1-6 MB, where a round trip on a slow link is tens of ms); more share the bandwidth (and,
+// on loopback, the two cores) between them, so that the first answer, which the worker waits
+// for, came only with the others: six together (a browser's connections to one host over
+// HTTP/1.1) made the first answer take 0.4-0.9 s on loopback, the worker idle meanwhile.
+const IN_FLIGHT = 2;
+// A frame at the full level for the surfaces whose bricks are in waits for the others where
+// those lack no more than this many batches (redrawIfReady).
+const WAIT_BATCHES = 6;
 // Requests a level's bricks are cut into, about: each request costs this thread a fetch, an
 // answer and a hand-over to the worker, and the server a round of its event loop (one brick a
 // request was 256-512 requests on a 512-wide volume). The batches are the same at every load
@@ -131,7 +138,7 @@ function askExact(s) {
 // A surface whose bricks have all arrived is drawn again, at the full level: one frame for
 // everything that arrived since the last (completions are coalesced, not drawn brick by brick),
 // and none where no surface has become ready (a change draws its own frame). Where the other
-// surfaces lack no more bricks than one round of requests brings, the frame waits for them: a
+// surfaces lack no more than WAIT_BATCHES batches of bricks, the frame waits for them: a
 // frame at the full level costs seconds on a software renderer, and the surfaces of a CT (skin
 // and bone) need nearly the same bricks.
 function redrawIfReady(s) {
@@ -149,7 +156,7 @@ function redrawIfReady(s) {
       }
     }
   }
-  if (missing.size && missing.size <= IN_FLIGHT * s.batch && !s.error) {
+  if (missing.size && missing.size <= WAIT_BATCHES * s.batch && !s.error) {
     return false; // the last of them redraws (a brick that failed: no waiting)
   }
   s.readyKey = key;
@@ -209,7 +216,7 @@ export async function startStream(level) {
   }
   const count = manifest.ranges.length;
   state.stream = { level, path: state.path, manifest, type, dims, resident: new Uint8Array(count),
-    pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, received: 0,
+    pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, neededInFlight: 0, received: 0,
     total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), exact: new Map(),
     asked: new Set(), requested: [], arrived: [], readyKey: "", error: "", started: false, framed: false,
     batch: Math.max(1, Math.ceil(count / BATCHES)), times };
@@ -261,9 +268,10 @@ function begin(s, late = false) {
 }
 
 // The next batch: up to s.batch bricks the current isovalues need (those of the first value
-// first), else up to s.batch of the others in id order; a batch does not mix the two, so that
-// the last needed bricks do not wait for others.
-function nextBatch(s) {
+// first), else up to s.batch of the others in id order (none while a batch of needed bricks is
+// still travelling: `othersToo` false); a batch does not mix the two, so that the last needed
+// bricks do not wait for others.
+function nextBatch(s, othersToo) {
   const ids = [];
   for (const v of currentValues()) {
     for (const id of needed(s, v)) {
@@ -276,7 +284,7 @@ function nextBatch(s) {
       }
     }
   }
-  if (ids.length) {
+  if (ids.length || !othersToo) {
     return ids;
   }
   for (const id of s.pending) {
@@ -289,13 +297,24 @@ function nextBatch(s) {
   return ids;
 }
 
+// Up to IN_FLIGHT requests. The others' batches (no current surface needs them) wait until every
+// batch of needed bricks has arrived: on loopback the server's sending and the browser's
+// inflating of the others took the two cores from the needed ones (and the writing) at the end
+// of the needed bricks, and on a slow link their bytes took its bandwidth; the others follow at
+// most one round trip later.
 function fetchMore() {
   const s = state.stream;
   while (s && state.stream === s && s.inFlight < IN_FLIGHT && s.pending.size) {
-    const batch = nextBatch(s);
-    s.requested.push({ ids: batch, values: currentValues() });
+    const batch = nextBatch(s, !s.neededInFlight);
+    if (!batch.length) {
+      break; // others, after the needed batches in flight
+    }
+    const values = currentValues();
+    const neededBatch = batch.some((id) => values.some((v) => needed(s, v).has(id)));
+    s.requested.push({ ids: batch, values });
     ++s.inFlight;
-    fetchBatch(s, batch).catch((error) => {
+    s.neededInFlight += neededBatch ? 1 : 0;
+    fetchBatch(s, batch, neededBatch).catch((error) => {
       // Said in the readout; the surfaces that need the brick stay at level 0.
       s.error = "bricks " + batch.join(", ") + ": " + error.message;
       console.error("streaming: " + s.error);
@@ -306,13 +325,14 @@ function fetchMore() {
   }
 }
 
-async function fetchBatch(s, ids) {
+async function fetchBatch(s, ids, neededBatch) {
   let response, body;
   try {
     ({ response, body } = await request("/api/bricks/" + state.dataset.id + "?level=" + s.level +
       "&ids=" + ids.join(","), "no-cache"));
   } finally {
     --s.inFlight;
+    s.neededInFlight -= neededBatch ? 1 : 0;
   }
   if (state.stream !== s) {
     return; // another volume since
