@@ -23,15 +23,10 @@ import { afterFrame, beforeFrame, renderNow } from "./viewer.js";
 import { fetchLevel, levelURL, loadVolume, mallocZeros, prefetch, request, requestJSON,
   typedValues } from "./volume.js";
 
-// Requests in flight at once. Two keep the link and the server busy (a batch is 11-22 bricks,
-// about 1-6 MB, where a round trip on a slow link is tens of ms); more share the bandwidth (and,
-// on loopback, the two cores) between them, so that the first answer, which the worker waits
-// for, came only with the others: six together (a browser's connections to one host over
-// HTTP/1.1) made the first answer take 0.4-0.9 s on loopback, the worker idle meanwhile.
-const IN_FLIGHT = 2;
-// A frame at the full level for the surfaces whose bricks are in waits for the others where
-// those lack no more than this many batches (redrawIfReady).
-const WAIT_BATCHES = 6;
+// Requests in flight at once (a browser opens 6 connections to a host over HTTP/1.1). Two made
+// the first answer come sooner but the bricks as a whole later (docs/web.md, The critical path
+// from level 0 to the full level).
+const IN_FLIGHT = 6;
 // Requests a level's bricks are cut into, about: each request costs this thread a fetch, an
 // answer and a hand-over to the worker, and the server a round of its event loop (one brick a
 // request was 256-512 requests on a 512-wide volume). The batches are the same at every load
@@ -138,7 +133,7 @@ function askExact(s) {
 // A surface whose bricks have all arrived is drawn again, at the full level: one frame for
 // everything that arrived since the last (completions are coalesced, not drawn brick by brick),
 // and none where no surface has become ready (a change draws its own frame). Where the other
-// surfaces lack no more than WAIT_BATCHES batches of bricks, the frame waits for them: a
+// surfaces lack no more bricks than one round of requests brings, the frame waits for them: a
 // frame at the full level costs seconds on a software renderer, and the surfaces of a CT (skin
 // and bone) need nearly the same bricks.
 function redrawIfReady(s) {
@@ -156,7 +151,7 @@ function redrawIfReady(s) {
       }
     }
   }
-  if (missing.size && missing.size <= WAIT_BATCHES * s.batch && !s.error) {
+  if (missing.size && missing.size <= IN_FLIGHT * s.batch && !s.error) {
     return false; // the last of them redraws (a brick that failed: no waiting)
   }
   s.readyKey = key;
@@ -216,8 +211,8 @@ export async function startStream(level) {
   }
   const count = manifest.ranges.length;
   state.stream = { level, path: state.path, manifest, type, dims, resident: new Uint8Array(count),
-    pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, neededInFlight: 0, received: 0,
-    total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), exact: new Map(),
+    pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, neededInFlight: 0,
+    received: 0, total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), exact: new Map(),
     asked: new Set(), requested: [], arrived: [], readyKey: "", error: "", started: false, framed: false,
     batch: Math.max(1, Math.ceil(count / BATCHES)), times };
   times.begun = epochNow();
