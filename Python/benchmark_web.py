@@ -35,7 +35,9 @@ Chromium, under each network (MBIT/LATENCY_MS through CDP's Network.emulateNetwo
 loopback): the time to the first image, to the current surfaces at the full level, to the whole
 level, and the bytes on the wire. Inputs: ct, ct512, or any server spec phantom:N[:noise=HU]
 (the issue's: the 512-wide CT and phantom:512:noise=40, the default). Below it, where each
-streamed page's time went (its stats().streamTimes) beside the whole page's frames.
+streamed page's time went (its stats().streamTimes) beside the whole page's frames. With
+--before REF, the streaming page of git REF (its Python/ and Web/static, served by a server of
+its own with this tree's WebAssembly module) is timed too, between the whole page and this one.
 
 --startup (issue 31's first image): the streaming page's start-up request by request, in a fresh
 context under each network (Testing/Web/bench-startup.mjs): when each of the page's requests was
@@ -84,7 +86,8 @@ def parse_args(argv):
                    help="the page before (--before) against this one: first answer, drag, long tasks")
     p.add_argument("--before", default="",
                    help="--interactive: the git ref of the page before (default: where this branch "
-                        "left main, whose page takes this tree's WebAssembly module)")
+                        "left main, whose page takes this tree's WebAssembly module); --stream: "
+                        "that ref's streaming page too (default: none)")
     p.add_argument("--moves", type=int, default=30, help="--interactive: mouse moves of the drag")
     p.add_argument("--paths", default="cpu,gpu", help="--interactive: the page's paths to run")
     p.add_argument("--scene", default="", choices=["", "skin-bone"],
@@ -317,6 +320,20 @@ def first_drag_lines(results):
     return lines
 
 
+def before_tree(args):
+    """The page of git ref args.before (its Python/ and Web/static) in a folder under --work, or ""
+    for --before none."""
+    if args.before == "none":
+        return ""
+    before_root = os.path.join(args.work, "before-" + args.before.replace("/", "-"))
+    shutil.rmtree(before_root, ignore_errors=True)
+    os.makedirs(before_root)
+    archive = subprocess.run(["git", "-C", ROOT, "archive", args.before, "Python", "Web/static"],
+                             check=True, stdout=subprocess.PIPE).stdout
+    subprocess.run(["tar", "-x", "-C", before_root], input=archive, check=True)
+    return before_root
+
+
 def main_interactive(args, argv):
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     load_before = load_average()
@@ -324,14 +341,7 @@ def main_interactive(args, argv):
     if not args.before:
         args.before = subprocess.run(["git", "-C", ROOT, "merge-base", "HEAD", "main"], check=True,
                                      stdout=subprocess.PIPE, text=True).stdout.strip()[:12]
-    before_root = ""
-    if args.before != "none":
-        before_root = os.path.join(args.work, "before-" + args.before.replace("/", "-"))
-        shutil.rmtree(before_root, ignore_errors=True)
-        os.makedirs(before_root)
-        archive = subprocess.run(["git", "-C", ROOT, "archive", args.before, "Python", "Web/static"],
-                                 check=True, stdout=subprocess.PIPE).stdout
-        subprocess.run(["tar", "-x", "-C", before_root], input=archive, check=True)
+    before_root = before_tree(args)
     results = {name: run_interactive(args, name, before_root) for name in args.inputs.split(",")}
     budget = args.frame_budget or 100
     lines = ["# The page before and after the worker (issue 30)", "",
@@ -406,6 +416,11 @@ def main_stream(args, argv):
     load_before = load_average()
     t0 = time.perf_counter()
     networks = parse_networks(args.networks)
+    before_root = before_tree(args) if args.before else ""
+    trees = {"page": ROOT, "before": before_root} if before_root else {"page": ROOT}
+    modes = ("whole", "before", "stream") if before_root else ("whole", "stream")
+    labels = {"whole": "whole level (`?stream=0`)", "before": "streaming, before (`%s`)" % args.before,
+              "stream": "**streaming**"}
     lines = ["# The page streaming against the whole level (issue 31)", "",
              "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv), "",
              "| input | network | page | first image ms | surfaces at full level ms | whole level ms | bytes "
@@ -413,17 +428,19 @@ def main_stream(args, argv):
              "|---|---|---|---:|---:|---:|---:|---:|"]
     results = []
     for name in args.inputs.split(","):
-        with serving(args, name, {"page": ROOT}) as urls:
+        with serving(args, name, trees) as urls:
             if args.warm:
-                warm(urls["page"])
+                for url in urls.values():
+                    warm(url)
             progress("%s: whole and streamed, %s" % (name, args.networks))
             runs = run_script(work_folder(args, "stream-", name), "bench-stream.mjs",
-                              {"url": urls["page"], "size": [int(v) for v in args.size.split("x")],
+                              {"url": urls["page"], "beforeUrl": urls.get("before"),
+                               "size": [int(v) for v in args.size.split("x")],
                                "networks": networks, "repeats": args.repeats})["runs"]
         results.append((name, runs))
         for network in networks:
             whole = {}
-            for mode in ("whole", "stream"):
+            for mode in modes:
                 rs = [r for r in runs if r["network"] == network["name"] and r["mode"] == mode]
                 med = lambda key: statistics.median(r[key] for r in rs)  # noqa: E731
                 if mode == "whole":
@@ -434,7 +451,7 @@ def main_stream(args, argv):
                               " (%.2fx)" % (med("wholeMs") / whole["wholeMs"]),
                               " (%.2fx)" % (med("bytes") / whole["bytes"]))
                 lines.append("| %s | %s | %s | %.0f | %.0f%s | %.0f%s | %d%s | %d (%.0f%%) |" % (
-                    name, network["name"], "whole level (`?stream=0`)" if mode == "whole" else "**streaming**",
+                    name, network["name"], labels[mode],
                     med("firstMs"), med("fullMs"), ratios[0], med("wholeMs"), ratios[1], med("bytes"),
                     ratios[2], med("bytesAtFull"), 100 * med("receivedAtFull")))
     lines += stream_parts(results)
@@ -454,24 +471,25 @@ def stream_parts(results):
              "writing summed over the bricks; frames: each frame's ms, the part that made and "
              "uploaded the surfaces, its triangles, L0 where some came from level 0; the whole "
              "page's frames for comparison):", "",
-             "| input | network | level 0 in | first frame | bricks asked | last answer | last handed over "
-             "| last written | full level | decode ms | write ms | frames | whole page's frames |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|"]
+             "| input | network | page | level 0 in | first frame | bricks asked | last answer "
+             "| last handed over | last written | full level | decode ms | write ms | frames "
+             "| whole page's frames |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|"]
     frame = lambda f: "%d (%d, %dk%s)" % (f["ms"], f["buildMs"], f["triangles"] / 1000,  # noqa: E731
                                           " L0" if f["coarse"] else "")
     for name, runs in results:
         for r in runs:
             t = r.get("times")
-            if r["mode"] != "stream" or not t:
+            if r["mode"] == "whole" or not t:
                 continue
             w = t.get("worker") or {}
             whole = [x for x in runs if x["mode"] == "whole" and x["network"] == r["network"]]
             whole_frames = ", ".join("%d (%dk)" % (f["ms"], f["triangles"] / 1000)
                                      for f in (whole[0].get("frames") or [])) if whole else ""
-            lines.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
-                name, r["network"], t.get("level0"), t.get("framed"), t.get("requested"),
-                t.get("lastAnswer"), t.get("lastHanded"), w.get("lastBricks"), t.get("full"),
-                w.get("decodeMs"), w.get("writeMs"),
+            lines.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+                name, r["network"], "before" if r["mode"] == "before" else "this", t.get("level0"),
+                t.get("framed"), t.get("requested"), t.get("lastAnswer"), t.get("lastHanded"),
+                w.get("lastBricks"), t.get("full"), w.get("decodeMs"), w.get("writeMs"),
                 ", ".join(frame(f) for f in w.get("frames", [])), whole_frames))
     return lines
 

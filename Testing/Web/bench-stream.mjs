@@ -8,7 +8,8 @@
 // (CDP loadingFinished), in all and when the surfaces were at the full level, with the fraction of
 // the level received then.
 //   node bench-stream.mjs CONFIG.json OUT.json
-// CONFIG: {url, size: [w, h], networks: [{name, mbps, latencyMs} | {name: "loopback"}], repeats}
+// CONFIG: {url, beforeUrl?, size: [w, h], networks: [{name, mbps, latencyMs} | {name: "loopback"}], repeats}
+// (beforeUrl: another tree's page, streaming, timed between the two as mode "before")
 import { launch } from "./page.mjs";
 import { readFileSync, writeFileSync } from "node:fs";
 
@@ -18,7 +19,7 @@ const browser = await launch();
 const runs = [];
 for (let repeat = 0; repeat < (config.repeats || 1); ++repeat) {
   for (const network of config.networks) {
-    for (const mode of ["whole", "stream"]) {
+    for (const mode of config.beforeUrl ? ["whole", "before", "stream"] : ["whole", "stream"]) {
       const context = await browser.newContext({ viewport: { width: config.size[0] + 420, height: config.size[1] + 100 } });
       const page = await context.newPage();
       page.on("pageerror", (e) => console.log(mode + " pageerror: " + e.message));
@@ -31,7 +32,7 @@ for (let repeat = 0; repeat < (config.repeats || 1); ++repeat) {
           downloadThroughput: (network.mbps * 1e6) / 8, uploadThroughput: (network.mbps * 1e6) / 8 });
       }
       const start = Date.now();
-      await page.goto(config.url + "&path=cpu&size=" + config.size.join("x") + (mode === "whole" ? "&stream=0" : ""),
+      await page.goto((mode === "before" ? config.beforeUrl : config.url) + "&path=cpu&size=" + config.size.join("x") + (mode === "whole" ? "&stream=0" : ""),
         { waitUntil: "commit" });
       await page.waitForFunction(() => window.mediso, null, { timeout: 600000 });
       await page.evaluate(() => window.mediso.ready);

@@ -23,7 +23,9 @@ import { afterFrame, beforeFrame, renderNow } from "./viewer.js";
 import { fetchLevel, levelURL, loadVolume, mallocZeros, prefetch, request, requestJSON,
   typedValues } from "./volume.js";
 
-// Requests in flight at once (a browser opens 6 connections to a host over HTTP/1.1).
+// Requests in flight at once (a browser opens 6 connections to a host over HTTP/1.1). Two made
+// the first answer come sooner but the bricks as a whole later (docs/web.md, The critical path
+// from level 0 to the full level).
 const IN_FLIGHT = 6;
 // Requests a level's bricks are cut into, about: each request costs this thread a fetch, an
 // answer and a hand-over to the worker, and the server a round of its event loop (one brick a
@@ -209,37 +211,43 @@ export async function startStream(level) {
   }
   const count = manifest.ranges.length;
   state.stream = { level, path: state.path, manifest, type, dims, resident: new Uint8Array(count),
-    pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, received: 0,
-    total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), exact: new Map(),
+    pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, neededInFlight: 0,
+    received: 0, total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), exact: new Map(),
     asked: new Set(), requested: [], arrived: [], readyKey: "", error: "", started: false, framed: false,
     batch: Math.max(1, Math.ceil(count / BATCHES)), times };
   times.begun = epochNow();
   lastTimes = times;
   state.received = 0;
-  // The bricks are asked for once the first frame (level 0's) is drawn (afterEach): on a fast
-  // link they would otherwise come first, and their writing and the server's encoding would
-  // hold that frame (the page's start-up, docs/web.md). The bricks the first surfaces need are
-  // asked of the server before that frame (beforeEach), so that the first requests are theirs;
-  // a timer in case no frame comes.
+  // The bricks are asked for as soon as the server has said which ones the first surfaces need
+  // (askExact, sent with the first frame's request: beforeEach), while the worker draws that
+  // frame (level 0's), so that the link and the server work during it; what arrives before the
+  // frame is drawn is held here (handOver), since the worker would write it before drawing and
+  // the first image would wait (the page's start-up, docs/web.md). A timer in case no frame
+  // comes.
   const s = state.stream;
   setTimeout(() => framed(s), 1000);
 }
 
-// The first frame is drawn (or a second has passed without one): the bricks may be asked for.
+// The first frame is drawn (or a second has passed without one): the bricks that came meanwhile
+// may go to the worker, and the bricks be asked for if the need answer has not started them.
 function framed(s) {
   if (s && state.stream === s) {
     s.framed = true;
     s.times.framed = s.times.framed || epochNow();
     begin(s);
+    if (s.arrived.length) {
+      handOver(s);
+    }
   }
 }
 
-// The bricks are asked for once the first frame is drawn and the server has said which bricks
-// the current isovalues need (one round trip, sent before that frame: it has mostly come by
-// then): the batches are then those of the exact sets, the same at every load (BATCHES). A need
-// query that fails (the supersets) or takes over 2 s more does not hold the bricks.
+// The bricks are asked for once the server has said which bricks the current isovalues need
+// (one round trip, sent with the first frame's request; begin runs again at its answer), or once
+// the first frame is drawn with no need query sent: the batches are then those of the exact
+// sets, the same at every load (BATCHES). A need query that fails (the supersets) or takes over
+// 2 s more does not hold the bricks.
 function begin(s, late = false) {
-  if (!s || state.stream !== s || s.started || !s.framed) {
+  if (!s || state.stream !== s || s.started || (!s.framed && !s.asked.size)) {
     return;
   }
   askExact(s);
@@ -255,9 +263,10 @@ function begin(s, late = false) {
 }
 
 // The next batch: up to s.batch bricks the current isovalues need (those of the first value
-// first), else up to s.batch of the others in id order; a batch does not mix the two, so that
-// the last needed bricks do not wait for others.
-function nextBatch(s) {
+// first), else up to s.batch of the others in id order (none while a batch of needed bricks is
+// still travelling: `othersToo` false); a batch does not mix the two, so that the last needed
+// bricks do not wait for others.
+function nextBatch(s, othersToo) {
   const ids = [];
   for (const v of currentValues()) {
     for (const id of needed(s, v)) {
@@ -270,7 +279,7 @@ function nextBatch(s) {
       }
     }
   }
-  if (ids.length) {
+  if (ids.length || !othersToo) {
     return ids;
   }
   for (const id of s.pending) {
@@ -283,13 +292,24 @@ function nextBatch(s) {
   return ids;
 }
 
+// Up to IN_FLIGHT requests. The others' batches (no current surface needs them) wait until every
+// batch of needed bricks has arrived: on loopback the server's sending and the browser's
+// inflating of the others took the two cores from the needed ones (and the writing) at the end
+// of the needed bricks, and on a slow link their bytes took its bandwidth; the others follow at
+// most one round trip later.
 function fetchMore() {
   const s = state.stream;
   while (s && state.stream === s && s.inFlight < IN_FLIGHT && s.pending.size) {
-    const batch = nextBatch(s);
-    s.requested.push({ ids: batch, values: currentValues() });
+    const batch = nextBatch(s, !s.neededInFlight);
+    if (!batch.length) {
+      break; // others, after the needed batches in flight
+    }
+    const values = currentValues();
+    const neededBatch = batch.some((id) => values.some((v) => needed(s, v).has(id)));
+    s.requested.push({ ids: batch, values });
     ++s.inFlight;
-    fetchBatch(s, batch).catch((error) => {
+    s.neededInFlight += neededBatch ? 1 : 0;
+    fetchBatch(s, batch, neededBatch).catch((error) => {
       // Said in the readout; the surfaces that need the brick stay at level 0.
       s.error = "bricks " + batch.join(", ") + ": " + error.message;
       console.error("streaming: " + s.error);
@@ -300,13 +320,14 @@ function fetchMore() {
   }
 }
 
-async function fetchBatch(s, ids) {
+async function fetchBatch(s, ids, neededBatch) {
   let response, body;
   try {
     ({ response, body } = await request("/api/bricks/" + state.dataset.id + "?level=" + s.level +
       "&ids=" + ids.join(","), "no-cache"));
   } finally {
     --s.inFlight;
+    s.neededInFlight -= neededBatch ? 1 : 0;
   }
   if (state.stream !== s) {
     return; // another volume since
@@ -331,8 +352,8 @@ async function fetchBatch(s, ids) {
 // that a surface's last brick asks for would hold that frame. They go as soon as every current
 // surface has its bricks (after that frame's request), or a brick has failed.
 async function handOver(s) {
-  if (state.stream !== s) {
-    return;
+  if (state.stream !== s || !s.framed) {
+    return; // held until the first frame is drawn (afterEach hands them over then)
   }
   const values = currentValues();
   const needs = (id) => values.some((v) => needed(s, v).has(id));
@@ -434,9 +455,8 @@ function fullNow() {
 }
 function afterEach() {
   if (state.stream && !state.stream.framed) {
-    framed(state.stream);
-  }
-  if (state.stream && state.stream.arrived.length) {
+    framed(state.stream); // hands over what came meanwhile
+  } else if (state.stream && state.stream.arrived.length) {
     handOver(state.stream); // a change since may need them, or need nothing more
   }
   const stats = state.viewer.stats();
