@@ -495,7 +495,8 @@ export function streamTimes() {
     const worker = (t) => (t ? since(lastTimes.begun + t - w.begun) : null);
     out.worker = { firstBricks: worker(w.firstBricks), lastBricks: worker(w.lastBricks),
       batches: w.batches, bricks: w.bricks, decodeMs: Math.round(w.decodeMs),
-      writeMs: Math.round(w.writeMs), setupMs: (w.setupMs || []).map(Math.round), frames: w.frames.map((f) => ({ at: worker(f.at), ms: Math.round(f.ms),
+      writeMs: Math.round(w.writeMs), setupMs: (w.setupMs || []).map(Math.round),
+      frames: w.frames.map((f) => ({ at: worker(f.at), ms: Math.round(f.ms),
         buildMs: Math.round(f.buildMs), triangles: f.triangles, coarse: f.coarse })) };
   }
   return out;
