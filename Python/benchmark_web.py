@@ -85,9 +85,10 @@ def parse_args(argv):
     p.add_argument("--interactive", action="store_true",
                    help="the page before (--before) against this one: first answer, drag, long tasks")
     p.add_argument("--before", default="",
-                   help="--interactive: the git ref of the page before (default: where this branch "
-                        "left main, whose page takes this tree's WebAssembly module); --stream: "
-                        "that ref's streaming page too (default: none)")
+                   help="--interactive, --startup: the git ref of the page before (--interactive's "
+                        "default: where this branch left main; --startup's: none), whose page takes "
+                        "this tree's WebAssembly module; --stream: that ref's streaming page too "
+                        "(default: none)")
     p.add_argument("--moves", type=int, default=30, help="--interactive: mouse moves of the drag")
     p.add_argument("--paths", default="cpu,gpu", help="--interactive: the page's paths to run")
     p.add_argument("--scene", default="", choices=["", "skin-bone"],
@@ -501,16 +502,50 @@ def main_startup(args, argv, networks):
              "- Started %s; load average %s; Chromium headless, SwiftShader; CPU path in the worker; "
              "canvas %s; each run in a fresh context; ms from navigation" % (
                  time.strftime("%Y-%m-%d %H:%M:%S"), load_average(), args.size)]
+    trees = {"before": before_tree(args), "after": ROOT} if args.before else {"page": ROOT}
+    if args.before:
+        lines.append("- before: `%s`'s page, after: this tree's; the same WebAssembly module (this tree's); "
+                     "the pages taken in turn for each repeat and network" % args.before)
+    lines += ["", "| input | network | page | first image ms (each run) | median | worker ready | level 0 in "
+              "| stream set up | first frame answered | (medians, ms from navigation) |",
+              "|---|---|---|---|---:|---:|---:|---:|---:|---|"]
+    summary = len(lines)
     for name in args.inputs.split(","):
-        with serving(args, name, {"page": ROOT}) as urls:
+        with serving(args, name, trees) as urls:
             progress("%s: start-up, %s" % (name, args.networks))
             runs = run_script(work_folder(args, "startup-", name), "bench-startup.mjs",
-                              {"url": urls["page"], "size": [int(v) for v in args.size.split("x")],
+                              {"pages": urls, "size": [int(v) for v in args.size.split("x")],
                                "networks": networks, "repeats": args.repeats})["runs"]
+        for network in networks:
+            for label in trees:
+                rs = [r for r in runs if r["network"] == network["name"] and r["page"] == label]
+                mark = lambda r, n: next((m["at"] for m in r["marks"] if m["name"] == n), None)  # noqa: E731
+                step = lambda r, k: (r.get("stream") or {}).get(k)  # noqa: E731
+                med = lambda values: ("%.0f" % statistics.median(values)  # noqa: E731
+                                      if values and None not in values else "-")
+                lines.insert(summary, "| %s | %s | %s | %s | %s | %s | %s | %s | %s | |" % (
+                    name, network["name"], label, ", ".join(str(r["firstMs"]) for r in rs),
+                    med([r["firstMs"] for r in rs]), med([mark(r, "mediso:worker") for r in rs]),
+                    med([step(r, "level0") for r in rs]), med([step(r, "begun") for r in rs]),
+                    med([step(r, "framed") for r in rs])))
+                summary += 1
         for run in runs:
-            marks = ", ".join("%s %.0f" % (m["name"][len("mediso:"):], m["at"]) for m in run["marks"])
-            lines += ["", "## %s, %s: first image %d ms (%s)" % (name, run["network"], run["firstMs"], marks),
-                      "", "| request | sent | response | end | bytes | encoding |", "|---|---:|---:|---:|---:|---|"]
+            # the page's marks in time order (the worker's on its own clock: worker-*)
+            marks = ", ".join("%s %.0f" % (m["name"][len("mediso:"):], m["at"])
+                              for m in sorted(run["marks"], key=lambda m: m["at"]))
+            lines += ["", "## %s, %s, %s: first image %d ms (%s)" % (name, run["network"], run["page"],
+                                                                     run["firstMs"], marks)]
+            w = (run.get("stream") or {}).get("worker")
+            if w:
+                first = w["frames"][0] if w.get("frames") else {}
+                lines += ["", "The worker's stream set-up ms (buffers, setStreamingVolume, "
+                          "setCoarseVolume): %s; its first frame began at %s ms and took %s ms (%s making "
+                          "and uploading the surfaces)" % (", ".join(str(v) for v in w.get("setupMs", [])),
+                                                           first.get("at"), first.get("ms"), first.get("buildMs"))]
+            tasks = [t for t in run.get("longTasks") or [] if t["at"] < run["firstMs"]]
+            lines += ["", "The main thread's long tasks before the first image (at ms, for ms): %s" % (
+                ", ".join("%d for %d" % (t["at"], t["ms"]) for t in tasks) or "none")]
+            lines += ["", "| request | sent | response | end | bytes | encoding |", "|---|---:|---:|---:|---:|---|"]
             for r in sorted(run["requests"], key=lambda r: r["sentMs"]):
                 if "ids=" in r["url"] or r["sentMs"] > run["firstMs"]:
                     continue  # the bricks, and what came after the first image

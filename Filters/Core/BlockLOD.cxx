@@ -658,26 +658,31 @@ bool ComputeBlockRange(const Volume<T>& volume, BlockRanges& ranges, std::int64_
   return true;
 }
 
-template <typename T>
-void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const ParallelFor& parallel)
+std::int64_t SizeBlockRanges(const int dims[3], BlockRanges& ranges)
 {
   for (int a = 0; a < 3; ++a)
   {
-    ranges.Dims[a] = volume.Dims[a];
-    ranges.Blocks[a] = (volume.Dims[a] - 1 + BlockCells - 1) / BlockCells;
+    ranges.Dims[a] = dims[a];
+    ranges.Blocks[a] = std::max(0, (dims[a] - 1 + BlockCells - 1) / BlockCells);
   }
-  const std::int64_t numBlocks = ranges.GetNumberOfBlocks();
-  if (numBlocks <= 0)
+  const std::int64_t numBlocks = std::max<std::int64_t>(0, ranges.GetNumberOfBlocks());
+  ranges.Min.assign(numBlocks, std::numeric_limits<double>::infinity());
+  ranges.Max.assign(numBlocks, -std::numeric_limits<double>::infinity());
+  ranges.NaNCount = ranges.InfiniteCount = 0;
+  ranges.ValueRange[0] = std::numeric_limits<double>::infinity();
+  ranges.ValueRange[1] = -std::numeric_limits<double>::infinity();
+  return numBlocks;
+}
+
+template <typename T>
+void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const ParallelFor& parallel)
+{
+  if (SizeBlockRanges(volume.Dims, ranges) <= 0)
   {
     // A piece too thin to hold one cube of a coarse level.
-    ranges.Min.clear();
-    ranges.Max.clear();
-    ranges.NaNCount = ranges.InfiniteCount = 0;
     ranges.ValueRange[0] = ranges.ValueRange[1] = 0;
     return;
   }
-  ranges.Min.assign(numBlocks, std::numeric_limits<double>::infinity());
-  ranges.Max.assign(numBlocks, -std::numeric_limits<double>::infinity());
   std::vector<std::int64_t> nanPerSlab(ranges.Blocks[2], 0), infPerSlab(ranges.Blocks[2], 0);
 
   // One z-slab of blocks per task.

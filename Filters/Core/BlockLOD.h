@@ -199,6 +199,14 @@ template <typename T>
 Volume<T> MakeStrideCopy(const Volume<T>& full, int stride, std::vector<T>& storage,
   const ParallelFor& parallel);
 
+/// Sizes `ranges` for a volume of `dims` points with every block's range empty
+/// (minimum +inf, maximum -inf), no missing sample counted and an empty value
+/// range: where ComputeBlockRanges() starts, and the ranges of a streamed
+/// volume before any of its values has arrived (BlockLODVolume's
+/// SetStreamingVolume), taken without reading a buffer that holds nothing yet.
+/// Returns the number of blocks (0 for a volume too thin to hold one cube).
+std::int64_t SizeBlockRanges(const int dims[3], BlockRanges& ranges);
+
 /// Computes BlockRanges of a volume (one read of the data, in parallel).
 template <typename T>
 void ComputeBlockRanges(const Volume<T>& volume, BlockRanges& ranges, const ParallelFor& parallel);

@@ -47,18 +47,26 @@ BlockLODSurfacesBase::~BlockLODSurfacesBase() = default;
 
 bool BlockLODSurfacesBase::SetVolume(const VolumeDescription& description)
 {
-  if (!this->Volume.SetVolume(description))
+  return this->Adopted(this->Volume.SetVolume(description));
+}
+
+bool BlockLODSurfacesBase::Adopted(bool adopted)
+{
+  if (adopted)
   {
-    // The same volume: an update now does no one-time work for it (a host
-    // may adopt a volume and then make nothing, e.g. for a bad isovalue).
-    this->PendingOneTimeWork = false;
-    return false;
+    this->Estimator.Reset();
+    this->ClearCache();
+    this->Plans.clear(); // sized for the old volume
   }
-  this->Estimator.Reset();
-  this->ClearCache();
-  this->Plans.clear(); // sized for the old volume
-  this->PendingOneTimeWork = true;
-  return true;
+  // Not adopted (the same volume): an update now does no one-time work for it
+  // (a host may adopt a volume and then make nothing, e.g. for a bad isovalue).
+  this->PendingOneTimeWork = adopted;
+  return adopted;
+}
+
+bool BlockLODSurfacesBase::SetStreamingVolume(const VolumeDescription& description)
+{
+  return this->Adopted(this->Volume.SetStreamingVolume(description));
 }
 
 void BlockLODSurfacesBase::BeginStreaming()

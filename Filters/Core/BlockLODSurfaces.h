@@ -199,6 +199,10 @@ public:
   /// Adopts a volume; true when it is new (counts, plans and surfaces of the
   /// old one forgotten, block ranges computed).
   bool SetVolume(const VolumeDescription& description);
+  /// Adopts a volume whose values are still to arrive, streaming from the
+  /// start (BlockLODVolume::SetStreamingVolume: no block ranges read from the
+  /// empty buffer); otherwise as SetVolume() then BeginStreaming().
+  bool SetStreamingVolume(const VolumeDescription& description);
   const BlockLODVolume& GetVolume() const { return this->Volume; }
 
   /// Streaming (BlockLODVolume's BeginStreaming, RegionArrived, EndStreaming):
@@ -261,6 +265,9 @@ protected:
   std::vector<ExtractionPlan> Plans; // one per isovalue, buffers reused between updates
 
 private:
+  // After the volume's SetVolume or SetStreamingVolume: what a new volume
+  // forgets; returns `adopted`.
+  bool Adopted(bool adopted);
   bool PendingOneTimeWork = false; // a volume was adopted since the last update
   int CoarseCopiesAtBegin = 0;
   // The allowance of the current update, once read, and what it has allocated since.

@@ -286,19 +286,37 @@ bool BlockLODVolume::SetVolume(const VolumeDescription& description)
   {
     return false;
   }
-  this->Reset();
-  this->Description = description;
-  VisitScalarType(description.Type, [this, &description](auto tag) {
-    this->Impl = std::make_unique<TypedImpl<decltype(tag)>>(
-      description, this->Cases, this->Parallel, this->Ranges);
-  });
-  if (!this->Impl)
+  if (!this->Adopt(description))
   {
     return false; // not a ScalarType value: nothing to contour
   }
   this->Impl->ComputeRanges(this->Ranges);
   this->Valid = true;
   return true;
+}
+
+bool BlockLODVolume::SetStreamingVolume(const VolumeDescription& description)
+{
+  if (!this->Adopt(description))
+  {
+    return false;
+  }
+  // Sized and empty; BeginStreaming keeps them so until regions arrive.
+  SizeBlockRanges(description.Dims, this->Ranges);
+  this->Valid = true;
+  this->BeginStreaming();
+  return true;
+}
+
+bool BlockLODVolume::Adopt(const VolumeDescription& description)
+{
+  this->Reset();
+  this->Description = description;
+  VisitScalarType(description.Type, [this, &description](auto tag) {
+    this->Impl = std::make_unique<TypedImpl<decltype(tag)>>(
+      description, this->Cases, this->Parallel, this->Ranges);
+  });
+  return this->Impl != nullptr;
 }
 
 bool BlockLODVolume::Plan(

@@ -117,6 +117,13 @@ public:
   /// true then, false when the volume is the same (or its Type is no
   /// ScalarType value: IsValid() is then false).
   bool SetVolume(const VolumeDescription& description);
+  /// Adopts a volume whose values are still to arrive, streaming from the
+  /// start: what SetVolume() then BeginStreaming() leave, without the block
+  /// ranges SetVolume() would compute from a buffer that holds nothing yet
+  /// (one read of all of it, which on the web page's 512^3 volume held its
+  /// first frame, drawn from level 0). Always adopts (the values arrive
+  /// anew); false only when the Type is no ScalarType value.
+  bool SetStreamingVolume(const VolumeDescription& description);
   /// Forgets the volume (IsValid() turns false).
   void Reset();
   bool IsValid() const;
@@ -201,6 +208,10 @@ private:
   template <typename T>
   struct TypedImpl;
   struct Ahead;
+  // SetVolume's and SetStreamingVolume's start: everything forgotten, the
+  // description and its typed implementation taken, no ranges yet; false for
+  // a Type that is no ScalarType value.
+  bool Adopt(const VolumeDescription& description);
   // Extraction ahead on the blocks RegionArrived() just completed.
   void AdvanceAhead(const std::vector<std::int32_t>& completed);
 

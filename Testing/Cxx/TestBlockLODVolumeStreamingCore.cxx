@@ -11,7 +11,11 @@
 //   exactly: the same triangles, points and normals;
 // - once every brick arrived, the ranges are the dense volume's, block for
 //   block, with the value range; a region outside the volume, or a region
-//   given when not streaming, completes nothing.
+//   given when not streaming, completes nothing;
+// - a volume adopted streaming from the start (SetStreamingVolume: no ranges
+//   read from the buffer) starts as SetVolume then BeginStreaming leave it,
+//   every block's range empty whatever the buffer holds, and gives the same
+//   surfaces at every stage and the same ranges at the end.
 #include "BlockLODVolume.h"
 #include "FanCaseTable.h"
 #include "MedicalTestUtilities.h"
@@ -57,6 +61,20 @@ int main()
   streamed.BeginStreaming();
   Check(streamed.IsStreaming() && streamed.GetNumberOfResidentBlocks() == 0,
     "streaming, nothing resident");
+  std::vector<std::int16_t> atOnceBuffer(field.Values.size(), 30000);
+  mediso::BlockLODVolume atOnce(medical_test::FanCases.Cases, mediso::SerialFor);
+  Check(atOnce.SetStreamingVolume(field.Describe(atOnceBuffer.data())) && atOnce.IsValid() &&
+      atOnce.IsStreaming() && atOnce.GetNumberOfResidentBlocks() == 0,
+    "adopted streaming from the start: valid, streaming, nothing resident");
+  {
+    const mediso::BlockRanges& r = atOnce.GetRanges();
+    const mediso::BlockRanges& s = streamed.GetRanges();
+    Check(r.GetNumberOfBlocks() == dense.GetRanges().GetNumberOfBlocks() && r.Min == s.Min &&
+        r.Max == s.Max &&
+        std::all_of(r.Min.begin(), r.Min.end(), [](double m) { return std::isinf(m) && m > 0; }) &&
+        !r.HasFiniteValues(),
+      "... its ranges sized and empty, as SetVolume then BeginStreaming leave them");
+  }
   for (double v : isovalues)
   {
     Check(ExtractFullLevel(streamed, v).Triangles.empty(), "no triangle before any brick");
@@ -76,6 +94,7 @@ int main()
   {
     const int id = field.Arriving(n);
     field.Arrive(id, buffer, streamed);
+    field.Arrive(id, atOnceBuffer, atOnce);
     resident[id] = 1;
     for (int s = 0; s < 2; ++s)
     {
@@ -94,6 +113,10 @@ int main()
       Check(got.Triangles == expected[s].Triangles, stage + ": the dense surface's triangles");
       Check(got.Points == expected[s].Points, stage + ": the dense surface's points");
       Check(got.Normals == expected[s].Normals, stage + ": the dense surface's normals");
+      const Mesh gotAtOnce = ExtractFullLevel(atOnce, isovalues[s]);
+      Check(gotAtOnce.Triangles == expected[s].Triangles &&
+          gotAtOnce.Points == expected[s].Points && gotAtOnce.Normals == expected[s].Normals,
+        stage + ", streaming from the start: the dense surface");
       ++exactStages[s];
     }
   }
@@ -107,6 +130,10 @@ int main()
   Check(a.Min == d.Min && a.Max == d.Max, "the ranges are the dense volume's at the end");
   Check(a.ValueRange[0] == d.ValueRange[0] && a.ValueRange[1] == d.ValueRange[1],
     "the value range is the dense volume's at the end");
+  const mediso::BlockRanges& o = atOnce.GetRanges();
+  Check(atOnce.GetNumberOfResidentBlocks() == d.GetNumberOfBlocks() && o.Min == d.Min &&
+      o.Max == d.Max && o.ValueRange[0] == d.ValueRange[0] && o.ValueRange[1] == d.ValueRange[1],
+    "streaming from the start: every block resident and the dense ranges at the end");
   streamed.EndStreaming();
   Check(!streamed.IsStreaming(), "streaming ended");
   for (int s = 0; s < 2; ++s)

@@ -7,10 +7,11 @@
 // - index.html preloads (modulepreload) exactly the modules app.js imports, directly or not;
 // - in Chromium, a fresh context, the network throttled (30 Mbit/s, 40 ms through CDP): every
 //   module is asked for before app.js has arrived (one wave, not one per import level), the
-//   render worker's script before this thread's module has arrived (the two modules load side
-//   by side), and level 0 and the bricks' manifest before the worker is ready (the
+//   render worker's script before app.js has arrived (index.html starts the worker) and once,
+//   and so before this thread's module has arrived (the two modules load side by side), and level 0 and the bricks' manifest before the worker is ready (the
 //   mediso:worker mark); the first image is level 0's; the scripts and the module cross gzip'd;
-// - with ?stream=0 nothing is asked for ahead: the level comes once, and level 0 never.
+// - with ?stream=0 nothing is asked for ahead: the level comes once, and level 0 never;
+// - with ?worker=0 (the viewer on the main thread) index.html starts no worker.
 import { readFileSync } from "node:fs";
 import http from "node:http";
 import path from "node:path";
@@ -120,6 +121,11 @@ async function open(query) {
   checks.check(worker && wasmFile && worker.sent < wasmFile.end,
     "the render worker's script asked for " + (worker && wasmFile ? Math.round(1000 * (wasmFile.end - worker.sent)) : "?") +
     " ms before this thread's module had arrived");
+  // index.html starts the worker, before the page's modules have arrived; the page takes it over.
+  const workers = find(/\/static\/render-worker\.js/);
+  checks.check(worker && app && worker.sent < app.end && workers.length === 1,
+    "the render worker's script asked for by index.html, " + (worker && app ? Math.round(1000 * (app.end - worker.sent)) : "?") +
+    " ms before app.js had arrived, and once (" + workers.length + ")");
   // Level 0 and the manifest against the worker's readiness (the page's own clock).
   const timing = await page.evaluate(() => ({
     worker: performance.getEntriesByName("mediso:worker")[0]?.startTime,
@@ -154,6 +160,16 @@ async function open(query) {
   checks.check(volumes.length === 1 && volumes[0] === "level=3" && !manifests.length && stats.received === 1,
     "?stream=0: the volume asked for once (" + volumes.join(", ") + "), no manifest (" + manifests.length +
     "), nothing ahead");
+  await page.context().close();
+}
+{
+  // The viewer on this thread: index.html starts no worker.
+  const { page, find } = await open("&worker=0&threads=0");
+  const stats = await page.evaluate(() => window.mediso.stats());
+  const workers = find(/\/static\/render-worker\.js/);
+  checks.check(stats.renderer === "main" && workers.length === 0,
+    "?worker=0: drawn on the main thread (" + stats.renderer + "), no render worker asked for (" +
+    workers.length + ")");
   await page.context().close();
 }
 await checks.finish(browser, server);

@@ -77,6 +77,7 @@ export function prefetchPath(dataset, requested) {
   const budgetMB = Number($("budget").value) || 1024;
   const choice = choosePath(requested, null, dataset, budgetMB);
   if (canStream(choice.path, choice.level.level)) {
+    performance.mark("mediso:prefetch");
     prefetchStream(dataset, choice.level.level);
   }
 }

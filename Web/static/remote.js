@@ -30,7 +30,7 @@ export class RemoteViewer {
    */
   static launch(canvas, { threads, budgetMs, abort, slowExtractionMs, slowPass, refineDelayMs,
     slowFirstDragFrameMs, prepareDrag }) {
-    const worker = new Worker("static/render-worker.js");
+    const worker = RemoteViewer.takeEarlyWorker(threads) || new Worker("static/render-worker.js");
     const offscreen = canvas.transferControlToOffscreen();
     const base = new URL("static/", location.href).href;
     const ready = new Promise((resolve, reject) => {
@@ -45,11 +45,33 @@ export class RemoteViewer {
   }
 
   /**
+   * The worker index.html started before the page's modules (loading its module with `threads`
+   * or not), where its choice of threads is `threads`; else null, and that worker is ended.
+   * Called once: where the page draws on its own thread, with no `threads`, to end it.
+   */
+  static takeEarlyWorker(threads) {
+    const early = window.medisoEarlyWorker;
+    window.medisoEarlyWorker = null;
+    if (early && early.threads === threads) {
+      return early.worker;
+    }
+    if (early) {
+      early.worker.terminate();
+    }
+    return null;
+  }
+
+  /**
    * The viewer of a launched worker (launch()) once it is ready, with the module `M` of this
    * thread (the camera, the CPU model's count). Resolves to the viewer, or rejects.
    */
   static async start({ worker, ready }, M, onFrame) {
     const answer = await ready;
+    // The worker's start-up on the page's timeline (docs/web.md, "The page's start-up"): its
+    // clock's epoch times as this thread's marks.
+    for (const [step, at] of Object.entries(answer.startup || {})) {
+      performance.mark("mediso:worker-" + step, { startTime: Math.max(0, at - performance.timeOrigin) });
+    }
     const viewer = new RemoteViewer(worker, M, onFrame);
     viewer.readyState = answer;
     viewer.generation = answer.generation || null;

@@ -7,7 +7,8 @@
 // stats. A classic worker, not a module: it loads the Emscripten module with importScripts.
 //
 // Messages in (each applied in the order sent):
-//   {op: "init", canvas, base, threads}                 load the module, make the viewer
+//   {op: "load", threads}                                begin loading the module (index.html)
+//   {op: "init", canvas, base, threads}                 load the module (unless begun), make the viewer
 //   {op: "call", method, args, id?}                      a WebViewer call; with id, its answer
 //   {op: "volume", type, bytes, dims, spacing, origin}   the volume's values (transferred)
 //   {op: "mesh", points, triangles, color, opacity}      a surface the server made
@@ -15,7 +16,7 @@
 //   {op: "streamEnd", id}                                streaming (stream.js, startStream here;
 //                                                        streamEnd answers the level's bytes)
 //   {op: "frame", id, surfaces, view, interactive, generation}  the frame wanted now
-// Messages out: {op: "ready", ok, error, info, generation}, {op: "answer", id, value},
+// Messages out: {op: "ready", ok, error, info, generation, startup}, {op: "answer", id, value},
 //   {op: "frame", id, stats, settled}, {op: "error", message},
 //   {op: "prepared", value, count} (a drag's frame made ready ahead: schedulePrepare).
 //
@@ -103,11 +104,34 @@ function post(message, transfer) {
   self.postMessage(message, transfer || []);
 }
 
+// The worker's start-up (the page's marks "mediso:worker-*", docs/web.md "The page's start-up"):
+// this script running, index.html's load message in, the init message in, the module's script
+// loaded, the module compiled and instantiated (its wasm fetched), the viewer made (the WebGL2
+// context, the probe); the epoch's ms.
+const startup = { script: performance.timeOrigin + performance.now() };
+
+// The module (threaded or not), loading: begun by "load" (index.html starts this worker before
+// the page's modules have arrived, docs/web.md "The page's start-up") or else by "init".
+let loading = null;
+function load(base, threads) {
+  if (!loading) {
+    loading = (async () => {
+      const name = threads ? "mediso-mt" : "mediso";
+      importScripts(base + name + ".js");
+      startup.imported = now();
+      const create = threads ? self.createMedisoThreads : self.createMediso;
+      const module = await create({ locateFile: (f) => base + f, mainScriptUrlOrBlob: base + name + ".js" });
+      startup.module = now();
+      return module;
+    })();
+    loading.catch(() => {}); // "init" awaits it and says why
+  }
+  return loading;
+}
+
 async function init(m) {
-  const name = m.threads ? "mediso-mt" : "mediso";
-  importScripts(m.base + name + ".js");
-  const create = m.threads ? self.createMedisoThreads : self.createMediso;
-  M = await create({ locateFile: (f) => m.base + f, mainScriptUrlOrBlob: m.base + name + ".js" });
+  startup.init = now();
+  M = await load(m.base, m.threads);
   if (!M.specialHTMLTargets) {
     post({ op: "ready", ok: false, error: "the module cannot be given an OffscreenCanvas" });
     return;
@@ -124,9 +148,10 @@ async function init(m) {
   }
   prepareDragOn = m.prepareDrag === true;
   viewer = new M.WebViewer("#view");
+  startup.viewer = now();
   shareGeneration(m.abort !== false, m.slowExtractionMs, m.slowPass);
   post({ op: "ready", ok: viewer.ready(), error: viewer.error(), info: viewer.info(),
-    generation: generationWord });
+    generation: generationWord, startup });
 }
 
 // The generation word: in the threaded module's (shared) memory, where the module reads it from
@@ -424,6 +449,7 @@ function startStream(m) {
   // hold the first frame. No point of it is read before its brick arrives (the BlockLOD core's
   // residency; the GPU scene takes the buffer after the last brick: WebViewer's
   // UpdateSceneVolume), so a view of the memory older than a pthread's growth costs nothing.
+  const setup = [performance.now()]; // the set-up's steps (streamTimes.setupMs)
   const end = M.HEAPU8.length;
   volumeBytes = M._malloc(length);
   if (volumeBytes && volumeBytes < end) {
@@ -432,14 +458,18 @@ function startStream(m) {
   const coarse = new Uint8Array(m.coarse.bytes);
   coarseBytes = M._malloc(coarse.length);
   M.HEAPU8.set(coarse, coarseBytes);
-  let ok = viewer.setVolume(m.type, volumeBytes, m.dims, m.spacing, m.origin) &&
-    viewer.beginStreaming(m.brick) &&
-    viewer.setCoarseVolume(m.type, coarseBytes, m.coarse.dims, m.coarse.spacing, m.coarse.origin);
+  setup.push(performance.now());
+  // Streaming from the start: no BlockLOD ranges read from the empty buffer (setVolume's).
+  let ok = viewer.setStreamingVolume(m.type, volumeBytes, m.dims, m.spacing, m.origin, m.brick);
+  setup.push(performance.now());
+  ok = ok && viewer.setCoarseVolume(m.type, coarseBytes, m.coarse.dims, m.coarse.spacing, m.coarse.origin);
+  setup.push(performance.now());
   streaming = ok;
   freeScratch();
   streamGrid = { dims: m.dims, brick: m.brick, size, length, scratch: 0 };
+  // setupMs: the buffers allocated, setStreamingVolume, setCoarseVolume
   streamTimes = { begun: now(), batches: 0, bricks: 0, decodeMs: 0, writeMs: 0, firstBricks: 0,
-    lastBricks: 0, frames: [], ended: 0 };
+    lastBricks: 0, frames: [], ended: 0, setupMs: setup.slice(1).map((t, i) => t - setup[i]) };
   shownKey = "";
   refine = null;
   post({ op: "answer", id: m.id, value: ok ? "" : viewer.stats().error || "the volume cannot be streamed" });
@@ -513,7 +543,10 @@ function freeScratch() {
 self.onmessage = async (event) => {
   const m = event.data;
   try {
-    if (m.op === "init") {
+    if (m.op === "load") {
+      startup.load = now();
+      load(new URL(".", self.location.href).href, m.threads);
+    } else if (m.op === "init") {
       await init(m);
     } else if (m.op === "call") {
       if (m.method === "setPath") {

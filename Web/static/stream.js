@@ -184,6 +184,7 @@ export async function startStream(level) {
   }
   const coarse = await fetchLevel(0);
   times.level0 = epochNow();
+  performance.mark("mediso:level0");
   const type = coarse.type;
   const dims = manifest.dims;
   const M = state.module;
@@ -214,22 +215,23 @@ export async function startStream(level) {
     pending: new Set(Array.from({ length: count }, (_, i) => i)), inFlight: 0, neededInFlight: 0,
     received: 0, total: manifest.bytes.reduce((a, b) => a + b, 0), need: new Map(), exact: new Map(),
     asked: new Set(), requested: [], arrived: [], readyKey: "", error: "", started: false, framed: false,
+    showing: false,
     batch: Math.max(1, Math.ceil(count / BATCHES)), times };
   times.begun = epochNow();
+  performance.mark("mediso:stream");
   lastTimes = times;
   state.received = 0;
-  // The bricks are asked for as soon as the server has said which ones the first surfaces need
-  // (askExact, sent with the first frame's request: beforeEach), while the worker draws that
-  // frame (level 0's), so that the link and the server work during it; what arrives before the
-  // frame is drawn is held here (handOver), since the worker would write it before drawing and
-  // the first image would wait (the page's start-up, docs/web.md). A timer in case no frame
-  // comes.
+  // The bricks are asked for once the first frame (level 0's) is drawn and shown (afterEach): on
+  // a fast link they would otherwise come first, and their writing and the server's encoding
+  // would hold that frame (the page's start-up, docs/web.md). The bricks the first surfaces need
+  // are asked of the server before that frame (beforeEach), so that the first requests are
+  // theirs; a timer in case no frame comes.
   const s = state.stream;
   setTimeout(() => framed(s), 1000);
 }
 
-// The first frame is drawn (or a second has passed without one): the bricks that came meanwhile
-// may go to the worker, and the bricks be asked for if the need answer has not started them.
+// The first frame is drawn and shown (or a second has passed without one): the bricks may be
+// asked for.
 function framed(s) {
   if (s && state.stream === s) {
     s.framed = true;
@@ -241,13 +243,12 @@ function framed(s) {
   }
 }
 
-// The bricks are asked for once the server has said which bricks the current isovalues need
-// (one round trip, sent with the first frame's request; begin runs again at its answer), or once
-// the first frame is drawn with no need query sent: the batches are then those of the exact
-// sets, the same at every load (BATCHES). A need query that fails (the supersets) or takes over
-// 2 s more does not hold the bricks.
+// The bricks are asked for once the first frame is shown and the server has said which bricks
+// the current isovalues need (one round trip, sent before that frame: it has mostly come by
+// then): the batches are then those of the exact sets, the same at every load (BATCHES). A need
+// query that fails (the supersets) or takes over 2 s more does not hold the bricks.
 function begin(s, late = false) {
-  if (!s || state.stream !== s || s.started || (!s.framed && !s.asked.size)) {
+  if (!s || state.stream !== s || s.started || !s.framed) {
     return;
   }
   askExact(s);
@@ -353,7 +354,7 @@ async function fetchBatch(s, ids, neededBatch) {
 // surface has its bricks (after that frame's request), or a brick has failed.
 async function handOver(s) {
   if (state.stream !== s || !s.framed) {
-    return; // held until the first frame is drawn (afterEach hands them over then)
+    return; // held until the first frame is shown (framed hands them over then)
   }
   const values = currentValues();
   const needs = (id) => values.some((v) => needed(s, v).has(id));
@@ -454,9 +455,19 @@ function fullNow() {
     drawnValues.every((v, i) => v === values[i]);
 }
 function afterEach() {
-  if (state.stream && !state.stream.framed) {
-    framed(state.stream); // hands over what came meanwhile
-  } else if (state.stream && state.stream.arrived.length) {
+  const s = state.stream;
+  if (s && !s.framed && !s.showing) {
+    // Once the first frame is on the screen (two animation frames, as drawn() waits): the bricks'
+    // answers, their hand-over and their writing in the worker, begun at its answer, held the
+    // page's next frames, and so the first image's display (docs/web.md, "The page's start-up").
+    s.showing = true;
+    s.times.framed = epochNow();
+    requestAnimationFrame(() => requestAnimationFrame(() => {
+      s.times.shown = epochNow();
+      framed(s);
+    }));
+  }
+  if (state.stream && state.stream.arrived.length) {
     handOver(state.stream); // a change since may need them, or need nothing more
   }
   const stats = state.viewer.stats();
@@ -482,11 +493,11 @@ function epochNow() {
 /**
  * Where the last stream's time went (the streaming benchmark's table of parts, docs/web.md), in
  * ms from the page's navigation, or null where the level came whole: on this thread, the stream
- * begun (startStream), level 0 in, the stream set up in the worker, the first frame drawn, the
- * first bricks asked for, the first and last answer in, the last batch handed to the worker,
+ * begun (startStream), level 0 in, the stream set up in the worker, the first frame drawn (its
+ * answer) and shown (two animation frames later), the first bricks asked for, the first and last answer in, the last batch handed to the worker,
  * every current surface at the full level, and the level's end; in the worker (from its newest
- * frame's stats), the first and last batch written, the bricks' decoding and writing (writeBrick:
- * the copy, the residency and the extraction ahead) and each frame (when it began, its time,
+ * frame's stats), the set-up's steps, the first and last batch written, the bricks' decoding and
+ * writing (writeBrick: the copy, the residency and the extraction ahead) and each frame (when it began, its time,
  * the part that made and uploaded the surfaces, its surfaces from level 0).
  */
 export function streamTimes() {
@@ -502,7 +513,8 @@ export function streamTimes() {
     const worker = (t) => (t ? since(lastTimes.begun + t - w.begun) : null);
     out.worker = { firstBricks: worker(w.firstBricks), lastBricks: worker(w.lastBricks),
       batches: w.batches, bricks: w.bricks, decodeMs: Math.round(w.decodeMs),
-      writeMs: Math.round(w.writeMs), frames: w.frames.map((f) => ({ at: worker(f.at), ms: Math.round(f.ms),
+      writeMs: Math.round(w.writeMs), setupMs: (w.setupMs || []).map(Math.round),
+      frames: w.frames.map((f) => ({ at: worker(f.at), ms: Math.round(f.ms),
         buildMs: Math.round(f.buildMs), triangles: f.triangles, coarse: f.coarse })) };
   }
   return out;

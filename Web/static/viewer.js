@@ -79,6 +79,9 @@ export async function startViewer(canvas, probe, moduleLoaded = () => {}) {
       refineDelayMs: Number(params.get("refineDelay")) || 0,
       slowFirstDragFrameMs: Number(params.get("slowFirstDragFrame")) || 0,
       prepareDrag: params.get("prepareDrag") === "1" });
+  if (!inWorker) {
+    RemoteViewer.takeEarlyWorker(); // the worker index.html started, ended
+  }
   state.remote = inWorker;
   const debug = probe.getExtension("WEBGL_debug_renderer_info");
   state.unmaskedRenderer = debug ? probe.getParameter(debug.UNMASKED_RENDERER_WEBGL) : "";
@@ -212,6 +215,9 @@ function refusedOnGPU(stats) {
 
 // The worker's answer to a frame (remote.js).
 function frameAnswered(stats) {
+  if (state.framesLogged === 0) {
+    performance.mark("mediso:first-answer");
+  }
   recordFrame(stats.ms, stats);
   if (!stats.ok) {
     refusedOnGPU(stats);
@@ -244,6 +250,9 @@ export function renderNow(interactive = false) {
     call();
   }
   if (state.remote) {
+    if (!latest) {
+      performance.mark("mediso:first-asked");
+    }
     latest = viewer.frame(interactive);
     state.settled = false; // until its answer (frameOwed)
     return latest;

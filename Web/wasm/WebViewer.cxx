@@ -238,35 +238,21 @@ public:
   bool SetVolume(int type, std::uintptr_t bytes, const val& dims, const val& spacing,
     const val& origin)
   {
-    if (!this->Ready())
-    {
-      return false;
-    }
-    this->Viewpoint.SetPlacement(dims, spacing, origin);
-    const VolumePlacement& placement = this->Viewpoint.GetPlacement();
-    this->Type = static_cast<ScalarType>(type);
-    this->Data = reinterpret_cast<const void*>(bytes);
-    emscripten_webgl_make_context_current(this->Context);
-    VolumeDescription description;
-    description.Type = this->Type;
-    description.Data = this->Data;
-    std::copy(placement.Dimensions, placement.Dimensions + 3, description.Dims);
-    std::copy(placement.Origin, placement.Origin + 3, description.Origin);
-    std::copy(placement.Spacing, placement.Spacing + 3, description.Spacing);
-    description.Stamp = ++this->VolumeStamp;
-    this->Described = description;
-    this->SceneVolumeStale = true;
-    std::string error;
-    if (!this->CPUPath && !this->UpdateSceneVolume(error))
-    {
-      this->LastError = error;
-      return false;
-    }
-    this->CPU.SetVolume(description);
-    this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
-    this->Warm.clear(); // another volume: other pyramids, other programs
-    this->Viewpoint.ResetCamera();
-    return true;
+    return this->AdoptVolume(type, bytes, dims, spacing, origin, false);
+  }
+
+  /**
+   * Streaming from the start (the page's stream, render-worker.js): the
+   * volume as SetVolume takes it, its values still to arrive as bricks of
+   * `brickPoints` points a side (BeginStreaming), without the BlockLOD ranges
+   * SetVolume would read from the buffer that holds nothing yet
+   * (BlockLODSurfaces::SetStreamingVolume): that read held the first frame.
+   */
+  bool SetStreamingVolume(int type, std::uintptr_t bytes, const val& dims, const val& spacing,
+    const val& origin, int brickPoints)
+  {
+    return this->AdoptVolume(type, bytes, dims, spacing, origin, true) &&
+      this->BeginStreaming(brickPoints);
   }
 
   /// "gpu" or "cpu": which path draws.
@@ -1109,6 +1095,48 @@ public:
   }
 
 private:
+  // SetVolume, or with `streaming` the start of SetStreamingVolume.
+  bool AdoptVolume(int type, std::uintptr_t bytes, const val& dims, const val& spacing,
+    const val& origin, bool streaming)
+  {
+    if (!this->Ready())
+    {
+      return false;
+    }
+    this->Viewpoint.SetPlacement(dims, spacing, origin);
+    const VolumePlacement& placement = this->Viewpoint.GetPlacement();
+    this->Type = static_cast<ScalarType>(type);
+    this->Data = reinterpret_cast<const void*>(bytes);
+    emscripten_webgl_make_context_current(this->Context);
+    VolumeDescription description;
+    description.Type = this->Type;
+    description.Data = this->Data;
+    std::copy(placement.Dimensions, placement.Dimensions + 3, description.Dims);
+    std::copy(placement.Origin, placement.Origin + 3, description.Origin);
+    std::copy(placement.Spacing, placement.Spacing + 3, description.Spacing);
+    description.Stamp = ++this->VolumeStamp;
+    this->Described = description;
+    this->SceneVolumeStale = true;
+    std::string error;
+    if (!this->CPUPath && !this->UpdateSceneVolume(error))
+    {
+      this->LastError = error;
+      return false;
+    }
+    if (streaming)
+    {
+      this->CPU.SetStreamingVolume(description);
+    }
+    else
+    {
+      this->CPU.SetVolume(description);
+    }
+    this->ShownKeys.assign(MaximumIsovalues, SurfaceKey{ NAN, -1 });
+    this->Warm.clear(); // another volume: other pyramids, other programs
+    this->Viewpoint.ResetCamera();
+    return true;
+  }
+
   // The GPU path's volume level: the one asked for (SetGPULevel), or while the scene streams, for
   // all the frame's surfaces, the coarse volume's level when any of them is named coarse
   // (SetCoarseValues: its bricks are not all there), else the full level.
@@ -1787,6 +1815,7 @@ EMSCRIPTEN_BINDINGS(mediso_web)
     .function("error", &WebViewer::GetError)
     .function("info", &WebViewer::Info)
     .function("setVolume", &WebViewer::SetVolume)
+    .function("setStreamingVolume", &WebViewer::SetStreamingVolume)
     .function("setSurfaces", &WebViewer::SetSurfaces)
     .function("resize", &WebViewer::Resize)
     .function("setBackground", &WebViewer::SetBackground)
