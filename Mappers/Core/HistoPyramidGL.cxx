@@ -969,6 +969,24 @@ bool HistoPyramidGL::FinishBuild(std::string& error)
   return true;
 }
 
+bool HistoPyramidGL::AdoptIsovalues(const std::vector<double>& isovalues)
+{
+  Internals& impl = *this->Impl;
+  if (!impl.Built || isovalues.empty() ||
+    isovalues.size() > static_cast<std::size_t>(MaximumIsovalues))
+  {
+    return false;
+  }
+  const IsoThresholds thresholds = MakeIsoThresholds(impl.Type, isovalues);
+  const bool childMasks = thresholds.Count == 1 && impl.Layout.GetNumberOfLevels() >= 3;
+  if (childMasks != impl.ChildMasks || (thresholds.Count == 0) != (impl.Current.Count == 0))
+  {
+    return false;
+  }
+  impl.Current = thresholds;
+  return true;
+}
+
 //------------------------------------------------------------------------------
 bool HistoPyramidGL::AllocatePool(ScalarType type, int slotPoints, const int slots[3],
   const int drawnCells[3], const GLParallelFor& parallel, std::string& error)

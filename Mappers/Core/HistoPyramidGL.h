@@ -224,6 +224,18 @@ public:
   bool FinishBuild(std::string& error);
   ///@}
 
+  /**
+   * Take `isovalues` as the built pyramid's without building it again, where
+   * the caller knows that they count every cell as the last build's did
+   * (IsosurfaceScene: a brick that the same values of both sets cross, since
+   * a value outside a brick's range crosses none of its cells): the walk
+   * uses them from now on (their thresholds, and which surface each cell's
+   * crossings belong to). False, with nothing changed, where the pyramid is
+   * not built, or where level 1 would hold another thing (child masks for
+   * one counted isovalue, counts for several).
+   */
+  bool AdoptIsovalues(const std::vector<double>& isovalues);
+
   bool HasVolume() const;
   bool IsBuilt() const;
   /// Primitives (active cell-isovalue pairs) of the last successful Build() (0 before).

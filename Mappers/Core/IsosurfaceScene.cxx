@@ -51,6 +51,20 @@ std::string Megabytes(std::uint64_t bytes)
   return text.str();
 }
 
+// The isovalues of `values` that cross `range` (min < iso <= max), in order.
+std::vector<double> Crossing(const BrickRange& range, const std::vector<double>& values)
+{
+  std::vector<double> crossing;
+  for (const double v : values)
+  {
+    if (range.Min < v && v <= range.Max)
+    {
+      crossing.push_back(v);
+    }
+  }
+  return crossing;
+}
+
 // "2x", "1.5x": a ratio as the reasons say it.
 std::string RatioText(double ratio)
 {
@@ -145,6 +159,8 @@ struct IsosurfaceScene::Internals
   std::vector<BrickRange> Ranges;
   BrickResidency Residency;
   std::unordered_map<std::int64_t, std::unique_ptr<HistoPyramidGL>> Bricks;
+  // The isovalues of each brick's pyramid, the last build's or those adopted since.
+  std::unordered_map<std::int64_t, std::vector<double>> BrickValues;
   std::vector<std::int64_t> Active;
 
   // The brick pool (SetBrickPool()): the resident bricks in the slots of one
@@ -219,6 +235,7 @@ struct IsosurfaceScene::Internals
       brick.second->Release();
     }
     this->Bricks.clear();
+    this->BrickValues.clear();
     this->Residency.Clear();
   }
   void ReleaseBricks()
@@ -555,6 +572,7 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
           found->second->Release();
           this->Bricks.erase(found);
         }
+        this->BrickValues.erase(gone);
       }
       std::unique_ptr<HistoPyramidGL> pyramid(new HistoPyramidGL(this->GL));
       pyramid->ShareProgramsWith(*this->Pyramid);
@@ -575,7 +593,22 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
       this->Bricks[brick] = std::move(pyramid);
       ++stats.BrickUploads;
     }
-    if (!this->Bricks.at(brick)->BuildPasses(values, error))
+    // A brick whose pyramid the same of the old and the new isovalues cross
+    // keeps it (a value outside the brick's range crosses none of its cells,
+    // so every cell counts as it did): a change of one of several surfaces
+    // builds only the bricks it touches. With one isovalue, as in a sweep,
+    // a brick the new one crosses was crossed by another or by none: built.
+    HistoPyramidGL& pyramid = *this->Bricks.at(brick);
+    std::vector<double>& builtFor = this->BrickValues[brick];
+    const BrickRange& range = this->Ranges[static_cast<std::size_t>(brick)];
+    if (pyramid.IsBuilt() && Crossing(range, builtFor) == Crossing(range, values) &&
+      pyramid.AdoptIsovalues(values))
+    {
+      builtFor = values;
+      continue;
+    }
+    builtFor.clear(); // until its build is read back
+    if (!pyramid.BuildPasses(values, error))
     {
       return false;
     }
@@ -584,13 +617,18 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
   for (const std::int64_t brick : active)
   {
     HistoPyramidGL& pyramid = *this->Bricks.at(brick);
-    if (!pyramid.FinishBuild(error))
+    std::vector<double>& builtFor = this->BrickValues[brick];
+    if (builtFor.empty())
     {
-      return false;
+      if (!pyramid.FinishBuild(error))
+      {
+        return false;
+      }
+      builtFor = values;
+      ++stats.BrickPyramidBuilds;
+      stats.BuildTilesDrawn += pyramid.GetLastTilesDrawn();
     }
-    stats.BuildTilesDrawn += pyramid.GetLastTilesDrawn();
     stats.BuildTiles += pyramid.GetNumberOfTiles();
-    ++stats.BrickPyramidBuilds;
   }
   this->Active = active;
   return true;
