@@ -10,9 +10,10 @@
 // same; isovalue changes evict least recently used bricks within the budget and still count
 // exactly; active bricks over the budget fail with that reason; the limits set back to the defaults
 // give one texture again; a change of one of two surfaces builds only the bricks it touches
-// (each brick its own pyramid), the others keeping theirs. The brick pool (IsosurfaceScene::SetBrickPool(), on by default) is
-// checked the same way on a phantom whose active bricks it holds (one pyramid built per isovalue
-// change for all of them, one pass drawn), with slots reused across isovalue changes within a
+// (each brick its own pyramid), the others keeping theirs. The brick pool
+// (IsosurfaceScene::SetBrickPool(), on by default) is checked the same way on a phantom whose
+// active bricks it holds (one pyramid built per isovalue change for all of them, one pass
+// drawn), with slots reused across isovalue changes within a
 // budget; where it cannot hold them (a limit of 32) and with the pool off, the bricks' own
 // pyramids, and on a long thin volume whose bricks fill a fraction of their slots (a pool there
 // would take over IsosurfaceScene::MaximumPoolMemoryRatio the GPU memory of the bricks' own
