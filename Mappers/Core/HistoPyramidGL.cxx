@@ -209,6 +209,7 @@ void HistoPyramidGL::Internals::ReleaseLevels()
 {
   this->Levels.clear();
   this->Built = false;
+  this->Queued = false; // and a build queued before is stale
   this->Total = 0;
   this->ChildMasks = false;
 }
@@ -579,6 +580,7 @@ bool HistoPyramidGL::Internals::Store(ScalarType type, const void* data, const i
     this->ReleaseLevels();
   }
   this->Built = false;
+  this->Queued = false; // and a build queued before is stale
   this->Total = 0;
   this->Volume = Name(gl, NameKind::Texture);
   BindTextureUnit(gl, 0, GL_TEXTURE_3D, this->Volume.Get());
@@ -617,6 +619,7 @@ void HistoPyramidGL::EmptyTiles()
     impl.Tiles.Reset(impl.Type, impl.Layout);
   }
   impl.Built = false;
+  impl.Queued = false; // and a build queued before is stale
   impl.Total = 0;
 }
 
@@ -692,6 +695,7 @@ bool HistoPyramidGL::UploadRegion(const void* values, const int first[3], const 
   }
   impl.Tiles.ComputeRegion(impl.Type, values, impl.Points, lo, hi, arrived);
   impl.Built = false;
+  impl.Queued = false; // and a build queued before is stale
   impl.Total = 0;
   return true;
 }
@@ -705,6 +709,7 @@ void HistoPyramidGL::SetOwnedCells(const int first[3], const int end[3])
     impl.OwnedEnd[a] = std::max(impl.OwnedFirst[a], std::min(end[a], impl.Points[a] - 1));
   }
   impl.Built = false;
+  impl.Queued = false; // and a build queued before is stale
   impl.Total = 0;
 }
 
@@ -1224,6 +1229,7 @@ void HistoPyramidGL::Internals::UpdateSlot(int slot)
   this->Tiles.Place(
     owns ? &this->SlotTiles[static_cast<std::size_t>(slot)] : nullptr, origin, count);
   this->Built = false;
+  this->Queued = false; // and a build queued before is stale
   this->Total = 0;
 }
 
