@@ -14,6 +14,9 @@
  * Exit status: 0 done; 2 bad options; 3 the volume cannot be read or is not
  * usable; 4 no usable OpenGL (no EGL display, too old a context, the bricks
  * the isovalues cross over the GPU budget); 1 anything else that failed.
+ * A --sweep goes on past isovalues whose crossed bricks are over the GPU
+ * budget, says how many in one line and times the others (exit 0); it exits
+ * 4 only where no isovalue of the sweep fits.
  */
 #include "Camera.h"
 #include "GLApiFunctions.h"
@@ -88,7 +91,9 @@ Output:
 The paper's protocol (prints a table):
   --rotate [N]          N one-degree rotations (azimuth), default 360
   --sweep [N]           N equidistant isovalues strictly inside the data
-                        range (default 95), each built and drawn
+                        range (default 95), each built and drawn; those whose
+                        crossed bricks exceed the GPU budget are counted in one
+                        line and left out of the row (exit 0; 4 if all are)
 
 Context:
   --api es|gl           OpenGL ES 3.0 (the WebGL2 subset; default) or OpenGL 3.2 core
@@ -837,11 +842,26 @@ int Run(int argc, char* argv[])
     std::vector<double> steps, builds;
     double total = 0.0;
     std::uint64_t primitives = 0;
+    // Isovalues whose crossed bricks exceed the GPU budget are not drawn (a
+    // host falls back for them); the sweep goes on over the others and says
+    // how many there were, with the first one's reason.
+    int overBudget = 0;
+    std::string firstOver;
     for (int i = 0; i < opt.Sweep; ++i)
     {
       look.Value = range[0] + (range[1] - range[0]) * (i + 1) / (opt.Sweep + 1);
       const auto start = Clock::now();
       error = scene.Build({ look });
+      if (!error.empty() && scene.Scene.GetStats().OverBudget)
+      {
+        if (overBudget++ == 0)
+        {
+          std::ostringstream first;
+          first << "the first, " << look.Value << ": " << error;
+          firstOver = first.str();
+        }
+        continue;
+      }
       if (error.empty())
       {
         error = scene.Draw();
@@ -856,8 +876,20 @@ int Run(int argc, char* argv[])
       total += ms;
       primitives = std::max(primitives, scene.Scene.GetStats().Primitives);
     }
-    std::printf("%-9s %7d %10.3f %9.2f %10.3f %10.3f %10.3f %12llu\n", "sweep", opt.Sweep,
-      total / 1000.0, 1000.0 * opt.Sweep / total, Median(steps),
+    const int drawn = static_cast<int>(steps.size());
+    if (overBudget > 0)
+    {
+      std::printf("(sweep: %d of the %d isovalues not drawn, their crossed bricks over the GPU "
+                  "budget; the row is over the other %d; %s)\n",
+        overBudget, opt.Sweep, drawn, firstOver.c_str());
+    }
+    if (drawn == 0)
+    {
+      std::fflush(stdout);
+      return Fail(4, opt.Input + ": no isovalue of the sweep fits the GPU budget");
+    }
+    std::printf("%-9s %7d %10.3f %9.2f %10.3f %10.3f %10.3f %12llu\n", "sweep", drawn,
+      total / 1000.0, 1000.0 * drawn / total, Median(steps),
       *std::min_element(steps.begin(), steps.end()), Median(builds),
       static_cast<unsigned long long>(primitives));
     std::printf("(sweep: median ms is one isovalue change + frame; primitives the largest)\n");

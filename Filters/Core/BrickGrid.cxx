@@ -62,30 +62,27 @@ BrickRange ExtentRange(const T* data, const int points[3], const int extent[6])
 {
   double low = std::numeric_limits<double>::infinity();
   double high = -std::numeric_limits<double>::infinity();
-  // Per row in T (NaN compares false, so it is left out), then as double.
+  // Per row in T, then as double. The row's bounds start past every value
+  // (infinities for floats, the type's ends for integers) so that the loop
+  // has no branch and vectorises: a NaN compares false and is left out, and
+  // a row of NaN values only keeps low > high, which adds nothing.
+  const T rowStartLow = std::numeric_limits<T>::has_infinity ? std::numeric_limits<T>::infinity()
+                                                             : std::numeric_limits<T>::max();
+  const T rowStartHigh = std::numeric_limits<T>::has_infinity ? -std::numeric_limits<T>::infinity()
+                                                              : std::numeric_limits<T>::lowest();
   for (int z = extent[4]; z <= extent[5]; ++z)
   {
     for (int y = extent[2]; y <= extent[3]; ++y)
     {
       const T* row = data + (static_cast<std::int64_t>(z) * points[1] + y) * points[0];
-      bool any = false;
-      T rowLow{}, rowHigh{};
+      T rowLow = rowStartLow, rowHigh = rowStartHigh;
       for (int x = extent[0]; x <= extent[1]; ++x)
       {
         const T v = row[x];
-        if (!(v == v))
-        {
-          continue;
-        }
-        if (!any)
-        {
-          rowLow = rowHigh = v;
-          any = true;
-        }
         rowLow = v < rowLow ? v : rowLow;
         rowHigh = v > rowHigh ? v : rowHigh;
       }
-      if (any)
+      if (rowLow <= rowHigh)
       {
         low = std::min(low, static_cast<double>(rowLow));
         high = std::max(high, static_cast<double>(rowHigh));

@@ -113,6 +113,7 @@ struct HistoPyramidGL::Internals
   // The stored levels (index = level; 0 is empty), each a 2D atlas.
   std::vector<Name> Levels;
   bool Built = false;
+  bool Queued = false; // BuildPasses() done, FinishBuild() to come
   std::uint64_t Total = 0;
   IsoThresholds Current; // of the last successful Build()
   bool ChildMasks = false;
@@ -143,6 +144,11 @@ struct HistoPyramidGL::Internals
     return this->SlotsPerAxis[0] * this->SlotsPerAxis[1] * this->SlotsPerAxis[2];
   }
 
+  bool Store(ScalarType type, const void* data, const int points[3], int rowValues,
+    const GLParallelFor& run, std::string& error);
+  bool SlotFits(int slot, const void* values, const int points[3], std::string& error) const;
+  bool StoreSlot(int slot, const void* data, const int points[3], int rowValues,
+    const int placement[3], std::string& error);
   bool Target(GLuint texture, int width, int height, std::string& error);
   Program* Pass(
     const char* vertex, const char* fragment, const std::string& defines, std::string& error);
@@ -203,6 +209,7 @@ void HistoPyramidGL::Internals::ReleaseLevels()
 {
   this->Levels.clear();
   this->Built = false;
+  this->Queued = false; // and a build queued before is stale
   this->Total = 0;
   this->ChildMasks = false;
 }
@@ -422,45 +429,56 @@ std::uint64_t HistoPyramidGL::EstimateGPUMemoryBytes(ScalarType type, const int 
 }
 
 //------------------------------------------------------------------------------
-bool HistoPyramidGL::UploadVolume(ScalarType type, const void* values, const int points[3],
-  const GLParallelFor& parallel, std::string& error)
+namespace
 {
-  Internals& impl = *this->Impl;
-  const GLApi& gl = *impl.GL;
-  const GLApi::Functions& f = gl.F();
-  if (!values || !points)
-  {
-    error = "no volume given";
-    return false;
-  }
+// Whether a volume of `points` can be a pyramid's volume on `gl`'s context: "" or why not.
+std::string CheckVolumeSize(const GLApi& gl, const int points[3])
+{
   if (points[0] < 2 || points[1] < 2 || points[2] < 2)
   {
-    error = "the volume must have at least 2 points per axis, not " + std::to_string(points[0]) +
+    return "the volume must have at least 2 points per axis, not " + std::to_string(points[0]) +
       "x" + std::to_string(points[1]) + "x" + std::to_string(points[2]);
-    return false;
   }
   const int cells[3] = { points[0] - 1, points[1] - 1, points[2] - 1 };
   const PyramidLayout layout(cells);
   const int width = PackedVolumeWidth(points[0]);
   if (std::max({ width, points[1], points[2] }) > gl.GetMax3DTextureSize())
   {
-    error = "the " + std::to_string(points[0]) + "x" + std::to_string(points[1]) + "x" +
+    return "the " + std::to_string(points[0]) + "x" + std::to_string(points[1]) + "x" +
       std::to_string(points[2]) + " volume (a " + std::to_string(width) + "x" +
       std::to_string(points[1]) + "x" + std::to_string(points[2]) +
       " texture) exceeds GL_MAX_3D_TEXTURE_SIZE " + std::to_string(gl.GetMax3DTextureSize());
-    return false;
   }
   for (int l = 1; l < layout.GetNumberOfLevels(); ++l)
   {
     const auto atlas = layout.AtlasSize(l);
     if (std::max(atlas[0], atlas[1]) > gl.GetMaxTextureSize())
     {
-      error = "level " + std::to_string(l) + " of the pyramid (a " + std::to_string(atlas[0]) +
+      return "level " + std::to_string(l) + " of the pyramid (a " + std::to_string(atlas[0]) +
         "x" + std::to_string(atlas[1]) + " texture) exceeds GL_MAX_TEXTURE_SIZE " +
         std::to_string(gl.GetMaxTextureSize());
-      return false;
     }
   }
+  return "";
+}
+} // namespace
+
+bool HistoPyramidGL::UploadVolume(ScalarType type, const void* values, const int points[3],
+  const GLParallelFor& parallel, std::string& error)
+{
+  Internals& impl = *this->Impl;
+  const GLApi& gl = *impl.GL;
+  if (!values || !points)
+  {
+    error = "no volume given";
+    return false;
+  }
+  error = CheckVolumeSize(gl, points);
+  if (!error.empty())
+  {
+    return false;
+  }
+  const int width = PackedVolumeWidth(points[0]);
   const GLParallelFor run = SerialIfEmpty(parallel);
   const std::int64_t numPoints = static_cast<std::int64_t>(points[0]) * points[1] * points[2];
   const VolumeFormat format = VolumeFormatOf(type);
@@ -516,44 +534,80 @@ bool HistoPyramidGL::UploadVolume(ScalarType type, const void* values, const int
       return false;
     }
   }
+  return impl.Store(type, packed.empty() ? data : packed.data(), points,
+    packed.empty() ? points[0] : 4 * width, run, error);
+}
 
+bool HistoPyramidGL::UploadPackedVolume(ScalarType type, const void* packedRows,
+  const int points[3], const GLParallelFor& parallel, std::string& error)
+{
+  Internals& impl = *this->Impl;
+  if (!packedRows || !points)
+  {
+    error = "no volume given";
+    return false;
+  }
+  if (type == ScalarType::Float64)
+  {
+    error = "packed rows hold the texture's values, and a double volume's texture holds floats";
+    return false;
+  }
+  error = CheckVolumeSize(*impl.GL, points);
+  if (!error.empty())
+  {
+    return false;
+  }
+  return impl.Store(
+    type, packedRows, points, 4 * PackedVolumeWidth(points[0]), SerialIfEmpty(parallel), error);
+}
+
+// The volume texture from `data`, the texture's values with rows of `rowValues` (a multiple
+// of 4 where points[0] is not), and its tile ranges.
+bool HistoPyramidGL::Internals::Store(ScalarType type, const void* data, const int points[3],
+  int rowValues, const GLParallelFor& run, std::string& error)
+{
+  const GLApi& gl = *this->GL;
+  const GLApi::Functions& f = gl.F();
+  const int cells[3] = { points[0] - 1, points[1] - 1, points[2] - 1 };
+  const PyramidLayout layout(cells);
+  const int width = PackedVolumeWidth(points[0]);
+  const VolumeFormat format = VolumeFormatOf(type);
   ScopedGLState saved(gl, 1);
   gl.TakeErrors();
-  const bool sameSize = impl.Layout == layout && impl.Volume;
+  const bool sameSize = this->Layout == layout && this->Volume;
   if (!sameSize)
   {
-    impl.ReleaseLevels();
+    this->ReleaseLevels();
   }
-  impl.Built = false;
-  impl.Total = 0;
-  impl.Volume = Name(gl, NameKind::Texture);
-  BindTextureUnit(gl, 0, GL_TEXTURE_3D, impl.Volume.Get());
+  this->Built = false;
+  this->Queued = false; // and a build queued before is stale
+  this->Total = 0;
+  this->Volume = Name(gl, NameKind::Texture);
+  BindTextureUnit(gl, 0, GL_TEXTURE_3D, this->Volume.Get());
   SetNearest(gl, GL_TEXTURE_3D);
   f.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
   f.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
   f.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
-  {
-    f.TexImage3D(GL_TEXTURE_3D, 0, static_cast<GLint>(format.InternalFormat), width, points[1],
-      points[2], 0, format.Format, format.Type, packed.empty() ? data : packed.data());
-  }
+  f.TexImage3D(GL_TEXTURE_3D, 0, static_cast<GLint>(format.InternalFormat), width, points[1],
+    points[2], 0, format.Format, format.Type, data);
   const std::string errors = gl.TakeErrors();
   if (!errors.empty())
   {
     error = "cannot upload the " + std::to_string(points[0]) + "x" + std::to_string(points[1]) +
       "x" + std::to_string(points[2]) + " volume as a 3D texture: " + errors;
-    impl.ReleaseAll();
+    this->ReleaseAll();
     return false;
   }
 
   // The value range under each tile of level 1, which lets the level-1 pass
   // draw only the tiles an isovalue can cross.
-  impl.Tiles.Compute(type, data, points, layout, run);
-  impl.Type = type;
-  impl.Layout = layout;
-  impl.Parallel = run;
-  std::copy(points, points + 3, impl.Points);
-  std::fill(impl.OwnedFirst, impl.OwnedFirst + 3, 0);
-  std::copy(cells, cells + 3, impl.OwnedEnd);
+  this->Tiles.Compute(type, data, points, rowValues, layout, run);
+  this->Type = type;
+  this->Layout = layout;
+  this->Parallel = run;
+  std::copy(points, points + 3, this->Points);
+  std::fill(this->OwnedFirst, this->OwnedFirst + 3, 0);
+  std::copy(cells, cells + 3, this->OwnedEnd);
   return true;
 }
 
@@ -565,6 +619,7 @@ void HistoPyramidGL::EmptyTiles()
     impl.Tiles.Reset(impl.Type, impl.Layout);
   }
   impl.Built = false;
+  impl.Queued = false; // and a build queued before is stale
   impl.Total = 0;
 }
 
@@ -640,6 +695,7 @@ bool HistoPyramidGL::UploadRegion(const void* values, const int first[3], const 
   }
   impl.Tiles.ComputeRegion(impl.Type, values, impl.Points, lo, hi, arrived);
   impl.Built = false;
+  impl.Queued = false; // and a build queued before is stale
   impl.Total = 0;
   return true;
 }
@@ -653,6 +709,7 @@ void HistoPyramidGL::SetOwnedCells(const int first[3], const int end[3])
     impl.OwnedEnd[a] = std::max(impl.OwnedFirst[a], std::min(end[a], impl.Points[a] - 1));
   }
   impl.Built = false;
+  impl.Queued = false; // and a build queued before is stale
   impl.Total = 0;
 }
 
@@ -709,10 +766,16 @@ void HistoPyramidGL::Internals::DrawFullScreen()
 //------------------------------------------------------------------------------
 bool HistoPyramidGL::Build(const std::vector<double>& isovalues, std::string& error)
 {
+  return this->BuildPasses(isovalues, error) && this->FinishBuild(error);
+}
+
+bool HistoPyramidGL::BuildPasses(const std::vector<double>& isovalues, std::string& error)
+{
   Internals& impl = *this->Impl;
   const GLApi& gl = *impl.GL;
   const GLApi::Functions& f = gl.F();
   impl.Built = false;
+  impl.Queued = false;
   impl.Total = 0;
   if (!impl.Volume)
   {
@@ -843,9 +906,37 @@ bool HistoPyramidGL::Build(const std::vector<double>& isovalues, std::string& er
     impl.DrawFullScreen();
   }
 
-  // 5. Read back the top node only.
+  f.FramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, 0, 0);
+  const std::string errors = gl.TakeErrors();
+  if (!errors.empty())
+  {
+    error = "building the HistoPyramid failed: " + errors;
+    return false;
+  }
+  impl.Current = thresholds;
+  impl.ChildMasks = childMasks;
+  impl.TilesDrawn = tilesDrawn;
+  impl.Queued = true;
+  return true;
+}
+
+bool HistoPyramidGL::FinishBuild(std::string& error)
+{
+  Internals& impl = *this->Impl;
+  const GLApi& gl = *impl.GL;
+  const GLApi::Functions& f = gl.F();
+  if (!impl.Queued)
+  {
+    error = "FinishBuild needs BuildPasses() first";
+    return false;
+  }
+  impl.Queued = false;
+  // 5. Read back the top node only (which waits for the passes).
+  ScopedGLState saved(gl, 1);
+  gl.TakeErrors();
+  f.PixelStorei(GL_PACK_ALIGNMENT, 4);
   GLuint top[4] = { 0, 0, 0, 0 };
-  if (!impl.Target(impl.Levels[numLevels - 1].Get(), 1, 1, error))
+  if (!impl.Target(impl.Levels.back().Get(), 1, 1, error))
   {
     return false;
   }
@@ -858,9 +949,6 @@ bool HistoPyramidGL::Build(const std::vector<double>& isovalues, std::string& er
     return false;
   }
   impl.Total = top[0];
-  impl.Current = thresholds;
-  impl.ChildMasks = childMasks;
-  impl.TilesDrawn = tilesDrawn;
   impl.Built = true;
   if (impl.Pool)
   {
@@ -883,6 +971,24 @@ bool HistoPyramidGL::Build(const std::vector<double>& isovalues, std::string& er
         }
     impl.SlotOrderCount = 0;
   }
+  return true;
+}
+
+bool HistoPyramidGL::AdoptIsovalues(const std::vector<double>& isovalues)
+{
+  Internals& impl = *this->Impl;
+  if (!impl.Built || isovalues.empty() ||
+    isovalues.size() > static_cast<std::size_t>(MaximumIsovalues))
+  {
+    return false;
+  }
+  const IsoThresholds thresholds = MakeIsoThresholds(impl.Type, isovalues);
+  const bool childMasks = thresholds.Count == 1 && impl.Layout.GetNumberOfLevels() >= 3;
+  if (childMasks != impl.ChildMasks || (thresholds.Count == 0) != (impl.Current.Count == 0))
+  {
+    return false;
+  }
+  impl.Current = thresholds;
   return true;
 }
 
@@ -965,19 +1071,28 @@ bool HistoPyramidGL::AllocatePool(ScalarType type, int slotPoints, const int slo
   return true;
 }
 
-bool HistoPyramidGL::UploadSlot(
-  int slot, const void* values, const int points[3], const int placement[3], std::string& error)
+bool HistoPyramidGL::Internals::SlotFits(
+  int slot, const void* values, const int points[3], std::string& error) const
 {
-  Internals& impl = *this->Impl;
-  const GLApi& gl = *impl.GL;
-  const int side = 1 << impl.SlotShift;
-  if (!impl.Pool || slot < 0 || slot >= impl.SlotCount() || !values ||
+  const int side = 1 << this->SlotShift;
+  if (!this->Pool || slot < 0 || slot >= this->SlotCount() || !values ||
     std::min({ points[0], points[1], points[2] }) < 2 ||
     std::max({ points[0], points[1], points[2] }) > side)
   {
     error = "a brick of " + std::to_string(points[0]) + "x" + std::to_string(points[1]) + "x" +
       std::to_string(points[2]) + " points does not fit slot " + std::to_string(slot) +
       " of the brick pool";
+    return false;
+  }
+  return true;
+}
+
+bool HistoPyramidGL::UploadSlot(
+  int slot, const void* values, const int points[3], const int placement[3], std::string& error)
+{
+  Internals& impl = *this->Impl;
+  if (!impl.SlotFits(slot, values, points, error))
+  {
     return false;
   }
   const std::int64_t numPoints = static_cast<std::int64_t>(points[0]) * points[1] * points[2];
@@ -1007,28 +1122,55 @@ bool HistoPyramidGL::UploadSlot(
     error = "memory ran out while copying a brick for the GPU upload";
     return false;
   }
-  const int* n = impl.SlotsPerAxis;
+  return impl.StoreSlot(slot, packed.empty() ? data : packed.data(), points,
+    packed.empty() ? points[0] : 4 * PackedVolumeWidth(points[0]), placement, error);
+}
+
+bool HistoPyramidGL::UploadPackedSlot(int slot, const void* packedRows, const int points[3],
+  const int placement[3], std::string& error)
+{
+  Internals& impl = *this->Impl;
+  if (!impl.SlotFits(slot, packedRows, points, error))
+  {
+    return false;
+  }
+  if (impl.Type == ScalarType::Float64)
+  {
+    error = "packed rows hold the texture's values, and a double volume's texture holds floats";
+    return false;
+  }
+  return impl.StoreSlot(
+    slot, packedRows, points, 4 * PackedVolumeWidth(points[0]), placement, error);
+}
+
+// A slot's texels from `data`, the texture's values with rows of `rowValues`, its tile
+// ranges and its row of the table (owning no cell yet).
+bool HistoPyramidGL::Internals::StoreSlot(int slot, const void* data, const int points[3],
+  int rowValues, const int placement[3], std::string& error)
+{
+  const int side = 1 << this->SlotShift;
+  const VolumeFormat format = VolumeFormatOf(this->Type);
+  const int* n = this->SlotsPerAxis;
   const int offset[3] = { (slot % n[0]) * side / 4, ((slot / n[0]) % n[1]) * side,
     (slot / (n[0] * n[1])) * side };
   const int texels[3] = { PackedVolumeWidth(points[0]), points[1], points[2] };
-  if (!UploadBox(gl, impl.Volume.Get(), format, offset, texels,
-        packed.empty() ? data : packed.data(), error))
+  if (!UploadBox(*this->GL, this->Volume.Get(), format, offset, texels, data, error))
   {
     error = "cannot upload a brick into the brick pool: " + error;
     return false;
   }
   const int cells[3] = { points[0] - 1, points[1] - 1, points[2] - 1 };
-  impl.SlotTiles[static_cast<std::size_t>(slot)].Compute(
-    impl.Type == ScalarType::Float64 ? ScalarType::Float32 : impl.Type, data, points,
-    PyramidLayout(cells), impl.Parallel);
-  std::array<GLuint, 12>& row = impl.SlotRows[static_cast<std::size_t>(slot)];
+  this->SlotTiles[static_cast<std::size_t>(slot)].Compute(
+    this->Type == ScalarType::Float64 ? ScalarType::Float32 : this->Type, data, points,
+    rowValues, PyramidLayout(cells), this->Parallel);
+  std::array<GLuint, 12>& row = this->SlotRows[static_cast<std::size_t>(slot)];
   for (int a = 0; a < 3; ++a)
   {
     row[a] = row[4 + a] = 0; // owns nothing until SetSlotCells()
     row[8 + a] = static_cast<GLuint>(cells[a]);
     row[4 * a + 3] = static_cast<GLuint>(placement[a]);
   }
-  impl.UpdateSlot(slot);
+  this->UpdateSlot(slot);
   return true;
 }
 
@@ -1087,6 +1229,7 @@ void HistoPyramidGL::Internals::UpdateSlot(int slot)
   this->Tiles.Place(
     owns ? &this->SlotTiles[static_cast<std::size_t>(slot)] : nullptr, origin, count);
   this->Built = false;
+  this->Queued = false; // and a build queued before is stale
   this->Total = 0;
 }
 

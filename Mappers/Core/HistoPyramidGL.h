@@ -108,6 +108,17 @@ public:
   bool UploadVolume(ScalarType type, const void* values, const int points[3],
     const GLParallelFor& parallel, std::string& error);
 
+  /**
+   * UploadVolume() of values already as the texture holds them: rows of
+   * 4 * PackedVolumeWidth(points[0]) values, padded as PackVolumeRows() pads
+   * them (PackVolumeBox() cuts them out of a larger volume), of any type but
+   * Float64 (whose texture holds floats: use UploadVolume()). A brick is so
+   * sent with the one copy that cuts it out of the host's volume, where
+   * UploadVolume() would pad a copy of the copy.
+   */
+  bool UploadPackedVolume(ScalarType type, const void* packedRows, const int points[3],
+    const GLParallelFor& parallel, std::string& error);
+
   ///@{
   /**
    * A volume whose values arrive region by region (a streamed one,
@@ -167,6 +178,9 @@ public:
     const GLParallelFor& parallel, std::string& error);
   bool UploadSlot(
     int slot, const void* values, const int points[3], const int placement[3], std::string& error);
+  /// UploadSlot() of rows already padded, as UploadPackedVolume() takes them.
+  bool UploadPackedSlot(int slot, const void* packedRows, const int points[3],
+    const int placement[3], std::string& error);
   void SetSlotCells(int slot, const int first[3], const int end[3]);
   void SetSlotOrder(const std::vector<int>& slots);
   bool IsPool() const;
@@ -193,6 +207,34 @@ public:
    * isovalues (NaN ones count nothing) and read back the total.
    */
   bool Build(const std::vector<double>& isovalues, std::string& error);
+
+  ///@{
+  /**
+   * Build() in two halves, for several pyramids built one after another
+   * (the bricks of one volume): BuildPasses() queues the passes and returns
+   * without waiting for them; FinishBuild() reads the total (and a pool's
+   * slot counts) back, which waits for them. Reading a total back stalls
+   * the CPU until the GPU has done everything queued before it, so a scene
+   * that queues every brick's passes (and uploads the next bricks meanwhile)
+   * before the first read-back waits once per update, not once per brick.
+   * The pyramid is built (IsBuilt()) only after FinishBuild(); Build() is
+   * the two in turn.
+   */
+  bool BuildPasses(const std::vector<double>& isovalues, std::string& error);
+  bool FinishBuild(std::string& error);
+  ///@}
+
+  /**
+   * Take `isovalues` as the built pyramid's without building it again, where
+   * the caller knows that they count every cell as the last build's did
+   * (IsosurfaceScene: a brick that the same values of both sets cross, since
+   * a value outside a brick's range crosses none of its cells): the walk
+   * uses them from now on (their thresholds, and which surface each cell's
+   * crossings belong to). False, with nothing changed, where the pyramid is
+   * not built, or where level 1 would hold another thing (child masks for
+   * one counted isovalue, counts for several).
+   */
+  bool AdoptIsovalues(const std::vector<double>& isovalues);
 
   bool HasVolume() const;
   bool IsBuilt() const;

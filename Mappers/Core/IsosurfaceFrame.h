@@ -148,7 +148,8 @@ struct IsosurfaceSceneStats
   ///@{
   /// The brick pool (IsosurfaceScene::SetBrickPool()): its slots (0: none, the bricks drawn as
   /// their own pyramids), and the pyramids the last build of a bricked volume built (1 with the
-  /// pool, one per active brick without).
+  /// pool; without, one per active brick less those kept: a brick that the same of the old and
+  /// the new isovalues cross keeps its pyramid, whose counts they do not change).
   std::uint64_t PoolSlots = 0;
   std::uint64_t BrickPyramidBuilds = 0;
   ///@}

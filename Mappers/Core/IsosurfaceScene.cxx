@@ -51,6 +51,20 @@ std::string Megabytes(std::uint64_t bytes)
   return text.str();
 }
 
+// The isovalues of `values` that cross `range` (min < iso <= max), in order.
+std::vector<double> Crossing(const BrickRange& range, const std::vector<double>& values)
+{
+  std::vector<double> crossing;
+  for (const double v : values)
+  {
+    if (range.Min < v && v <= range.Max)
+    {
+      crossing.push_back(v);
+    }
+  }
+  return crossing;
+}
+
 // "2x", "1.5x": a ratio as the reasons say it.
 std::string RatioText(double ratio)
 {
@@ -145,6 +159,8 @@ struct IsosurfaceScene::Internals
   std::vector<BrickRange> Ranges;
   BrickResidency Residency;
   std::unordered_map<std::int64_t, std::unique_ptr<HistoPyramidGL>> Bricks;
+  // The isovalues of each brick's pyramid, the last build's or those adopted since.
+  std::unordered_map<std::int64_t, std::vector<double>> BrickValues;
   std::vector<std::int64_t> Active;
 
   // The brick pool (SetBrickPool()): the resident bricks in the slots of one
@@ -219,6 +235,7 @@ struct IsosurfaceScene::Internals
       brick.second->Release();
     }
     this->Bricks.clear();
+    this->BrickValues.clear();
     this->Residency.Clear();
   }
   void ReleaseBricks()
@@ -236,6 +253,8 @@ struct IsosurfaceScene::Internals
   }
   bool AdoptBricks(const VolumeDescription& volume, const std::string& why, std::string& error);
   bool UpdateBricks(const std::vector<double>& values, std::string& error);
+  bool SendBrick(std::int64_t brick, const int extent[6], const int points[3],
+    std::vector<unsigned char>& staging, HistoPyramidGL* pyramid, int slot, std::string& error);
   bool UpdatePool(const std::vector<std::int64_t>& active, const std::vector<double>& values,
     bool& held, std::string& error);
   bool ChoosePoolSlots(std::size_t count, int side, int slots[3], std::uint64_t& bytes) const;
@@ -528,76 +547,131 @@ bool IsosurfaceScene::Internals::UpdateBricks(const std::vector<double>& values,
   {
     this->Residency.Touch(brick);
   }
-  const int bytesPerValue = ScalarTypeSize(this->Volume.Type);
-  std::vector<unsigned char> values3d;
-  for (const std::int64_t brick : active)
-  {
-    if (this->Residency.IsResident(brick))
-    {
-      continue;
-    }
-    std::vector<std::int64_t> evicted;
-    if (!this->Residency.MakeResident(brick, this->BrickBytes(brick), evicted))
-    {
-      error = "a brick of " + std::to_string(this->Grid.GetBrickPoints()) +
-        " points exceeds the GPU budget of " + Megabytes(this->GetBudget());
-      return false;
-    }
-    for (const std::int64_t gone : evicted)
-    {
-      const auto found = this->Bricks.find(gone);
-      if (found != this->Bricks.end())
-      {
-        found->second->Release();
-        this->Bricks.erase(found);
-      }
-    }
-    int extent[6], points[3];
-    this->BrickTexture(brick, extent, points);
-    try
-    {
-      values3d.resize(BrickGrid::ExtentPoints(extent) * bytesPerValue);
-    }
-    catch (const std::bad_alloc&)
-    {
-      this->Residency.Evict(brick);
-      error = "memory ran out while copying a brick for the GPU upload";
-      return false;
-    }
-    CopyBrick(this->Grid, brick, extent, this->Volume.Data, bytesPerValue, values3d.data());
-    std::unique_ptr<HistoPyramidGL> pyramid(new HistoPyramidGL(this->GL));
-    pyramid->ShareProgramsWith(*this->Pyramid);
-    if (!pyramid->UploadVolume(this->Volume.Type, values3d.data(), points, this->Parallel, error))
-    {
-      this->Residency.Evict(brick);
-      return false;
-    }
-    // Only the cells whose first corner the brick owns count.
-    int owned[6];
-    this->Grid.OwnedPoints(brick, owned);
-    const int first[3] = { owned[0] - extent[0], owned[2] - extent[2], owned[4] - extent[4] };
-    const int end[3] = { owned[1] - extent[0] + 1, owned[3] - extent[2] + 1,
-      owned[5] - extent[4] + 1 };
-    pyramid->SetOwnedCells(first, end);
-    this->Bricks[brick] = std::move(pyramid);
-    ++stats.BrickUploads;
-  }
-  stats.ResidentBricks = this->Residency.GetNumberOfResidentBricks();
+  // Each brick's passes are queued as soon as it is there, and the totals
+  // read back after the last: one wait for the GPU per update, and the GPU
+  // builds a brick while the next one is cut out and sent.
   stats.BuildTilesDrawn = 0;
   stats.BuildTiles = 0;
+  std::vector<unsigned char> staging; // one brick's texture values at a time
+  for (const std::int64_t brick : active)
+  {
+    if (!this->Residency.IsResident(brick))
+    {
+      std::vector<std::int64_t> evicted;
+      if (!this->Residency.MakeResident(brick, this->BrickBytes(brick), evicted))
+      {
+        error = "a brick of " + std::to_string(this->Grid.GetBrickPoints()) +
+          " points exceeds the GPU budget of " + Megabytes(this->GetBudget());
+        return false;
+      }
+      for (const std::int64_t gone : evicted)
+      {
+        const auto found = this->Bricks.find(gone);
+        if (found != this->Bricks.end())
+        {
+          found->second->Release();
+          this->Bricks.erase(found);
+        }
+        this->BrickValues.erase(gone);
+      }
+      std::unique_ptr<HistoPyramidGL> pyramid(new HistoPyramidGL(this->GL));
+      pyramid->ShareProgramsWith(*this->Pyramid);
+      int extent[6], points[3];
+      this->BrickTexture(brick, extent, points);
+      if (!this->SendBrick(brick, extent, points, staging, pyramid.get(), -1, error))
+      {
+        this->Residency.Evict(brick);
+        return false;
+      }
+      // Only the cells whose first corner the brick owns count.
+      int owned[6];
+      this->Grid.OwnedPoints(brick, owned);
+      const int first[3] = { owned[0] - extent[0], owned[2] - extent[2], owned[4] - extent[4] };
+      const int end[3] = { owned[1] - extent[0] + 1, owned[3] - extent[2] + 1,
+        owned[5] - extent[4] + 1 };
+      pyramid->SetOwnedCells(first, end);
+      this->Bricks[brick] = std::move(pyramid);
+      ++stats.BrickUploads;
+    }
+    // A brick whose pyramid the same of the old and the new isovalues cross
+    // keeps it (a value outside the brick's range crosses none of its cells,
+    // so every cell counts as it did): a change of one of several surfaces
+    // builds only the bricks it touches. With one isovalue, as in a sweep,
+    // a brick the new one crosses was crossed by another or by none: built.
+    HistoPyramidGL& pyramid = *this->Bricks.at(brick);
+    std::vector<double>& builtFor = this->BrickValues[brick];
+    const BrickRange& range = this->Ranges[static_cast<std::size_t>(brick)];
+    if (pyramid.IsBuilt() && Crossing(range, builtFor) == Crossing(range, values) &&
+      pyramid.AdoptIsovalues(values))
+    {
+      builtFor = values;
+      continue;
+    }
+    builtFor.clear(); // until its build is read back
+    if (!pyramid.BuildPasses(values, error))
+    {
+      return false;
+    }
+  }
+  stats.ResidentBricks = this->Residency.GetNumberOfResidentBricks();
   for (const std::int64_t brick : active)
   {
     HistoPyramidGL& pyramid = *this->Bricks.at(brick);
-    if (!pyramid.Build(values, error))
+    std::vector<double>& builtFor = this->BrickValues[brick];
+    if (builtFor.empty())
     {
-      return false;
+      if (!pyramid.FinishBuild(error))
+      {
+        return false;
+      }
+      builtFor = values;
+      ++stats.BrickPyramidBuilds;
+      stats.BuildTilesDrawn += pyramid.GetLastTilesDrawn();
     }
-    stats.BuildTilesDrawn += pyramid.GetLastTilesDrawn();
     stats.BuildTiles += pyramid.GetNumberOfTiles();
-    ++stats.BrickPyramidBuilds;
   }
   this->Active = active;
   return true;
+}
+
+// A brick's texture values (the points of `extent`, with their apron) cut
+// out of the host's volume into `staging` and sent: as `pyramid`'s volume,
+// or into the pool's slot `slot` where `pyramid` is null. Rows go padded to
+// whole texels in the one copy that cuts them out (PackVolumeBox()); double
+// values are copied, then converted and padded by the upload.
+bool IsosurfaceScene::Internals::SendBrick(std::int64_t brick, const int extent[6],
+  const int points[3], std::vector<unsigned char>& staging, HistoPyramidGL* pyramid, int slot,
+  std::string& error)
+{
+  const int bytesPerValue = ScalarTypeSize(this->Volume.Type);
+  const bool packed = this->Volume.Type != ScalarType::Float64;
+  try
+  {
+    if (packed)
+    {
+      PackVolumeBox(
+        this->Volume.Data, this->Volume.Dims, extent, bytesPerValue, this->Parallel, staging);
+    }
+    else
+    {
+      staging.resize(BrickGrid::ExtentPoints(extent) * bytesPerValue);
+      CopyBrick(this->Grid, brick, extent, this->Volume.Data, bytesPerValue, staging.data());
+    }
+  }
+  catch (const std::bad_alloc&)
+  {
+    error = "memory ran out while copying a brick for the GPU upload";
+    return false;
+  }
+  const int placement[3] = { extent[0], extent[2], extent[4] };
+  if (pyramid)
+  {
+    const ScalarType type = this->Volume.Type;
+    return packed ? pyramid->UploadPackedVolume(type, staging.data(), points, this->Parallel, error)
+                  : pyramid->UploadVolume(type, staging.data(), points, this->Parallel, error);
+  }
+  return packed ? this->Pool->UploadPackedSlot(slot, staging.data(), points, placement, error)
+                : this->Pool->UploadSlot(slot, staging.data(), points, placement, error);
 }
 
 // The slots per axis of a pool for `count` bricks of `side` points a side
@@ -763,8 +837,7 @@ bool IsosurfaceScene::Internals::UpdatePool(const std::vector<std::int64_t>& act
   {
     this->PoolResidency.Touch(brick);
   }
-  const int bytesPerValue = ScalarTypeSize(this->Volume.Type);
-  std::vector<unsigned char> values3d;
+  std::vector<unsigned char> staging; // one brick's texture values at a time
   for (const std::int64_t brick : active)
   {
     if (this->PoolResidency.IsResident(brick))
@@ -786,20 +859,8 @@ bool IsosurfaceScene::Internals::UpdatePool(const std::vector<std::int64_t>& act
     const int slot = static_cast<int>(free - this->PoolBrick.begin());
     int extent[6], points[3];
     this->BrickTexture(brick, extent, points);
-    try
-    {
-      values3d.resize(BrickGrid::ExtentPoints(extent) * bytesPerValue);
-    }
-    catch (const std::bad_alloc&)
-    {
-      this->PoolResidency.Evict(brick);
-      error = "memory ran out while copying a brick for the GPU upload";
-      return false;
-    }
-    CopyBrick(this->Grid, brick, extent, this->Volume.Data, bytesPerValue, values3d.data());
-    const int placement[3] = { extent[0], extent[2], extent[4] };
     if (free == this->PoolBrick.end() ||
-      !this->Pool->UploadSlot(slot, values3d.data(), points, placement, error))
+      !this->SendBrick(brick, extent, points, staging, nullptr, slot, error))
     {
       this->PoolResidency.Evict(brick);
       error = error.empty() ? "the brick pool has no free slot" : error;

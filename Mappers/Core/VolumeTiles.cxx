@@ -12,8 +12,8 @@ namespace
 // out[2 t] the least and out[2 t + 1] the greatest point value of tile t's
 // real cells, as R (every value of T is exact in it).
 template<typename T, typename R>
-void ComputeTileRanges(const T* data, const int points[3], const PyramidLayout& layout,
-  const GLParallelFor& parallel, std::vector<R>& out)
+void ComputeTileRanges(const T* data, const int points[3], std::size_t rowValues,
+  const PyramidLayout& layout, const GLParallelFor& parallel, std::vector<R>& out)
 {
   const auto tiles = layout.TileCounts();
   const auto factor = layout.Factor(1);
@@ -50,7 +50,7 @@ void ComputeTileRanges(const T* data, const int points[3], const PyramidLayout& 
         {
           for (int y = 0; y < points[1]; ++y)
           {
-            const T* row = data + (static_cast<std::size_t>(z) * points[1] + y) * points[0];
+            const T* row = data + (static_cast<std::size_t>(z) * points[1] + y) * rowValues;
             // Each tile's points of this row: x in [tx span, min((tx + 1) span, cells)].
             for (int tx = 0; tx < tiles[0]; ++tx)
             {
@@ -188,18 +188,34 @@ int PackedVolumeWidth(int pointsX)
 std::vector<unsigned char> PackVolumeRows(
   const void* data, const int points[3], int bytesPerValue, const GLParallelFor& parallel)
 {
+  const int whole[6] = { 0, points[0] - 1, 0, points[1] - 1, 0, points[2] - 1 };
+  std::vector<unsigned char> packed;
+  PackVolumeBox(data, points, whole, bytesPerValue, parallel, packed);
+  return packed;
+}
+
+void PackVolumeBox(const void* volume, const int volumePoints[3], const int extent[6],
+  int bytesPerValue, const GLParallelFor& parallel, std::vector<unsigned char>& packed)
+{
+  const int points[3] = { extent[1] - extent[0] + 1, extent[3] - extent[2] + 1,
+    extent[5] - extent[4] + 1 };
   const std::size_t inRow = static_cast<std::size_t>(points[0]) * bytesPerValue;
   const std::size_t outRow =
     static_cast<std::size_t>(4 * PackedVolumeWidth(points[0])) * bytesPerValue;
   const std::int64_t rows = static_cast<std::int64_t>(points[1]) * points[2];
-  std::vector<unsigned char> packed(outRow * static_cast<std::size_t>(rows));
-  const unsigned char* in = static_cast<const unsigned char*>(data);
+  packed.resize(outRow * static_cast<std::size_t>(rows));
+  const unsigned char* in = static_cast<const unsigned char*>(volume);
   SerialIfEmpty(parallel)(0, rows,
     [&](std::int64_t begin, std::int64_t end)
     {
       for (std::int64_t r = begin; r < end; ++r)
       {
-        const unsigned char* from = in + inRow * r;
+        // Row r of the box: its y and z in the volume.
+        const std::int64_t y = extent[2] + r % points[1];
+        const std::int64_t z = extent[4] + r / points[1];
+        const unsigned char* from = in +
+          ((z * volumePoints[1] + y) * volumePoints[0] + extent[0]) *
+            static_cast<std::int64_t>(bytesPerValue);
         unsigned char* to = packed.data() + outRow * r;
         std::copy(from, from + inRow, to);
         for (std::size_t pad = inRow; pad < outRow; pad += bytesPerValue)
@@ -208,14 +224,20 @@ std::vector<unsigned char> PackVolumeRows(
         }
       }
     });
-  return packed;
 }
 
 //------------------------------------------------------------------------------
 void VolumeTiles::Compute(ScalarType type, const void* data, const int points[3],
   const PyramidLayout& layout, const GLParallelFor& parallel)
 {
+  this->Compute(type, data, points, points[0], layout, parallel);
+}
+
+void VolumeTiles::Compute(ScalarType type, const void* data, const int points[3], int rowValues,
+  const PyramidLayout& layout, const GLParallelFor& parallel)
+{
   this->Clear();
+  const std::size_t row = static_cast<std::size_t>(std::max(rowValues, points[0]));
   const GLParallelFor run = SerialIfEmpty(parallel);
   const ScalarType rangeType = type == ScalarType::Float64 ? ScalarType::Float32 : type;
   VisitScalarType(rangeType,
@@ -226,13 +248,13 @@ void VolumeTiles::Compute(ScalarType type, const void* data, const int points[3]
       switch (ValueKindOf(type))
       {
         case ValueKind::Signed:
-          ComputeTileRanges(typed, points, layout, run, this->IntRanges);
+          ComputeTileRanges(typed, points, row, layout, run, this->IntRanges);
           break;
         case ValueKind::Unsigned:
-          ComputeTileRanges(typed, points, layout, run, this->UIntRanges);
+          ComputeTileRanges(typed, points, row, layout, run, this->UIntRanges);
           break;
         case ValueKind::Float:
-          ComputeTileRanges(typed, points, layout, run, this->FloatRanges);
+          ComputeTileRanges(typed, points, row, layout, run, this->FloatRanges);
           break;
       }
     });

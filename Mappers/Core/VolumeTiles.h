@@ -59,6 +59,16 @@ int PackedVolumeWidth(int pointsX);
 std::vector<unsigned char> PackVolumeRows(
   const void* data, const int points[3], int bytesPerValue, const GLParallelFor& parallel);
 
+/**
+ * PackVolumeRows() of the box `extent` (inclusive point indices per axis,
+ * inside the volume) of a volume of `volumePoints` points, into `packed`
+ * (resized; storage it already has is reused, so that a caller packing one
+ * brick after another allocates once): a brick's texture is cut out of the
+ * host's volume and padded in one copy instead of two.
+ */
+void PackVolumeBox(const void* volume, const int volumePoints[3], const int extent[6],
+  int bytesPerValue, const GLParallelFor& parallel, std::vector<unsigned char>& packed);
+
 /// The value range of every level-1 tile of a volume, and the active ones' rectangles.
 class VolumeTiles
 {
@@ -72,6 +82,10 @@ public:
    */
   void Compute(ScalarType type, const void* data, const int points[3], const PyramidLayout& layout,
     const GLParallelFor& parallel);
+  /// Compute() of values whose rows hold `rowValues` (>= points[0]) values each, of which the
+  /// first points[0] are the row's (PackVolumeRows()' rows: the texture's own copy).
+  void Compute(ScalarType type, const void* data, const int points[3], int rowValues,
+    const PyramidLayout& layout, const GLParallelFor& parallel);
 
   void Clear();
 

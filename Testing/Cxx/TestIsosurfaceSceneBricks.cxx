@@ -9,9 +9,11 @@
 // clipping plane, a parallel view, a sample distance of 2); float data with NaN values counts the
 // same; isovalue changes evict least recently used bricks within the budget and still count
 // exactly; active bricks over the budget fail with that reason; the limits set back to the defaults
-// give one texture again. The brick pool (IsosurfaceScene::SetBrickPool(), on by default) is
-// checked the same way on a phantom whose active bricks it holds (one pyramid built per isovalue
-// change for all of them, one pass drawn), with slots reused across isovalue changes within a
+// give one texture again; a change of one of two surfaces builds only the bricks it touches
+// (each brick its own pyramid), the others keeping theirs. The brick pool
+// (IsosurfaceScene::SetBrickPool(), on by default) is checked the same way on a phantom whose
+// active bricks it holds (one pyramid built per isovalue change for all of them, one pass
+// drawn), with slots reused across isovalue changes within a
 // budget; where it cannot hold them (a limit of 32) and with the pool off, the bricks' own
 // pyramids, and on a long thin volume whose bricks fill a fraction of their slots (a pool there
 // would take over IsosurfaceScene::MaximumPoolMemoryRatio the GPU memory of the bricks' own
@@ -233,6 +235,72 @@ void RunCases(const std::shared_ptr<const GLApi>& gl, Target& target, const std:
     Check(s.FirstHit == dense.GetStats().FirstHit,
       name + ": the bricks take the first-hit pass where one texture does (one, shared)");
     CompareImages(a, b, name);
+  }
+  dense.Release();
+  bricked.Release();
+}
+
+// One of two surfaces changed, with each brick its own pyramid (the pool off): a brick that the
+// same of the old and the new isovalues cross keeps its pyramid (the unchanged skin's alone), the
+// others are built; the counts stay the brute force's and the images the one texture's at every
+// change (bone changed, skin changed, bone changed back).
+void CheckKeptPyramids(const std::shared_ptr<const GLApi>& gl, Target& target,
+  const std::vector<std::int16_t>& values, const int dims[3])
+{
+  VolumeDescription volume;
+  volume.Type = ScalarType::Int16;
+  volume.Data = values.data();
+  std::copy(dims, dims + 3, volume.Dims);
+  volume.Stamp = 1;
+  IsosurfaceScene dense(nullptr), bricked(nullptr);
+  dense.SetContext(gl);
+  bricked.SetContext(gl);
+  bricked.SetMaxTextureSize(32);
+  bricked.SetGPUMemoryBudget(3u << 20);
+  bricked.SetBrickPool(false);
+  std::string error;
+  Check(dense.SetVolume(volume, error) && bricked.SetVolume(volume, error) && bricked.IsBricked(),
+    "kept pyramids: the volume as bricks (" + error + ")");
+  const IsosurfaceFrame frame = View(dims, 40, 25, false);
+  const double bones[] = { 400, 600, 600, 400 };
+  const double skins[] = { -500, -500, -450, -450 };
+  for (int step = 0; step < 4; ++step)
+  {
+    const std::vector<IsosurfaceLook> looks = { Look(skins[step], 0.93f, 0.75f, 0.62f, 1.0f),
+      Look(bones[step], 0.95f, 0.95f, 0.9f, 1.0f) };
+    dense.SetSurfaces(looks);
+    bricked.SetSurfaces(looks);
+    std::string denseError, brickError;
+    const std::vector<unsigned char> a = target.Draw(dense, frame, denseError);
+    const std::vector<unsigned char> b = target.Draw(bricked, frame, brickError);
+    const std::string name = "kept pyramids, skin " + std::to_string(int(skins[step])) +
+      ", bone " + std::to_string(int(bones[step]));
+    Check(!a.empty() && !b.empty(), name + ": drawn (" + denseError + brickError + ")");
+    const std::uint64_t expected =
+      BruteForceCount(values, dims, { skins[step], bones[step] });
+    const IsosurfaceSceneStats& s = bricked.GetStats();
+    std::printf("%s: %llu primitives (brute force %llu), %llu active bricks, %llu pyramids "
+                "built\n",
+      name.c_str(), static_cast<unsigned long long>(bricked.GetActivePairs()),
+      static_cast<unsigned long long>(expected), static_cast<unsigned long long>(s.ActiveBricks),
+      static_cast<unsigned long long>(s.BrickPyramidBuilds));
+    Check(bricked.GetActivePairs() == expected && dense.GetActivePairs() == expected,
+      name + ": the brute-force count");
+    if (step == 0 || step == 2)
+    {
+      // The first build, and the skin changed: the skin crosses every active brick here.
+      Check(s.PoolSlots == 0 && s.BrickPyramidBuilds == s.ActiveBricks,
+        name + ": every active brick built");
+    }
+    else
+    {
+      Check(s.BrickPyramidBuilds > 0 && s.BrickPyramidBuilds < s.ActiveBricks,
+        name + ": the bricks that only the unchanged skin crosses keep their pyramids");
+    }
+    if (!a.empty() && !b.empty())
+    {
+      CompareImages(a, b, name);
+    }
   }
   dense.Release();
   bricked.Release();
@@ -484,6 +552,7 @@ int main(int argc, char* argv[])
     off.Pool = false;
     RunCases(gl, target, phantom, dims, { cases[1], cases[2] }, "int16, no pool", off);
   }
+  CheckKeptPyramids(gl, target, phantom, dims);
   // The pool holding every active brick: 27 bricks of 56 points (a 24 MB budget allows no
   // larger) in 64-point slots of a pool within a texture limit of 128.
   const int large[3] = { 150, 130, 120 };

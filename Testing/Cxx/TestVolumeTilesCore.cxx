@@ -2,6 +2,8 @@
 // Unit test of the GPU pyramid's CPU-side volume work (Mappers/Core/VolumeTiles),
 // without VTK or OpenGL:
 //  - PackVolumeRows() keeps every value and pads each row with its last point;
+//    PackVolumeBox() packs a box of a volume as its copy would be packed, and
+//    the tiles of packed rows (Compute() with their row length) are the values';
 //  - a level-1 tile is active for a set of isovalues exactly when one of its
 //    cells crosses one (a superset where the volume has NaN values, whose
 //    cells cross nothing), for several scalar types and shapes that fill no
@@ -52,6 +54,54 @@ void CheckPacking(const std::vector<T>& values, const int points[3])
     }
   }
   Check(ok, Shape(points) + ": packed rows keep every value and repeat a row's last point");
+
+  // A box of the volume (a brick with its apron) packed in one copy is the
+  // box copied out and packed; the tiles of the packed rows are those of the box.
+  const int extent[6] = { points[0] / 3, points[0] - 1, 0, points[1] / 2, points[2] > 2 ? 1 : 0,
+    points[2] - 1 };
+  const int boxPoints[3] = { extent[1] - extent[0] + 1, extent[3] - extent[2] + 1,
+    extent[5] - extent[4] + 1 };
+  std::vector<T> box;
+  for (int z = extent[4]; z <= extent[5]; ++z)
+    for (int y = extent[2]; y <= extent[3]; ++y)
+      for (int x = extent[0]; x <= extent[1]; ++x)
+      {
+        box.push_back(values[(static_cast<std::size_t>(z) * points[1] + y) * points[0] + x]);
+      }
+  std::vector<unsigned char> boxPacked(3, 0xff); // storage there is reused, not appended to
+  mediso::PackVolumeBox(values.data(), points, extent, static_cast<int>(sizeof(T)),
+    [](std::int64_t begin, std::int64_t end,
+      const std::function<void(std::int64_t, std::int64_t)>& body)
+    {
+      for (std::int64_t b = begin; b < end; b += 5)
+      {
+        body(b, std::min(end, b + 5));
+      }
+    },
+    boxPacked);
+  Check(boxPacked == mediso::PackVolumeRows(box.data(), boxPoints, static_cast<int>(sizeof(T)), {}),
+    Shape(points) + ": PackVolumeBox() of a " + Shape(boxPoints) +
+      " box is the box copied out, then packed");
+  if (boxPoints[0] >= 2 && boxPoints[1] >= 2 && boxPoints[2] >= 2)
+  {
+    const int cells[3] = { boxPoints[0] - 1, boxPoints[1] - 1, boxPoints[2] - 1 };
+    const PyramidLayout layout(cells);
+    const mediso::ScalarType type = mediso::ScalarTypeOf<T>();
+    mediso::VolumeTiles fromBox, fromPacked;
+    fromBox.Compute(type, box.data(), boxPoints, layout, {});
+    fromPacked.Compute(
+      type, boxPacked.data(), boxPoints, 4 * mediso::PackedVolumeWidth(boxPoints[0]), layout, {});
+    bool same = fromBox.GetNumberOfTiles() == fromPacked.GetNumberOfTiles();
+    for (const double iso : { -500.0, 0.0, 100.0, 0.25 })
+    {
+      const mediso::IsoThresholds t = mediso::MakeIsoThresholds(type, { iso });
+      for (std::size_t i = 0; same && i < fromBox.GetNumberOfTiles(); ++i)
+      {
+        same = fromBox.IsActive(t, i) == fromPacked.IsActive(t, i);
+      }
+    }
+    Check(same, Shape(points) + ": the tiles of packed rows are those of the values themselves");
+  }
 }
 
 // Every cell's crossing, in double precision (a NaN corner crosses nothing).
