@@ -311,13 +311,15 @@ def long_task_lines(results):
                 near = min(traced, key=lambda t: abs(t["ms"] - task["ms"]) + abs(t["start"] - task["start"]),
                            default=None) if traced else None
                 what = "; ".join("%s %.0f ms" % (k, v) for k, v in near["self"][:4]) if near else "-"
-                rows.append("| %s | %s | %s | %.0f | %.0f | %s | %s |" % (
-                    name, run["path"], run["page"], task["ms"], task["start"] - run["phases"]["window"],
+                cpu = "%.0f" % near["cpuMs"] if near and near.get("cpuMs") is not None else "-"
+                rows.append("| %s | %s | %s | %.0f | %s | %.0f | %s | %s |" % (
+                    name, run["path"], run["page"], task["ms"], cpu, task["start"] - run["phases"]["window"],
                     phase(run, task["start"]), what))
     if not rows:
         return lines[:-1] + ["none."]
-    return lines + ["| input | path | page | task ms | at ms (from the window's start) | phase | where its time "
-                    "went (self time, with --trace) |", "|---|---|---|---:|---:|---|---|"] + rows
+    return lines + ["| input | path | page | task ms | its CPU time ms (with --trace; far less: it waited for a "
+                    "core) | at ms (from the window's start) | phase | where its time went (self time, with "
+                    "--trace) |", "|---|---|---|---:|---:|---:|---|---|"] + rows
 
 
 def main_interactive(args, argv):

@@ -131,15 +131,17 @@ export function explain(events, anchor, minMs = 50) {
       const b = (open.get(key + e.name) || []).pop();
       if (b) {
         byThread.has(key) || byThread.set(key, []);
-        byThread.get(key).push({ ...b, args: { ...b.args, ...e.args }, ph: "X", dur: e.ts - b.ts, end: e.ts });
+        byThread.get(key).push({ ...b, args: { ...b.args, ...e.args }, ph: "X", dur: e.ts - b.ts, end: e.ts,
+          tdur: b.tts !== undefined && e.tts !== undefined ? e.tts - b.tts : undefined });
       }
     }
   }
   const out = [];
   for (const [thread, list] of byThread) {
     list.sort((a, b) => a.ts - b.ts || b.dur - a.dur);
+    // the outermost of nested task events (the scheduler's RunTask inside its controller's)
     const tasks = list.filter((e) => (e.name === "ThreadControllerImpl::RunTask" || e.name === "RunTask") &&
-      e.dur >= minMs * 1000);
+      e.dur >= minMs * 1000).filter((e, i, all) => !all.some((o) => o !== e && o.ts <= e.ts && o.end >= e.end));
     for (const task of tasks) {
       // nested: the task's own events in time order; a stack gives each its parent
       const inside = list.filter((e) => e !== task && e.ts >= task.ts && e.end <= task.end);
@@ -170,7 +172,10 @@ export function explain(events, anchor, minMs = 50) {
         const ms = Math.max(0, e.dur - e.childMs) / 1000;
         self.set(label(e), (self.get(label(e)) || 0) + ms);
       }
+      // cpuMs: the thread's own time in the task (the trace's thread clock): a task far longer
+      // than its CPU time waited for a core (a loaded machine), not for the page's work
       out.push({ thread: threadNames.get(thread) + " " + thread, ms: task.dur / 1000, start: toPage(task.ts), top,
+        cpuMs: task.tdur !== undefined ? Math.round(task.tdur / 100) / 10 : null,
         self: [...self].sort((a, b) => b[1] - a[1]).slice(0, 8).map(([k, v]) => [k, Math.round(v * 10) / 10]),
         // the task's time outside any event of these categories (the scheduler's own, or work
         // these categories do not name)
