@@ -110,6 +110,9 @@ def parse_args(argv):
                         "changed again, then a drag of its own: the first-drag table)")
     p.add_argument("--stills", type=int, default=0,
                    help="--interactive: still frames after the drag (their median beside the drag's)")
+    p.add_argument("--trace", action="store_true",
+                   help="--interactive: Chromium's trace over the measured window names what ran in "
+                        "each main-thread task over 50 ms (Testing/Web/longtasks.mjs)")
     p.add_argument("--stream", action="store_true",
                    help="streaming against the whole level (issue 31): first image, full level, bytes")
     p.add_argument("--networks", default="30/40,loopback",
@@ -280,7 +283,7 @@ def run_interactive(args, name, before_root):
         config = {"pages": pages, "paths": args.paths.split(","),
                   "dragAfterMs": [int(v) for v in args.drag_after_ms.split(",")],
                   "size": [int(v) for v in args.size.split("x")], "isovalues": isovalues,
-                  "moves": args.moves, "stills": args.stills, "moveMs": args.move_ms}
+                  "moves": args.moves, "stills": args.stills, "moveMs": args.move_ms, "trace": args.trace}
         if args.scene == "skin-bone":
             config["surfaces"] = [{"value": -500, "opacity": 0.3, "color": [0.93, 0.75, 0.62]},
                                   {"value": 400}]
@@ -335,6 +338,40 @@ def before_tree(args):
     return before_root
 
 
+def long_task_lines(results):
+    """Each main-thread task over 50 ms in the measured window (issue 30's budget), with the phase it
+    began in and, with --trace, what ran in it (Chromium's trace: the largest self times)."""
+    def phase(run, start):
+        p = run.get("phases") or {}
+        for key, text in (("release", "after the drag (its refinement)"), ("drag", "the drag"),
+                          ("scene", "the drag's scene set and refined"), ("window", "the timed changes")):
+            if key in p and start >= p[key]:
+                return text
+        return "-"
+    lines = ["", "Main-thread tasks over 50 ms (PerformanceObserver `longtask`) in the measured window: from "
+             "after the load and a first change (1 s later) through the timed changes, the drag's scene and "
+             "its refinement, the drag, and its refinement (until settled, and 500 ms):", ""]
+    rows = []
+    for name, r in results.items():
+        for run in r["runs"]:
+            traced = run.get("traced") or []
+            for task in run.get("longTasks") or []:
+                if not isinstance(task, dict):
+                    continue
+                near = min(traced, key=lambda t: abs(t["ms"] - task["ms"]) + abs(t["start"] - task["start"]),
+                           default=None) if traced else None
+                what = "; ".join("%s %.0f ms" % (k, v) for k, v in near["self"][:4]) if near else "-"
+                cpu = "%.0f" % near["cpuMs"] if near and near.get("cpuMs") is not None else "-"
+                rows.append("| %s | %s | %s | %.0f | %s | %.0f | %s | %s |" % (
+                    name, run["path"], run["page"], task["ms"], cpu, task["start"] - run["phases"]["window"],
+                    phase(run, task["start"]), what))
+    if not rows:
+        return lines[:-1] + ["none."]
+    return lines + ["| input | path | page | task ms | its CPU time ms (with --trace; far less: it waited for a "
+                    "core) | at ms (from the window's start) | phase | where its time went (self time, with "
+                    "--trace) |", "|---|---|---|---:|---:|---:|---|---|"] + rows
+
+
 def main_interactive(args, argv):
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     load_before = load_average()
@@ -351,8 +388,9 @@ def main_interactive(args, argv):
                  started, time.perf_counter() - t0, load_before, load_average()),
              "- Machine: nproc %d (%s); Chromium headless, SwiftShader; canvas %s" % (
                  os.cpu_count() or 0, cpu_model(), args.size),
-             ("- before: `%s`'s page (the viewer on the main thread); after: this tree's (the viewer in a "
-              "worker, frame budget %d ms); the same WebAssembly module" % (args.before, budget)) if before_root else
+             ("- before: `%s`'s page (the viewer on the main thread, where that page has no worker); after: "
+              "this tree's (the viewer in a worker, frame budget %d ms); the same WebAssembly module"
+              % (args.before, budget)) if before_root else
              "- after: this tree's page (the viewer in a worker, frame budget %d ms) only (`--before none`)"
              % budget, "",
              "| input | path | page | first visible answer ms, median (max) | full level ms, median | "
@@ -393,6 +431,7 @@ def main_interactive(args, argv):
     lines += ["", "The frame-time model's median error on the drag frames it chose (after): " +
               (", ".join(errors) or "none recorded") + "."]
     lines += first_drag_lines(results)
+    lines += long_task_lines(results)
     write_report(lines, args.out)
     return 0
 

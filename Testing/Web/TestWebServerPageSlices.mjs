@@ -221,6 +221,30 @@ const browser = await launchBrowser();
     [...select.options].find((o) => o.textContent.startsWith("Full range")).value));
   const full = (await page.evaluate(() => window.mediso.slices()))[0].window;
   checks.check(Math.abs(full.width - range) < 1e-6 * range, "the Full range preset: W " + full.width.toFixed(3));
+  // The view keeps its slice's picture while the values, the slice and the window stay (slices.js,
+  // slicePicture): another window redraws it, and the first window again gives the first pixels
+  // (above the window's own line of text, at the bottom, which changes whether the picture does or not).
+  const axialPixels = () => page.evaluate(() => {
+    const canvas = document.querySelector('#slices .slice[data-view="axial"] canvas');
+    const above = canvas.height - Math.ceil(20 * canvas.width / canvas.clientWidth);
+    const data = canvas.getContext("2d").getImageData(0, 0, canvas.width, above).data;
+    let hash = 0;
+    for (let i = 0; i < data.length; ++i) {
+      hash = (Math.imul(hash, 31) + data[i]) | 0;
+    }
+    return hash;
+  });
+  const fullPixels = await axialPixels();
+  const otherChoice = await page.$eval(axialWindow, (select) =>
+    [...select.options].find((o) => !o.textContent.startsWith("Full range")).value);
+  await page.selectOption(axialWindow, otherChoice);
+  const otherPixels = await axialPixels();
+  await page.selectOption(axialWindow, await page.$eval(axialWindow, (select) =>
+    [...select.options].find((o) => o.textContent.startsWith("Full range")).value));
+  const againPixels = await axialPixels();
+  checks.check(otherPixels !== fullPixels && againPixels === fullPixels,
+    "the axial picture redrawn for another window (" + (otherPixels !== fullPixels) + ") and the same again " +
+    "for the Full range window (" + (againPixels === fullPixels) + ")");
 
   // A click on the sphere in the 3D view (anterior view) puts the crosshair on its front.
   const v = await page.evaluate(() => window.mediso.getView());

@@ -12,7 +12,10 @@
 //          moveMs (optional: the wait after each mouse move, 30 by default),
 //          dragAfterMs (optional: [ms, ...]: the idle wait between the scene's settled frame and
 //          the drag, [0] by default; each further wait: the scene changed again (each value 10
-//          up), settled, that long idle, and the same drag, run.laterDrags)}
+//          up), settled, that long idle, and the same drag, run.laterDrags),
+//          trace (optional: Chromium's trace over the measured window, each main-thread task over
+//          50 ms named in run.traced: longtasks.mjs)}
+import { explain, longTasks, resetLongTasks, traceStart, traceStop, watchLongTasks } from "./longtasks.mjs";
 import { frameMark, framesSince, launch, turnStills } from "./page.mjs";
 import { readFileSync, writeFileSync } from "node:fs";
 
@@ -48,6 +51,10 @@ async function dragOnce(page, path, run) {
   }
   await page.mouse.up();
   const dragSeconds = (Date.now() - t0) / 1000;
+  if (run.phases) {
+    run.phases.drag = movedAt;
+    run.phases.release = await page.evaluate(() => performance.now());
+  }
   await page.waitForFunction(() => window.mediso.stats().settled !== false, null, { timeout: 300000 });
   await page.waitForTimeout(500);
   const frames = await framesSince(page, before);
@@ -87,14 +94,7 @@ for (const path of config.paths) {
   for (const [name, url] of Object.entries(config.pages)) {
     const page = await browser.newPage({ viewport: { width: config.size[0] + 420, height: config.size[1] + 100 } });
     page.on("pageerror", (e) => console.log(name + " pageerror: " + e.message));
-    await page.addInitScript(() => {
-      window.longTasks = [];
-      new PerformanceObserver((list) => {
-        for (const e of list.getEntries()) {
-          window.longTasks.push(e.duration);
-        }
-      }).observe({ type: "longtask", buffered: true });
-    });
+    await watchLongTasks(page);
     await page.goto(url + "&path=" + path + "&size=" + config.size.join("x"), { waitUntil: "commit" });
     await page.waitForFunction(() => window.mediso, null, { timeout: 300000 });
     await page.evaluate(() => window.mediso.ready);
@@ -103,13 +103,18 @@ for (const path of config.paths) {
     // the load's own tasks left out: a first change, a second's rest
     await page.evaluate((v) => window.mediso.setIsovalues([v]), config.isovalues[0]);
     await page.waitForTimeout(1000);
-    await page.evaluate(() => { window.longTasks = []; });
-    const run = { page: name, path, changes: [], drag: {} };
+    // the measured window: from here (the timed changes, the drag's scene, the drag, its
+    // refinement) to the long tasks' read below; with config.trace, Chromium's trace of it names
+    // what ran in each long task (longtasks.mjs)
+    const trace = config.trace && (await traceStart(page));
+    const anchor = await resetLongTasks(page);
+    const run = { page: name, path, changes: [], drag: {}, phases: { window: anchor } };
     for (const v of config.isovalues.slice(1)) {
       const s = await page.evaluate((value) => window.mediso.setIsovalues([value]), v);
       run.changes.push({ value: v, firstMs: s.lastChangeMs, fullMs: s.lastRefinedMs || s.lastChangeMs,
         level: s.cpuLevel, elements: path === "gpu" ? s.primitives : s.triangles });
     }
+    run.phases.scene = await page.evaluate(() => performance.now());
     if (config.surfaces) {
       // the drag's scene (issue 30's: skin 0.3 over bone), drawn at its full level first
       await page.evaluate((surfaces) => window.mediso.setSurfaces(surfaces), config.surfaces);
@@ -119,7 +124,12 @@ for (const path of config.paths) {
     await page.waitForTimeout(afterMs[0]);
     run.drag = await dragOnce(page, path, run);
     run.drag.afterMs = afterMs[0];
-    run.longestTaskMs = await page.evaluate(() => Math.max(0, ...window.longTasks));
+    run.longTasks = await longTasks(page);
+    run.phases.end = await page.evaluate(() => performance.now());
+    run.longestTaskMs = Math.max(0, ...run.longTasks.map((t) => t.ms));
+    if (trace) {
+      run.traced = explain(await traceStop(trace), anchor);
+    }
     if (config.stills) {
       // still frames of the same scene: the camera turned about its view-up by 2 degrees each,
       // every frame awaited at its full level (the frames' own times, as the drag's)

@@ -111,49 +111,62 @@ function sliceValues(view) {
 // crosses `iso`, their ends on the cell's edges by linear interpolation (as marching cubes puts
 // its vertices). Corners at or above the value are inside; a saddle (two opposite corners in) is
 // joined as the cell's centre, the mean of its corners, says. Returns [u0, v0, u1, v1, ...].
+// Nothing is allocated per cell: a 512-wide slice has a quarter of a million cells per isovalue,
+// and a small array per cell (its corners, each crossing) made the contours the larger part of a
+// slice view's redraw, a main-thread task after every change (docs/web.md, The worker).
 function marchingSquares(values, nu, nv, iso) {
   const out = [];
+  // the crossing on edge e (0: corners 0-1, 1: 1-2, 2: 2-3, 3: 3-0) of the cell at (pu, pv),
+  // corners counter-clockwise on the picture: 0 (u, v), 1 (u+1, v), 2 (u+1, v+1), 3 (u, v+1)
+  const at = (e, pu, pv, c0, c1, c2, c3) => {
+    switch (e) {
+      case 0:
+        out.push(pu + (iso - c0) / (c1 - c0), pv);
+        break;
+      case 1:
+        out.push(pu + 1, pv + (iso - c1) / (c2 - c1));
+        break;
+      case 2:
+        out.push(pu + 1 - (iso - c2) / (c3 - c2), pv + 1);
+        break;
+      default:
+        out.push(pu, pv + 1 - (iso - c3) / (c0 - c3));
+    }
+  };
   for (let pv = 0; pv + 1 < nv; ++pv) {
-    for (let pu = 0; pu + 1 < nu; ++pu) {
-      const o = pv * nu + pu;
-      // corners counter-clockwise on the picture: 0 (u, v), 1 (u+1, v), 2 (u+1, v+1), 3 (u, v+1)
-      const c = [values[o], values[o + 1], values[o + nu + 1], values[o + nu]];
-      if (!(c[0] === c[0] && c[1] === c[1] && c[2] === c[2] && c[3] === c[3])) {
+    for (let pu = 0, o = pv * nu; pu + 1 < nu; ++pu, ++o) {
+      const c0 = values[o], c1 = values[o + 1], c2 = values[o + nu + 1], c3 = values[o + nu];
+      if (!(c0 === c0 && c1 === c1 && c2 === c2 && c3 === c3)) {
         continue; // NaN: no surface through the cell
       }
-      const code = (c[0] >= iso) | ((c[1] >= iso) << 1) | ((c[2] >= iso) << 2) | ((c[3] >= iso) << 3);
+      const code = (c0 >= iso) | ((c1 >= iso) << 1) | ((c2 >= iso) << 2) | ((c3 >= iso) << 3);
       if (code === 0 || code === 15) {
         continue;
       }
-      // the crossing on edge e (0: corners 0-1, 1: 1-2, 2: 2-3, 3: 3-0)
-      const at = (e) => {
-        const a = e, b = (e + 1) & 3;
-        const t = (iso - c[a]) / (c[b] - c[a]);
-        const corner = [[0, 0], [1, 0], [1, 1], [0, 1]];
-        return [pu + corner[a][0] + t * (corner[b][0] - corner[a][0]),
-          pv + corner[a][1] + t * (corner[b][1] - corner[a][1])];
-      };
-      const segment = (e0, e1) => out.push(...at(e0), ...at(e1));
+      let e0 = -1, e1 = -1;
       switch (code) {
-        case 1: case 14: segment(3, 0); break;
-        case 2: case 13: segment(0, 1); break;
-        case 3: case 12: segment(3, 1); break;
-        case 4: case 11: segment(1, 2); break;
-        case 6: case 9: segment(0, 2); break;
-        case 7: case 8: segment(2, 3); break;
-        case 5: case 10: {
-          const centreIn = (c[0] + c[1] + c[2] + c[3]) / 4 >= iso;
+        case 1: case 14: e0 = 3; e1 = 0; break;
+        case 2: case 13: e0 = 0; e1 = 1; break;
+        case 3: case 12: e0 = 3; e1 = 1; break;
+        case 4: case 11: e0 = 1; e1 = 2; break;
+        case 6: case 9: e0 = 0; e1 = 2; break;
+        case 7: case 8: e0 = 2; e1 = 3; break;
+        default: { // 5, 10
+          const centreIn = (c0 + c1 + c2 + c3) / 4 >= iso;
           // 5: corners 0 and 2 in. Centre in: the two are joined, cut off corners 1 and 3.
           if ((code === 5) === centreIn) {
-            segment(0, 1);
-            segment(2, 3);
+            at(0, pu, pv, c0, c1, c2, c3);
+            at(1, pu, pv, c0, c1, c2, c3);
+            e0 = 2; e1 = 3;
           } else {
-            segment(3, 0);
-            segment(1, 2);
+            at(3, pu, pv, c0, c1, c2, c3);
+            at(0, pu, pv, c0, c1, c2, c3);
+            e0 = 1; e1 = 2;
           }
-          break;
         }
       }
+      at(e0, pu, pv, c0, c1, c2, c3);
+      at(e1, pu, pv, c0, c1, c2, c3);
     }
   }
   return out;
@@ -179,6 +192,38 @@ function css(color) {
   return "rgb(" + color.map((c) => Math.round(255 * c)).join(",") + ")";
 }
 
+/**
+ * The view's slice values (sliceValues) and its picture in `view.picture` at the view's window,
+ * kept while the values, the slice and the window stay (state.values is never written in place:
+ * a new level is a new array). A change of the surfaces, which redraws every view, then only
+ * draws their contours: the slice's copy and picture were most of a 512-wide view's redraw, a
+ * main-thread task after every change (docs/web.md, The worker).
+ */
+function slicePicture(view) {
+  const { n, u, v, su, sv } = view.axes;
+  const key = [view.index, n, u, v, su, sv].join();
+  let slice = view.slice;
+  if (!slice || slice.of !== state.values || slice.key !== key) {
+    slice = view.slice = { of: state.values, key, window: "", ...sliceValues(view) };
+  }
+  const { values, nu, nv } = slice;
+  const windowKey = view.window.level + "/" + view.window.width;
+  if (slice.window !== windowKey) {
+    const image = new ImageData(nu, nv);
+    const low = view.window.level - view.window.width / 2, perValue = 255 / view.window.width;
+    for (let i = 0; i < values.length; ++i) {
+      const grey = (values[i] - low) * perValue; // NaN draws black
+      image.data[4 * i] = image.data[4 * i + 1] = image.data[4 * i + 2] = grey;
+      image.data[4 * i + 3] = 255;
+    }
+    view.picture.width = nu;
+    view.picture.height = nv;
+    view.picture.getContext("2d").putImageData(image, 0, 0);
+    slice.window = windowKey;
+  }
+  return slice;
+}
+
 function drawView(view) {
   const canvas = view.canvas;
   const dpr = window.devicePixelRatio || 1;
@@ -195,17 +240,7 @@ function drawView(view) {
   g.setTransform(dpr, 0, 0, dpr, 0, 0);
   g.fillStyle = "#000";
   g.fillRect(0, 0, width, height);
-  const { values, nu, nv } = sliceValues(view);
-  const image = new ImageData(nu, nv);
-  const low = view.window.level - view.window.width / 2, perValue = 255 / view.window.width;
-  for (let i = 0; i < values.length; ++i) {
-    const grey = (values[i] - low) * perValue; // NaN draws black
-    image.data[4 * i] = image.data[4 * i + 1] = image.data[4 * i + 2] = grey;
-    image.data[4 * i + 3] = 255;
-  }
-  view.picture.width = nu;
-  view.picture.height = nv;
-  view.picture.getContext("2d").putImageData(image, 0, 0);
+  const { values, nu, nv } = slicePicture(view);
   const place = placement(view);
   g.imageSmoothingEnabled = false; // voxels as they are
   g.drawImage(view.picture, place.left, place.top, nu * place.du, nv * place.dv);
@@ -215,9 +250,10 @@ function drawView(view) {
   for (const { surface, segments } of view.contours) {
     g.strokeStyle = css(surface.color);
     g.beginPath();
+    const { left, top, du, dv } = place; // toCanvas, without an array per point
     for (let i = 0; i < segments.length; i += 4) {
-      g.moveTo(...toCanvas(place, segments[i], segments[i + 1]));
-      g.lineTo(...toCanvas(place, segments[i + 2], segments[i + 3]));
+      g.moveTo(left + (segments[i] + 0.5) * du, top + (segments[i + 1] + 0.5) * dv);
+      g.lineTo(left + (segments[i + 2] + 0.5) * du, top + (segments[i + 3] + 0.5) * dv);
     }
     g.stroke();
   }
