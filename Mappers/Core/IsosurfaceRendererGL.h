@@ -86,7 +86,8 @@
  * ranges clips a point whose pixels all hold a hit already, before its
  * setup, binning and fragments. The depth test would have rejected every
  * fragment of such a point (a pixel's first hit rejects every later one), so
- * the image and the counts are those of one range, exactly. It pays where
+ * the image is exactly that of one range (and the primitives drawn are
+ * still counted as the pyramid's total). It pays where
  * points' setup and fragments cost the hardware (a GPU); a software
  * rasteriser measured no gain (the ranges' flushes and pyramids cost what
  * was saved), so it is on by default only on hardware renderers. Pieces
