@@ -72,6 +72,11 @@ Scene:
                         (default 0.15,0.8,0.25,30)
   --no-points           never draw point footprints (always quads)
   --no-first-hit        draw opaque frames in one pass
+  --hit-cull auto|on|off
+                        drop hidden points in the first-hit pass (drawn in 4
+                        ranges, each culled against the hits before it; the same
+                        image); auto (default): on hardware renderers only, off
+                        on software ones (llvmpipe, softpipe, SwiftShader)
   --clip A,B,C,D        keep the part of the volume where A x + B y + C z + D >= 0
                         (world coordinates, as VTK's clipping planes); up to 6
   --crop I0,I1,J0,J1,K0,K1
@@ -136,6 +141,7 @@ struct Options
   int MaxTextureSize = 0;      // 0: the context's
   std::uint64_t GPUBudget = 0; // bytes; 0: the scene's default
   bool BrickPool = true;
+  HitCull Cull = HitCull::Auto;
 };
 
 struct UsageError
@@ -377,6 +383,15 @@ Options Parse(int argc, char* argv[])
       }
       opt.ES = api == "es";
     }
+    else if (arg == "--hit-cull")
+    {
+      const std::string mode = value("--hit-cull");
+      if (mode != "auto" && mode != "on" && mode != "off")
+      {
+        throw UsageError{ "--hit-cull is auto, on or off, not " + mode };
+      }
+      opt.Cull = mode == "on" ? HitCull::On : mode == "off" ? HitCull::Off : HitCull::Auto;
+    }
     else if (arg == "--no-brick-pool")
     {
       opt.BrickPool = false;
@@ -487,6 +502,7 @@ public:
     this->Scene.SetMaxTextureSize(options.MaxTextureSize);
     this->Scene.SetGPUMemoryBudget(options.GPUBudget);
     this->Scene.SetBrickPool(options.BrickPool);
+    this->Scene.SetHitCull(options.Cull);
   }
 
   ~HeadlessView()
@@ -787,6 +803,7 @@ int Run(int argc, char* argv[])
            << ", \"volume_bytes\": " << image.Bytes.size()
            << ", \"footprint\": " << JsonString(stats.PointFootprint ? "points" : "boxes")
            << ", \"first_hit\": " << (stats.FirstHit ? "true" : "false")
+           << ", \"hit_cull\": " << (stats.HitCull ? "true" : "false")
            << ", \"sample_distance\": " << stats.SampleDistance << ", \"bricks\": " << stats.Bricks
            << ", \"brick_points\": " << stats.BrickPoints
            << ", \"active_bricks\": " << stats.ActiveBricks

@@ -78,6 +78,62 @@ uniform float pointMargin;   // pixels added around each footprint
 uniform float maxPointSize;  // the largest point size
 #endif
 
+#ifdef MEDISO_HIT_CULL
+// Hidden points dropped in the first-hit pass, which the renderer draws in
+// ranges of the primitives (front to back) with the coverage pyramid of the
+// hits drawn so far made after each (HistoPyramidCoverage_fs.glsl).
+uniform sampler2D hitCoverage; // level l: 1 where a block of 2^(l + 1) buffer pixels all hold a hit
+uniform int coverageLevels;
+uniform vec2 coverageOrigin;   // this viewport's pixel (0, 0) in the hit buffers
+uniform int cullHidden;        // 0 in the first range (no hit drawn yet)
+
+// Whether every pixel a point of `size` pixels centred at NDC `ndc` can
+// cover already holds a hit. Then the first-hit pass's depth test (every
+// primitive at one depth, GL_LESS: a pixel's first hit rejects every later
+// fragment) would reject all of its fragments, so dropping the point leaves
+// the image and the depth exactly as they were, and spares its setup,
+// binning and fragments. Only the pixels whose rays can hit the surface in
+// the cell matter (any other fragment finds no root and writes nothing):
+// they lie in the projected surface box, which the square of the point's
+// size about its centre holds with the footprint's margin to spare, so a
+// rasteriser that rounds the size up adds only pixels that cannot hit. The
+// square is widened by a hundredth of a pixel for the rounding of the
+// window transform. The pixels whose centres it holds lie in at most 2x2
+// blocks of the lowest level whose blocks are at least as wide as it, and
+// all 4 must be covered; blocks beyond the buffers never are.
+bool pointCovered(vec2 ndc, float size)
+{
+  vec2 centre = (0.5 * ndc + 0.5) * viewportSize + coverageOrigin;
+  float radius = 0.5 * max(size, 1.0) + 0.01;
+  ivec2 first = ivec2(ceil(centre - radius - 0.5));
+  ivec2 last = ivec2(floor(centre + radius - 0.5));
+  if (any(lessThan(first, ivec2(0))))
+  {
+    return false;
+  }
+  int span = max(max(last.x - first.x, last.y - first.y) + 1, 1);
+  int level = 0;
+  for (int k = 0; k < 14; ++k) // blocks of 2^(level + 1) >= span; 14 levels: 32768 pixels
+  {
+    level += (2 << level) < span ? 1 : 0;
+  }
+  if (level >= coverageLevels)
+  {
+    return false;
+  }
+  ivec2 b0 = first >> (level + 1);
+  ivec2 b1 = last >> (level + 1);
+  if (any(greaterThanEqual(b1, textureSize(hitCoverage, level))))
+  {
+    return false;
+  }
+  float covered = min(
+    min(texelFetch(hitCoverage, b0, level).r, texelFetch(hitCoverage, ivec2(b1.x, b0.y), level).r),
+    min(texelFetch(hitCoverage, ivec2(b0.x, b1.y), level).r, texelFetch(hitCoverage, b1, level).r));
+  return covered > 0.5;
+}
+#endif
+
 // The fragment stage's inputs: few slots (OpenGL ES 3.0 promises 15 vec4s).
 flat out ivec4 vCellMask;    // the cell (xyz) and its crossing isovalues (w; bit t: threshold t)
 flat out vec4 vLook;         // the colour (rgb) and value (w) of the isovalue drawn
@@ -462,6 +518,13 @@ void footprint(ivec3 c, vec3 boxLo, vec3 boxHi)
   vec2 pixels = 0.5 * (hi - lo) * viewportSize;
   gl_PointSize = min(max(pixels.x, pixels.y) + pointMargin, maxPointSize);
   gl_Position = vec4(0.5 * (lo + hi), depth, 1.0);
+#ifdef MEDISO_HIT_CULL
+  if (cullHidden == 1 && pointCovered(gl_Position.xy, gl_PointSize))
+  {
+    gl_Position = vec4(0.0, 0.0, 2.0, 1.0); // beyond the far plane: clipped before its setup
+    gl_PointSize = 1.0;
+  }
+#endif
 #else
   vec2 margin = pointMargin / viewportSize; // half the margin on each side, in NDC
   vec2 corner01 = vec2(float(gl_VertexID & 1), float(gl_VertexID >> 1));

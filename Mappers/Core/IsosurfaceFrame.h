@@ -29,6 +29,19 @@ constexpr int MaximumLights = 6;
 /// faces of a cropping box.
 constexpr int MaximumClipPlanes = 12;
 
+/**
+ * Whether the first-hit pass drops hidden points (IsosurfaceRendererGL::SetHitCull(),
+ * IsosurfaceScene::SetHitCull()): Auto where the context is a hardware one (the GL renderer
+ * string names no software rasteriser, and the context is no WebGL one, whose renderer string
+ * the browser hides), On and Off whatever it is. The image is the same either way.
+ */
+enum class HitCull
+{
+  Auto,
+  On,
+  Off
+};
+
 /// One isosurface: its value, colour and opacity (0 < opacity <= 1).
 struct IsosurfaceLook
 {
@@ -101,6 +114,9 @@ struct IsosurfaceSceneStats
   bool PointFootprint = false;
   bool FirstHit = false;
   ///@}
+
+  /// The last frame's first-hit pass dropped hidden points (see HitCull).
+  bool HitCull = false;
 
   /// The image sample distance the last frame was drawn at (1: every pixel; see
   /// IsosurfaceFrame::SampleDistance).

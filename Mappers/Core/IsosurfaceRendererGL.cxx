@@ -8,6 +8,8 @@
 #include "MedisoShaders.h"
 
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <climits>
 #include <cmath>
 #include <sstream>
@@ -152,6 +154,7 @@ struct FrameVariant
   double GradientToView[9] = { 0 };
   bool Points = false;
   bool FirstHit = false;
+  bool HitCull = false; // the first-hit pass in ranges, hidden points dropped
   bool Cull = false;
   // The clipping planes that cut the volume (index space); Clipped: one of
   // them removes all of it.
@@ -293,6 +296,124 @@ struct IsosurfaceRendererGL::Internals
   // pass: the buffers over all their rectangles are ready and cleared, each
   // piece only draws its cells into them, and the hits are composited once.
   bool SharedHit = false;
+  HitCull Mode = HitCull::Auto;
+
+  // The first-hit pass's coverage pyramid (HistoPyramidCoverage_fs.glsl):
+  // level l over blocks of 2^(l + 1) hit-buffer pixels, one framebuffer per level.
+  Name Coverage;
+  std::vector<Name> CoverageFBOs;
+  std::vector<std::array<int, 2>> CoverageSizes;
+
+  void ReleaseCoverage()
+  {
+    this->CoverageFBOs.clear();
+    this->CoverageSizes.clear();
+    this->Coverage.Reset();
+  }
+
+  // The pyramid over the hit buffers (HitSize). "" when ready, else why not.
+  std::string PrepareCoverage()
+  {
+    const int w = std::max(1, (this->HitSize[0] + 1) / 2);
+    const int h = std::max(1, (this->HitSize[1] + 1) / 2);
+    if (this->Coverage && !this->CoverageSizes.empty() && this->CoverageSizes[0][0] == w &&
+      this->CoverageSizes[0][1] == h)
+    {
+      return "";
+    }
+    this->ReleaseCoverage();
+    const GLApi& gl = *this->GL;
+    const GLApi::Functions& f = gl.F();
+    gl.TakeErrors();
+    this->Coverage = Name(gl, NameKind::Texture);
+    BindTextureUnit(gl, 0, GL_TEXTURE_2D, this->Coverage.Get());
+    for (int lw = w, lh = h;; lw = std::max(1, lw / 2), lh = std::max(1, lh / 2))
+    {
+      this->CoverageSizes.push_back({ { lw, lh } });
+      if (lw == 1 && lh == 1)
+      {
+        break;
+      }
+    }
+    const int levels = static_cast<int>(this->CoverageSizes.size());
+    for (int l = 0; l < levels; ++l)
+    {
+      f.TexImage2D(GL_TEXTURE_2D, l, GL_R8, this->CoverageSizes[l][0], this->CoverageSizes[l][1], 0,
+        GL_RED, GL_UNSIGNED_BYTE, nullptr);
+    }
+    f.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
+    f.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    f.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    f.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    f.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0);
+    f.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, levels - 1);
+    std::string problem;
+    for (int l = 0; l < levels && problem.empty(); ++l)
+    {
+      this->CoverageFBOs.emplace_back(gl, NameKind::Framebuffer);
+      f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, this->CoverageFBOs.back().Get());
+      f.FramebufferTexture2D(
+        GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, this->Coverage.Get(), l);
+      problem = FramebufferProblem(gl);
+    }
+    const std::string errors = gl.TakeErrors();
+    if (problem.empty() && !errors.empty())
+    {
+      problem = errors;
+    }
+    if (!problem.empty())
+    {
+      this->ReleaseCoverage();
+    }
+    return problem;
+  }
+
+  // The pyramid of the hits drawn so far, level by level, each from the one
+  // below (the first from the hit colour's alpha). While a level is drawn
+  // the texture's base and maximum level are the level read, so that no
+  // level is read and drawn at once (WebGL reports that as a feedback loop
+  // even where the levels differ); then all levels again, for the vertex
+  // stage. Leaves its program, framebuffer, viewport and unit 0 bound, and
+  // the counting passes' state set. "" or why not.
+  std::string BuildCoverage()
+  {
+    const GLApi& gl = *this->GL;
+    const GLApi::Functions& f = gl.F();
+    std::string error;
+    Program* reduce = this->Programs.Get(
+      gl, "", shaders::HistoPyramidFullScreen_vs, shaders::HistoPyramidCoverage_fs, error);
+    if (!reduce)
+    {
+      return "the coverage shader does not build: " + error;
+    }
+    SetCountingPassState(gl); // inside RenderPiece()'s ScopedGLState, as the whole pass
+    reduce->Use();
+    reduce->Set("source", 0);
+    const int levels = static_cast<int>(this->CoverageSizes.size());
+    for (int l = 0; l < levels; ++l)
+    {
+      if (l == 0)
+      {
+        BindTextureUnit(gl, 0, GL_TEXTURE_2D, this->HitColor.Get());
+        reduce->Set2i("sourceSize", this->HitSize[0], this->HitSize[1]);
+      }
+      else
+      {
+        BindTextureUnit(gl, 0, GL_TEXTURE_2D, this->Coverage.Get());
+        f.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, l - 1);
+        f.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, l - 1);
+        reduce->Set2i("sourceSize", this->CoverageSizes[l - 1][0], this->CoverageSizes[l - 1][1]);
+      }
+      reduce->Set("fromHits", l == 0 ? 1 : 0);
+      f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, this->CoverageFBOs[l].Get());
+      f.Viewport(0, 0, this->CoverageSizes[l][0], this->CoverageSizes[l][1]);
+      f.DrawArrays(GL_TRIANGLES, 0, 3);
+    }
+    BindTextureUnit(gl, 0, GL_TEXTURE_2D, this->Coverage.Get());
+    f.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0);
+    f.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, levels - 1);
+    return "";
+  }
 
   // Reduced target of frames drawn at an image sample distance above 1.
   Name ReducedFBO, ReducedColor, ReducedDepth;
@@ -429,8 +550,9 @@ struct IsosurfaceRendererGL::Internals
     const FrameVariant& v, std::string& error);
   void SetUniforms(Program& program, const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
     const FrameVariant& v);
-  std::string DrawFirstHit(
-    const FrameVariant& v, GLuint hostFramebuffer, const ScopedGLState& saved);
+  std::string DrawFirstHit(Program& program, const HistoPyramidGL& pyramid,
+    const IsosurfaceFrame& frame, const FrameVariant& v, int coverageUnit, GLuint hostFramebuffer,
+    const ScopedGLState& saved);
   void ClearHits();
   std::string CompositeHits();
 
@@ -459,6 +581,7 @@ IsosurfaceRendererGL::~IsosurfaceRendererGL() = default;
 void IsosurfaceRendererGL::Release()
 {
   this->Impl->ReleaseHitBuffers();
+  this->Impl->ReleaseCoverage();
   this->Impl->ReleaseReduced();
   this->Impl->Programs.Clear();
   this->Impl->VertexArray.Reset();
@@ -468,8 +591,47 @@ std::uint64_t IsosurfaceRendererGL::GetFrameBufferBytes() const
 {
   // First hit: RGBA8 colour, 32-bit depth (R32F or R32UI), 16-bit depth
   // buffer. Reduced target: RGBA8 colour, 32-bit float depth.
-  return static_cast<std::uint64_t>(this->Impl->HitSize[0]) * this->Impl->HitSize[1] * 10u +
+  // The coverage pyramid of hidden points: R8 levels.
+  std::uint64_t bytes =
+    static_cast<std::uint64_t>(this->Impl->HitSize[0]) * this->Impl->HitSize[1] * 10u +
     static_cast<std::uint64_t>(this->Impl->ReducedSize[0]) * this->Impl->ReducedSize[1] * 8u;
+  for (const auto& size : this->Impl->CoverageSizes)
+  {
+    bytes += static_cast<std::uint64_t>(size[0]) * size[1];
+  }
+  return bytes;
+}
+
+void IsosurfaceRendererGL::SetHitCull(HitCull mode)
+{
+  this->Impl->Mode = mode;
+}
+
+HitCull IsosurfaceRendererGL::GetHitCull() const
+{
+  return this->Impl->Mode;
+}
+
+bool IsosurfaceRendererGL::HitCullPays(const GLApi& gl)
+{
+  // The browser hides the device behind "WebKit WebGL" unless asked, and the
+  // page has not been measured with it: a WebGL context counts as unknown.
+  auto lower = [](std::string text)
+  {
+    std::transform(text.begin(), text.end(), text.begin(),
+      [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return text;
+  };
+  const std::string renderer = lower(gl.GetRenderer());
+  const std::string version = lower(gl.GetVersion());
+  for (const char* software : { "llvmpipe", "softpipe", "swiftshader", "software" })
+  {
+    if (renderer.find(software) != std::string::npos)
+    {
+      return false;
+    }
+  }
+  return version.find("webgl") == std::string::npos;
 }
 
 //------------------------------------------------------------------------------
@@ -490,6 +652,10 @@ Program* IsosurfaceRendererGL::Internals::ComposeProgram(const HistoPyramidWalk&
   if (v.FirstHit)
   {
     defines << "#define MEDISO_FIRST_HIT 1\n";
+  }
+  if (v.HitCull)
+  {
+    defines << "#define MEDISO_HIT_CULL 1\n";
   }
   if (v.Nearest())
   {
@@ -574,8 +740,9 @@ void IsosurfaceRendererGL::Internals::SetUniforms(Program& program, const HistoP
 
 // Step 5 (first-hit pass): the cells into the buffers, then their hits into
 // the host's framebuffer. "" or why not.
-std::string IsosurfaceRendererGL::Internals::DrawFirstHit(
-  const FrameVariant& v, GLuint hostFramebuffer, const ScopedGLState& saved)
+std::string IsosurfaceRendererGL::Internals::DrawFirstHit(Program& program,
+  const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame, const FrameVariant& v,
+  int coverageUnit, GLuint hostFramebuffer, const ScopedGLState& saved)
 {
   const GLApi& gl = *this->GL;
   const GLApi::Functions& f = gl.F();
@@ -589,7 +756,47 @@ std::string IsosurfaceRendererGL::Internals::DrawFirstHit(
     this->ClearHits();
   }
   f.DepthFunc(GL_LESS);
-  this->DrawCells(v.Points, v.Total);
+  if (!v.HitCull)
+  {
+    this->DrawCells(v.Points, v.Total);
+  }
+  else
+  {
+    // In ranges, front to back. Before each range but the first, the hits
+    // drawn so far make the coverage pyramid (which leaves its own program,
+    // framebuffer and unit 0 bound), and the range's points whose pixels all
+    // hold a hit already are clipped in the vertex stage: the depth test
+    // would have rejected all their fragments, so the image is the same.
+    program.Set("hitCoverage", coverageUnit);
+    program.Set("coverageLevels", static_cast<int>(this->CoverageSizes.size()));
+    program.Set2f("coverageOrigin", static_cast<float>(frame.Viewport[0] - this->HitRect[0]),
+      static_cast<float>(frame.Viewport[1] - this->HitRect[1]));
+    const int ranges = IsosurfaceRendererGL::HitCullRanges;
+    std::uint64_t begin = 0;
+    for (int r = 1; r <= ranges; ++r)
+    {
+      const std::uint64_t end = v.Total * static_cast<std::uint64_t>(r) / ranges;
+      if (end <= begin)
+      {
+        continue;
+      }
+      if (begin > 0)
+      {
+        const std::string problem = this->BuildCoverage();
+        if (!problem.empty())
+        {
+          return problem;
+        }
+        this->SetUniforms(program, pyramid, frame, v);
+        f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, this->HitFBO.Get());
+        f.DepthFunc(GL_LESS);
+      }
+      BindTextureUnit(gl, coverageUnit, GL_TEXTURE_2D, this->Coverage.Get());
+      program.Set("cullHidden", begin > 0 ? 1 : 0);
+      f.DrawArrays(GL_POINTS, static_cast<GLint>(begin), static_cast<GLsizei>(end - begin));
+      begin = end;
+    }
+  }
   f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, hostFramebuffer);
   saved.RestoreDepthFunc();
   return this->SharedHit ? "" : this->CompositeHits();
@@ -766,6 +973,7 @@ bool IsosurfaceRendererGL::Render(const std::vector<IsosurfacePiece>& pieces,
     stats.Primitives += pieceStats.Primitives;
     stats.PointFootprint = stats.PointFootprint || pieceStats.PointFootprint;
     stats.FirstHit = stats.FirstHit || pieceStats.FirstHit;
+    stats.HitCull = stats.HitCull || pieceStats.HitCull;
   }
   impl.SharedHit = false;
   if (drawn && stats.FirstHit)
@@ -842,7 +1050,7 @@ bool IsosurfaceRendererGL::RenderPiece(const HistoPyramidGL& pyramid, const Isos
   // 2. The first-hit pass's buffers, made before the program is chosen, so
   //    that a context that cannot make them draws in one pass instead (the
   //    same image).
-  ScopedGLState saved(gl, std::max(walk.TextureUnits, 2));
+  ScopedGLState saved(gl, std::max(walk.TextureUnits + 1, 2));
   gl.TakeErrors();
   GLint hostFramebuffer = 0;
   f.GetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &hostFramebuffer);
@@ -853,6 +1061,18 @@ bool IsosurfaceRendererGL::RenderPiece(const HistoPyramidGL& pyramid, const Isos
       impl.PrepareFirstHit(impl.HitRect[2], impl.HitRect[3], frame.Viewport);
     f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(hostFramebuffer));
     v.FirstHit = problem.empty();
+  }
+  // Hidden points dropped in the first-hit pass of a volume drawn alone
+  // (pieces sharing one pass draw theirs in one range each), where it is
+  // wanted, a vertex texture unit is left for the coverage pyramid, and the
+  // pyramid can be made (else the same image in one range).
+  const bool cullWanted = impl.Mode == HitCull::On ||
+    (impl.Mode == HitCull::Auto && IsosurfaceRendererGL::HitCullPays(gl));
+  if (v.FirstHit && !impl.SharedHit && cullWanted &&
+    walk.TextureUnits + 1 <= gl.GetMaxVertexTextureUnits())
+  {
+    v.HitCull = impl.PrepareCoverage().empty();
+    f.BindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(hostFramebuffer));
   }
 
   // 3. Compose the program, 4. set its state and uniforms.
@@ -872,7 +1092,8 @@ bool IsosurfaceRendererGL::RenderPiece(const HistoPyramidGL& pyramid, const Isos
   // 5. Draw the cells, through the first-hit pass or in one.
   if (v.FirstHit)
   {
-    const std::string problem = impl.DrawFirstHit(v, static_cast<GLuint>(hostFramebuffer), saved);
+    const std::string problem = impl.DrawFirstHit(
+      *program, pyramid, frame, v, walk.TextureUnits, static_cast<GLuint>(hostFramebuffer), saved);
     if (!problem.empty())
     {
       error = problem;
@@ -891,6 +1112,7 @@ bool IsosurfaceRendererGL::RenderPiece(const HistoPyramidGL& pyramid, const Isos
   }
   stats.PointFootprint = v.Points;
   stats.FirstHit = v.FirstHit;
+  stats.HitCull = v.HitCull;
   return true;
 }
 

@@ -78,6 +78,22 @@
  * still the nearest), composited once; other pieces draw in one pass, and
  * the depth test joins both.
  *
+ * Hidden points (SetHitCull()): the first-hit pass of a volume drawn as one
+ * pyramid draws its primitives in HitCullRanges ranges, front to back.
+ * After each range but the last, a coverage pyramid of the hit buffer is
+ * made (HistoPyramidCoverage_fs.glsl: level l is 1 over a block of
+ * 2^(l + 1) pixels that all hold a hit), and the vertex stage of the next
+ * ranges clips a point whose pixels all hold a hit already, before its
+ * setup, binning and fragments. The depth test would have rejected every
+ * fragment of such a point (a pixel's first hit rejects every later one), so
+ * the image is exactly that of one range (and the primitives drawn are
+ * still counted as the pyramid's total). It pays where
+ * points' setup and fragments cost the hardware (a GPU); a software
+ * rasteriser measured no gain (the ranges' flushes and pyramids cost what
+ * was saved), so it is on by default only on hardware renderers. Pieces
+ * sharing one first-hit pass (bricks the pool cannot hold) are drawn
+ * without it.
+ *
  * Hosts do not call the renderer: IsosurfaceScene does.
  *
  * The renderer draws into the framebuffer bound when Render() is called,
@@ -110,6 +126,7 @@ struct IsosurfaceFrameStats
   std::uint64_t Primitives = 0;
   bool PointFootprint = false; ///< points (else quads over the box)
   bool FirstHit = false;       ///< drawn through the first-hit pass
+  bool HitCull = false;        ///< the first-hit pass dropped hidden points
   float SampleDistance = 1.0f; ///< image sample distance drawn at (1: every pixel)
 };
 
@@ -123,6 +140,15 @@ struct IsosurfacePiece
 class IsosurfaceRendererGL
 {
 public:
+  /**
+   * The ranges a first-hit pass with hidden points dropped is drawn in: 4,
+   * the fastest of 4, 16 and 64 on a GPU (docs/histopyramid.md, "Hidden
+   * points in the first-hit pass"): each range after the first costs a
+   * pyramid and a wait for the hits before it, and the first quarter of
+   * the primitives (the nearest, roughly) already hides much of the rest.
+   */
+  static constexpr int HitCullRanges = 4;
+
   explicit IsosurfaceRendererGL(std::shared_ptr<const GLApi> gl);
   ~IsosurfaceRendererGL();
   IsosurfaceRendererGL(const IsosurfaceRendererGL&) = delete;
@@ -143,6 +169,18 @@ public:
    */
   bool Render(const std::vector<IsosurfacePiece>& pieces, const IsosurfaceFrame& frame,
     IsosurfaceFrameStats& stats, std::string& error);
+
+  /**
+   * Whether the first-hit pass drops hidden points (default HitCull::Auto:
+   * on hardware renderers only; see the class's documentation). The image
+   * is the same either way.
+   */
+  void SetHitCull(HitCull mode);
+  HitCull GetHitCull() const;
+
+  /// Whether HitCull::Auto drops hidden points on `gl`'s context: not where its renderer is
+  /// a software one (Mesa's llvmpipe or softpipe, SwiftShader) or hidden (WebGL).
+  static bool HitCullPays(const GLApi& gl);
 
   /// Bytes of the first-hit pass's buffers and the reduced target (0 until one is drawn).
   std::uint64_t GetFrameBufferBytes() const;

@@ -87,6 +87,7 @@ struct IsosurfaceScene::Internals
   std::shared_ptr<const GLApi> GL;
   std::unique_ptr<HistoPyramidGL> Pyramid;
   std::unique_ptr<IsosurfaceRendererGL> Renderer;
+  HitCull HitCullMode = HitCull::Auto; // SetHitCull(), kept across contexts
 
   // What the uploaded volume and the built pyramid were made from.
   bool HasVolume = false;
@@ -277,6 +278,10 @@ void IsosurfaceScene::SetContext(std::shared_ptr<const GLApi> gl)
   impl.GL = std::move(gl);
   impl.Pyramid.reset(impl.GL ? new HistoPyramidGL(impl.GL) : nullptr);
   impl.Renderer.reset(impl.GL ? new IsosurfaceRendererGL(impl.GL) : nullptr);
+  if (impl.Renderer)
+  {
+    impl.Renderer->SetHitCull(impl.HitCullMode);
+  }
   impl.Bricks.clear(); // Release()d in their own context before, as the doc asks
   impl.Pool.reset();
   impl.ReleaseBricks();
@@ -427,6 +432,20 @@ void IsosurfaceScene::SetBrickPool(bool on)
 bool IsosurfaceScene::GetBrickPool() const
 {
   return this->Impl->UsePool;
+}
+
+void IsosurfaceScene::SetHitCull(HitCull mode)
+{
+  this->Impl->HitCullMode = mode;
+  if (this->Impl->Renderer)
+  {
+    this->Impl->Renderer->SetHitCull(mode);
+  }
+}
+
+HitCull IsosurfaceScene::GetHitCull() const
+{
+  return this->Impl->HitCullMode;
 }
 
 std::string IsosurfaceScene::GetBrickPoolReason() const
@@ -1373,6 +1392,7 @@ bool IsosurfaceScene::Render(const IsosurfaceFrame& frame, std::string& error)
   stats.Primitives = 0;
   stats.PointFootprint = false;
   stats.FirstHit = false;
+  stats.HitCull = false;
   stats.SampleDistance = 1.0f;
   stats.Level = FullLevel;
   if (!this->UpdateLevel(frame.Level, error))
@@ -1438,6 +1458,7 @@ bool IsosurfaceScene::Render(const IsosurfaceFrame& frame, std::string& error)
   stats.Primitives = frameStats.Primitives;
   stats.PointFootprint = frameStats.PointFootprint;
   stats.FirstHit = frameStats.FirstHit;
+  stats.HitCull = frameStats.HitCull;
   stats.SampleDistance = frameStats.SampleDistance;
   return true;
 }

@@ -180,6 +180,16 @@ public:
   bool GetBrickPool() const;
   ///@}
 
+  ///@{
+  /**
+   * Whether the first-hit pass drops hidden points (IsosurfaceRendererGL::SetHitCull()):
+   * HitCull::Auto (the default) on hardware renderers only, On or Off everywhere. The
+   * image is the same either way; GetStats().HitCull says whether the last frame did.
+   */
+  void SetHitCull(HitCull mode);
+  HitCull GetHitCull() const;
+  ///@}
+
   /**
    * The most GPU memory a pool may take, made or kept, as a multiple of the active
    * bricks' own pyramids (each brick's texture and its pyramid padded to
