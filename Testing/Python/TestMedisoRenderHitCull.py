@@ -11,13 +11,12 @@ pass with point footprints, the stats say whether the cull ran, and the PNGs are
 with equal primitive counts. By default (auto) the cull is off on a software renderer (llvmpipe,
 softpipe, SwiftShader). A bad mode is refused (exit 2). A context that cannot be made skips (125).
 """
-import json
 import os
-import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
+from medisorender import run_stats  # noqa: E402
 
 check = Checks()
 SOFTWARE = ("llvmpipe", "softpipe", "swiftshader")
@@ -36,17 +35,10 @@ SCENES = {
 
 
 def render(binary, api, volume, options, mode, path):
-    args = [binary, volume, "--size", "320x240", "--api", api, "--stats", "--output", path]
-    args += options
+    args = [volume, "--size", "320x240", "--api", api, "--stats", "--output", path] + options
     if mode is not None:
         args += ["--hit-cull", mode]
-    p = subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                       timeout=300)
-    stats = None
-    for line in p.stdout.splitlines():
-        if line.startswith("{"):
-            stats = json.loads(line)
-    return p.returncode, stats, p.stdout
+    return run_stats(binary, args)
 
 
 def main():

@@ -9,15 +9,14 @@ are drawn at sample distance 1 and 3: the stats say the distance drawn at, the r
 cover the full ones' pixels within 10% and differ from them. A distance below 1 is refused
 (exit 2). A context that cannot be made skips (125).
 """
-import json
 import os
 import struct
-import subprocess
 import sys
 import zlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
+from medisorender import run_stats  # noqa: E402
 
 check = Checks()
 BACKGROUND = (26, 31, 41)  # mediso-render's default 0.1, 0.12, 0.16
@@ -51,17 +50,11 @@ def covered(rows):
 
 
 def render(binary, api, distance, isos, path):
-    args = [binary, "phantom:48", "--size", "160x120", "--api", api, "--stats", "--output", path,
+    args = ["phantom:48", "--size", "160x120", "--api", api, "--stats", "--output", path,
             "--sample-distance", str(distance)]
     for iso in isos:
         args += ["--iso", iso]
-    p = subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                       timeout=300)
-    stats = None
-    for line in p.stdout.splitlines():
-        if line.startswith("{"):
-            stats = json.loads(line)
-    return p.returncode, stats, p.stdout
+    return run_stats(binary, args)
 
 
 def main():
