@@ -158,15 +158,23 @@ struct Bricking
   bool PoolHolds = false;
 };
 
+// The volume of `values` on `dims` points, as the scenes take it.
 template<typename T>
-void RunCases(const std::shared_ptr<const GLApi>& gl, Target& target, const std::vector<T>& values,
-  const int dims[3], const std::vector<Case>& cases, const std::string& prefix,
-  const Bricking& how = Bricking())
+VolumeDescription Describe(const std::vector<T>& values, const int dims[3])
 {
   VolumeDescription volume;
   volume.Type = ScalarTypeOf<T>();
   volume.Data = values.data();
   std::copy(dims, dims + 3, volume.Dims);
+  return volume;
+}
+
+template<typename T>
+void RunCases(const std::shared_ptr<const GLApi>& gl, Target& target, const std::vector<T>& values,
+  const int dims[3], const std::vector<Case>& cases, const std::string& prefix,
+  const Bricking& how = Bricking())
+{
+  VolumeDescription volume = Describe(values, dims);
   volume.Stamp = 1;
 
   IsosurfaceScene dense(nullptr), bricked(nullptr);
@@ -247,10 +255,7 @@ void RunCases(const std::shared_ptr<const GLApi>& gl, Target& target, const std:
 void CheckKeptPyramids(const std::shared_ptr<const GLApi>& gl, Target& target,
   const std::vector<std::int16_t>& values, const int dims[3])
 {
-  VolumeDescription volume;
-  volume.Type = ScalarType::Int16;
-  volume.Data = values.data();
-  std::copy(dims, dims + 3, volume.Dims);
+  VolumeDescription volume = Describe(values, dims);
   volume.Stamp = 1;
   IsosurfaceScene dense(nullptr), bricked(nullptr);
   dense.SetContext(gl);
@@ -374,10 +379,7 @@ PoolChanges RunPoolChanges(const std::shared_ptr<const GLApi>& gl, Target& targe
   const std::vector<std::int16_t>& values, const int dims[3], std::uint64_t budget,
   const std::vector<std::vector<double>>& changes, const std::string& prefix)
 {
-  VolumeDescription volume;
-  volume.Type = ScalarType::Int16;
-  volume.Data = values.data();
-  std::copy(dims, dims + 3, volume.Dims);
+  VolumeDescription volume = Describe(values, dims);
   volume.Stamp = 1;
   std::string error;
   IsosurfaceScene scene(nullptr);
@@ -467,10 +469,7 @@ void CheckPoolFollowsIsovalues(const std::shared_ptr<const GLApi>& gl, Target& t
   // that the pool's 10 slots would hold, over the ratio: their own pyramids).
   {
     const std::vector<std::int16_t> ramp = MakeRamp(dims);
-    VolumeDescription volume;
-    volume.Type = ScalarType::Int16;
-    volume.Data = ramp.data();
-    std::copy(dims, dims + 3, volume.Dims);
+    VolumeDescription volume = Describe(ramp, dims);
     const std::vector<double> one = { 30.5 }, two = { 30.5, 85.5 }, thin = { 130.5 };
     const std::uint64_t budget = UpdateAlone(gl, volume, two, 24u << 20, true).Bytes;
     const PoolChanges seen = RunPoolChanges(gl, target, ramp, dims, budget,
@@ -503,10 +502,7 @@ void CheckPoolFollowsIsovalues(const std::shared_ptr<const GLApi>& gl, Target& t
         }
       }
     }
-    VolumeDescription volume;
-    volume.Type = ScalarType::Int16;
-    volume.Data = values.data();
-    std::copy(dims, dims + 3, volume.Dims);
+    VolumeDescription volume = Describe(values, dims);
     const std::vector<double> oneBrick = { -1500.5 }, fourBricks = { -500.5 }, all = { 500.5 };
     const std::uint64_t pool = UpdateAlone(gl, volume, fourBricks, 24u << 20, true).Bytes;
     const std::uint64_t own = UpdateAlone(gl, volume, all, 24u << 20, false).Bytes;
@@ -582,10 +578,7 @@ int main(int argc, char* argv[])
   {
     const int thin[3] = { 26, 26, 500 };
     const std::vector<std::int16_t> values = pyramid_checks::MakePhantom(thin, 40.0, 5);
-    VolumeDescription volume;
-    volume.Type = ScalarType::Int16;
-    volume.Data = values.data();
-    std::copy(thin, thin + 3, volume.Dims);
+    VolumeDescription volume = Describe(values, thin);
     std::uint64_t bytes[2] = { 0, 0 };
     std::string reasons[2];
     for (int pool = 0; pool < 2; ++pool)
@@ -648,10 +641,7 @@ int main(int argc, char* argv[])
   // Isovalue changes within a budget that holds the bricks of one change but
   // not of all: least recently used bricks go, the counts stay exact.
   {
-    VolumeDescription volume;
-    volume.Type = ScalarType::Int16;
-    volume.Data = phantom.data();
-    std::copy(dims, dims + 3, volume.Dims);
+    VolumeDescription volume = Describe(phantom, dims);
     // Bricks of 8 points (a limit of 16 texels); the bytes each isovalue's
     // bricks take, each alone; the budget then holds the largest of them.
     const std::vector<double> changes = { 1000.0, -500.0, 400.0, 1000.0, -500.0 };
