@@ -10,9 +10,19 @@ frame at sample distance 2) are drawn with --hit-cull on and off: both go throug
 pass with point footprints, the stats say whether the cull ran, and the PNGs are byte-identical
 with equal primitive counts. By default (auto) the cull is off on a software renderer (llvmpipe,
 softpipe, SwiftShader). A bad mode is refused (exit 2). A context that cannot be made skips (125).
+
+The phantom's scenes hardly ever put an earlier hit over part of a later point: the points behind
+its skin are hidden whole. Two scenes of a volume this test writes do (balls in front of a wall,
+write_balls()): on a coarse grid seen close, points some 15-20 pixels wide, the silhouettes of the
+balls, drawn mostly in the first range, cross the points of the wall, drawn in the later ones. A
+cull that tests less than a point's whole square (its centre's block, one of its four blocks)
+drops wall points that still show at some of their pixels, and the images differ (checked:
+hundreds of pixels in each of the four).
 """
+import math
 import os
 import sys
+from array import array
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
@@ -21,7 +31,7 @@ from medisorender import run_stats  # noqa: E402
 check = Checks()
 SOFTWARE = ("llvmpipe", "softpipe", "swiftshader")
 
-# name: the phantom's size and mediso-render's options
+# name: the volume (phantom:N, or "balls": write_balls()) and mediso-render's options
 SCENES = {
     "bone": ("phantom:64", ["--iso", "400", "--elevation", "-60"]),
     "skin_bone": ("phantom:64", ["--iso", "-500:0.93,0.75,0.62", "--iso", "400:0.97,0.95,0.88",
@@ -31,7 +41,35 @@ SCENES = {
     "zoomed": ("phantom:24", ["--iso", "-500", "--zoom", "2.5", "--azimuth", "20"]),
     "parallel": ("phantom:64", ["--iso", "-500", "--iso", "400", "--parallel", "--azimuth", "-40"]),
     "reduced": ("phantom:64", ["--iso", "400", "--sample-distance", "2"]),
+    "balls": ("balls", ["--iso", "0", "--zoom", "2.5"]),
+    "balls_parallel": ("balls", ["--iso", "0", "--zoom", "3.5", "--parallel", "--azimuth", "-25",
+                                 "--elevation", "15"]),
 }
+# Three overlapping balls (centre x, y, z and radius, in points) in front of a wall: the
+# half-space z < WALL, whose surface faces the camera (VTK's, looking down -z). The walk draws
+# the balls' points in the first ranges and the wall's after them.
+BALLS = ((9.45, 12.15, 15.3, 5.4), (15.6, 9.3, 18.75, 3.45), (13.65, 16.5, 12.6, 3.15))
+WALL = 5.25
+
+
+def write_balls(path, n=24):
+    """The balls and the wall as one int16 field on n^3 points, 100 per point inside (iso 0)."""
+    values = array("h")
+    for z in range(n):
+        for y in range(n):
+            for x in range(n):
+                inside = WALL - z
+                for cx, cy, cz, r in BALLS:
+                    inside = max(inside, r - math.sqrt((x - cx) ** 2 + (y - cy) ** 2 +
+                                                       (z - cz) ** 2))
+                values.append(int(round(100 * inside)))
+    if sys.byteorder != "little":
+        values.byteswap()
+    with open(path, "wb") as f:
+        f.write(("ObjectType = Image\nNDims = 3\nDimSize = %d %d %d\nElementType = MET_SHORT\n"
+                 "ElementSpacing = 1 1 1\nElementDataFile = LOCAL\n" % (n, n, n)).encode())
+        f.write(values.tobytes())
+    return path
 
 
 def render(binary, api, volume, options, mode, path):
@@ -44,9 +82,11 @@ def render(binary, api, volume, options, mode, path):
 def main():
     binary, temp = sys.argv[1], sys.argv[2]
     os.makedirs(temp, exist_ok=True)
+    volumes = {"balls": write_balls(os.path.join(temp, "balls.mha"))}
     ran = False
     for api in ("es", "gl"):
         for name, (volume, options) in SCENES.items():
+            volume = volumes.get(volume, volume)
             results = {}
             for mode in ("on", "off"):
                 path = os.path.join(temp, "%s_%s_%s.png" % (api, name, mode))
