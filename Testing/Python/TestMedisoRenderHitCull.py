@@ -12,12 +12,12 @@ with equal primitive counts. By default (auto) the cull is off on a software ren
 softpipe, SwiftShader). A bad mode is refused (exit 2). A context that cannot be made skips (125).
 
 The phantom's scenes hardly ever put an earlier hit over part of a later point: the points behind
-its skin are hidden whole. Two scenes of a volume this test writes do (balls in front of a wall,
-write_balls()): on a coarse grid seen close, points some 15-20 pixels wide, the silhouettes of the
-balls, drawn mostly in the first range, cross the points of the wall, drawn in the later ones. A
-cull that tests less than a point's whole square (its centre's block, one of its four blocks)
-drops wall points that still show at some of their pixels, and the images differ (checked:
-hundreds of pixels in each of the four).
+its skin are hidden whole. Three scenes of volumes this test writes do (write_volume(): balls, and
+a plate with two slits, in front of a wall): on a coarse grid seen close, points some 15-20 pixels
+wide, the edges of the nearer surface, drawn mostly in the first range, cross the points of the
+wall, drawn in the later ones. A cull that tests less than a point's whole square (its centre's
+block, one of its four blocks, a square half as wide) drops wall points that still show at some
+of their pixels, and the images differ (checked by hand: see docs/histopyramid.md).
 """
 import math
 import os
@@ -31,7 +31,7 @@ from medisorender import run_stats  # noqa: E402
 check = Checks()
 SOFTWARE = ("llvmpipe", "softpipe", "swiftshader")
 
-# name: the volume (phantom:N, or "balls": write_balls()) and mediso-render's options
+# name: the volume (phantom:N, or "balls" or "slits": write_volume()) and mediso-render's options
 SCENES = {
     "bone": ("phantom:64", ["--iso", "400", "--elevation", "-60"]),
     "skin_bone": ("phantom:64", ["--iso", "-500:0.93,0.75,0.62", "--iso", "400:0.97,0.95,0.88",
@@ -44,25 +44,34 @@ SCENES = {
     "balls": ("balls", ["--iso", "0", "--zoom", "2.5"]),
     "balls_parallel": ("balls", ["--iso", "0", "--zoom", "3.5", "--parallel", "--azimuth", "-25",
                                  "--elevation", "15"]),
+    "slits": ("slits", ["--iso", "0", "--zoom", "2.5"]),
 }
-# Three overlapping balls (centre x, y, z and radius, in points) in front of a wall: the
-# half-space z < WALL, whose surface faces the camera (VTK's, looking down -z). The walk draws
-# the balls' points in the first ranges and the wall's after them.
-BALLS = ((9.45, 12.15, 15.3, 5.4), (15.6, 9.3, 18.75, 3.45), (13.65, 16.5, 12.6, 3.15))
+# Volumes whose surface faces the camera (VTK's, looking down -z) with a wall behind: the
+# half-space z < WALL. The walk draws the nearer surface's points mostly in the first range and
+# the wall's after them. "balls": three overlapping balls (centre x, y, z and radius, in points);
+# "slits": a plate (mid-plane z = PLATE[0], PLATE[1] thick on either side) cut by slits 2 SLITS[2]
+# wide along x = SLITS[0] and y = SLITS[1], the wall seen through them (centred on planes of points:
+# between them, trilinear interpolation would close a slit narrower than a cell).
 WALL = 5.25
+BALLS = ((9.45, 12.15, 15.3, 5.4), (15.6, 9.3, 18.75, 3.45), (13.65, 16.5, 12.6, 3.15))
+PLATE = (16, 0.3)
+SLITS = (12, 9, 0.3)
 
 
-def write_balls(path, n=24):
-    """The balls and the wall as one int16 field on n^3 points, 100 per point inside (iso 0)."""
-    values = array("h")
-    for z in range(n):
-        for y in range(n):
-            for x in range(n):
-                inside = WALL - z
-                for cx, cy, cz, r in BALLS:
-                    inside = max(inside, r - math.sqrt((x - cx) ** 2 + (y - cy) ** 2 +
-                                                       (z - cz) ** 2))
-                values.append(int(round(100 * inside)))
+def balls(x, y, z):
+    return max(r - math.sqrt((x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2)
+               for cx, cy, cz, r in BALLS)
+
+
+def slits(x, y, z):
+    return min(PLATE[1] - abs(z - PLATE[0]), abs(x - SLITS[0]) - SLITS[2],
+               abs(y - SLITS[1]) - SLITS[2])
+
+
+def write_volume(path, front, n=24):
+    """`front` and the wall as one int16 field on n^3 points, 100 per point inside (iso 0)."""
+    values = array("h", (int(round(100 * max(WALL - z, front(x, y, z))))
+                         for z in range(n) for y in range(n) for x in range(n)))
     if sys.byteorder != "little":
         values.byteswap()
     with open(path, "wb") as f:
@@ -82,7 +91,8 @@ def render(binary, api, volume, options, mode, path):
 def main():
     binary, temp = sys.argv[1], sys.argv[2]
     os.makedirs(temp, exist_ok=True)
-    volumes = {"balls": write_balls(os.path.join(temp, "balls.mha"))}
+    volumes = {name: write_volume(os.path.join(temp, name + ".mha"), front)
+               for name, front in (("balls", balls), ("slits", slits))}
     ran = False
     for api in ("es", "gl"):
         for name, (volume, options) in SCENES.items():
