@@ -890,6 +890,45 @@ void GenerateSurface(const Volume<T>& volume, const BlockRanges& ranges, Triangl
     volume, ranges, cases, plan, nullptr, GeneratePoints | GenerateTriangles, out, parallel);
 }
 
+namespace
+{
+// normals[3 i + c] = g[c] * (1 / sqrt(len2)) for the n entries (gx, gy, gz,
+// len2) of `gradients`, rounded to float. Two entries at a time where SSE2 is
+// there: packed square roots and divisions round as scalar ones do, so the
+// bits are those of one entry at a time.
+void NormaliseGradients(const double* gradients, std::int64_t n, float* normals)
+{
+  std::int64_t i = 0;
+#if defined(__SSE2__)
+  const __m128d one = _mm_set1_pd(1.0);
+  for (; i + 2 <= n; i += 2)
+  {
+    const double* g = gradients + 4 * i;
+    alignas(16) double inv[2];
+    _mm_store_pd(inv, _mm_div_pd(one, _mm_sqrt_pd(_mm_set_pd(g[7], g[3]))));
+    for (int p = 0; p < 2; ++p)
+    {
+      float* nn = normals + 3 * (i + p);
+      for (int c = 0; c < 3; ++c)
+      {
+        nn[c] = static_cast<float>(g[4 * p + c] * inv[p]);
+      }
+    }
+  }
+#endif
+  for (; i < n; ++i)
+  {
+    const double* g = gradients + 4 * i;
+    const double inv = 1.0 / std::sqrt(g[3]);
+    float* nn = normals + 3 * i;
+    for (int c = 0; c < 3; ++c)
+    {
+      nn[c] = static_cast<float>(g[c] * inv);
+    }
+  }
+}
+} // namespace
+
 template <typename T, typename IdType>
 void GenerateBlocks(const Volume<T>& volume, const BlockRanges& ranges, TriangleCaseTable cases,
   const ExtractionPlan& plan, const std::vector<std::int64_t>* list, int parts,
@@ -974,6 +1013,10 @@ void GenerateBlocks(const Volume<T>& volume, const BlockRanges& ranges, Triangle
     // Point id of each of the block's own cut edges, by bit: filled while the
     // points are written, so most triangle vertices are one load.
     std::vector<IdType> ownIds(static_cast<std::size_t>(words) * 64);
+    // The block's unnormalised normals (x, y, z, squared length), normalised
+    // after its points: the square roots and divisions then run two at a
+    // time, off the point loop's path.
+    std::vector<double> gradients(out.Normals ? static_cast<std::size_t>(words) * 64 * 4 : 0);
     SurfaceRanges written; // ranges of this range of blocks, merged at its end
     for (std::int64_t listed = a0; listed < a1; ++listed)
     {
@@ -984,7 +1027,9 @@ void GenerateBlocks(const Volume<T>& volume, const BlockRanges& ranges, Triangle
 
       // Points of the owned cut edges, in bit order (values read in place).
       const std::uint64_t* bits = plan.EdgeBits.data() + a * words;
-      std::int64_t pid = plan.PointOffset[a];
+      const std::int64_t firstPid = plan.PointOffset[a];
+      std::int64_t pid = firstPid;
+      double* gradient4 = gradients.data();
       for (int w = 0; w < words; ++w)
       {
         for (std::uint64_t m = bits[w]; m; m &= m - 1)
@@ -1035,20 +1080,15 @@ void GenerateBlocks(const Volume<T>& volume, const BlockRanges& ranges, Triangle
               g[axis] = v1 > v0 ? -1.0 : 1.0;
               len2 = 1;
             }
-            const double inv = 1.0 / std::sqrt(len2);
-            float* nn = out.Normals + 3 * pid;
-            for (int c = 0; c < 3; ++c)
-            {
-              nn[c] = static_cast<float>(g[c] * inv);
-            }
+            gradient4[0] = g[0];
+            gradient4[1] = g[1];
+            gradient4[2] = g[2];
+            gradient4[3] = len2;
+            gradient4 += 4;
           }
           if (out.Ranges)
           {
             written.Points.Add(x);
-            if (out.Normals)
-            {
-              written.Normals.Add(out.Normals + 3 * pid);
-            }
           }
           if (out.Scalars)
           {
@@ -1056,6 +1096,17 @@ void GenerateBlocks(const Volume<T>& volume, const BlockRanges& ranges, Triangle
           }
           ownIds[bit] = static_cast<IdType>(out.FirstPointId + pid);
           ++pid;
+        }
+      }
+      if (writePoints && out.Normals)
+      {
+        NormaliseGradients(gradients.data(), pid - firstPid, out.Normals + 3 * firstPid);
+        if (out.Ranges)
+        {
+          for (std::int64_t q = firstPid; q < pid; ++q)
+          {
+            written.Normals.Add(out.Normals + 3 * q);
+          }
         }
       }
       if (!writeTriangles)
