@@ -444,8 +444,8 @@ function startStream(m) {
   }
   const size = M.scalarTypes().find((t) => t.value === m.type).bytes;
   const length = size * m.dims[0] * m.dims[1] * m.dims[2];
-  // Zeros where the memory was in use before (volume.js's mallocZeros, which this classic worker
-  // cannot import): the part the heap has just grown by is zero already, and writing it would
+  // Zeros where the memory was in use before: the part the heap has just grown by is zero
+  // already (WebAssembly's new pages), and writing it would
   // hold the first frame. No point of it is read before its brick arrives (the BlockLOD core's
   // residency; the GPU scene takes the buffer after the last brick: WebViewer's
   // UpdateSceneVolume), so a view of the memory older than a pthread's growth costs nothing.
