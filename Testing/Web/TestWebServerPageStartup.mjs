@@ -148,11 +148,6 @@ async function open(query) {
   checks.check(timing.worker > 0 && timing.level0 < timing.worker && timing.manifest < timing.worker,
     "level 0 and the bricks' manifest asked for at " + Math.round(timing.level0) + " and " +
     Math.round(timing.manifest) + " ms, before the worker was ready (" + Math.round(timing.worker) + " ms)");
-  // Nor do they wait for this thread's module: the path and level come from the dataset and
-  // where the viewer draws (path.js's prefetchPath).
-  checks.check(timing.level0 < marks.module && timing.manifest < marks.module,
-    "level 0 and the bricks' manifest asked for before this thread's module ran (" +
-    Math.round(marks.module) + " ms)");
   const [first] = await page.evaluate(() => window.mediso.frames());
   checks.check(stats.levels.length > 0 && first && first.coarse.length === stats.levels.length &&
     first.coarse.every(Boolean) && first.triangles > 0,

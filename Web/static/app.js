@@ -44,13 +44,6 @@ import { countBytes, request, requestJSON, sessionToken } from "./volume.js";
 import { brickRanges, setupStream, stopStream, streamInfo, streamTimes, whenFull } from "./stream.js";
 
 async function start() {
-  // The page's start-up (docs/web.md): the datasets first (a WebGL2 context, the probe's, takes
-  // this thread a tenth of a second or more on a software renderer), then this thread's module
-  // and the worker's at once; once the dataset and where the viewer draws are known, the first
-  // requests of the stream the path will choose (level 0, the bricks' manifest), while both
-  // modules load.
-  const datasets = requestJSON("/api/datasets");
-  datasets.catch(() => {}); // awaited below
   const probe = document.createElement("canvas").getContext("webgl2");
   if (typeof WebAssembly !== "object" || !probe) {
     throw unsupported("This page computes isosurfaces in the browser with WebAssembly and WebGL2, " +
@@ -62,10 +55,15 @@ async function start() {
   if (params.get("budget")) {
     $("budget").value = params.get("budget");
   }
-  // Only the link's path is read here: its surfaces wait for the module's limit (below).
+  // The page's start-up (docs/web.md): the datasets, this thread's module and the worker's are
+  // asked for at once; once the dataset and the module's facts are known, the first requests of
+  // the stream the path will choose (level 0, the bricks' manifest), while the worker starts.
+  const datasets = requestJSON("/api/datasets");
+  datasets.catch(() => {}); // awaited below
   const prefetch = () => datasets.then((list) => {
     const d = list.datasets[0];
-    prefetchPath(d, readLink(location.hash, d.range, Infinity).path || state.requestedPath);
+    prefetchPath(d, readLink(location.hash, d.range, state.facts.maximumIsovalues).path ||
+      state.requestedPath);
   }).catch(() => {});
   if (!(await startViewer(canvas, probe, prefetch))) {
     throw unsupported("WebGL2 is here but cannot run the GPU path: " + state.viewer.error());

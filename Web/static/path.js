@@ -23,18 +23,16 @@ export function ordinal(n) {
 // The finest level of the volume a path can afford. GPU: the volume itself within the budget
 // (the core keeps a volume over the 3D texture limit or its GPU budget as bricks, only those the
 // isovalues cross on the GPU; where even those exceed its budget it says so at the frame, and
-// the page falls back: fallBackFromGPU below). CPU: the volume within its share. The dataset's
-// levels are the module's (the server's strides are the cores', TestWebPage_budget), so the
-// choice needs no module (prefetchPath, before it has loaded: no strides for the note then).
+// the page falls back: fallBackFromGPU below). CPU: the volume within its share.
 function chooseLevel(dataset, info, budgetMB, path) {
-  const strides = state.facts ? state.facts.levels.strides : null;
-  const full = dataset.levels.length - 1;
+  const { count, strides } = state.facts.levels;
+  const full = count - 1;
   for (let k = full; k >= 0; --k) {
     const level = dataset.levels[k];
     const d = level.dims;
     const bytes = path === "cpu" ? CPU_VOLUME_SHARE * level.bytes : level.bytes;
     if (bytes <= budgetMB * 1e6) {
-      const why = k === full || !strides ? "" :
+      const why = k === full ? "" :
         "The volume is sent at level " + k + " (every " + ordinal(strides[k]) + " point, " +
         d.join("x") + "): the full " + dataset.dims.join("x") + " volume exceeds the memory budget.";
       return { level: k, why };
@@ -73,8 +71,7 @@ function choosePath(requested, info, dataset, budgetMB) {
 /**
  * The page's start-up (app.js, docs/web.md): where the page will stream `dataset` (the path and
  * level applyPath will choose, the path asked for being `requested`), its first requests are
- * sent now, before the modules have loaded and the viewer is ready, and applyPath's stream
- * takes their answers.
+ * sent now, before the viewer is ready, and applyPath's stream takes their answers.
  */
 export function prefetchPath(dataset, requested) {
   const budgetMB = Number($("budget").value) || 1024;

@@ -59,11 +59,10 @@ function readFacts(M) {
  * Loads the module and makes its viewer on `canvas` (sized by the size=WIDTHxHEIGHT parameter
  * when given). `probe` is a WebGL2 context of the page's, which names the renderer. With the
  * viewer in a worker, the worker loads its module while this thread loads its own (the page's
- * start-up, docs/web.md); `placed` is called once where the viewer draws (state.remote) and
- * whether the renderer is a software one (state.software) are known, before either module has
- * loaded: the page's first requests need no more (app.js, path.js's prefetchPath).
+ * start-up, docs/web.md); `moduleLoaded` is called once this thread's module and state.facts
+ * are there, before the worker is waited for.
  */
-export async function startViewer(canvas, probe, placed = () => {}) {
+export async function startViewer(canvas, probe, moduleLoaded = () => {}) {
   // The viewer in a worker where the browser can draw WebGL2 there (?worker=0: on this thread).
   const inWorker = params.get("worker") !== "0" && offscreenWebGL2();
   // The canvas's size first: once handed to the worker, it is sized there.
@@ -88,10 +87,10 @@ export async function startViewer(canvas, probe, placed = () => {}) {
   const debug = probe.getExtension("WEBGL_debug_renderer_info");
   state.unmaskedRenderer = debug ? probe.getParameter(debug.UNMASKED_RENDERER_WEBGL) : "";
   state.software = /SwiftShader|llvmpipe|softpipe|Software/i.test(state.unmaskedRenderer);
-  placed();
   state.module = await loadModule(inWorker);
   state.facts = readFacts(state.module);
   performance.mark("mediso:module");
+  moduleLoaded();
   if (inWorker) {
     state.viewer = await RemoteViewer.start(launched, state.module, frameAnswered);
     performance.mark("mediso:worker");
