@@ -464,10 +464,10 @@ function startStream(m) {
   const size = M.scalarTypes().find((t) => t.value === m.type).bytes;
   const length = size * m.dims[0] * m.dims[1] * m.dims[2];
   // Zeros where the memory was in use before: the part the heap has just grown by is zero
-  // already (WebAssembly's new pages), and writing it would
-  // hold the first frame. No point of it is read before its brick arrives (the BlockLOD core's
-  // residency; the GPU scene takes the buffer after the last brick: WebViewer's
-  // UpdateSceneVolume), so a view of the memory older than a pthread's growth costs nothing.
+  // already (WebAssembly's new pages), and writing it would hold the first frame. No point of it
+  // is read before its brick arrives (the BlockLOD core's residency; the GPU scene takes the
+  // buffer after the last brick: WebViewer's UpdateSceneVolume), so a view of the memory older
+  // than a pthread's growth costs nothing.
   const setup = [performance.now()]; // the set-up's steps (streamTimes.setupMs)
   const end = M.HEAPU8.length;
   volumeBytes = M._malloc(length);

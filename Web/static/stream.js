@@ -198,7 +198,8 @@ export async function startStream(level) {
   state.values = coarse.values;
   state.grid = { dims: coarse.dims, spacing: coarse.spacing, origin: coarse.origin };
   state.level = 0;
-  const refused = await state.viewer.beginStream({ type: type.value, dims, spacing: d.levels[level].spacing, origin: coarse.origin, brick: manifest.brick,
+  const refused = await state.viewer.beginStream({ type: type.value, dims,
+    spacing: d.levels[level].spacing, origin: coarse.origin, brick: manifest.brick,
     coarse: { bytes: coarse.bytes, dims: coarse.dims, spacing: coarse.spacing, origin: coarse.origin } });
   if (refused) {
     // The GPU path's volume kept as bricks (over the texture limit or GPU budget) does not stream.
