@@ -128,11 +128,17 @@ async function open(query) {
   const workers = find(/\/static\/render-worker\.js/);
   const marks = await page.evaluate(() => ({
     created: performance.getEntriesByName("mediso:worker-created")[0]?.startTime,
-    module: performance.getEntriesByName("mediso:module")[0]?.startTime }));
+    module: performance.getEntriesByName("mediso:module")[0]?.startTime,
+    wasm: performance.getEntriesByName("mediso:worker-wasm")[0]?.startTime,
+    imported: performance.getEntriesByName("mediso:worker-imported")[0]?.startTime }));
   checks.check(worker && marks.created !== undefined && marks.module !== undefined &&
     marks.created < marks.module && workers.length === 1,
     "the render worker started by index.html (at " + Math.round(marks.created) + " ms), before this thread's module ran (" +
     Math.round(marks.module) + " ms), and its script asked for once (" + workers.length + ")");
+  // The worker's wasm asked for beside its module's script, not after it (the worker's clock).
+  checks.check(marks.wasm !== undefined && marks.imported !== undefined && marks.wasm < marks.imported,
+    "the worker's wasm asked for at " + Math.round(marks.wasm) + " ms, before its module's script had loaded (" +
+    Math.round(marks.imported) + " ms)");
   // Level 0 and the manifest against the worker's readiness (the page's own clock).
   const timing = await page.evaluate(() => ({
     worker: performance.getEntriesByName("mediso:worker")[0]?.startTime,

@@ -14,6 +14,7 @@
 import { lpsFromDrawnPoint, lpsFromDrawnVector, sceneView, vec } from "./orientation.js";
 import { crosshairInfo } from "./slices.js";
 import { state } from "./state.js";
+import { hasVolume } from "./volume.js";
 
 const PATHS = ["auto", "gpu", "cpu"];
 const hex = (color) => color.map((c) => Math.round(255 * c).toString(16).padStart(2, "0")).join("");
@@ -115,7 +116,7 @@ let timer = 0;
 export function scheduleLink() {
   clearTimeout(timer);
   timer = setTimeout(() => {
-    if (state.viewer && state.volumePointer) {
+    if (state.viewer && hasVolume()) {
       history.replaceState(history.state, "", writeLink());
     }
   }, 150);

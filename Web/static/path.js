@@ -5,7 +5,7 @@
 
 import { showPathNote } from "./readout.js";
 import { $, state } from "./state.js";
-import { loadVolume } from "./volume.js";
+import { hasVolume, loadVolume } from "./volume.js";
 import { canStream, prefetchStream, startStream, stopStream } from "./stream.js";
 import { renderNow } from "./viewer.js";
 
@@ -92,11 +92,12 @@ export async function applyPath() {
   showPathNote(choice.path, choice.why, choice.level.why);
   $("path").value = state.requestedPath;
   state.viewer.setPath(choice.path);
-  if (!state.volumePointer || (state.level !== choice.level.level && !state.stream) ||
+  const had = hasVolume();
+  if (!had || (state.level !== choice.level.level && !state.stream) ||
       (state.stream && (state.stream.level !== choice.level.level || choice.path !== state.stream.path))) {
     stopStream();
     // Streamed (stream.js: level 0 first, then the bricks) where the path allows it.
-    await (canStream(choice.path, choice.level.level) && !state.volumePointer
+    await (canStream(choice.path, choice.level.level) && !had
       ? startStream(choice.level.level) : loadVolume(choice.level.level));
   }
   const volumeBytes = state.dataset.levels[state.stream ? state.stream.level : state.level].bytes;

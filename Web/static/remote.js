@@ -167,12 +167,14 @@ export class RemoteViewer {
   }
 
   /**
-   * Streaming (stream.js): the full level's buffer at `pointer` in this thread's module (its
-   * bricks written as they come), and level 0 as the coarse volume; the worker allocates its own
-   * buffer. Resolves to "" or why the worker refused.
+   * Streaming (stream.js): a full level of `dims` (its bricks written as they come) in the
+   * worker's own buffer, and level 0 as the coarse volume. This thread has no copy of the level
+   * until the end (keepStreamedVolume); the CPU model's count finds none until then. Resolves to
+   * "" or why the worker refused.
    */
-  beginStream({ type, pointer, dims, spacing, origin, brick, coarse }) {
-    this.volume = { type, pointer, dims: [...dims] };
+  beginStream({ type, dims, spacing, origin, brick, coarse }) {
+    this.volume = null;
+    this.streamed = { type, dims: [...dims] };
     this.camera.setVolume(dims, spacing, origin);
     const id = this.nextId++;
     const uploaded = new Promise((resolve) => this.answers.set(id, resolve));
@@ -196,6 +198,13 @@ export class RemoteViewer {
     const bytes = new Promise((resolve) => this.answers.set(id, resolve));
     this.worker.postMessage({ op: "streamEnd", id });
     return bytes;
+  }
+  /**
+   * The streamed level's values, copied from endStream's bytes into this thread's module at
+   * `pointer` (stream.js): the CPU model's count reads them from now on.
+   */
+  keepStreamedVolume(pointer) {
+    this.volume = { ...this.streamed, pointer };
   }
   setCoarseValues(values) { this.call("setCoarseValues", values); }
 

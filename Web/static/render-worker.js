@@ -105,9 +105,9 @@ function post(message, transfer) {
 }
 
 // The worker's start-up (the page's marks "mediso:worker-*", docs/web.md "The page's start-up"):
-// this script running, index.html's load message in, the init message in, the module's script
-// loaded, the module compiled and instantiated (its wasm fetched), the viewer made (the WebGL2
-// context, the probe); the epoch's ms.
+// this script running, index.html's load message in, the module's wasm asked for, the init
+// message in, the module's script loaded, the module compiled and instantiated (its wasm
+// fetched), the viewer made (the WebGL2 context, the probe); the epoch's ms.
 const startup = { script: performance.timeOrigin + performance.now() };
 
 // The module (threaded or not), loading: begun by "load" (index.html starts this worker before
@@ -117,10 +117,29 @@ function load(base, threads) {
   if (!loading) {
     loading = (async () => {
       const name = threads ? "mediso-mt" : "mediso";
+      // The module's wasm asked for now, beside its script (which importScripts waits for), not
+      // after it: one round trip less on the first image's path (docs/web.md, "The first image
+      // at 30 Mbit/s: the third pass"). Compiled as it arrives, as the module would.
+      const wasm = fetch(base + name + ".wasm", { credentials: "same-origin" });
+      wasm.catch(() => {}); // said by instantiate's fallback
+      startup.wasm = now();
       importScripts(base + name + ".js");
       startup.imported = now();
       const create = threads ? self.createMedisoThreads : self.createMediso;
-      const module = await create({ locateFile: (f) => base + f, mainScriptUrlOrBlob: base + name + ".js" });
+      let failed = null;
+      const failure = new Promise((resolve, reject) => { failed = reject; });
+      const instantiate = (imports) => wasm
+        .then((response) => WebAssembly.instantiateStreaming(response, imports))
+        .catch(() => fetch(base + name + ".wasm", { credentials: "same-origin" })
+          .then((response) => response.arrayBuffer())
+          .then((bytes) => WebAssembly.instantiate(bytes, imports)));
+      const module = await Promise.race([failure, create({ locateFile: (f) => base + f,
+        mainScriptUrlOrBlob: base + name + ".js",
+        // Emscripten's hook: the exports come later, through `done`.
+        instantiateWasm: (imports, done) => {
+          instantiate(imports).then((result) => done(result.instance, result.module), failed);
+          return {};
+        } })]);
       startup.module = now();
       return module;
     })();
@@ -444,11 +463,11 @@ function startStream(m) {
   }
   const size = M.scalarTypes().find((t) => t.value === m.type).bytes;
   const length = size * m.dims[0] * m.dims[1] * m.dims[2];
-  // Zeros where the memory was in use before (volume.js's mallocZeros, which this classic worker
-  // cannot import): the part the heap has just grown by is zero already, and writing it would
-  // hold the first frame. No point of it is read before its brick arrives (the BlockLOD core's
-  // residency; the GPU scene takes the buffer after the last brick: WebViewer's
-  // UpdateSceneVolume), so a view of the memory older than a pthread's growth costs nothing.
+  // Zeros where the memory was in use before: the part the heap has just grown by is zero
+  // already (WebAssembly's new pages), and writing it would hold the first frame. No point of it
+  // is read before its brick arrives (the BlockLOD core's residency; the GPU scene takes the
+  // buffer after the last brick: WebViewer's UpdateSceneVolume), so a view of the memory older
+  // than a pthread's growth costs nothing.
   const setup = [performance.now()]; // the set-up's steps (streamTimes.setupMs)
   const end = M.HEAPU8.length;
   volumeBytes = M._malloc(length);

@@ -25,8 +25,9 @@ export const state = Object.seal({
   // app.js, once: the dataset shown (/api/datasets' first).
   dataset: null,
 
-  // volume.js: the fetched volume in the module's memory, its level, and the bytes the page
-  // moved (its requests, and the server panel's WebSocket frames counted through volume.js).
+  // volume.js: the fetched volume in the module's memory (0 while a stream is under way: stream.js
+  // puts the level there at its end), its level, and the bytes the page moved (its requests, and
+  // the server panel's WebSocket frames counted through volume.js).
   volumePointer: 0,
   level: null,
   // volume.js too: the page's own copy of the fetched level's values (a typed array of its

@@ -20,7 +20,7 @@ import { drawnLevel } from "./path.js";
 import { updateReadout } from "./readout.js";
 import { params, state } from "./state.js";
 import { afterFrame, beforeFrame, renderNow } from "./viewer.js";
-import { fetchLevel, levelURL, loadVolume, mallocZeros, prefetch, request, requestJSON,
+import { fetchLevel, hasVolume, levelURL, loadVolume, prefetch, request, requestJSON,
   typedValues } from "./volume.js";
 
 // Requests in flight at once (a browser opens 6 connections to a host over HTTP/1.1). Two made
@@ -187,19 +187,19 @@ export async function startStream(level) {
   performance.mark("mediso:level0");
   const type = coarse.type;
   const dims = manifest.dims;
-  const M = state.module;
-  const pointerBefore = state.volumePointer;
-  const kept = pointerBefore ? state.viewer.getView() : null;
-  if (pointerBefore) {
-    M._free(pointerBefore);
+  const kept = hasVolume() ? state.viewer.getView() : null;
+  if (state.volumePointer) {
+    state.module._free(state.volumePointer);
+    state.volumePointer = 0;
   }
-  state.volumePointer = mallocZeros(M, type.bytes * dims[0] * dims[1] * dims[2]);
-  // The page's own copy (slices, histogram) is level 0 until the full level has arrived.
+  // The page's own copy (slices, histogram) is level 0 until the full level has arrived; this
+  // thread's module has none of it until then (finish): allocating the full level here held the
+  // first image (docs/web.md, "The first image at 30 Mbit/s: the third pass").
   state.values = coarse.values;
   state.grid = { dims: coarse.dims, spacing: coarse.spacing, origin: coarse.origin };
   state.level = 0;
-  const refused = await state.viewer.beginStream({ type: type.value, pointer: state.volumePointer,
-    dims, spacing: d.levels[level].spacing, origin: coarse.origin, brick: manifest.brick,
+  const refused = await state.viewer.beginStream({ type: type.value, dims,
+    spacing: d.levels[level].spacing, origin: coarse.origin, brick: manifest.brick,
     coarse: { bytes: coarse.bytes, dims: coarse.dims, spacing: coarse.spacing, origin: coarse.origin } });
   if (refused) {
     // The GPU path's volume kept as bricks (over the texture limit or GPU budget) does not stream.
@@ -419,7 +419,14 @@ async function finish(s) {
   if (state.stream !== s) {
     return; // another volume since
   }
-  state.module.HEAPU8.set(bytes, state.volumePointer);
+  const M = state.module;
+  const pointer = M._malloc(bytes.length);
+  if (!pointer) {
+    throw new Error("no memory in this page's module for the level's " + bytes.length + " bytes");
+  }
+  M.HEAPU8.set(bytes, pointer);
+  state.volumePointer = pointer;
+  state.viewer.keepStreamedVolume(pointer);
   state.values = typedValues(bytes, s.type.name);
   state.grid = { dims: s.dims, spacing: state.dataset.levels[s.level].spacing,
     origin: state.grid.origin };

@@ -9,6 +9,7 @@ import { parsePLY } from "./ply.js";
 import { RemoteViewer, offscreenWebGL2 } from "./remote.js";
 import { updateReadout } from "./readout.js";
 import { params, state } from "./state.js";
+import { hasVolume } from "./volume.js";
 
 // Threads where the page is cross-origin isolated (the server sends the headers) and not
 // declined (?threads=0).
@@ -149,7 +150,7 @@ export function fitCanvas(canvas) {
       return;
     }
     state.viewer.resize(width, height);
-    if (state.volumePointer) {
+    if (hasVolume()) {
       renderNow();
     }
   };

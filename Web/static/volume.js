@@ -123,18 +123,11 @@ export async function fetchLevel(level) {
 }
 
 /**
- * `length` bytes of zeros in module `M`'s memory (malloc'd: the caller frees them). The part of
- * them the heap has just grown by is zero already (WebAssembly's new pages) and is not written
- * again: a streamed level's buffer (stream.js) would otherwise be hundreds of MB of zeros
- * written before the first frame (the page's start-up, docs/web.md).
+ * Whether the viewer has been given a volume: a fetched level, or a stream's level 0 (whose full
+ * level reaches this thread's module only at its end: state.volumePointer is 0 until then).
  */
-export function mallocZeros(M, length) {
-  const end = M.HEAPU8.length; // the memory's size before the malloc
-  const at = M._malloc(length);
-  if (at && at < end) {
-    M.HEAPU8.fill(0, at, Math.min(end, at + length));
-  }
-  return at;
+export function hasVolume() {
+  return state.grid !== null;
 }
 
 /** The URL of level `level` of dataset `d` (kept by the browser: request it with "no-cache"). */
@@ -161,19 +154,18 @@ export async function loadVolume(level) {
 
 // The level's values (little-endian bytes) into the page's copy and the module's memory.
 async function putVolume(type, typeName, dims, spacing, origin, bytes, level) {
+  // The module resets its camera with a new volume; another level of the same volume keeps the
+  // view the user has.
+  const kept = hasVolume() ? state.viewer.getView() : null;
   state.values = typedValues(bytes, typeName);
   state.grid = { dims, spacing, origin };
   const M = state.module;
-  const pointerBefore = state.volumePointer;
   if (state.volumePointer) {
     M._free(state.volumePointer);
   }
   state.volumePointer = M._malloc(bytes.length);
   M.HEAPU8.set(bytes, state.volumePointer);
   state.level = level;
-  // The module resets its camera with a new volume; another level of the same volume keeps the
-  // view the user has.
-  const kept = pointerBefore ? state.viewer.getView() : null;
   if (!state.viewer.setVolume(type.value, state.volumePointer, dims, spacing, origin)) {
     throw new Error("the volume cannot be uploaded: " + state.viewer.stats().error);
   }
