@@ -399,12 +399,23 @@ std::vector<std::uint16_t> VolumeTiles::ActiveRectangles(
   const auto tiles = layout.TileCounts();
   const auto packed = layout.Packed(1);
   const std::size_t perSlice = static_cast<std::size_t>(tiles[0]) * tiles[1];
-  // Per slice, in parallel; then joined in slice order.
+  // Per slice, in tasks of whole slices of at least MinimumTilesPerTask tiles;
+  // then joined in slice order. A host's parallel for may start a thread per
+  // task (mediso-render's ThreadedFor starts up to one per core at each
+  // call), which costs more than scanning a brick's few thousand tiles: a
+  // bricked volume's update scans each of its bricks in turn, on the calling
+  // thread, where one task per slice started threads for every brick.
+  const std::int64_t slicesPerTask = std::max<std::int64_t>(1,
+    static_cast<std::int64_t>(
+      (MinimumTilesPerTask + perSlice - 1) / std::max<std::size_t>(perSlice, 1)));
+  const std::int64_t tasks = (tiles[2] + slicesPerTask - 1) / slicesPerTask;
   std::vector<std::vector<std::uint16_t>> slices(static_cast<std::size_t>(tiles[2]));
   std::vector<std::uint64_t> counts(static_cast<std::size_t>(tiles[2]), 0);
-  SerialIfEmpty(parallel)(0, tiles[2],
-    [&](std::int64_t begin, std::int64_t end)
+  SerialIfEmpty(parallel)(0, tasks,
+    [&](std::int64_t firstTask, std::int64_t endTask)
     {
+      const std::int64_t begin = firstTask * slicesPerTask;
+      const std::int64_t end = std::min<std::int64_t>(endTask * slicesPerTask, tiles[2]);
       for (std::int64_t z = begin; z < end; ++z)
       {
         std::vector<std::uint16_t>& out = slices[z];

@@ -27,6 +27,7 @@
 #include "PyramidLayout.h"
 #include "ScalarTypes.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -121,10 +122,22 @@ public:
    * The level-1 pass's vertices for `thresholds` (of the volume's value
    * kind): per slice and row of tiles, each run of tiles whose range holds a
    * threshold, as two triangles in level-1 atlas texels (x, y pairs).
-   * @a tilesDrawn is the number of tiles they cover.
+   * @a tilesDrawn is the number of tiles they cover. `parallel` gets tasks
+   * of whole slices of at least MinimumTilesPerTask tiles: one task (on the
+   * calling thread, for a host whose parallel for runs a single task there)
+   * for a volume of fewer tiles, as a brick's.
    */
   std::vector<std::uint16_t> ActiveRectangles(const IsoThresholds& thresholds,
     const GLParallelFor& parallel, std::uint64_t& tilesDrawn) const;
+
+  /**
+   * The fewest tiles one task of ActiveRectangles() scans: 2^16. A tile's
+   * test is a few comparisons; starting and joining a thread costs about as
+   * much as tens of thousands of them (more on a loaded machine), and a
+   * brick of 120 points a side has 4096 tiles, scanned once per brick at
+   * every isovalue change of a bricked volume.
+   */
+  static constexpr std::size_t MinimumTilesPerTask = std::size_t(1) << 16;
 
   /// Whether tile t's range holds a threshold (t = x + tiles.x (y + tiles.y z)).
   bool IsActive(const IsoThresholds& thresholds, std::size_t t) const;
