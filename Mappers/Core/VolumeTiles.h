@@ -65,7 +65,8 @@ std::vector<unsigned char> PackVolumeRows(
  * inside the volume) of a volume of `volumePoints` points, into `packed`
  * (resized; storage it already has is reused, so that a caller packing one
  * brick after another allocates once): a brick's texture is cut out of the
- * host's volume and padded in one copy instead of two.
+ * host's volume and padded in one copy instead of two. Both hand `parallel`
+ * tasks of whole rows of at least VolumeTiles::MinimumPointsPerTask points.
  */
 void PackVolumeBox(const void* volume, const int volumePoints[3], const int extent[6],
   int bytesPerValue, const GLParallelFor& parallel, std::vector<unsigned char>& packed);
@@ -79,7 +80,9 @@ public:
    * read as the float data it becomes on the GPU, so pass it converted) on
    * `layout`'s tiles. An empty tile (padding cells only, or only NaN values)
    * gets least > greatest, which no threshold lies between; NaN values are
-   * left out (a cell with a NaN corner counts nothing anyway).
+   * left out (a cell with a NaN corner counts nothing anyway). `parallel`
+   * gets tasks of whole slices of tiles of at least MinimumPointsPerTask
+   * points.
    */
   void Compute(ScalarType type, const void* data, const int points[3], const PyramidLayout& layout,
     const GLParallelFor& parallel);
@@ -138,6 +141,16 @@ public:
    * every isovalue change of a bricked volume.
    */
   static constexpr std::size_t MinimumTilesPerTask = std::size_t(1) << 16;
+
+  /**
+   * The fewest points one task of Compute() (its slices of tiles) and of
+   * PackVolumeBox() / PackVolumeRows() (their rows) takes: 2^18, a fraction
+   * of a millisecond of copying or comparing, about what a thread's start
+   * and join cost. A brick of 56 points (59 a side with its apron, 205379
+   * points) is one task, one of 120 (123 a side) eight; a 512^3 volume has
+   * 512.
+   */
+  static constexpr std::size_t MinimumPointsPerTask = std::size_t(1) << 18;
 
   /// Whether tile t's range holds a threshold (t = x + tiles.x (y + tiles.y z)).
   bool IsActive(const IsoThresholds& thresholds, std::size_t t) const;

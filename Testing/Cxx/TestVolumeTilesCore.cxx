@@ -11,7 +11,9 @@
 //  - ActiveRectangles() covers exactly the active tiles' texels, and hands a
 //    host's parallel for one task for a brick's tiles (no thread started per
 //    brick at each isovalue change) and tasks of at least MinimumTilesPerTask
-//    tiles for a large volume, with the serial scan's rectangles.
+//    tiles for a large volume, with the serial scan's rectangles; Compute()
+//    and PackVolumeBox() hand it tasks of at least MinimumPointsPerTask
+//    points (one for a brick of 56 points), with the serial results.
 #include "MedicalTestUtilities.h"
 
 #include "IsoThresholds.h"
@@ -296,6 +298,48 @@ void CheckRectangleTasks(std::mt19937& random)
     static_cast<std::int64_t>((tiles + mediso::VolumeTiles::MinimumTilesPerTask - 1) /
       mediso::VolumeTiles::MinimumTilesPerTask);
   const std::uint64_t brickDrawn = serialDrawn;
+
+  // Compute() and PackVolumeBox() of a brick of 56 points (59 a side: one
+  // task) and of 120 (123 a side: 8 tasks of 9 slices of 2 x 123 x 123
+  // points, and of 2132 rows of 123 points), against the serial ones.
+  const int volumePoints[3] = { 130, 125, 124 };
+  const auto volume = RandomVolume<std::int16_t>(volumePoints, -1000.0, 1000.0, random);
+  const mediso::IsoThresholds two =
+    mediso::MakeIsoThresholds(mediso::ScalarType::Int16, { -300.0, 250.0 });
+  for (const int side : { 59, 123 })
+  {
+    const int boxPoints[3] = { side, side, side };
+    const int boxCells[3] = { side - 1, side - 1, side - 1 };
+    const int extent[6] = { 3, 2 + side, 1, side, 0, side - 1 };
+    const std::size_t points = static_cast<std::size_t>(side) * side * side;
+    const std::int64_t rowTasks = side == 59 ? 1 : 8;
+    std::vector<unsigned char> serialRows, taskedRows;
+    mediso::PackVolumeBox(volume.data(), volumePoints, extent, 2, {}, serialRows);
+    calls.clear();
+    mediso::PackVolumeBox(volume.data(), volumePoints, extent, 2, recording, taskedRows);
+    Check(calls.size() == 1 && calls[0] == std::make_pair(std::int64_t(0), rowTasks) &&
+        taskedRows == serialRows,
+      "PackVolumeBox() of " + std::to_string(points) + " points: " + std::to_string(rowTasks) +
+        " task(s) of whole rows, the serial copy");
+    const PyramidLayout boxLayout(boxCells);
+    mediso::VolumeTiles serialTiles, taskedTiles;
+    serialTiles.Compute(mediso::ScalarType::Int16, serialRows.data(), boxPoints,
+      4 * mediso::PackedVolumeWidth(side), boxLayout, {});
+    calls.clear();
+    taskedTiles.Compute(mediso::ScalarType::Int16, serialRows.data(), boxPoints,
+      4 * mediso::PackedVolumeWidth(side), boxLayout, recording);
+    bool same = calls.size() == 1 && calls[0] == std::make_pair(std::int64_t(0), rowTasks);
+    for (const mediso::IsoThresholds* t : { &thresholds, &two })
+    {
+      std::uint64_t a = 0, b = 0;
+      same = same &&
+        serialTiles.ActiveRectangles(*t, {}, a) == taskedTiles.ActiveRectangles(*t, {}, b) &&
+        a == b && a > 0;
+    }
+    Check(same,
+      "Compute() of " + std::to_string(points) + " points: " + std::to_string(rowTasks) +
+        " task(s) of whole slices, the serial ranges");
+  }
   calls.clear();
   const auto largeSerial = large.ActiveRectangles(thresholds, {}, serialDrawn);
   const auto largeTasked = large.ActiveRectangles(thresholds, recording, drawn);
