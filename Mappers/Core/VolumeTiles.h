@@ -144,11 +144,10 @@ public:
 
   /**
    * The fewest points one task of Compute() (its slices of tiles) and of
-   * PackVolumeBox() / PackVolumeRows() (their rows) takes: 2^18, a fraction
-   * of a millisecond of copying or comparing, about what a thread's start
-   * and join cost. A brick of 56 points (59 a side with its apron, 205379
-   * points) is one task, one of 120 (123 a side) eight; a 512^3 volume has
-   * 512.
+   * PackVolumeBox() / PackVolumeRows() (their rows) takes: 2^18, about as
+   * much copying or comparing as a thread's start and join costs. A brick
+   * of 56 points (59 a side with its apron, 205379 points) is one task, one
+   * of 120 (123 a side) eight; a 512^3 volume has 512.
    */
   static constexpr std::size_t MinimumPointsPerTask = std::size_t(1) << 18;
 
