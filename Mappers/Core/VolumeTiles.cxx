@@ -9,6 +9,24 @@ namespace mediso
 {
 namespace
 {
+// Runs body over items [0, items) through `parallel` in tasks of whole items
+// of at least `minimum` units (each item `unitsPerItem` units: a slice's
+// tiles, a row's points). A host's parallel for may start a thread per task
+// (mediso-render's ThreadedFor starts up to one per core at each call), which
+// costs more than a small volume's work: a brick's scan or copy, done for
+// each of a bricked volume's bricks in turn, then runs as one task.
+void ForInTasks(const GLParallelFor& parallel, std::int64_t items, std::size_t unitsPerItem,
+  std::size_t minimum, const std::function<void(std::int64_t, std::int64_t)>& body)
+{
+  const std::int64_t itemsPerTask = std::max<std::int64_t>(1,
+    static_cast<std::int64_t>(
+      (minimum + unitsPerItem - 1) / std::max<std::size_t>(unitsPerItem, 1)));
+  const std::int64_t tasks = (items + itemsPerTask - 1) / itemsPerTask;
+  parallel(0, tasks,
+    [&](std::int64_t firstTask, std::int64_t endTask)
+    { body(firstTask * itemsPerTask, std::min(endTask * itemsPerTask, items)); });
+}
+
 // out[2 t] the least and out[2 t + 1] the greatest point value of tile t's
 // real cells, as R (every value of T is exact in it).
 template<typename T, typename R>
@@ -27,7 +45,9 @@ void ComputeTileRanges(const T* data, const int points[3], std::size_t rowValues
   const R noneHigh = std::numeric_limits<R>::has_infinity ? -std::numeric_limits<R>::infinity()
                                                           : std::numeric_limits<R>::lowest();
   out.assign(2 * perSlice * tiles[2], R());
-  parallel(0, tiles[2],
+  const std::size_t pointsPerSlice =
+    static_cast<std::size_t>(points[0]) * points[1] * static_cast<std::size_t>(factor[2]);
+  ForInTasks(parallel, tiles[2], pointsPerSlice, VolumeTiles::MinimumPointsPerTask,
     [&](std::int64_t sliceBegin, std::int64_t sliceEnd)
     {
       std::vector<R> rowLow(tiles[0]), rowHigh(tiles[0]);
@@ -205,7 +225,8 @@ void PackVolumeBox(const void* volume, const int volumePoints[3], const int exte
   const std::int64_t rows = static_cast<std::int64_t>(points[1]) * points[2];
   packed.resize(outRow * static_cast<std::size_t>(rows));
   const unsigned char* in = static_cast<const unsigned char*>(volume);
-  SerialIfEmpty(parallel)(0, rows,
+  ForInTasks(SerialIfEmpty(parallel), rows, static_cast<std::size_t>(points[0]),
+    VolumeTiles::MinimumPointsPerTask,
     [&](std::int64_t begin, std::int64_t end)
     {
       for (std::int64_t r = begin; r < end; ++r)
@@ -399,10 +420,12 @@ std::vector<std::uint16_t> VolumeTiles::ActiveRectangles(
   const auto tiles = layout.TileCounts();
   const auto packed = layout.Packed(1);
   const std::size_t perSlice = static_cast<std::size_t>(tiles[0]) * tiles[1];
-  // Per slice, in parallel; then joined in slice order.
+  // Per slice, in tasks of whole slices of at least MinimumTilesPerTask tiles
+  // (a brick's scan at each isovalue change is one task); then joined in
+  // slice order.
   std::vector<std::vector<std::uint16_t>> slices(static_cast<std::size_t>(tiles[2]));
   std::vector<std::uint64_t> counts(static_cast<std::size_t>(tiles[2]), 0);
-  SerialIfEmpty(parallel)(0, tiles[2],
+  ForInTasks(SerialIfEmpty(parallel), tiles[2], perSlice, MinimumTilesPerTask,
     [&](std::int64_t begin, std::int64_t end)
     {
       for (std::int64_t z = begin; z < end; ++z)

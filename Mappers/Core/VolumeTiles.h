@@ -27,6 +27,7 @@
 #include "PyramidLayout.h"
 #include "ScalarTypes.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -64,7 +65,8 @@ std::vector<unsigned char> PackVolumeRows(
  * inside the volume) of a volume of `volumePoints` points, into `packed`
  * (resized; storage it already has is reused, so that a caller packing one
  * brick after another allocates once): a brick's texture is cut out of the
- * host's volume and padded in one copy instead of two.
+ * host's volume and padded in one copy instead of two. Both hand `parallel`
+ * tasks of whole rows of at least VolumeTiles::MinimumPointsPerTask points.
  */
 void PackVolumeBox(const void* volume, const int volumePoints[3], const int extent[6],
   int bytesPerValue, const GLParallelFor& parallel, std::vector<unsigned char>& packed);
@@ -78,7 +80,9 @@ public:
    * read as the float data it becomes on the GPU, so pass it converted) on
    * `layout`'s tiles. An empty tile (padding cells only, or only NaN values)
    * gets least > greatest, which no threshold lies between; NaN values are
-   * left out (a cell with a NaN corner counts nothing anyway).
+   * left out (a cell with a NaN corner counts nothing anyway). `parallel`
+   * gets tasks of whole slices of tiles of at least MinimumPointsPerTask
+   * points.
    */
   void Compute(ScalarType type, const void* data, const int points[3], const PyramidLayout& layout,
     const GLParallelFor& parallel);
@@ -121,10 +125,31 @@ public:
    * The level-1 pass's vertices for `thresholds` (of the volume's value
    * kind): per slice and row of tiles, each run of tiles whose range holds a
    * threshold, as two triangles in level-1 atlas texels (x, y pairs).
-   * @a tilesDrawn is the number of tiles they cover.
+   * @a tilesDrawn is the number of tiles they cover. `parallel` gets tasks
+   * of whole slices of at least MinimumTilesPerTask tiles: one task (on the
+   * calling thread, for a host whose parallel for runs a single task there)
+   * for a volume of fewer tiles, as a brick's.
    */
   std::vector<std::uint16_t> ActiveRectangles(const IsoThresholds& thresholds,
     const GLParallelFor& parallel, std::uint64_t& tilesDrawn) const;
+
+  /**
+   * The fewest tiles one task of ActiveRectangles() scans: 2^16. A tile's
+   * test is a few comparisons; starting and joining a thread costs about as
+   * much as tens of thousands of them (more on a loaded machine), and a
+   * brick of 120 points a side has 4096 tiles, scanned once per brick at
+   * every isovalue change of a bricked volume.
+   */
+  static constexpr std::size_t MinimumTilesPerTask = std::size_t(1) << 16;
+
+  /**
+   * The fewest points one task of Compute() (its slices of tiles) and of
+   * PackVolumeBox() / PackVolumeRows() (their rows) takes: 2^18, about as
+   * much copying or comparing as a thread's start and join costs. A brick
+   * of 56 points (59 a side with its apron, 205379 points) is one task, one
+   * of 120 (123 a side) eight; a 512^3 volume has 512.
+   */
+  static constexpr std::size_t MinimumPointsPerTask = std::size_t(1) << 18;
 
   /// Whether tile t's range holds a threshold (t = x + tiles.x (y + tiles.y z)).
   bool IsActive(const IsoThresholds& thresholds, std::size_t t) const;

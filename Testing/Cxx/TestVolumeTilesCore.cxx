@@ -8,7 +8,12 @@
 //    cells crosses one (a superset where the volume has NaN values, whose
 //    cells cross nothing), for several scalar types and shapes that fill no
 //    whole tile;
-//  - ActiveRectangles() covers exactly the active tiles' texels.
+//  - ActiveRectangles() covers exactly the active tiles' texels, and hands a
+//    host's parallel for one task for a brick's tiles (no thread started per
+//    brick at each isovalue change) and tasks of at least MinimumTilesPerTask
+//    tiles for a large volume, with the serial scan's rectangles; Compute()
+//    and PackVolumeBox() hand it tasks of at least MinimumPointsPerTask
+//    points (one for a brick of 56 points), with the serial results.
 #include "MedicalTestUtilities.h"
 
 #include "IsoThresholds.h"
@@ -22,6 +27,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace
@@ -240,11 +246,115 @@ std::vector<T> RandomVolume(const int points[3], double lo, double hi, std::mt19
       }
   return v;
 }
+// ActiveRectangles()'s tasks, as a host's parallel for receives them.
+void CheckRectangleTasks(std::mt19937& random)
+{
+  std::vector<std::pair<std::int64_t, std::int64_t>> calls;
+  const mediso::GLParallelFor recording =
+    [&calls](std::int64_t begin, std::int64_t end,
+      const std::function<void(std::int64_t, std::int64_t)>& body)
+  {
+    calls.emplace_back(begin, end);
+    for (std::int64_t task = begin; task < end; ++task)
+    {
+      body(task, task + 1);
+    }
+  };
+  const mediso::IsoThresholds thresholds =
+    mediso::MakeIsoThresholds(mediso::ScalarType::Int16, { 0.0 });
+
+  // A brick of 120 points with its apron (123 a side): 8 x 8 x 64 tiles, one task.
+  const int brickPoints[3] = { 123, 123, 123 };
+  const int brickCells[3] = { 122, 122, 122 };
+  const auto brick = RandomVolume<std::int16_t>(brickPoints, -1000.0, 1000.0, random);
+  const PyramidLayout brickLayout(brickCells);
+  mediso::VolumeTiles brickTiles;
+  brickTiles.Compute(mediso::ScalarType::Int16, brick.data(), brickPoints, brickLayout, {});
+  std::uint64_t serialDrawn = 0, drawn = 0;
+  const auto serial = brickTiles.ActiveRectangles(thresholds, {}, serialDrawn);
+  const auto tasked = brickTiles.ActiveRectangles(thresholds, recording, drawn);
+  Check(calls.size() == 1 && calls[0] == std::make_pair(std::int64_t(0), std::int64_t(1)) &&
+      tasked == serial && drawn == serialDrawn && drawn > 0,
+    "a brick's " + std::to_string(brickTiles.GetNumberOfTiles()) +
+      " tiles are scanned as one task (" + std::to_string(calls.size()) + " calls, the first [" +
+      (calls.empty() ? std::string("-")
+                     : std::to_string(calls[0].first) + ", " + std::to_string(calls[0].second)) +
+      "))");
+
+  // A volume of 1024 x 1024 x 256 cells: 64 x 64 tiles a slice, 128 slices,
+  // 2^19 tiles: 8 tasks of 16 slices, the brick's tiles placed across them.
+  const int cells[3] = { 1024, 1024, 256 };
+  const PyramidLayout layout(cells);
+  mediso::VolumeTiles large;
+  large.Reset(mediso::ScalarType::Int16, layout);
+  const int count[3] = { 8, 8, 64 };
+  for (const int z : { 0, 30, 64 })
+  {
+    const int origin[3] = { 4 * z % 56, 56 - z % 56, z }; // apart in x and y
+    large.Place(&brickTiles, origin, count);
+  }
+  const std::size_t tiles = large.GetNumberOfTiles();
+  const std::int64_t tasks =
+    static_cast<std::int64_t>((tiles + mediso::VolumeTiles::MinimumTilesPerTask - 1) /
+      mediso::VolumeTiles::MinimumTilesPerTask);
+  const std::uint64_t brickDrawn = serialDrawn;
+
+  // Compute() and PackVolumeBox() of a brick of 56 points (59 a side: one
+  // task) and of 120 (123 a side: 8 tasks of 9 slices of 2 x 123 x 123
+  // points, and of 2132 rows of 123 points), against the serial ones.
+  const int volumePoints[3] = { 130, 125, 124 };
+  const auto volume = RandomVolume<std::int16_t>(volumePoints, -1000.0, 1000.0, random);
+  const mediso::IsoThresholds two =
+    mediso::MakeIsoThresholds(mediso::ScalarType::Int16, { -300.0, 250.0 });
+  for (const int side : { 59, 123 })
+  {
+    const int boxPoints[3] = { side, side, side };
+    const int boxCells[3] = { side - 1, side - 1, side - 1 };
+    const int extent[6] = { 3, 2 + side, 1, side, 0, side - 1 };
+    const std::size_t points = static_cast<std::size_t>(side) * side * side;
+    const std::int64_t rowTasks = side == 59 ? 1 : 8;
+    std::vector<unsigned char> serialRows, taskedRows;
+    mediso::PackVolumeBox(volume.data(), volumePoints, extent, 2, {}, serialRows);
+    calls.clear();
+    mediso::PackVolumeBox(volume.data(), volumePoints, extent, 2, recording, taskedRows);
+    Check(calls.size() == 1 && calls[0] == std::make_pair(std::int64_t(0), rowTasks) &&
+        taskedRows == serialRows,
+      "PackVolumeBox() of " + std::to_string(points) + " points: " + std::to_string(rowTasks) +
+        " task(s) of whole rows, the serial copy");
+    const PyramidLayout boxLayout(boxCells);
+    mediso::VolumeTiles serialTiles, taskedTiles;
+    serialTiles.Compute(mediso::ScalarType::Int16, serialRows.data(), boxPoints,
+      4 * mediso::PackedVolumeWidth(side), boxLayout, {});
+    calls.clear();
+    taskedTiles.Compute(mediso::ScalarType::Int16, serialRows.data(), boxPoints,
+      4 * mediso::PackedVolumeWidth(side), boxLayout, recording);
+    bool same = calls.size() == 1 && calls[0] == std::make_pair(std::int64_t(0), rowTasks);
+    for (const mediso::IsoThresholds* t : { &thresholds, &two })
+    {
+      std::uint64_t a = 0, b = 0;
+      same = same &&
+        serialTiles.ActiveRectangles(*t, {}, a) == taskedTiles.ActiveRectangles(*t, {}, b) &&
+        a == b && a > 0;
+    }
+    Check(same,
+      "Compute() of " + std::to_string(points) + " points: " + std::to_string(rowTasks) +
+        " task(s) of whole slices, the serial ranges");
+  }
+  calls.clear();
+  const auto largeSerial = large.ActiveRectangles(thresholds, {}, serialDrawn);
+  const auto largeTasked = large.ActiveRectangles(thresholds, recording, drawn);
+  Check(calls.size() == 1 && calls[0] == std::make_pair(std::int64_t(0), tasks) && tasks > 1 &&
+      largeTasked == largeSerial && drawn == serialDrawn && drawn == 3 * brickDrawn,
+    std::to_string(tiles) + " tiles are scanned in " + std::to_string(tasks) +
+      " tasks of at least " + std::to_string(mediso::VolumeTiles::MinimumTilesPerTask) +
+      " tiles, with the serial scan's rectangles");
+}
 } // namespace
 
 int main()
 {
   std::mt19937 random(7);
+  CheckRectangleTasks(random);
   const int shapes[][3] = { { 2, 2, 2 }, { 5, 3, 2 }, { 41, 37, 33 }, { 70, 19, 6 },
     { 18, 66, 9 } };
   for (const auto& points : shapes)
