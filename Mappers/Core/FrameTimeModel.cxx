@@ -856,7 +856,7 @@ double FrameTimeModel::PredictFor(const Candidate& candidate, bool wholeFrame) c
 }
 
 std::size_t FrameTimeModel::ChooseHeld(const std::vector<Candidate>& candidates,
-  double budgetSeconds, std::size_t held, bool wholeFrame) const
+  double budgetSeconds, std::size_t held, bool wholeFrame, bool finer) const
 {
   if (held >= candidates.size())
   {
@@ -870,11 +870,14 @@ std::size_t FrameTimeModel::ChooseHeld(const std::vector<Candidate>& candidates,
   // -1 in 19 frames, a flickering picture). Why one step finer: a candidate
   // far from every frame drawn is the fit's extrapolation along counts those
   // frames hardly varied (the same drag's level 0 at every pixel, predicted
-  // at 85 ms from frames at distances 4 to 8, took 633 ms).
+  // at 85 ms from frames at distances 4 to 8, took 633 ms). Why no step finer
+  // after a step coarser (the host's `finer`): on a loaded machine a step
+  // finer predicted within the band took 2-5x its prediction, the next frame
+  // went back, and the drag went up and down between distances 2 and 6.
   const double predicted = this->PredictFor(candidates[held], wholeFrame);
   if (predicted <= budgetSeconds * (1.0 + HoldMargin))
   {
-    if (held > 0 &&
+    if (finer && held > 0 &&
       this->PredictFor(candidates[held - 1], wholeFrame) <= budgetSeconds / (1.0 + HoldMargin))
     {
       return held - 1;

@@ -271,13 +271,16 @@ public:
   /// The next frame of a drag whose last frame drew candidates[held] (Choose()
   /// or, with `wholeFrame`, ChooseWholeFrame(), where `held` is not an index
   /// of `candidates`): the held candidate stays while its prediction is
-  /// within (1 + HoldMargin) x budgetSeconds; the candidate just finer than
-  /// it is taken where predicted within budgetSeconds / (1 + HoldMargin);
-  /// past the margin, the first coarser candidate predicted within the
-  /// budget, else the last. One step finer at a time, because the candidate
-  /// next to the frames drawn is the one the model extrapolates least to.
+  /// within (1 + HoldMargin) x budgetSeconds; with `finer`, the candidate
+  /// just finer than it is taken where predicted within budgetSeconds / (1 +
+  /// HoldMargin); past the margin, the first coarser candidate predicted
+  /// within the budget, else the last. One step finer at a time, because the
+  /// candidate next to the frames drawn is the one the model extrapolates
+  /// least to; a host stops the steps finer (`finer` false) once its drag has
+  /// gone coarser: the finer candidate did not hold on this machine now, and
+  /// climbing back to it would flicker.
   std::size_t ChooseHeld(const std::vector<Candidate>& candidates, double budgetSeconds,
-    std::size_t held, bool wholeFrame) const;
+    std::size_t held, bool wholeFrame, bool finer) const;
 
 private:
   using Vector3 = std::array<double, 3>;

@@ -241,6 +241,7 @@ void GPUSession(const char* name, const std::vector<double>& noise, bool checkEr
   double slowest = 0.0;
   int switches = 0;
   std::size_t held = ~std::size_t(0);
+  bool finer = true; // until the drag goes coarser
   std::string listing;
   for (int move = 0; move < 20; ++move)
   {
@@ -258,8 +259,9 @@ void GPUSession(const char* name, const std::vector<double>& noise, bool checkEr
         candidates.push_back(c);
       }
     }
-    const std::size_t chosen = model.ChooseHeld(candidates, 0.1, held, true);
+    const std::size_t chosen = model.ChooseHeld(candidates, 0.1, held, true, finer);
     switches += move > 0 && chosen != held ? 1 : 0;
+    finer = finer && !(move > 0 && chosen > held);
     held = chosen;
     const FrameWork work = candidates[chosen].Work;
     if (work.BuildElements > 0)

@@ -943,10 +943,13 @@ public:
         }
       }
     }
+    const bool finer = held == candidates.size() || this->HeldChoice.Finer;
     const std::size_t chosen = !this->CPUPath && interactive
-      ? this->Times.ChooseHeld(candidates, budgetSeconds, held, wholeFrame)
+      ? this->Times.ChooseHeld(candidates, budgetSeconds, held, wholeFrame, finer)
       : wholeFrame ? this->Times.ChooseWholeFrame(candidates, budgetSeconds)
                    : this->Times.Choose(candidates, budgetSeconds);
+    // A drag that went coarser goes no finer again (ChooseHeld's `finer`).
+    this->HeldChoice.Finer = finer && !(held < candidates.size() && chosen > held);
     // The frame drawn next is this choice's (the worker draws it at once).
     this->HeldChoice.Level = candidates[chosen].Level;
     this->HeldChoice.SampleDistance = candidates[chosen].SampleDistance;
@@ -1669,6 +1672,7 @@ private:
     int Level = 0;
     float SampleDistance = 1.0f;
     std::uint64_t Frame = 0;
+    bool Finer = true; // the drag has not gone coarser
   } HeldChoice;
   // The one-off work of the frame being drawn (Finish() reports it), and what was drawn before.
   double FrameExtractSeconds = 0.0;
