@@ -348,6 +348,41 @@ void FrameTimeModel::Observe(const FrameWork& work, double seconds)
   }
 }
 
+void FrameTimeModel::Observe(const FrameWork& work, double seconds, double buildSeconds)
+{
+  if (!std::isfinite(buildSeconds) || buildSeconds < 0.0 || work.BuildElements == 0 ||
+    !std::isfinite(seconds) || seconds < 0.0 ||
+    (work.Method != FrameMethod::CellRasterisation && work.Method != FrameMethod::Triangles))
+  {
+    this->Observe(work, seconds);
+    return;
+  }
+  // Split where the host timed it: nothing of the build is left for the
+  // drawing's fit to take, and nothing of the drawing for the build's. An
+  // untimed build is split by the two fits' predictions instead, which a frame
+  // at a work the drawing fit has not seen cannot settle: on the page's GPU
+  // path every full-volume frame before a drag (each isovalue's refinement)
+  // built its pyramid, the one-off fit took its drawing as build, and a drag
+  // drew the full volume at a distance predicted at 76 ms that took 2.3 s
+  // (issue 30, docs/web.md, *The CT's GPU drag*).
+  const double build = std::min(buildSeconds, seconds);
+  FrameWork built;
+  built.Method = work.Method;
+  built.Translucent = work.Translucent;
+  built.Blended = work.Blended;
+  built.BuildElements = work.BuildElements;
+  OneOffFit& fit = this->OneOffs[MethodKey(work.Method)];
+  fit.Samples.push_back({ built, build, true });
+  while (fit.Samples.size() > OneOffHistoryLength)
+  {
+    fit.Samples.pop_front();
+  }
+  FrameWork rest = work;
+  rest.BuildElements = 0;
+  // Refits the one-off fit as well (the sample above is in it).
+  this->Observe(rest, seconds - build);
+}
+
 bool FrameTimeModel::OneOffTeachesDrawing(const FrameWork& work, double seconds) const
 {
   // A pair without a drawing frame yet learns from this one (else its next
@@ -367,8 +402,30 @@ bool FrameTimeModel::OneOffTeachesDrawing(const FrameWork& work, double seconds)
   // pair's prior), but never less than half its share in proportion to the
   // two predictions (one-off work predicted too long must not leave the
   // drawing nothing).
+  //
+  // And so does a frame that draws more primitives or more pixels than any
+  // drawing frame the pair keeps: the fit's prediction for it extrapolates
+  // from frames that never drew so much, so the share it leaves to the one-off
+  // work is a guess that this frame, the only one of its kind, would confirm.
+  // The page's GPU path drew its first full-volume translucent frame (skin
+  // over bone) with its program compiled, after only coarse-level frames of
+  // that pair: its 4 s were taken as 3.9 s of compile, the next program was
+  // predicted at seconds, and the full volume's drawing stayed at the coarse
+  // levels' extrapolation (issue 30).
   const Pair& pair = this->Pairs[Key(work)];
-  return pair.Samples.empty() || this->PredictDrawing(work) > seconds;
+  if (pair.Samples.empty() || this->PredictDrawing(work) > seconds)
+  {
+    return true;
+  }
+  const Vector3 counts = DrawingCounts(work);
+  for (const Sample& s : pair.Samples)
+  {
+    if (s.Counts[1] >= counts[1] && s.Counts[2] >= counts[2])
+    {
+      return false;
+    }
+  }
+  return true;
 }
 
 void FrameTimeModel::RefitOneOff(FrameMethod method)
@@ -381,7 +438,8 @@ void FrameTimeModel::RefitOneOff(FrameMethod method)
   std::deque<Sample> residuals;
   for (const OneOffSample& s : fit.Samples)
   {
-    residuals.push_back({ OneOffCounts(s.Work), s.Seconds - this->PredictDrawing(s.Work) });
+    residuals.push_back(
+      { OneOffCounts(s.Work), s.Timed ? s.Seconds : s.Seconds - this->PredictDrawing(s.Work) });
   }
   const Vector3 prior = AsVector(OneOffPrior(method));
   double scale = 1.0;
@@ -785,6 +843,50 @@ std::size_t FrameTimeModel::ChooseWholeFrame(
   for (std::size_t i = 0; i < candidates.size(); ++i)
   {
     if (this->Predict(candidates[i].Work) <= budgetSeconds)
+    {
+      return i;
+    }
+  }
+  return candidates.size() - 1;
+}
+
+double FrameTimeModel::PredictFor(const Candidate& candidate, bool wholeFrame) const
+{
+  return wholeFrame ? this->Predict(candidate.Work) : this->PredictDrawing(candidate.Work);
+}
+
+std::size_t FrameTimeModel::ChooseHeld(const std::vector<Candidate>& candidates,
+  double budgetSeconds, std::size_t held, bool wholeFrame, bool finer) const
+{
+  if (held >= candidates.size())
+  {
+    return wholeFrame ? this->ChooseWholeFrame(candidates, budgetSeconds)
+                      : this->Choose(candidates, budgetSeconds);
+  }
+  // Why a band and not the budget itself: the choice follows the model's
+  // predictions, which move with every frame observed, so a drag whose
+  // candidates sit near the budget switched on each frame's noise (the CT's
+  // GPU drag went through distances 4, 6, 8 and 1 and volume levels 0, 3 and
+  // -1 in 19 frames, a flickering picture). Why one step finer: a candidate
+  // far from every frame drawn is the fit's extrapolation along counts those
+  // frames hardly varied (the same drag's level 0 at every pixel, predicted
+  // at 85 ms from frames at distances 4 to 8, took 633 ms). Why no step finer
+  // after a step coarser (the host's `finer`): on a loaded machine a step
+  // finer predicted within the band took 2-5x its prediction, the next frame
+  // went back, and the drag went up and down between distances 2 and 6.
+  const double predicted = this->PredictFor(candidates[held], wholeFrame);
+  if (predicted <= budgetSeconds * (1.0 + HoldMargin))
+  {
+    if (finer && held > 0 &&
+      this->PredictFor(candidates[held - 1], wholeFrame) <= budgetSeconds / (1.0 + HoldMargin))
+    {
+      return held - 1;
+    }
+    return held;
+  }
+  for (std::size_t i = held + 1; i < candidates.size(); ++i)
+  {
+    if (this->PredictFor(candidates[i], wholeFrame) <= budgetSeconds)
     {
       return i;
     }

@@ -94,13 +94,25 @@
  * than nothing, so the drawing fit is wrong there): a first frame whose
  * one-off work was far over its prediction (a shader compile on a software
  * WebGL2) otherwise seeds a drawing fit many times too slow, which frames
- * that always make something (a level switched to) never correct.
+ * that always make something (a level switched to) never correct. And so
+ * does a frame that draws more primitives or pixels than any drawing frame
+ * of its pair: the split there is the fit's extrapolation, and the frame is
+ * the only news of that work. Where the host timed the build on its own (a
+ * GPU pyramid build ends in a read-back), it says so (Observe with
+ * buildSeconds) and nothing is split by prediction: the build is a one-off
+ * sample of its own and the rest of the frame a drawing sample (issue 30:
+ * every full-volume frame the page's GPU path drew before a drag built its
+ * pyramid, so the drawing fit had only coarse levels to extrapolate from).
  *
  * Choose() picks on the drawing alone: the level a drag can hold, whose
  * one-off work is paid once (choosing on the whole frame would keep a drag on
  * whatever level is already made, and never reach the finer one). A host
  * whose every candidate has to be made anyway (an isovalue's first answer)
- * uses ChooseWholeFrame().
+ * uses ChooseWholeFrame(). A drag's later frames use ChooseHeld(): the
+ * candidate drawn last is kept while its prediction is within HoldMargin of
+ * the budget, so that predictions moving by a frame's noise do not switch
+ * the picture's level or distance on every frame, and a drag goes finer one
+ * candidate at a time.
  *
  * Limits: a frame's time also depends on what the counts do not say (overdraw,
  * the depth complexity of translucent layers, caches, other load on the
@@ -204,6 +216,13 @@ public:
   /// folded into the fit for its method and translucency, or, when it did
   /// one-off work, into its method's one-off fit.
   void Observe(const FrameWork& work, double seconds);
+  /// The same for a frame whose BuildElements the host timed on their own,
+  /// to their end (`buildSeconds` of `seconds`: a GPU pyramid build that ends
+  /// in a read-back): the build is a one-off sample of its own, and the rest
+  /// of the frame is observed as a frame without it (a drawing sample where
+  /// it made nothing else). A `buildSeconds` that is negative or not finite,
+  /// or a frame that builds nothing: Observe(work, seconds).
+  void Observe(const FrameWork& work, double seconds, double buildSeconds);
   /// Predicted seconds for a frame, its one-off work included (before any
   /// frame of its method and translucency: its prior, scaled as another
   /// pair's frames scale theirs).
@@ -243,6 +262,26 @@ public:
   std::size_t ChooseWholeFrame(
     const std::vector<Candidate>& candidates, double budgetSeconds) const;
 
+  /// How far a held choice's prediction may leave the budget before a drag
+  /// gives it up, and how far within it the next finer candidate's must be
+  /// before a drag takes that: the accuracy the model is held to (issue 30:
+  /// within 25%). Inside that band a prediction does not say on which side
+  /// of the budget the frame will fall.
+  static constexpr double HoldMargin = 0.25;
+  /// The next frame of a drag whose last frame drew candidates[held] (Choose()
+  /// or, with `wholeFrame`, ChooseWholeFrame(), where `held` is not an index
+  /// of `candidates`): the held candidate stays while its prediction is
+  /// within (1 + HoldMargin) x budgetSeconds; with `finer`, the candidate
+  /// just finer than it is taken where predicted within budgetSeconds / (1 +
+  /// HoldMargin); past the margin, the first coarser candidate predicted
+  /// within the budget, else the last. One step finer at a time, because the
+  /// candidate next to the frames drawn is the one the model extrapolates
+  /// least to; a host stops the steps finer (`finer` false) once its drag has
+  /// gone coarser: the finer candidate did not hold on this machine now, and
+  /// climbing back to it would flicker.
+  std::size_t ChooseHeld(const std::vector<Candidate>& candidates, double budgetSeconds,
+    std::size_t held, bool wholeFrame, bool finer) const;
+
 private:
   using Vector3 = std::array<double, 3>;
   // A frame's three counts (the columns its coefficients multiply) and seconds.
@@ -263,6 +302,9 @@ private:
   {
     FrameWork Work;
     double Seconds = 0.0;
+    // Seconds of the one-off work alone, timed by the host (Observe with
+    // buildSeconds): no drawing to take off.
+    bool Timed = false;
   };
   struct OneOffFit
   {
@@ -293,9 +335,12 @@ private:
   void Refit(std::size_t key);
   void RefitOneOff(FrameMethod method);
   // Whether a frame with one-off work is also a sample of its pair's drawing:
-  // the pair has no drawing frame yet, or its drawing alone is predicted
-  // longer than the whole frame took.
+  // the pair has no drawing frame yet, its drawing alone is predicted longer
+  // than the whole frame took, or it draws more primitives or more pixels
+  // than any drawing frame the pair keeps.
   bool OneOffTeachesDrawing(const FrameWork& work, double seconds) const;
+  // The predicted drawing or whole frame of a candidate (Choose, ChooseWholeFrame).
+  double PredictFor(const Candidate& candidate, bool wholeFrame) const;
   // The robust, recency-weighted, non-negative fit of x in counts . x =
   // seconds, anchored to `anchor` scaled to the frames, relative to `prior`.
   static Vector3 Solve(const std::deque<Sample>& samples, const Vector3& prior,

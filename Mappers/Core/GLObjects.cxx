@@ -281,6 +281,7 @@ Program* ProgramCache::Get(const GLApi& gl, const std::string& defines, const st
   {
     return nullptr;
   }
+  ++this->Builds;
   return this->Programs.emplace(std::move(key), std::move(program)).first->second.get();
 }
 

@@ -23,6 +23,8 @@
 
 #include "GLApiFunctions.h"
 
+#include <cstdint>
+
 #include <map>
 #include <memory>
 #include <string>
@@ -97,9 +99,14 @@ public:
   Program* Get(const GLApi& gl, const std::string& defines, const std::string& vertex,
     const std::string& fragment, std::string& error);
   void Clear() { this->Programs.clear(); }
+  /// Programs this cache has built so far (a variant cleared and asked for again counts again):
+  /// the difference over a frame is what it compiled, one-off work a host's frame-time model
+  /// keeps apart from the drawing.
+  std::uint64_t GetBuilds() const { return this->Builds; }
 
 private:
   std::map<std::string, std::unique_ptr<Program>> Programs;
+  std::uint64_t Builds = 0;
 };
 
 /// A GL object name with its deleter.

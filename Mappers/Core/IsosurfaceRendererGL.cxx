@@ -578,6 +578,11 @@ IsosurfaceRendererGL::IsosurfaceRendererGL(std::shared_ptr<const GLApi> gl)
 
 IsosurfaceRendererGL::~IsosurfaceRendererGL() = default;
 
+std::uint64_t IsosurfaceRendererGL::GetProgramBuilds() const
+{
+  return this->Impl->Programs.GetBuilds();
+}
+
 void IsosurfaceRendererGL::Release()
 {
   this->Impl->ReleaseHitBuffers();

@@ -188,6 +188,10 @@ public:
   /// Frees every GL object (the context must be current).
   void Release();
 
+  /// Programs this renderer has compiled so far (each variant of the isosurface shaders and of
+  /// its passes, on its first use): what a frame compiled is the difference across it.
+  std::uint64_t GetProgramBuilds() const;
+
 private:
   // The frame drawn into the reduced target of width x height, then up to its viewport.
   bool RenderReduced(const std::vector<IsosurfacePiece>& pieces, const IsosurfaceFrame& frame,

@@ -1510,6 +1510,11 @@ std::uint64_t IsosurfaceScene::GetActivePairs(int level) const
     : 0;
 }
 
+std::uint64_t IsosurfaceScene::GetProgramBuilds() const
+{
+  return this->Impl->Renderer ? this->Impl->Renderer->GetProgramBuilds() : 0;
+}
+
 std::vector<double> IsosurfaceScene::GetBuiltValues(int level) const
 {
   const Internals& impl = *this->Impl;

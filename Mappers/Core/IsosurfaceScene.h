@@ -335,6 +335,10 @@ public:
    */
   std::vector<double> GetBuiltValues(int level) const;
 
+  /// Programs the scene's renderer has compiled so far (0 without a context): a host that
+  /// times its frames takes the difference across a frame as that frame's compiled programs.
+  std::uint64_t GetProgramBuilds() const;
+
   /**
    * A level's active pairs before it is built, from the volume's: a surface
    * crosses about 1 / stride^2 as many cells of stride^3 voxels (at least 1

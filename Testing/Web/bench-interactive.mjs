@@ -154,6 +154,13 @@ for (const path of config.paths) {
         steadyMs: later.steadyMs, dragPrepared: later.dragPrepared }]);
     }
     run.stats = await page.evaluate(() => window.mediso.stats());
+    // every frame the page drew (its log keeps the last 200), in order, as the frame-time model
+    // observed them: what each drew, its time, its pyramid build and its prediction
+    run.allFrames = ((await framesSince(page, { length: 0, seq: 0 })) || []).map((f) => ({
+      seq: f.seq, interactive: f.interactive, settled: f.settled, gpuLevel: f.gpuLevel, cpuLevel: f.cpuLevel,
+      sampleDistance: f.sampleDistance, primitives: f.primitives, triangles: f.triangles, ms: f.ms,
+      buildMs: f.buildMs, programsCompiled: f.programsCompiled, pyramidBuilt: f.pyramidBuilt, predictedMs: f.predictedMs,
+      values: f.values }));
     console.log(JSON.stringify({ page: name, path, first: median(run.changes.map((c) => c.firstMs)),
       drag: run.drag.frameMs, still: run.still ? run.still.frameMs : null, longest: run.longestTaskMs }));
     result.runs.push(run);

@@ -698,6 +698,7 @@ public:
     // cells of the pyramids it builds.
     this->FrameExtractSeconds = 0.0;
     this->FrameBuildCells = 0;
+    const std::uint64_t programsBefore = this->Scene ? this->Scene->GetProgramBuilds() : 0;
     std::string sceneError;
     if (!this->CPUPath && !this->UpdateSceneVolume(sceneError))
     {
@@ -803,6 +804,11 @@ public:
     }
     this->DrawnSampleDistance = sampled ? this->SampleDistance : 1.0;
     this->FrameDrawn = true;
+    this->FramePrograms = this->Scene ? this->Scene->GetProgramBuilds() - programsBefore : 0;
+    if (!this->Rehearsing)
+    {
+      ++this->FramesDrawn;
+    }
     this->LastFrameMs = emscripten_get_now() - start;
     return true;
   }
@@ -812,7 +818,9 @@ public:
   /// the one-off work it did (GPU path: the pyramids it built; CPU path: the
   /// estimator's seconds of its extraction and the triangles it uploaded;
   /// either: a program not compiled before, WarmKey),
-  /// which the model keeps apart from the drawing.
+  /// which the model keeps apart from the drawing. The GPU path's pyramid
+  /// build ends in a read-back, so its time (LastBuildMs) is the build's own
+  /// and is given with it: the model then learns the drawing from the rest.
   void Finish()
   {
     emscripten_webgl_make_context_current(this->Context);
@@ -833,7 +841,22 @@ public:
         work.BuildElements = this->FrameBuildCells;
       }
       work.Programs = this->Warm.insert(this->WarmKey(level, work)).second ? 1 : 0;
-      this->Times.Observe(work, seconds);
+      if (!this->CPUPath)
+      {
+        // What the GPU path compiled, as its renderer counts it: a frame of two surfaces compiles
+        // a variant per look (an opaque bone beside a translucent skin) that a level's first
+        // translucent frame did not, and a drawing sample of such a frame took a compile of
+        // seconds on SwiftShader as drawing (issue 30). Warm still predicts the candidates.
+        work.Programs = static_cast<std::uint32_t>(this->FramePrograms);
+      }
+      if (!this->CPUPath && work.BuildElements > 0)
+      {
+        this->Times.Observe(work, seconds, this->LastBuildMs / 1000.0);
+      }
+      else
+      {
+        this->Times.Observe(work, seconds);
+      }
     }
     this->FrameDrawn = false;
   }
@@ -851,7 +874,10 @@ public:
    * (1 to 8), else the coarse volume levels 2, 1 and 0 (strides 2, 4, 8) the
    * same way, then level -1 (stride 16: where level 0's primitives alone are
    * over the budget), from each level's active pairs (estimated from the full
-   * level's before its first frame). fullMs: the prediction of the full frame (level
+   * level's before its first frame); a drag's next frame keeps the candidate its
+   * last frame drew unless its prediction leaves the budget by the model's
+   * margin, and goes finer one candidate at a time (FrameTimeModel::ChooseHeld).
+   * fullMs: the prediction of the full frame (level
    * the memory allows, every pixel), which the page states when it is over.
    */
   val ChooseFrame(double budgetSeconds, bool interactive)
@@ -900,10 +926,34 @@ public:
       this->AddGPUCandidates(candidates);
     }
     // CPU path: the whole frame (the drawing, the extraction of the surfaces not cached, the
-    // upload of a level not shown). GPU path: ChooseOnWholeFrame.
+    // upload of a level not shown). GPU path: ChooseOnWholeFrame; a drag's frame holds the
+    // candidate its last frame drew (FrameTimeModel::ChooseHeld) where that frame was the one
+    // this chose and drew last (no still frame since: a new drag chooses afresh).
     const bool wholeFrame = this->ChooseOnWholeFrame(interactive);
-    const std::size_t chosen = wholeFrame ? this->Times.ChooseWholeFrame(candidates, budgetSeconds)
-                                          : this->Times.Choose(candidates, budgetSeconds);
+    std::size_t held = candidates.size();
+    if (!this->CPUPath && interactive && this->HeldChoice.Frame > 0 &&
+      this->HeldChoice.Frame == this->FramesDrawn)
+    {
+      for (std::size_t i = 0; i < candidates.size(); ++i)
+      {
+        if (candidates[i].Level == this->HeldChoice.Level &&
+          candidates[i].SampleDistance == this->HeldChoice.SampleDistance)
+        {
+          held = i;
+        }
+      }
+    }
+    const bool finer = held == candidates.size() || this->HeldChoice.Finer;
+    const std::size_t chosen = !this->CPUPath && interactive
+      ? this->Times.ChooseHeld(candidates, budgetSeconds, held, wholeFrame, finer)
+      : wholeFrame ? this->Times.ChooseWholeFrame(candidates, budgetSeconds)
+                   : this->Times.Choose(candidates, budgetSeconds);
+    // A drag that went coarser goes no finer again (ChooseHeld's `finer`).
+    this->HeldChoice.Finer = finer && !(held < candidates.size() && chosen > held);
+    // The frame drawn next is this choice's (the worker draws it at once).
+    this->HeldChoice.Level = candidates[chosen].Level;
+    this->HeldChoice.SampleDistance = candidates[chosen].SampleDistance;
+    this->HeldChoice.Frame = interactive ? this->FramesDrawn + 1 : 0;
     val out = val::object();
     out.set("level", candidates[chosen].Level);
     out.set("sampleDistance", candidates[chosen].SampleDistance);
@@ -1040,6 +1090,9 @@ public:
     // level's first frame) before drawing; a drag frame on a level made ahead (PrepareDragStep)
     // did not.
     stats.set("pyramidBuilt", this->FrameBuildCells > 0);
+    // The programs the last frame compiled (the GPU path's renderer; one-off work the frame-time
+    // model keeps apart from the drawing).
+    stats.set("programsCompiled", static_cast<double>(this->FramePrograms));
     stats.set("sampleDistance", this->DrawnSampleDistance);
     stats.set("pixels",
       static_cast<double>(this->Viewpoint.GetWidth()) * this->Viewpoint.GetHeight() /
@@ -1611,9 +1664,20 @@ private:
   FrameTimeModel Times; // this client's frames: the time each level or sample distance takes
   double FrameStart = 0.0;
   bool FrameDrawn = false; // a frame was drawn since the last Finish
+  std::uint64_t FramesDrawn = 0; // frames drawn (not PrepareDragStep's rehearsals)
+  // The GPU path's last interactive choice (ChooseFrame), held by the next drag frame where the
+  // frame drawn last (FramesDrawn) was that choice's.
+  struct
+  {
+    int Level = 0;
+    float SampleDistance = 1.0f;
+    std::uint64_t Frame = 0;
+    bool Finer = true; // the drag has not gone coarser
+  } HeldChoice;
   // The one-off work of the frame being drawn (Finish() reports it), and what was drawn before.
   double FrameExtractSeconds = 0.0;
   std::uint64_t FrameBuildCells = 0;
+  std::uint64_t FramePrograms = 0; // the GPU path's programs compiled by the last frame
   std::set<std::array<int, 3>> Warm;
   bool MeshesUploaded = false; // the last frame made or uploaded a CPU path surface
   bool Rehearsing = false;     // PrepareDragStep's rehearsal: drawn into Sampled only, never shown
