@@ -22,11 +22,10 @@ of their pixels, and the images differ (checked by hand: see docs/histopyramid.m
 import math
 import os
 import sys
-from array import array
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
-from medisorender import run_stats  # noqa: E402
+from medisorender import run_stats, write_short_volume  # noqa: E402
 
 check = Checks()
 SOFTWARE = ("llvmpipe", "softpipe", "swiftshader")
@@ -70,15 +69,8 @@ def slits(x, y, z):
 
 def write_volume(path, front, n=24):
     """`front` and the wall as one int16 field on n^3 points, 100 per point inside (iso 0)."""
-    values = array("h", (int(round(100 * max(WALL - z, front(x, y, z))))
-                         for z in range(n) for y in range(n) for x in range(n)))
-    if sys.byteorder != "little":
-        values.byteswap()
-    with open(path, "wb") as f:
-        f.write(("ObjectType = Image\nNDims = 3\nDimSize = %d %d %d\nElementType = MET_SHORT\n"
-                 "ElementSpacing = 1 1 1\nElementDataFile = LOCAL\n" % (n, n, n)).encode())
-        f.write(values.tobytes())
-    return path
+    return write_short_volume(
+        path, n, lambda x, y, z: int(round(100 * max(WALL - z, front(x, y, z)))))
 
 
 def render(binary, api, volume, options, mode, path):

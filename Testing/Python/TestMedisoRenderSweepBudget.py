@@ -19,10 +19,10 @@ import os
 import re
 import subprocess
 import sys
-from array import array
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402  (Testing/Python/checks.py)
+from medisorender import write_short_volume  # noqa: E402
 
 check = Checks()
 SWEEP = 9
@@ -30,14 +30,8 @@ BUDGET = "0.15"
 
 
 def write_radial(path, n):
-    values = array("h", (int(round(10 * math.sqrt(x * x + y * y + z * z)))
-                         for z in range(n) for y in range(n) for x in range(n)))
-    if sys.byteorder != "little":
-        values.byteswap()
-    with open(path, "wb") as f:
-        f.write(("ObjectType = Image\nNDims = 3\nDimSize = %d %d %d\nElementType = MET_SHORT\n"
-                 "ElementSpacing = 1 1 1\nElementDataFile = LOCAL\n" % (n, n, n)).encode())
-        f.write(values.tobytes())
+    return write_short_volume(
+        path, n, lambda x, y, z: int(round(10 * math.sqrt(x * x + y * y + z * z))))
 
 
 def run(binary, args):
