@@ -561,8 +561,9 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   // The budget is the whole frame's: the window's cost outside this mapper,
   // measured over its last frames, is taken off it (see Internals::Watch).
   impl.Watch(ren->GetRenderWindow());
-  const double budget = impl.Spread.BudgetLeft(impl.WindowCost.BudgetLeft(
-    this->InteractiveFrameBudget > 0.0 ? this->InteractiveFrameBudget : allocated));
+  const double frameBudget =
+    this->InteractiveFrameBudget > 0.0 ? this->InteractiveFrameBudget : allocated;
+  const double budget = impl.Spread.BudgetLeft(impl.WindowCost.BudgetLeft(frameBudget));
   int width = 0, height = 0;
   ren->GetTiledSize(&width, &height);
   bool translucent = false;
@@ -646,7 +647,8 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       impl.Model.Observe(work, this->LastMeasuredSeconds);
       if (interactive && !work.HasOneOff())
       {
-        impl.Spread.Observe(this->LastPredictedSeconds, this->LastMeasuredSeconds);
+        impl.Spread.Observe(
+          this->LastPredictedSeconds, this->LastMeasuredSeconds, frameBudget);
       }
     }
     impl.LevelTriangles[static_cast<std::size_t>(level)] =
@@ -744,7 +746,8 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       impl.Model.Observe(work, this->LastMeasuredSeconds);
       if (interactive && !work.HasOneOff())
       {
-        impl.Spread.Observe(this->LastPredictedSeconds, this->LastMeasuredSeconds);
+        impl.Spread.Observe(
+          this->LastPredictedSeconds, this->LastMeasuredSeconds, frameBudget);
       }
     }
     else

@@ -67,14 +67,18 @@ double FrameFixedCost::BudgetLeft(double budget) const
 }
 
 //------------------------------------------------------------------------------
-void FrameTimeSpread::Observe(double predictedSeconds, double measuredSeconds)
+void FrameTimeSpread::Observe(
+  double predictedSeconds, double measuredSeconds, double budgetSeconds)
 {
   if (!std::isfinite(predictedSeconds) || !std::isfinite(measuredSeconds) ||
     !(predictedSeconds > 0.0) || !(measuredSeconds > 0.0))
   {
     return;
   }
-  const double ratio = measuredSeconds / predictedSeconds;
+  const double scale = std::isfinite(budgetSeconds) && budgetSeconds > predictedSeconds
+    ? budgetSeconds
+    : predictedSeconds;
+  const double ratio = 1.0 + (measuredSeconds - predictedSeconds) / scale;
   if (!std::isfinite(ratio))
   {
     return;

@@ -137,6 +137,15 @@ private:
  * one that over-predicts keeps none. A stalled frame is one ratio of nine and
  * moves the quantile by one place.
  *
+ * An overrun is counted against the larger of the frame's prediction and
+ * the whole budget it was chosen under (Observe with `budgetSeconds`): a
+ * frame predicted at 2 ms that took 6 ms under a 160 ms budget overran by
+ * 4 ms, 2.5% of what the next frame may spend, not by 200%. Frames far
+ * inside their budget are where a timer's and a loaded machine's noise is
+ * largest as a ratio (a coarse frame of a drag that has just left a stall),
+ * and their ratios would otherwise halve the budget of the frames near it
+ * that follow.
+ *
  * Bad input: a ratio that is not finite and positive (a prediction or a time
  * not finite or not positive) is not observed; with none observed the margin
  * is 0 and the budget is returned as it is.
@@ -149,8 +158,12 @@ public:
   /// The quantile of the ratios the margin is taken at (three frames in four).
   static constexpr double Quantile = 0.75;
 
-  /// One interactive frame: its predicted and measured seconds (its drawing only).
-  void Observe(double predictedSeconds, double measuredSeconds);
+  /// One interactive frame: its predicted and measured seconds (its drawing
+  /// only), and the whole frame budget it was chosen under (before this
+  /// margin and the window's cost were taken off; 0: none, the prediction
+  /// alone). The kept ratio is 1 + (measured - predicted) / max(predicted,
+  /// budget).
+  void Observe(double predictedSeconds, double measuredSeconds, double budgetSeconds = 0.0);
 
   /// The measured overrun the next choice allows for (0: none, or no frame yet).
   double Margin() const;
