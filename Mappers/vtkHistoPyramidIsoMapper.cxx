@@ -378,6 +378,7 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   this->LastPredictedSeconds = 0.0;
   this->LastPredictedOneOffSeconds = 0.0;
   this->LastMeasuredSeconds = 0.0;
+  this->LastOneOffSeconds = 0.0;
   this->LastBudgetSeconds = 0.0;
 
   // Say a message once (per distinct text), as an error or a warning.
@@ -743,7 +744,18 @@ void vtkHistoPyramidIsoMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       }
       const std::pair<int, bool> key = Internals::GPUKey(this->LastLevel, chosenWork.Translucent);
       work.Programs = impl.Warm.insert(key).second ? 1 : 0;
-      impl.Model.Observe(work, this->LastMeasuredSeconds);
+      // The upload and builds end in a read-back, so the GPU path timed them
+      // on their own: the model takes them as one-off work and the rest as
+      // the frame's drawing, not split by its own predictions.
+      this->LastOneOffSeconds = gpu->GetLastOneOffSeconds();
+      if (work.BuildElements > 0)
+      {
+        impl.Model.Observe(work, this->LastMeasuredSeconds, this->LastOneOffSeconds);
+      }
+      else
+      {
+        impl.Model.Observe(work, this->LastMeasuredSeconds);
+      }
       if (interactive && !work.HasOneOff())
       {
         impl.Spread.Observe(
@@ -895,6 +907,7 @@ void vtkHistoPyramidIsoMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LastLevel: " << this->LastLevel << "\n";
   os << indent << "LastPredictedSeconds: " << this->LastPredictedSeconds << "\n";
   os << indent << "LastPredictedOneOffSeconds: " << this->LastPredictedOneOffSeconds << "\n";
+  os << indent << "LastOneOffSeconds: " << this->LastOneOffSeconds << "\n";
   os << indent << "LastMeasuredSeconds: " << this->LastMeasuredSeconds << "\n";
   os << indent << "LastBudgetSeconds: " << this->LastBudgetSeconds << "\n";
   os << indent << "WindowFixedSeconds: " << this->GetWindowFixedSeconds() << "\n";

@@ -23,6 +23,7 @@
 #include "IsosurfaceScene.h"
 
 #include <algorithm>
+#include <chrono>
 #include <functional>
 
 vtkStandardNewMacro(vtkOpenGLHistoPyramidIsosurfaces);
@@ -50,6 +51,7 @@ struct vtkOpenGLHistoPyramidIsosurfaces::Internals
   mediso::IsosurfaceScene Scene{ ParallelFor };
   std::vector<Plane> ClipPlanes; // world coordinates
   int VolumeLevel = 3;           // mediso::IsosurfaceFrame::Level of the next frame
+  double LastOneOffSeconds = 0.0; // GetLastOneOffSeconds()
 
   // Frees the scene's objects (the window's context must be current).
   void Release()
@@ -178,6 +180,12 @@ std::string vtkOpenGLHistoPyramidIsosurfaces::GetBrickPoolReason() const
 }
 
 //------------------------------------------------------------------------------
+double vtkOpenGLHistoPyramidIsosurfaces::GetLastOneOffSeconds() const
+{
+  return this->Impl->LastOneOffSeconds;
+}
+
+//------------------------------------------------------------------------------
 std::uint64_t vtkOpenGLHistoPyramidIsosurfaces::GetGPUMemoryBytes() const
 {
   return this->Impl->Scene.GetGPUMemoryBytes();
@@ -196,6 +204,7 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
   std::string& reason)
 {
   Internals& impl = *this->Impl;
+  impl.LastOneOffSeconds = 0.0;
   auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
   if (!renWin)
   {
@@ -222,6 +231,8 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
   volume.Data = scalars->GetVoidPointer(0);
   image->GetDimensions(volume.Dims);
   volume.Stamp = scalars->GetMTime();
+  const mediso::IsosurfaceSceneStats before = impl.Scene.GetStats();
+  const auto oneOffStart = std::chrono::steady_clock::now();
   if (!impl.Scene.SetVolume(volume, reason))
   {
     return false;
@@ -244,6 +255,13 @@ bool vtkOpenGLHistoPyramidIsosurfaces::RenderIsosurfaces(vtkRenderer* ren, vtkVo
   if (!impl.Scene.UpdateLevel(impl.VolumeLevel, reason))
   {
     return false;
+  }
+  const mediso::IsosurfaceSceneStats& after = impl.Scene.GetStats();
+  if (after.VolumeUploads != before.VolumeUploads || after.PyramidBuilds != before.PyramidBuilds ||
+    after.CoarseBuilds != before.CoarseBuilds)
+  {
+    impl.LastOneOffSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - oneOffStart).count();
   }
 
   // 2. The frame: cell-index space (0-based on the extent) to view and clip.

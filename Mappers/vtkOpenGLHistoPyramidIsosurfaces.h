@@ -118,6 +118,18 @@ public:
    */
   std::string GetBrickPoolReason() const;
 
+  /**
+   * Seconds the last RenderIsosurfaces() spent making what later frames
+   * reuse, before it drew: the volume's upload and the pyramids it built,
+   * timed to the builds' read-back of their totals (so the upload's GL work
+   * is done too). 0 when it made nothing (a camera move). The mapper gives
+   * it to its frame-time model with the frame, so the model learns the
+   * drawing from the rest of the frame and not by splitting it with its own
+   * predictions (mediso::FrameTimeModel::Observe with buildSeconds, as the
+   * page does).
+   */
+  double GetLastOneOffSeconds() const;
+
   /// GPU memory held for the volume (volume and pyramid), and the first-hit buffers.
   std::uint64_t GetGPUMemoryBytes() const;
   std::uint64_t GetFrameBufferBytes() const;

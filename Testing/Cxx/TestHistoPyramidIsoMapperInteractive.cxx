@@ -187,9 +187,20 @@ void CheckGPUScene(
   Check(mapper->GetInteractiveAdjust() && mapper->GetInteractiveFrameBudget() == 0.1,
     name + ": InteractiveAdjust on and a 0.1 s budget by default");
 
-  // Still frames: every pixel, timed and predicted.
+  // Still frames: every pixel, timed and predicted. The first uploads the
+  // volume and builds the pyramid, timed on their own for the model; the
+  // second makes nothing.
   scene.Render(StillRate);
+  std::printf("%s first frame: one-off %.4f s (build %.4f s) of %.4f s\n", name.c_str(),
+    mapper->GetLastOneOffSeconds(), mapper->GetLastBuildSeconds(),
+    mapper->GetLastMeasuredSeconds());
+  Check(mapper->GetLastOneOffSeconds() >= mapper->GetLastBuildSeconds() &&
+      mapper->GetLastBuildSeconds() > 0.0 &&
+      mapper->GetLastOneOffSeconds() <= mapper->GetLastMeasuredSeconds(),
+    name + ": the first frame's upload and build are timed apart, within the frame");
   const std::vector<unsigned char> still = scene.Render(StillRate);
+  Check(mapper->GetLastOneOffSeconds() == 0.0 && mapper->GetLastMeasuredSeconds() > 0.0,
+    name + ": a frame that makes nothing has no one-off seconds");
   std::printf("%s still: %s\n", name.c_str(), Describe(mapper).c_str());
   Check(mapper->GetLastRenderPath() == vtkHistoPyramidIsoMapper::GPUPath &&
       !mapper->GetLastInteractive() && mapper->GetLastSampleDistance() == 1.0 &&
