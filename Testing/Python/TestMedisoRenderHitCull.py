@@ -68,8 +68,8 @@ SLITS = (12, 9, 0.3)
 # the wall's cells (the edges of a bar are where its field crosses 0 between two planes of points,
 # so a gap needs no plane of points inside, as a slit does). Both depths lie in the pyramid's near
 # half (cells z >= 16 of 32), the wall in its far half, so the walk draws every bar before any wall
-# point, and the bars are over half the primitives: the wall's points in the last range are tested
-# against all of them. The gaps are 2, 3 and 2 cells apart, so that they do not all fall at the
+# point, and the bars are under three quarters of the primitives: the last range draws only wall
+# points, tested against all of the bars. The gaps are 2, 3 and 2 cells apart, so that they do not all fall at the
 # same place in the blocks of the coverage pyramid (cells 27 pixels wide).
 BARS = (20, 17, 0.6)
 GAPS = (7.5, 9.5, 12.5, 14.5)
