@@ -18,6 +18,13 @@ wide, the edges of the nearer surface, drawn mostly in the first range, cross th
 wall, drawn in the later ones. A cull that tests less than a point's whole square (its centre's
 block, one of its four blocks, a square half as wide) drops wall points that still show at some
 of their pixels, and the images differ (checked by hand: see docs/histopyramid.md).
+
+A fourth ("bars") shows the wall only through gaps narrower than a block of the coverage pyramid,
+each at the middle of a wall point, with everything around them covered. Its points are some 28
+pixels wide: the level the cull reads has 32-pixel blocks, the level below 16-pixel ones, so a
+point spans three columns of those and the middle column lies inside it, away from its edges. A
+cull that read the level below (its four corner blocks) finds the two outer columns covered and
+drops the wall points that show through a gap lying in a middle column.
 """
 import math
 import os
@@ -44,6 +51,7 @@ SCENES = {
     "balls_parallel": ("balls", ["--iso", "0", "--zoom", "3.5", "--parallel", "--azimuth", "-25",
                                  "--elevation", "15"]),
     "slits": ("slits", ["--iso", "0", "--zoom", "2.5"]),
+    "bars": ("bars", ["--iso", "0", "--zoom", "4.5", "--parallel"]),
 }
 # Volumes whose surface faces the camera (VTK's, looking down -z) with a wall behind: the
 # half-space z < WALL. The walk draws the nearer surface's points mostly in the first range and
@@ -55,6 +63,17 @@ WALL = 5.25
 BALLS = ((9.45, 12.15, 15.3, 5.4), (15.6, 9.3, 18.75, 3.45), (13.65, 16.5, 12.6, 3.15))
 PLATE = (16, 0.3)
 SLITS = (12, 9, 0.3)
+# "bars": bars along y, BARS[2] thick on either side of their mid-planes, alternately at z =
+# BARS[0] and BARS[1], whose edges leave, seen head on, gaps 2 GAP wide at x = GAPS: the middles of
+# the wall's cells (the edges of a bar are where its field crosses 0 between two planes of points,
+# so a gap needs no plane of points inside, as a slit does). Both depths lie in the pyramid's near
+# half (cells z >= 16 of 32), the wall in its far half, so the walk draws every bar before any wall
+# point, and the bars are under three quarters of the primitives: the last range draws only wall
+# points, tested against all of the bars. The gaps are 2, 3 and 2 cells apart, so that they do not all fall at the
+# same place in the blocks of the coverage pyramid (cells 27 pixels wide).
+BARS = (20, 17, 0.6)
+GAPS = (7.5, 9.5, 12.5, 14.5)
+GAP = 0.1
 
 
 def balls(x, y, z):
@@ -65,6 +84,12 @@ def balls(x, y, z):
 def slits(x, y, z):
     return min(PLATE[1] - abs(z - PLATE[0]), abs(x - SLITS[0]) - SLITS[2],
                abs(y - SLITS[1]) - SLITS[2])
+
+
+def bars(x, y, z):
+    edges = (-math.inf,) + tuple(e for g in GAPS for e in (g - GAP, g + GAP)) + (math.inf,)
+    return max(min(BARS[2] - abs(z - BARS[k % 2]), x - edges[2 * k], edges[2 * k + 1] - x)
+               for k in range(len(GAPS) + 1))
 
 
 def write_volume(path, front, n=24):
@@ -84,7 +109,7 @@ def main():
     binary, temp = sys.argv[1], sys.argv[2]
     os.makedirs(temp, exist_ok=True)
     volumes = {name: write_volume(os.path.join(temp, name + ".mha"), front)
-               for name, front in (("balls", balls), ("slits", slits))}
+               for name, front in (("balls", balls), ("slits", slits), ("bars", bars))}
     ran = False
     for api in ("es", "gl"):
         for name, (volume, options) in SCENES.items():
