@@ -11,6 +11,7 @@
 //   neighbour);
 // - an isovalue changed mid-stream (to the corner's blob) is drawn at once, and the next bricks
 //   asked for are the ones it needs, while others are still to come;
+// - the stream's first requests carry 1, 2, 4, ... bricks, up to the batch (the first answer sooner);
 // - whenFull() resolves with every surface at level 3 (before the whole level has come, where
 //   the surface needs fewer bricks), its surface made ahead as the bricks arrived (stats()'s
 //   takenAhead), then received reaches 1; the bytes of level 0 and the bricks on the wire are at
@@ -122,6 +123,10 @@ if (checks.check(info !== null, "the stream was still under way after the change
     "and not all of them (" + owed.length + " of " + need.size + " of " + total + ")");
   checks.check(asked.slice(0, owed.length).every((id) => need.has(id)),
     "after the change the next bricks asked for are those the new isovalue needs");
+  // The first requests ramp up to the batch (stream.js, FIRST_BATCH): request i carries at most 2^i bricks.
+  const sizes = info.requested.map((r) => r.ids.length);
+  checks.check(sizes.length >= 2 && sizes[0] === 1 && sizes[1] === 2 && sizes.every((n, i) => n <= 2 ** i),
+    "the first requests carry 1, 2, 4, ... bricks (" + sizes + ")");
 }
 
 const full = await page.evaluate(() => window.mediso.whenFull());

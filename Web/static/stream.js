@@ -33,6 +33,16 @@ const IN_FLIGHT = 6;
 // with the same isovalues (the first waits for the server's need: nextBatch), so their URLs are
 // too, and the browser keeps each answer as it keeps a level: a reload revalidates them (304).
 const BATCHES = 24;
+// Bricks in a stream's first request; each next request carries twice the one before, up to the
+// batch (BATCHES), then every request the batch (a slow start). Six full batches asked for
+// together shared the two cores (loopback) or the link, so the first answer came with the other
+// five, 0.4-0.9 s after asking, with the worker idle meanwhile (docs/web.md, The critical path
+// from level 0 to the full level). The worker writes a brick in about the time the server and
+// the browser deliver one (5-6 ms a brick each in the quiet trace), so an answer of
+// twice the bricks before it comes about when the worker has written those. The sizes depend only
+// on a request's place in the stream, so the batches stay the same at every load; the ramp costs
+// about log2(batch) requests more.
+const FIRST_BATCH = 1;
 
 /**
  * Whether the page streams level `level` on `path` (?stream=0: the whole level at once). Both
@@ -263,18 +273,19 @@ function begin(s, late = false) {
   fetchMore();
 }
 
-// The next batch: up to s.batch bricks the current isovalues need (those of the first value
-// first), else up to s.batch of the others in id order (none while a batch of needed bricks is
+// The next batch: up to `size` bricks the current isovalues need (those of the first value
+// first), else up to `size` of the others in id order (none while a batch of needed bricks is
 // still travelling: `othersToo` false); a batch does not mix the two, so that the last needed
-// bricks do not wait for others.
+// bricks do not wait for others. `size` is s.batch after the first requests' ramp (FIRST_BATCH).
 function nextBatch(s, othersToo) {
+  const size = Math.min(s.batch, FIRST_BATCH * 2 ** s.requested.length);
   const ids = [];
   for (const v of currentValues()) {
     for (const id of needed(s, v)) {
       if (s.pending.has(id)) {
         s.pending.delete(id);
         ids.push(id);
-        if (ids.length === s.batch) {
+        if (ids.length === size) {
           return ids;
         }
       }
@@ -284,7 +295,7 @@ function nextBatch(s, othersToo) {
     return ids;
   }
   for (const id of s.pending) {
-    if (ids.length === s.batch) {
+    if (ids.length === size) {
       break;
     }
     ids.push(id);
