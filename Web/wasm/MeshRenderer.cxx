@@ -7,7 +7,6 @@
 #include "WebShaders.h"
 
 #include <algorithm>
-#include <cstring>
 
 namespace mediso
 {
@@ -17,155 +16,13 @@ namespace
 {
 using namespace glcore;
 
-// A run of a mesh's triangles drawn with 16-bit indices counted from its
-// first point (the attributes are pointed there: WebGL2 has no base vertex).
-struct Chunk
-{
-  std::int64_t FirstTriangle = 0, Triangles = 0;
-  std::uint32_t FirstPoint = 0;
-};
-
 struct Mesh
 {
-  Name VertexArray, Vertices, Indices;
+  Name VertexArray, Points, Normals, Indices;
   std::int64_t Triangles = 0;
-  std::vector<Chunk> Chunks; // empty: one draw with 32-bit indices
-  // A point is Offset + Scale * its stored position (PackVertices).
-  float Offset[3] = { 0.0f, 0.0f, 0.0f };
-  float Scale[3] = { 1.0f, 1.0f, 1.0f };
   float Color[4] = { 1.0f, 1.0f, 1.0f, 1.0f };
   bool Visible = true;
 };
-// Bytes of a packed point: its position as four normalized 16-bit integers
-// (the fourth unused: four-component formats are the ones every Vulkan device
-// reads as vertex input, which ANGLE would otherwise convert), its normal as
-// four normalized signed bytes.
-constexpr int PackedPointBytes = 12;
-
-// Points and normals packed for the upload, interleaved: positions quantized
-// within the mesh's bounds (`mesh`'s Offset and Scale give them back), normals
-// at 8 bits a component. Half the bytes of three floats each: the upload and
-// the software rasteriser's vertex fetch are half as long. The quantization
-// step, 1/65535 of the mesh's extent, is far below a pixel.
-std::vector<std::uint8_t> PackVertices(
-  const float* points, const float* normals, std::int64_t numberOfPoints, Mesh& mesh)
-{
-  float low[3], high[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    low[a] = high[a] = points[a];
-  }
-  for (std::int64_t i = 0; i < 3 * numberOfPoints; i += 3)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      const float v = points[i + a];
-      low[a] = v < low[a] ? v : low[a];
-      high[a] = v > high[a] ? v : high[a];
-    }
-  }
-  float toStored[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    const float extent = high[a] - low[a];
-    mesh.Offset[a] = low[a];
-    mesh.Scale[a] = extent;
-    toStored[a] = extent > 0.0f ? 65535.0f / extent : 0.0f;
-  }
-  // Rounded by adding a half and truncating (std::lround is a library call per
-  // component).
-  std::vector<std::uint8_t> packed(static_cast<std::size_t>(numberOfPoints) * PackedPointBytes);
-  std::uint8_t* out = packed.data();
-  for (std::int64_t i = 0; i < 3 * numberOfPoints; i += 3, out += PackedPointBytes)
-  {
-    std::uint16_t position[4] = { 0, 0, 0, 0 };
-    std::int8_t normal[4] = { 0, 0, 0, 0 };
-    for (int a = 0; a < 3; ++a)
-    {
-      position[a] = static_cast<std::uint16_t>((points[i + a] - low[a]) * toStored[a] + 0.5f);
-      float n = 127.0f * normals[i + a];
-      n = n > 127.0f ? 127.0f : n < -127.0f ? -127.0f : n;
-      normal[a] = static_cast<std::int8_t>(n + (n >= 0.0f ? 0.5f : -0.5f));
-    }
-    std::memcpy(out, position, sizeof(position));
-    std::memcpy(out + sizeof(position), normal, sizeof(normal));
-  }
-  return packed;
-}
-
-// The most points a chunk spans: 16-bit indices 0..65534 (WebGL2 always
-// restarts primitives at 65535).
-constexpr std::uint32_t ChunkPoints = 65535;
-// More chunks than this (a mesh whose triangles jump across its points) are
-// drawn with 32-bit indices instead: each chunk is a draw call.
-constexpr std::size_t MaximumChunks = 4096;
-
-// The triangles cut, in their order, into chunks that each span at most
-// ChunkPoints points, and their indices rewritten as 16-bit offsets from their
-// chunk's first point: half the index bytes to upload and fetch. The
-// extraction writes each block's points together and its triangles after one
-// another, so a chunk holds many blocks. False (nothing written) where that
-// would take over MaximumChunks draws.
-bool ChunkIndices(const std::uint32_t* triangles, std::int64_t numberOfTriangles,
-  std::vector<Chunk>& chunks, std::vector<std::uint16_t>& indices)
-{
-  chunks.clear();
-  Chunk chunk;
-  std::uint32_t low = 0, high = 0;
-  for (std::int64_t t = 0; t < numberOfTriangles; ++t)
-  {
-    const std::uint32_t* v = triangles + 3 * t;
-    const std::uint32_t tl = std::min({ v[0], v[1], v[2] });
-    const std::uint32_t th = std::max({ v[0], v[1], v[2] });
-    if (th - tl >= ChunkPoints)
-    {
-      return false; // one triangle wider than a chunk
-    }
-    const std::uint32_t l = std::min(low, tl), h = std::max(high, th);
-    if (chunk.Triangles > 0 && h - l < ChunkPoints)
-    {
-      low = l;
-      high = h;
-      ++chunk.Triangles;
-      continue;
-    }
-    if (chunk.Triangles > 0)
-    {
-      chunk.FirstPoint = low;
-      chunks.push_back(chunk);
-      if (chunks.size() >= MaximumChunks)
-      {
-        return false;
-      }
-    }
-    chunk.FirstTriangle = t;
-    chunk.Triangles = 1;
-    low = tl;
-    high = th;
-  }
-  chunk.FirstPoint = low;
-  chunks.push_back(chunk);
-  indices.resize(3 * static_cast<std::size_t>(numberOfTriangles));
-  for (const Chunk& c : chunks)
-  {
-    for (std::int64_t i = 3 * c.FirstTriangle; i < 3 * (c.FirstTriangle + c.Triangles); ++i)
-    {
-      indices[i] = static_cast<std::uint16_t>(triangles[i] - c.FirstPoint);
-    }
-  }
-  return true;
-}
-
-// The vertex array's attributes pointed at `firstPoint` of the bound packed
-// vertex buffer.
-void PointAttributes(const GLApi::Functions& f, std::uint32_t firstPoint)
-{
-  const std::size_t at = static_cast<std::size_t>(firstPoint) * PackedPointBytes;
-  f.VertexAttribPointer(
-    0, 4, GL_UNSIGNED_SHORT, GL_TRUE, PackedPointBytes, reinterpret_cast<const void*>(at));
-  f.VertexAttribPointer(
-    1, 4, GL_BYTE, GL_TRUE, PackedPointBytes, reinterpret_cast<const void*>(at + 8));
-}
 } // namespace
 
 struct MeshRenderer::Internals
@@ -240,30 +97,22 @@ void MeshRenderer::SetMesh(int slot, const float* points, const float* normals,
   std::copy(color, color + 4, mesh->Color);
   mesh->Visible = visible;
   ScopedGLState saved(gl, 0);
-  const std::vector<std::uint8_t> packed = PackVertices(points, normals, numberOfPoints, *mesh);
   mesh->VertexArray = Name(gl, NameKind::VertexArray);
-  mesh->Vertices = Name(gl, NameKind::Buffer);
+  mesh->Points = Name(gl, NameKind::Buffer);
+  mesh->Normals = Name(gl, NameKind::Buffer);
   mesh->Indices = Name(gl, NameKind::Buffer);
   f.BindVertexArray(mesh->VertexArray.Get());
-  f.BindBuffer(GL_ARRAY_BUFFER, mesh->Vertices.Get());
-  f.BufferData(
-    GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(packed.size()), packed.data(), GL_STATIC_DRAW);
+  f.BindBuffer(GL_ARRAY_BUFFER, mesh->Points.Get());
+  f.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(12 * numberOfPoints), points, GL_STATIC_DRAW);
   f.EnableVertexAttribArray(0);
+  f.VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  f.BindBuffer(GL_ARRAY_BUFFER, mesh->Normals.Get());
+  f.BufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(12 * numberOfPoints), normals, GL_STATIC_DRAW);
   f.EnableVertexAttribArray(1);
-  PointAttributes(f, 0);
+  f.VertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
   f.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh->Indices.Get());
-  std::vector<std::uint16_t> shortIndices;
-  if (ChunkIndices(triangles, numberOfTriangles, mesh->Chunks, shortIndices))
-  {
-    f.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(2 * shortIndices.size()),
-      shortIndices.data(), GL_STATIC_DRAW);
-  }
-  else
-  {
-    mesh->Chunks.clear();
-    f.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(12 * numberOfTriangles),
-      triangles, GL_STATIC_DRAW);
-  }
+  f.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(12 * numberOfTriangles), triangles,
+    GL_STATIC_DRAW);
   f.BindVertexArray(0); // (the element buffer stays with the vertex array)
   mesh->Triangles = numberOfTriangles;
   impl.Meshes[slot] = std::move(mesh);
@@ -328,22 +177,8 @@ bool MeshRenderer::Render(const IsosurfaceFrame& frame, const matrix4::Matrix& w
         continue;
       }
       program->Set4f("color", mesh->Color);
-      program->Set3fv("positionOffset", 1, mesh->Offset);
-      program->Set3fv("positionScale", 1, mesh->Scale);
       f.BindVertexArray(mesh->VertexArray.Get());
-      if (mesh->Chunks.empty())
-      {
-        f.DrawElements(
-          GL_TRIANGLES, static_cast<GLsizei>(3 * mesh->Triangles), GL_UNSIGNED_INT, nullptr);
-        continue;
-      }
-      f.BindBuffer(GL_ARRAY_BUFFER, mesh->Vertices.Get());
-      for (const Chunk& chunk : mesh->Chunks)
-      {
-        PointAttributes(f, chunk.FirstPoint);
-        f.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * chunk.Triangles), GL_UNSIGNED_SHORT,
-          reinterpret_cast<const void*>(static_cast<std::size_t>(6 * chunk.FirstTriangle)));
-      }
+      f.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * mesh->Triangles), GL_UNSIGNED_INT, nullptr);
     }
   }
   glFrontFace(GL_CCW); // WebGL's default, which the rest of the page's drawing takes

@@ -4,8 +4,7 @@
  * @brief Triangle meshes on WebGL2 for the web page: the CPU path's surfaces
  * (the BlockLOD core's triangles) and the surfaces the server makes.
  *
- * Each mesh is uploaded once (positions and normals packed, 12 bytes a point:
- * PackVertices in MeshRenderer.cxx; 32-bit indices) and drawn
+ * Each mesh is uploaded once (positions, normals, 32-bit indices) and drawn
  * with Phong shading under the same lights and material as the GPU path's
  * isosurfaces, opaque meshes first, then translucent ones blended over them
  * (premultiplied, no depth writes). It uses the GPU core's GL table and
