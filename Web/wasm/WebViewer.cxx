@@ -1684,7 +1684,7 @@ private:
   std::uint64_t FramePrograms = 0; // the GPU path's programs compiled by the last frame
   std::set<std::array<int, 3>> Warm;
   bool MeshesUploaded = false; // the last frame made or uploaded a CPU path surface
-  // The part of the last frame's buildMs that packed and uploaded its CPU path surfaces
+  // The part of the last frame's buildMs that uploaded its CPU path surfaces
   // (MeshRenderer::SetMesh; the rest took them from the extraction).
   double LastUploadMs = 0.0;
   bool Rehearsing = false;     // PrepareDragStep's rehearsal: drawn into Sampled only, never shown
