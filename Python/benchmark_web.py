@@ -6,7 +6,8 @@
     python3 Python/benchmark_web.py --stream [--inputs ct512,phantom:512:noise=40] [--networks 30/40,loopback] [--warm]
     python3 Python/benchmark_web.py --startup [--inputs ct] [--networks 30/40,loopback]
     python3 Python/benchmark_web.py --bricks [--inputs ct] [--limits 200,200/24] [--sweep 6] [--stills 6]
-    python3 Python/benchmark_web.py --fullframe [--inputs ct512,phantom:512:noise=40] [--sizes 800x600,200x150] [--base-wasm DIR]
+    python3 Python/benchmark_web.py --fullframe [--inputs ct512,phantom:512:noise=40] [--sizes 800x600,200x150]
+        [--base-wasm [LABEL=]DIR,...]
 
 In one headless Chromium (Debian's, software WebGL2: SwiftShader), on the same volume and canvas
 size: the page's GPU path (the core on WebGL2), its CPU path (the BlockLOD core in WebAssembly at
@@ -689,8 +690,8 @@ def main_fullframe(args, argv):
     table = ["", "Still frames: all the surfaces, nothing uploaded (median of --stills). Upload: the surfaces "
              "set again after none (taken from the cache and uploaded: its buildMs, of which the upload's calls "
              "uploadMs; the frame; the still frame after it), twice. Each surface alone: still frames (median).", "",
-             "| input | canvas | module | triangles | still frame ms | upload: buildMs (uploadMs) / frame ms / next still ms "
-             "| each surface alone: value (opacity) triangles still ms |",
+             "| input | canvas | module | triangles | still frame ms | upload: buildMs (uploadMs) / frame ms / "
+             "next still ms | each surface alone: value (opacity) triangles still ms |",
              "|---|---|---|---:|---:|---|---|"]
     for name in args.inputs.split(","):
         urls = {}
