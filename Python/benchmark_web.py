@@ -6,6 +6,8 @@
     python3 Python/benchmark_web.py --stream [--inputs ct512,phantom:512:noise=40] [--networks 30/40,loopback] [--warm]
     python3 Python/benchmark_web.py --startup [--inputs ct] [--networks 30/40,loopback]
     python3 Python/benchmark_web.py --bricks [--inputs ct] [--limits 200,200/24] [--sweep 6] [--stills 6]
+    python3 Python/benchmark_web.py --fullframe [--inputs ct512,phantom:512:noise=40] [--sizes 800x600,200x150]
+        [--base-wasm [LABEL=]DIR,...]
 
 In one headless Chromium (Debian's, software WebGL2: SwiftShader), on the same volume and canvas
 size: the page's GPU path (the core on WebGL2), its CPU path (the BlockLOD core in WebAssembly at
@@ -50,6 +52,13 @@ pyramid (`?brickPool=0`), each in a fresh context in one Chromium (Testing/Web/b
 isovalue change to its full-level frame and the part of it that built the pyramids (medians over the
 sweep's isovalues, the first left out), a still frame (median, the camera turned 2 degrees each),
 and the primitives, bricks and pool slots. Inputs: ct, ct512 or phantom:N[:noise=HU].
+
+--fullframe (issue 31's full-level frame): the CPU path's frame of every surface at the full level,
+part by part, on the page with its level whole (Testing/Web/bench-fullframe.mjs), at each canvas
+size of --sizes: still frames (nothing uploaded), the surfaces uploaded again (the upload's own
+time, stats().uploadMs, and the frame), and each surface alone (a translucent one also opaque).
+--base-wasm LABEL=DIR,... times other WebAssembly modules against --wasm, pages alternated in one
+Chromium (an A/B of a change to the drawing: --before cannot, its page takes this tree's module).
 """
 import argparse
 import contextlib
@@ -127,6 +136,14 @@ def parse_args(argv):
                    help="the GPU path as one texture, from the brick pool and per brick (issue 31)")
     p.add_argument("--limits", default="200,200/24",
                    help="--bricks: forced texture limits, each optionally /GPU budget in MB")
+    p.add_argument("--fullframe", action="store_true",
+                   help="the CPU path's full-level frame, part by part (issue 31): still frames, the "
+                        "upload, each surface alone, at each of --sizes")
+    p.add_argument("--sizes", default="800x600,200x150", help="--fullframe: canvas sizes")
+    p.add_argument("--base-wasm", default="",
+                   help="--fullframe: other WebAssembly modules' folders, [LABEL=]DIR comma-separated "
+                        "(e.g. main's build-web/bin), timed against --wasm page by page in the same "
+                        "Chromium (all the surfaces only, not each alone)")
     return p.parse_args(argv)
 
 
@@ -657,8 +674,60 @@ def main_bricks(args, argv):
     return 0
 
 
+def main_fullframe(args, argv):
+    """The CPU path's full-level frame, part by part (Testing/Web/bench-fullframe.mjs), for the
+    module of --wasm and, with --base-wasm, another one, pages alternated in one Chromium."""
+    started = time.strftime("%Y-%m-%d %H:%M:%S")
+    load_before = load_average()
+    t0 = time.perf_counter()
+    modules = {}
+    for i, spec in enumerate(filter(None, args.base_wasm.split(","))):
+        label, _, folder = spec.rpartition("=")
+        modules[label or ("base" if i == 0 else "base%d" % i)] = folder
+    modules["this"] = args.wasm
+    lines = ["# The full-level frame on SwiftShader, part by part (issue 31)", "",
+             "- Command: `python3 Python/benchmark_web.py %s`" % " ".join(argv)]
+    table = ["", "Still frames: all the surfaces, nothing uploaded (median of --stills). Upload: the surfaces "
+             "set again after none (taken from the cache and uploaded: its buildMs, of which the upload's calls "
+             "uploadMs; the frame; the still frame after it), twice. Each surface alone: still frames (median).", "",
+             "| input | canvas | module | triangles | still frame ms | upload: buildMs (uploadMs) / frame ms / "
+             "next still ms | each surface alone: value (opacity) triangles still ms |",
+             "|---|---|---|---:|---:|---|---|"]
+    for name in args.inputs.split(","):
+        urls = {}
+        with contextlib.ExitStack() as stack:
+            for label, wasm in modules.items():
+                server_args = argparse.Namespace(**vars(args))
+                server_args.wasm = wasm
+                urls[label] = stack.enter_context(serving(server_args, name, {"page": ROOT}))["page"]
+            progress("%s: full frames, %s" % (name, args.sizes))
+            runs = run_script(work_folder(args, "fullframe-", name), "bench-fullframe.mjs",
+                              {"urls": urls, "sizes": [[int(v) for v in s.split("x")] for s in args.sizes.split(",")],
+                               "stills": args.stills or 4, "repeats": args.repeats,
+                               "each": not args.base_wasm})["runs"]
+        for run in runs:
+            table.append("| %s | %s | %s | %d | %.0f (%s) | %s | %s |" % (
+                name, "x".join(map(str, run["size"])), run["label"], run["draw"]["triangles"], run["draw"]["ms"],
+                ", ".join(map(str, run["draw"]["all"])),
+                "; ".join("%d (%d) / %d / %d" % (u["buildMs"], u.get("uploadMs", 0), u["ms"], u["next"])
+                          for u in run["upload"]),
+                "; ".join("%g (%g) %dk %.0f" % (e["value"], e["opacity"], e["draw"]["triangles"] / 1000,
+                                                e["draw"]["ms"]) for e in run["each"])))
+    lines += ["- Started %s, %.0f s; load average %s before, %s after; %d run(s) of each page" % (
+        started, time.perf_counter() - t0, load_before, load_average(), args.repeats),
+        "- Machine: nproc %d (%s); Chromium headless, SwiftShader; CPU path in the worker, the level whole "
+        "(`?stream=0`); modules: %s" % (os.cpu_count() or 0, cpu_model(),
+                                        ", ".join("%s `%s`" % kv for kv in modules.items()))]
+    write_report(lines + table, args.out)
+    return 0
+
+
 def main(argv):
     args = parse_args(argv)
+    if args.fullframe:
+        if args.inputs == "ct,ct512":
+            args.inputs = "ct512,phantom:512:noise=40"
+        return main_fullframe(args, argv)
     if args.bricks:
         if args.inputs == "ct,ct512":
             args.inputs = "ct"

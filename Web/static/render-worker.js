@@ -535,8 +535,8 @@ function writeBricks(m) {
 // benchmark's table of parts, docs/web.md): the bricks' decoding and their writing (WebViewer's
 // writeBrick: the copy into the volume, the BlockLOD residency and the extraction ahead), the
 // first and last batch, and each frame (when it began, its time, the part that made and uploaded
-// the surfaces, how many surfaces came from level 0). Times are timeOrigin + now(); the page
-// takes them from `begun`, the stream's start, which it saw answered.
+// the surfaces and the upload's own part of it, how many surfaces came from level 0). Times are
+// timeOrigin + now(); the page takes them from `begun`, the stream's start, which it saw answered.
 function now() {
   return performance.timeOrigin + performance.now();
 }
@@ -545,7 +545,7 @@ function noteStreamFrame(stats) {
   const t = streamTimes;
   if (t && !t.ended) {
     t.frames.push({ at: now() - stats.ms, ms: stats.ms, buildMs: stats.buildMs || 0,
-      triangles: stats.triangles || 0, coarse: (stats.coarse || []).filter(Boolean).length });
+      uploadMs: stats.uploadMs || 0, triangles: stats.triangles || 0, coarse: (stats.coarse || []).filter(Boolean).length });
   }
   if (t) {
     stats.streamTimes = Object.assign({}, t, { frames: t.frames.slice() });

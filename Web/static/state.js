@@ -81,5 +81,5 @@ export const state = Object.seal({
   surfaceLevels: [],
   received: 0,
   framesLogged: 0, // frames drawn since the page began: the newest frame's `seq`
-  frameLog: [], // the last 200 frames: [{seq, values, cpuLevel, triangles, primitives, sampleDistance, interactive, settled, ms, predictedMs, buildMs, programsCompiled}]
+  frameLog: [], // the last 200 frames: [{seq, values, cpuLevel, triangles, primitives, sampleDistance, interactive, settled, ms, predictedMs, buildMs, uploadMs, programsCompiled}]
 });

@@ -194,7 +194,7 @@ function recordFrame(ms, stats) {
     triangles: stats.triangles, primitives: stats.primitives, sampleDistance: state.sampleDistance,
     gpuLevel: state.gpuLevel,
     interactive: state.interactive, settled: stats.settled !== false, ms, predictedMs: stats.predictedMs || 0,
-    pyramidBuilt: !!stats.pyramidBuilt, buildMs: stats.buildMs || 0,
+    pyramidBuilt: !!stats.pyramidBuilt, buildMs: stats.buildMs || 0, uploadMs: stats.uploadMs || 0,
     programsCompiled: stats.programsCompiled || 0, answeredAt: performance.now(),
     surfaceValues: stats.surfaceValues || [], coarse: stats.coarse || [],
     surfaceTriangles: stats.surfaceTriangles || [] });

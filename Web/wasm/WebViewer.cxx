@@ -687,6 +687,7 @@ public:
     const double start = emscripten_get_now();
     this->FrameStart = start;
     this->MeshesUploaded = false;
+    this->LastUploadMs = 0.0;
     std::vector<double> values;
     for (const IsosurfaceLook& s : this->Frame.Surfaces)
     {
@@ -1086,6 +1087,7 @@ public:
     stats.set("footprint", std::string(this->Stats.PointFootprint ? "points" : "boxes"));
     stats.set("firstHit", this->Stats.FirstHit);
     stats.set("buildMs", this->LastBuildMs);
+    stats.set("uploadMs", this->LastUploadMs);
     // Whether the last frame built a pyramid (its volume level's, for new isovalues or on the
     // level's first frame) before drawing; a drag frame on a level made ahead (PrepareDragStep)
     // did not.
@@ -1632,10 +1634,12 @@ private:
       if (!(this->ShownKeys[slot] == key))
       {
         this->MeshesUploaded = true;
+        const double uploadStart = emscripten_get_now();
         this->Meshes->SetMesh(slot, surface.Points.data(), surface.Normals.data(),
           static_cast<std::int64_t>(surface.Points.size() / 3),
           reinterpret_cast<const std::uint32_t*>(surface.Triangles.data()),
           static_cast<std::int64_t>(surface.Triangles.size() / 3));
+        this->LastUploadMs += emscripten_get_now() - uploadStart;
         this->ShownKeys[slot] = key;
       }
       const IsosurfaceLook& look = this->Frame.Surfaces[slot];
@@ -1680,6 +1684,9 @@ private:
   std::uint64_t FramePrograms = 0; // the GPU path's programs compiled by the last frame
   std::set<std::array<int, 3>> Warm;
   bool MeshesUploaded = false; // the last frame made or uploaded a CPU path surface
+  // The part of the last frame's buildMs that uploaded its CPU path surfaces
+  // (MeshRenderer::SetMesh; the rest took them from the extraction).
+  double LastUploadMs = 0.0;
   bool Rehearsing = false;     // PrepareDragStep's rehearsal: drawn into Sampled only, never shown
   glcore::Name Sampled, SampledColor, SampledDepth; // a sampled frame's framebuffer
   int SampledSize[2] = { 0, 0 };
