@@ -18,7 +18,8 @@
 //   {op: "frame", id, surfaces, view, interactive, generation}  the frame wanted now
 // Messages out: {op: "ready", ok, error, info, generation, startup}, {op: "answer", id, value},
 //   {op: "frame", id, stats, settled}, {op: "error", message},
-//   {op: "prepared", value, count} (a drag's frame made ready ahead: schedulePrepare).
+//   {op: "prepared", value, count} (a drag's frame made ready ahead: before a GPU change's
+//   refinement, refineNow, or with ?prepareDrag=1 after a settled frame, schedulePrepare).
 //
 // Frames. Only the newest frame wanted is drawn: messages that arrived while a frame was drawn
 // are all applied first, and the frames they asked for collapse into the last one. On the CPU
