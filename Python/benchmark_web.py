@@ -110,9 +110,10 @@ def parse_args(argv):
                    help="--interactive: this page with ?prepareDrag= each of these (e.g. 0,1: an A/B of "
                         "the drag's frame made ready ahead, render-worker.js), one page each")
     p.add_argument("--frame-budget", type=int, default=0,
-                   help="--interactive: this page's frame budget in ms (?frameBudget=; 0: the page's, "
-                        "100 ms): on a loaded machine, a budget as many times the page's as its frames "
-                        "are slower keeps the levels a quiet machine would choose")
+                   help="--interactive: the pages' frame budget in ms (?frameBudget=, the page "
+                        "before's too; 0: the page's, 100 ms): on a loaded machine, a budget as many "
+                        "times the page's as its frames are slower keeps the levels a quiet machine "
+                        "would choose")
     p.add_argument("--drag-after-ms", default="0",
                    help="--interactive with --scene: idle waits between the scene's settled frame and "
                         "a drag (the first: the drag of the tables; each further one: the scene "
@@ -287,7 +288,9 @@ def run_interactive(args, name, before_root):
         isovalues = [400, -500, 300, 500, -300, 200, 600]
         isovalues = [v for v in isovalues if lo < v < hi][:max(1, args.changes) + 1]
         if args.frame_budget:
-            pages["after"] += "&frameBudget=%d" % args.frame_budget
+            # every page's (the page before reads ?frameBudget= too), so that an A/B compares pages
+            # choosing within the same budget
+            pages = {k: url + "&frameBudget=%d" % args.frame_budget for k, url in pages.items()}
         if args.prepare_drag:
             # this tree's page once per ?prepareDrag= value, named after it (a value given again:
             # the page again, numbered, in the order given, so that A/B runs can alternate)

@@ -263,14 +263,30 @@ std::unique_ptr<Program> BuildProgram(const GLApi& gl, const std::string& define
   return std::unique_ptr<Program>(new Program(gl, id));
 }
 
-Program* ProgramCache::Get(const GLApi& gl, const std::string& defines, const std::string& vertex,
-  const std::string& fragment, std::string& error)
+namespace
+{
+std::string ProgramKey(
+  const std::string& defines, const std::string& vertex, const std::string& fragment)
 {
   std::string key = defines;
   key += '\x01';
   key += vertex;
   key += '\x01';
   key += fragment;
+  return key;
+}
+}
+
+bool ProgramCache::Has(
+  const std::string& defines, const std::string& vertex, const std::string& fragment) const
+{
+  return this->Programs.count(ProgramKey(defines, vertex, fragment)) > 0;
+}
+
+Program* ProgramCache::Get(const GLApi& gl, const std::string& defines, const std::string& vertex,
+  const std::string& fragment, std::string& error)
+{
+  std::string key = ProgramKey(defines, vertex, fragment);
   auto it = this->Programs.find(key);
   if (it != this->Programs.end())
   {

@@ -98,6 +98,9 @@ public:
   /// The program of this variant, built if needed; null (and error) when it does not build.
   Program* Get(const GLApi& gl, const std::string& defines, const std::string& vertex,
     const std::string& fragment, std::string& error);
+  /// Whether this variant is built already (Get() would compile nothing).
+  bool Has(
+    const std::string& defines, const std::string& vertex, const std::string& fragment) const;
   void Clear() { this->Programs.clear(); }
   /// Programs this cache has built so far (a variant cleared and asked for again counts again):
   /// the difference over a frame is what it compiled, one-off work a host's frame-time model

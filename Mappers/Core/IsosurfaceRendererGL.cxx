@@ -548,6 +548,9 @@ struct IsosurfaceRendererGL::Internals
 
   Program* ComposeProgram(const HistoPyramidWalk& walk, const IsosurfaceFrame& frame,
     const FrameVariant& v, std::string& error);
+  // The program's defines and composed sources, which are also its ProgramCache key.
+  void ProgramSources(const HistoPyramidWalk& walk, const IsosurfaceFrame& frame,
+    const FrameVariant& v, std::string& defines, std::string& vertex, std::string& fragment) const;
   void SetUniforms(Program& program, const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame,
     const FrameVariant& v);
   std::string DrawFirstHit(Program& program, const HistoPyramidGL& pyramid,
@@ -581,6 +584,64 @@ IsosurfaceRendererGL::~IsosurfaceRendererGL() = default;
 std::uint64_t IsosurfaceRendererGL::GetProgramBuilds() const
 {
   return this->Impl->Programs.GetBuilds();
+}
+
+int IsosurfaceRendererGL::ProgramsToBuild(
+  const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame) const
+{
+  const Internals& impl = *this->Impl;
+  const GLApi& gl = *impl.GL;
+  if (pyramid.GetTotal() == 0)
+  {
+    return 0; // an empty picture draws nothing
+  }
+  const auto missing = [&impl](const char* vertex, const char* fragment)
+  { return impl.Programs.Has("", vertex, fragment) ? 0 : 1; };
+  int programs = 0;
+  // An image sample distance that leaves fewer pixels: drawn into the reduced target (a
+  // viewport of that size), then up to the viewport (RenderReduced).
+  IsosurfaceFrame drawn = frame;
+  if (frame.SampleDistance > 1.0f && std::isfinite(frame.SampleDistance))
+  {
+    const int width = std::max(1,
+      static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[2]) / frame.SampleDistance)));
+    const int height = std::max(1,
+      static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[3]) / frame.SampleDistance)));
+    if (width < frame.Viewport[2] || height < frame.Viewport[3])
+    {
+      drawn.Viewport[0] = 0;
+      drawn.Viewport[1] = 0;
+      drawn.Viewport[2] = width;
+      drawn.Viewport[3] = height;
+      drawn.SampleDistance = 1.0f;
+      programs += missing(shaders::HistoPyramidFullScreen_vs, shaders::HistoPyramidUpsample_fs);
+    }
+  }
+  FrameVariant v;
+  if (!ChooseVariant(pyramid, drawn, gl.GetMaxPointSize(), v).empty() || v.Clipped)
+  {
+    return 0; // Render() draws nothing, or fails, without a program
+  }
+  // Render() keeps the first-hit pass and the hidden-point cull where their buffers can be made,
+  // which is taken as given here (a context that cannot make them compiles the one-pass variant).
+  const HistoPyramidWalk walk = pyramid.GetWalk();
+  if (v.FirstHit && !impl.SharedHit)
+  {
+    const bool cullWanted = impl.Mode == HitCull::On ||
+      (impl.Mode == HitCull::Auto && IsosurfaceRendererGL::HitCullPays(gl));
+    v.HitCull = cullWanted && walk.TextureUnits + 1 <= gl.GetMaxVertexTextureUnits();
+  }
+  if (v.FirstHit)
+  {
+    programs += missing(shaders::HistoPyramidFullScreen_vs, shaders::HistoPyramidComposite_fs);
+  }
+  if (v.HitCull)
+  {
+    programs += missing(shaders::HistoPyramidFullScreen_vs, shaders::HistoPyramidCoverage_fs);
+  }
+  std::string defines, vertex, fragment;
+  impl.ProgramSources(walk, drawn, v, defines, vertex, fragment);
+  return programs + (impl.Programs.Has(defines, vertex, fragment) ? 0 : 1);
 }
 
 void IsosurfaceRendererGL::Release()
@@ -641,8 +702,9 @@ bool IsosurfaceRendererGL::HitCullPays(const GLApi& gl)
 
 //------------------------------------------------------------------------------
 // Step 3: the program of this variant and pyramid walk.
-Program* IsosurfaceRendererGL::Internals::ComposeProgram(const HistoPyramidWalk& walk,
-  const IsosurfaceFrame& frame, const FrameVariant& v, std::string& error)
+void IsosurfaceRendererGL::Internals::ProgramSources(const HistoPyramidWalk& walk,
+  const IsosurfaceFrame& frame, const FrameVariant& v, std::string& definesText,
+  std::string& vertex, std::string& fragment) const
 {
   const GLApi& gl = *this->GL;
   std::ostringstream defines;
@@ -683,9 +745,17 @@ Program* IsosurfaceRendererGL::Internals::ComposeProgram(const HistoPyramidWalk&
     conservative ? "#extension GL_ARB_conservative_depth : require\nlayout(depth_greater) out "
                    "float gl_FragDepth;"
                  : "" } };
-  Program* program =
-    this->Programs.Get(gl, defines.str(), Compose(shaders::HistoPyramidIso_vs, walk.Hooks),
-      Compose(shaders::HistoPyramidIso_fs, fragmentHooks), error);
+  definesText = defines.str();
+  vertex = Compose(shaders::HistoPyramidIso_vs, walk.Hooks);
+  fragment = Compose(shaders::HistoPyramidIso_fs, fragmentHooks);
+}
+
+Program* IsosurfaceRendererGL::Internals::ComposeProgram(const HistoPyramidWalk& walk,
+  const IsosurfaceFrame& frame, const FrameVariant& v, std::string& error)
+{
+  std::string defines, vertex, fragment;
+  this->ProgramSources(walk, frame, v, defines, vertex, fragment);
+  Program* program = this->Programs.Get(*this->GL, defines, vertex, fragment, error);
   if (!program)
   {
     error = "the isosurface shaders do not build: " + error;

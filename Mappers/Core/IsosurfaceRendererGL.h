@@ -192,6 +192,20 @@ public:
   /// its passes, on its first use): what a frame compiled is the difference across it.
   std::uint64_t GetProgramBuilds() const;
 
+  /**
+   * The programs Render() of `pyramid` (built, drawn alone) for `frame` would compile: the
+   * isosurface shaders' variant it would choose (footprint, translucency, first-hit pass,
+   * isovalues counted, clipping, lights, the pyramid's walk) and the passes' own (the first-hit
+   * composite, the hidden-point cull's coverage, the sample distance's upsampling), looked up in
+   * the compiled ones without compiling anything. A host that predicts a frame's one-off work
+   * asks this rather than keep its own key of what was compiled: a key of level and
+   * translucency missed that a skin over a bone needs another variant than a skin alone (issue
+   * 30: a drag's first frame predicted at 86 ms compiled for 0.6 s). The first-hit pass and the
+   * cull are taken as made where the frame asks for them. 0 where Render() would draw nothing
+   * (no active pair, clipped away) or fail.
+   */
+  int ProgramsToBuild(const HistoPyramidGL& pyramid, const IsosurfaceFrame& frame) const;
+
 private:
   // The frame drawn into the reduced target of width x height, then up to its viewport.
   bool RenderReduced(const std::vector<IsosurfacePiece>& pieces, const IsosurfaceFrame& frame,

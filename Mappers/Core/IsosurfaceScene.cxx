@@ -126,6 +126,37 @@ struct IsosurfaceScene::Internals
   std::vector<IsosurfaceLook> Surfaces;
   IsosurfaceSceneStats Stats;
 
+  // `frame` as its level's pyramid is drawn: the scene's surfaces, and on a coarse level the
+  // index space scaled by the level's stride. Coarse point c stands for the volume's point
+  // stride * c: the index space scales by the stride (the matrix on the right, the planes'
+  // normals), so the cells land where the level's cells are. A last cell shorter than the
+  // stride (an axis of n points with (n - 1) % stride != 0) is drawn a whole stride long: up to
+  // stride - 1 voxels past the volume's far faces, in interactive frames only.
+  IsosurfaceFrame LevelFrame(const IsosurfaceFrame& frame) const
+  {
+    IsosurfaceFrame drawn = frame;
+    drawn.Surfaces = this->Surfaces;
+    if (frame.Level != FullLevel)
+    {
+      const double stride = VolumeLevelStride(frame.Level);
+      for (int r = 0; r < 4; ++r)
+      {
+        for (int c = 0; c < 3; ++c)
+        {
+          drawn.IndexToView[4 * r + c] *= stride;
+        }
+      }
+      for (std::array<double, 4>& plane : drawn.ClipPlanes)
+      {
+        for (int c = 0; c < 3; ++c)
+        {
+          plane[c] *= stride;
+        }
+      }
+    }
+    return drawn;
+  }
+
   void ReleaseCoarse()
   {
     for (CoarseLevel& c : this->Coarse)
@@ -1403,33 +1434,10 @@ bool IsosurfaceScene::Render(const IsosurfaceFrame& frame, std::string& error)
   {
     return true; // nothing to draw
   }
-  IsosurfaceFrame drawn = frame;
-  drawn.Surfaces = impl.Surfaces;
-  const HistoPyramidGL* pyramid = impl.Pyramid.get();
-  if (frame.Level != FullLevel)
-  {
-    // Coarse point c stands for the volume's point stride * c: the index space scales by the
-    // stride (the matrix on the right, the planes' normals), so the cells land where the
-    // level's cells are. A last cell shorter than the stride (an axis of n points with
-    // (n - 1) % stride != 0) is drawn a whole stride long: up to stride - 1 voxels past
-    // the volume's far faces, in interactive frames only.
-    pyramid = impl.Coarse[Internals::At(frame.Level)].Pyramid.get();
-    const double stride = VolumeLevelStride(frame.Level);
-    for (int r = 0; r < 4; ++r)
-    {
-      for (int c = 0; c < 3; ++c)
-      {
-        drawn.IndexToView[4 * r + c] *= stride;
-      }
-    }
-    for (std::array<double, 4>& plane : drawn.ClipPlanes)
-    {
-      for (int c = 0; c < 3; ++c)
-      {
-        plane[c] *= stride;
-      }
-    }
-  }
+  const IsosurfaceFrame drawn = impl.LevelFrame(frame);
+  const HistoPyramidGL* pyramid = frame.Level == FullLevel
+    ? impl.Pyramid.get()
+    : impl.Coarse[Internals::At(frame.Level)].Pyramid.get();
   IsosurfaceFrameStats frameStats;
   // A bricked volume's full level is drawn from the pool, its slots in the
   // bricks' visibility order, or brick by brick; its coarse levels are one texture each.
@@ -1513,6 +1521,34 @@ std::uint64_t IsosurfaceScene::GetActivePairs(int level) const
 std::uint64_t IsosurfaceScene::GetProgramBuilds() const
 {
   return this->Impl->Renderer ? this->Impl->Renderer->GetProgramBuilds() : 0;
+}
+
+int IsosurfaceScene::ProgramsToBuild(const IsosurfaceFrame& frame) const
+{
+  const Internals& impl = *this->Impl;
+  if (impl.Surfaces.empty() || !impl.HasVolume || frame.Level < CoarsestLevel ||
+    frame.Level > FullLevel)
+  {
+    return 0; // Render() draws nothing, or fails, without compiling
+  }
+  std::vector<double> values = impl.Values();
+  const bool full = frame.Level == FullLevel;
+  // The variant depends on the pyramid's counted isovalues and walk: known once the level is
+  // built for these surfaces. A bricked full level is drawn from pieces or the pool (each its
+  // own walk), which this does not follow.
+  const HistoPyramidGL* pyramid =
+    full ? impl.Pyramid.get() : impl.Coarse[Internals::At(frame.Level)].Pyramid.get();
+  const std::vector<double>& built =
+    full ? impl.BuiltValues : impl.Coarse[Internals::At(frame.Level)].BuiltValues;
+  if (!pyramid || built != values || (full && impl.Bricked))
+  {
+    return -1;
+  }
+  if (!impl.Renderer)
+  {
+    return pyramid->GetTotal() > 0 ? 1 : 0;
+  }
+  return impl.Renderer->ProgramsToBuild(*pyramid, impl.LevelFrame(frame));
 }
 
 std::vector<double> IsosurfaceScene::GetBuiltValues(int level) const

@@ -340,6 +340,16 @@ public:
   std::uint64_t GetProgramBuilds() const;
 
   /**
+   * The programs Render(`frame`) would compile (the isosurface shaders' variant for the frame's
+   * level and its passes', IsosurfaceRendererGL::ProgramsToBuild), asked before drawing it, so that
+   * a host predicts a frame's one-off work from what is compiled, not from a key of its own. -1
+   * where it cannot be known yet: the level is not built for the current surfaces (the variant
+   * depends on the isovalues the pyramid counts and on its layout), or the full level is kept as
+   * bricks.
+   */
+  int ProgramsToBuild(const IsosurfaceFrame& frame) const;
+
+  /**
    * A level's active pairs before it is built, from the volume's: a surface
    * crosses about 1 / stride^2 as many cells of stride^3 voxels (at least 1
    * when the volume's are not 0). Hosts predict a coarse level's first frame with it.

@@ -25,7 +25,8 @@ export class RemoteViewer {
    * `threads`: the worker loads the threaded module; `budgetMs`: the frame budget (0: the
    * worker's); `abort`: false to let a running refinement run to its end; `slowExtractionMs`,
    * `slowPass`, `refineDelayMs`, `slowFirstDragFrameMs`: test hooks (render-worker.js);
-   * `prepareDrag`: true to make a drag's level ready after a settled frame (render-worker.js). Returns
+   * `prepareDrag`: the page's ?prepareDrag= (when a drag's level is made ready, render-worker.js:
+   * "0" never, "1" after a settled frame, else before a change's refinement). Returns
    * {worker, ready}, ready a promise of the worker's "ready" message, for start().
    */
   static launch(canvas, { threads, budgetMs, abort, slowExtractionMs, slowPass, refineDelayMs,

@@ -18,7 +18,8 @@
 //   {op: "frame", id, surfaces, view, interactive, generation}  the frame wanted now
 // Messages out: {op: "ready", ok, error, info, generation, startup}, {op: "answer", id, value},
 //   {op: "frame", id, stats, settled}, {op: "error", message},
-//   {op: "prepared", value, count} (a drag's frame made ready ahead: schedulePrepare).
+//   {op: "prepared", value, count} (a drag's frame made ready ahead: before a GPU change's
+//   refinement, refineNow, or with ?prepareDrag=1 after a settled frame, schedulePrepare).
 //
 // Frames. Only the newest frame wanted is drawn: messages that arrived while a frame was drawn
 // are all applied first, and the frames they asked for collapse into the last one. On the CPU
@@ -86,16 +87,23 @@ let refineDelayMs = 40;
 let slowFirstDragFrameMs = 0;
 let dragging = false; // the last frame drawn was a drag's
 
-// The GPU frame a drag would be drawn as, made ready in the idle time after a settled frame
-// (WebViewer.prepareDragStep: its volume level's pyramid built for the current isovalues, its
-// programs compiled, nothing shown; schedulePrepare), so that the first drag frame after a
-// change does not pay for them: {level, sampleDistance, ms, longestStepMs, steps, values} of the
-// last time it made anything, and how many times it did. Only with ?prepareDrag=1: in one piece
-// the preparation held the worker (0.7 s on the head CT at 1024x768 on SwiftShader), and a drag
-// begun soon after a change waited for it, while without it the drag's first frame is chosen on
-// its whole frame (ChooseOnWholeFrame) and comes at once on a level whose build fits
-// (docs/web.md, The drag's frame made ready ahead).
+// The GPU frame a drag would be drawn as, made ready (WebViewer.prepareDragStep: its volume
+// level's pyramid built for the current isovalues, its programs compiled, nothing shown), so
+// that the first drag frame after a change does not pay for them: {level, sampleDistance, ms,
+// longestStepMs, steps, values} of the last time it made anything, and how many times it did.
+// When (the page's ?prepareDrag=):
+// - "refine" (the default: any value but "0" and "1"): after a GPU change's first answer, before
+//   its refinement (refineNow), in steps of their own. A drag begun the moment the refinement
+//   settles then finds its level made: on the 512^3 phantom its first frame compiled volume
+//   level -1's program for the scene's looks for 0.6 s (docs/web.md, "A drag begun the moment
+//   the refinement settles"). The refinement (the full volume's build, seconds) waits for the
+//   steps, which are what that drag's first frame would otherwise do.
+// - "1": in the idle time after a settled frame (schedulePrepare). A drag begun soon after the
+//   settled frame waited for it (0.7 s on the head CT at 1024x768 on SwiftShader), and one begun
+//   at once found nothing made yet.
+// - "0": never; the drag's first frame is chosen on its whole frame (ChooseOnWholeFrame).
 let prepareDragOn = false;
+let prepareBeforeRefine = true;
 let prepared = null;
 let preparedCount = 0;
 let prepareTimer = 0;
@@ -165,7 +173,8 @@ async function init(m) {
   if (m.slowFirstDragFrameMs > 0) {
     slowFirstDragFrameMs = m.slowFirstDragFrameMs;
   }
-  prepareDragOn = m.prepareDrag === true;
+  prepareDragOn = m.prepareDrag === "1" || m.prepareDrag === true;
+  prepareBeforeRefine = !prepareDragOn && m.prepareDrag !== "0" && m.prepareDrag !== false;
   viewer = new M.WebViewer("#view");
   startup.viewer = now();
   shareGeneration(m.abort !== false, m.slowExtractionMs, m.slowPass);
@@ -361,22 +370,35 @@ function cancelPrepare() {
 function prepareStep(job) {
   prepareTimer = 0;
   const frame = job.frame;
-  if (wanted || refine || scheduled || path !== "gpu" || streaming ||
-      (generationWord && Atomics.load(generationWord, 0) !== (frame.generation | 0))) {
+  if (wanted || refine || scheduled || path !== "gpu" || streaming || superseded(frame)) {
     return;
   }
+  if (makeReadyStep(job)) {
+    prepareTimer = setTimeout(() => prepareStep(job), 0);
+  }
+}
+
+// Whether the page asked for a newer frame than `frame` (a change or a drag: it adds to the
+// generation word before it sends one), even if its message has not arrived.
+function superseded(frame) {
+  return !!generationWord && Atomics.load(generationWord, 0) !== (frame.generation | 0);
+}
+
+// One step of making the drag's frame ready for job.frame's surfaces (WebViewer.prepareDragStep);
+// true when a step is left. The last step says what was made (stats().dragPrepared).
+function makeReadyStep(job) {
+  const frame = job.frame;
   const r = viewer.prepareDragStep(budgetSeconds);
   if (r.error) {
     post({ op: "error", message: "preparing the drag's frame: " + r.error });
-    return;
+    return false;
   }
   if (r.step) {
     job.ms += r.ms;
     job.steps.push({ step: r.step, level: r.level, ms: r.ms });
   }
   if (!r.done) {
-    prepareTimer = setTimeout(() => prepareStep(job), 0);
-    return;
+    return true;
   }
   if (job.steps.length) {
     ++preparedCount;
@@ -386,6 +408,7 @@ function prepareStep(job) {
       values: frame.surfaces.map((s) => s.value) };
     post({ op: "prepared", value: prepared, count: preparedCount });
   }
+  return false;
 }
 
 // What a coarse GPU frame drew: the volume level (every stride-th point) and the sample distance.
@@ -408,6 +431,20 @@ function refineNow() {
   }
   if (wanted) { // a newer frame came in first: pump decides
     return;
+  }
+  if (prepareBeforeRefine && path === "gpu" && !streaming) {
+    // The drag's frame made ready first, a step per task (prepareDragOn's steps, before the
+    // refinement instead of after it): a newer frame that comes between steps makes the
+    // refinement obsolete (pump) and drops the steps left.
+    if (superseded(refine.frame)) {
+      return; // the newer frame's message is next; pump skips this refinement
+    }
+    refine.job = refine.job || { frame: refine.frame, ms: 0, steps: [] };
+    if (!refine.job.done) {
+      refine.job.done = !makeReadyStep(refine.job);
+      refine.timer = setTimeout(refineNow, 0);
+      return;
+    }
   }
   const { id, frame } = refine;
   refine = null;

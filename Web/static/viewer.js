@@ -79,7 +79,7 @@ export async function startViewer(canvas, probe, moduleLoaded = () => {}) {
       slowPass: Number(params.get("slowPass")) || 1,
       refineDelayMs: Number(params.get("refineDelay")) || 0,
       slowFirstDragFrameMs: Number(params.get("slowFirstDragFrame")) || 0,
-      prepareDrag: params.get("prepareDrag") === "1" });
+      prepareDrag: params.get("prepareDrag") });
   if (!inWorker) {
     RemoteViewer.takeEarlyWorker(); // the worker index.html started, ended
   }

@@ -1008,7 +1008,11 @@ public:
     out.set("sampleDistance", drag.SampleDistance);
     const std::array<int, 3> key = this->WarmKey(drag.Level, drag.Work);
     const bool built = this->Scene->GetBuiltValues(drag.Level) == this->SurfaceValues();
-    if (built && this->Warm.count(key))
+    // Its programs: asked of the scene once the level is built (drag.Work's count was made
+    // before, where the level may not have been).
+    const bool compiled =
+      built && this->GPUPrograms(drag.Level, drag.SampleDistance, drag.Work) == 0;
+    if (compiled)
     {
       return out;
     }
@@ -1025,7 +1029,7 @@ public:
         return out;
       }
       out.set("step", std::string("pyramid"));
-      out.set("done", this->Warm.count(key) > 0);
+      out.set("done", this->GPUPrograms(drag.Level, drag.SampleDistance, drag.Work) == 0);
       out.set("ms", emscripten_get_now() - start);
       return out;
     }
@@ -1279,10 +1283,37 @@ private:
         c.SampleDistance = static_cast<float>(distance);
         c.Work = this->Work(pairs, distance);
         c.Work.BuildElements = builtNow ? 0 : this->LevelCells(level);
-        c.Work.Programs = this->Warm.count(this->WarmKey(level, c.Work)) ? 0 : 1;
+        c.Work.Programs = this->GPUPrograms(level, distance, c.Work);
         candidates.push_back(c);
       }
     }
+  }
+
+  // The programs a GPU frame of the current surfaces at volume level `level` and image sample
+  // distance `distance` would compile: the scene's own answer where the level is built for these
+  // surfaces (IsosurfaceScene::ProgramsToBuild: the variant looked up in what its renderer
+  // compiled; the view is the last frame's), else Warm's key. The key alone predicted a skin over
+  // a bone on volume level -1 as compiled because a skin alone had been drawn there, and the
+  // drag's first frame compiled for 0.6 s against 86 ms predicted (issue 30).
+  std::uint32_t GPUPrograms(int level, double distance, const FrameWork& work) const
+  {
+    if (this->Scene)
+    {
+      IsosurfaceFrame frame = this->Frame;
+      frame.Level = level;
+      const int width =
+        std::max(1, static_cast<int>(std::ceil(this->Viewpoint.GetWidth() / distance)));
+      const int height =
+        std::max(1, static_cast<int>(std::ceil(this->Viewpoint.GetHeight() / distance)));
+      SetFrameView(
+        frame, this->Viewpoint.GetCamera(), this->Viewpoint.GetPlacement(), width, height);
+      const int known = this->Scene->ProgramsToBuild(frame);
+      if (known >= 0)
+      {
+        return static_cast<std::uint32_t>(known);
+      }
+    }
+    return this->Warm.count(this->WarmKey(level, work)) ? 0 : 1;
   }
 
   // The work of a frame of the current surfaces with `primitives` (triangles on the CPU path)
@@ -1326,18 +1357,21 @@ private:
 
   // Warm's key: the programs a frame compiles, where a frame's one-off work
   // counts one (FrameWork::Programs). The GPU path compiles its pyramid walk
-  // per volume level (the level's layout is compiled in) and translucency; the
+  // per volume level (the level's layout is compiled in), translucency and
+  // number of isovalues (a translucent frame's shaders are compiled for the
+  // isovalues it counts, and one isovalue walks another layout); the
   // CPU path's meshes have one program whatever their level or translucency; a
   // sample distance compiles nothing on either (its framebuffer is resized,
   // the blit needs no program). Keyed by the distance as well, every new
   // distance of a drag was predicted to pay a level's set-up.
-  static std::array<int, 3> WarmKey(int level, const FrameWork& work)
+  std::array<int, 3> WarmKey(int level, const FrameWork& work) const
   {
     if (work.Method == FrameMethod::Triangles)
     {
       return { static_cast<int>(work.Method), 0, 0 };
     }
-    return { static_cast<int>(work.Method), level, work.Translucent ? 1 : 0 };
+    return { static_cast<int>(work.Method), level,
+      (work.Translucent ? 1 : 0) + 2 * static_cast<int>(this->Frame.Surfaces.size()) };
   }
 
   // The last frame's work, as drawn.
