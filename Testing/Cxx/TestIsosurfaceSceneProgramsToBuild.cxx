@@ -17,8 +17,8 @@
 #include "GLApiFunctions.h"
 #include "HeadlessTestUtilities.h"
 #include "IsosurfaceScene.h"
+#include "PhantomTestScene.h"
 #include "SceneView.h"
-#include "VolumeSources.h"
 
 #include <algorithm>
 #include <array>
@@ -43,35 +43,14 @@ int main(int argc, char* argv[])
   std::cout << "EGL platform: " << context->GetPlatform() << "\n";
   const std::shared_ptr<const GLApi>& gl = context->GetGLApi();
 
-  headless::MetaImage image;
-  if (!headless::MakePhantom(64, image, error))
+  medical_test::PhantomTestScene phantom;
+  if (!phantom.Make(64, Width, Height, error))
   {
     std::cerr << "FAIL: the phantom: " << error << "\n";
     return 1;
   }
-  VolumeDescription volume;
-  volume.Type = image.Type;
-  volume.Data = image.Bytes.data();
-  std::copy(image.Dimensions, image.Dimensions + 3, volume.Dims);
-  VolumePlacement placement;
-  std::copy(image.Dimensions, image.Dimensions + 3, placement.Dimensions);
-  std::copy(image.Spacing, image.Spacing + 3, placement.Spacing);
-  double bounds[6];
-  placement.Bounds(bounds);
-  Camera camera;
-  camera.Reset(bounds, static_cast<double>(Width) / Height);
-  camera.Azimuth(30.0);
-  camera.Elevation(20.0);
-  camera.OrthogonalizeViewUp();
-  camera.ResetClippingRange(bounds);
-
-  IsosurfaceLook skin, bone;
-  skin.Value = -500.0;
-  skin.Color[0] = 0.93f;
-  skin.Color[1] = 0.75f;
-  skin.Color[2] = 0.62f;
-  skin.Opacity = 0.3f;
-  bone.Value = 400.0;
+  const IsosurfaceLook skin = medical_test::PhantomSkin(0.3f);
+  const IsosurfaceLook bone = medical_test::PhantomBone();
   const std::vector<IsosurfaceLook> skinOverBone = { skin, bone };
   const std::vector<IsosurfaceLook> skinAlone = { skin };
   IsosurfaceLook boneAlone = bone;
@@ -85,7 +64,7 @@ int main(int argc, char* argv[])
   }
   IsosurfaceScene scene(nullptr);
   scene.SetContext(gl);
-  if (!scene.SetVolume(volume, error))
+  if (!scene.SetVolume(phantom.Volume, error))
   {
     std::cerr << "FAIL: the volume: " << error << "\n";
     return 1;
@@ -114,7 +93,7 @@ int main(int argc, char* argv[])
     for (const int distance : { 1, 6 })
     {
       IsosurfaceFrame frame;
-      SetFrameView(frame, camera, placement, Width / distance, Height / distance);
+      SetFrameView(frame, phantom.View, phantom.Placement, Width / distance, Height / distance);
       frame.Level = step.Level;
       scene.SetSurfaces(step.Surfaces);
       const bool translucent = std::any_of(step.Surfaces.begin(), step.Surfaces.end(),

@@ -19,8 +19,8 @@
 #include "GLApiFunctions.h"
 #include "HeadlessTestUtilities.h"
 #include "IsosurfaceScene.h"
+#include "PhantomTestScene.h"
 #include "SceneView.h"
-#include "VolumeSources.h"
 
 #include <cstdlib>
 #include <cstring>
@@ -93,35 +93,14 @@ int main(int argc, char* argv[])
   std::cout << "EGL platform: " << context->GetPlatform() << "\n";
   const std::shared_ptr<const GLApi>& gl = context->GetGLApi();
 
-  headless::MetaImage image;
-  if (!headless::MakePhantom(48, image, error))
+  medical_test::PhantomTestScene phantom;
+  if (!phantom.Make(48, Width, Height, error))
   {
     std::cerr << "FAIL: the phantom: " << error << "\n";
     return 1;
   }
-  VolumeDescription volume;
-  volume.Type = image.Type;
-  volume.Data = image.Bytes.data();
-  std::copy(image.Dimensions, image.Dimensions + 3, volume.Dims);
-  VolumePlacement placement;
-  std::copy(image.Dimensions, image.Dimensions + 3, placement.Dimensions);
-  std::copy(image.Spacing, image.Spacing + 3, placement.Spacing);
-  double bounds[6];
-  placement.Bounds(bounds);
-  Camera camera;
-  camera.Reset(bounds, static_cast<double>(Width) / Height);
-  camera.Azimuth(30.0);
-  camera.Elevation(20.0);
-  camera.OrthogonalizeViewUp();
-  camera.ResetClippingRange(bounds);
-
-  IsosurfaceLook skin, bone;
-  skin.Value = -500.0;
-  skin.Color[0] = 0.93f;
-  skin.Color[1] = 0.75f;
-  skin.Color[2] = 0.62f;
-  skin.Opacity = 0.35f;
-  bone.Value = 400.0;
+  const IsosurfaceLook skin = medical_test::PhantomSkin(0.35f);
+  const IsosurfaceLook bone = medical_test::PhantomBone();
   const std::vector<IsosurfaceLook> translucent = { skin, bone };
   const std::vector<IsosurfaceLook> opaque = { bone };
 
@@ -143,7 +122,7 @@ int main(int argc, char* argv[])
            Case{ "sample distance 2", true, 2.0f } })
     {
       IsosurfaceFrame frame;
-      SetFrameView(frame, camera, placement, Width, Height);
+      SetFrameView(frame, phantom.View, phantom.Placement, Width, Height);
       frame.AllowPointFootprint = c.Points;
       frame.SampleDistance = c.SampleDistance;
 
@@ -151,7 +130,7 @@ int main(int argc, char* argv[])
       fresh.SetContext(gl);
       IsosurfaceScene reused(nullptr);
       reused.SetContext(gl);
-      if (!fresh.SetVolume(volume, error) || !reused.SetVolume(volume, error))
+      if (!fresh.SetVolume(phantom.Volume, error) || !reused.SetVolume(phantom.Volume, error))
       {
         std::cerr << "FAIL: the volume: " << error << "\n";
         return 1;
