@@ -58,8 +58,12 @@ export async function open(browser, url, log = () => {}) {
   page.on("console", (m) => log("console: " + m.text()));
   page.on("pageerror", (e) => log("pageerror: " + e.message));
   await page.goto(url, { waitUntil: "commit" });
-  await page.waitForFunction(() => window.mediso || !document.getElementById("unsupported")?.hidden,
-    null, { timeout: 120000 });
+  // At "commit" the document may not be parsed yet: a box not there yet is not a box shown (taken
+  // as shown, the wait ended before app.js had set window.mediso, now and then on a loaded machine).
+  await page.waitForFunction(() => {
+    const box = document.getElementById("unsupported");
+    return window.mediso || (box && !box.hidden);
+  }, null, { timeout: 120000 });
   const state = await page.evaluate(() => window.mediso.ready.then(() => "ready", (e) => "failed: " + e.message));
   const unsupported = await page.evaluate(() => {
     const box = document.getElementById("unsupported");
