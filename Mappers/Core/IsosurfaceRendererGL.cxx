@@ -280,6 +280,21 @@ void SetSurfacePassState(const GLApi& gl, bool translucent)
   f.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   SetSurfacePassBlending(gl, translucent);
 }
+
+// Whether `frame` is drawn into a reduced target (an image sample distance above 1 that leaves
+// fewer pixels), and that target's size: ceil(viewport / distance), at least 1.
+bool ReducedTarget(const IsosurfaceFrame& frame, int& width, int& height)
+{
+  if (!(frame.SampleDistance > 1.0f) || !std::isfinite(frame.SampleDistance))
+  {
+    return false;
+  }
+  width = std::max(1,
+    static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[2]) / frame.SampleDistance)));
+  height = std::max(1,
+    static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[3]) / frame.SampleDistance)));
+  return width < frame.Viewport[2] || height < frame.Viewport[3];
+}
 } // namespace
 
 struct IsosurfaceRendererGL::Internals
@@ -601,21 +616,15 @@ int IsosurfaceRendererGL::ProgramsToBuild(
   // An image sample distance that leaves fewer pixels: drawn into the reduced target (a
   // viewport of that size), then up to the viewport (RenderReduced).
   IsosurfaceFrame drawn = frame;
-  if (frame.SampleDistance > 1.0f && std::isfinite(frame.SampleDistance))
+  int width = 0, height = 0;
+  if (ReducedTarget(frame, width, height))
   {
-    const int width = std::max(1,
-      static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[2]) / frame.SampleDistance)));
-    const int height = std::max(1,
-      static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[3]) / frame.SampleDistance)));
-    if (width < frame.Viewport[2] || height < frame.Viewport[3])
-    {
-      drawn.Viewport[0] = 0;
-      drawn.Viewport[1] = 0;
-      drawn.Viewport[2] = width;
-      drawn.Viewport[3] = height;
-      drawn.SampleDistance = 1.0f;
-      programs += missing(shaders::HistoPyramidFullScreen_vs, shaders::HistoPyramidUpsample_fs);
-    }
+    drawn.Viewport[0] = 0;
+    drawn.Viewport[1] = 0;
+    drawn.Viewport[2] = width;
+    drawn.Viewport[3] = height;
+    drawn.SampleDistance = 1.0f;
+    programs += missing(shaders::HistoPyramidFullScreen_vs, shaders::HistoPyramidUpsample_fs);
   }
   FrameVariant v;
   if (!ChooseVariant(pyramid, drawn, gl.GetMaxPointSize(), v).empty() || v.Clipped)
@@ -961,16 +970,10 @@ bool IsosurfaceRendererGL::Render(const std::vector<IsosurfacePiece>& pieces,
   }
   // An image sample distance above 1 that leaves fewer pixels: the reduced
   // target, then up to the viewport.
-  if (frame.SampleDistance > 1.0f && std::isfinite(frame.SampleDistance) && ready && total > 0)
+  int width = 0, height = 0;
+  if (ready && total > 0 && ReducedTarget(frame, width, height))
   {
-    const int width = std::max(1,
-      static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[2]) / frame.SampleDistance)));
-    const int height = std::max(1,
-      static_cast<int>(std::ceil(static_cast<double>(frame.Viewport[3]) / frame.SampleDistance)));
-    if (width < frame.Viewport[2] || height < frame.Viewport[3])
-    {
-      return this->RenderReduced(pieces, frame, width, height, stats, error);
-    }
+    return this->RenderReduced(pieces, frame, width, height, stats, error);
   }
   // One volume: drawn as it is. Bricks: each in its own index space, in one pass.
   if (pieces.size() == 1 && pieces[0].Offset[0] == 0 && pieces[0].Offset[1] == 0 &&
